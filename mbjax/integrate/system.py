@@ -1,0 +1,41 @@
+"""What a time integrator needs from a mechanical system.
+
+A system has configuration coordinates q and velocities u with
+
+    q_dot = kinematics(q, u),        u_dot = acceleration(t, q, u).
+
+q may live on a manifold (a quaternion, a rotation vector), so a system also gives a local chart
+about any configuration q0: q = retract(q0, xi) with xi in R^dim(u), xi = 0 at q0, and the rate
+xi_dot = local_rate(q0, xi, u). For rotations this is seed 000's incremental rotation vector about a
+reference configuration (§2): R = R0 exp(xi), xi_dot = Gamma(xi)^-T Omega. Euclidean systems keep the
+defaults (retract(q0, xi) = q0 + xi).
+"""
+
+import abc
+
+import equinox as eqx
+from jax import Array
+
+
+class AbstractSystem(eqx.Module):
+    """A first-order mechanical system in (q, u); see the module docstring."""
+
+    @abc.abstractmethod
+    def kinematics(self, q: Array, u: Array) -> Array:
+        """q_dot as a function of the configuration and the velocity."""
+
+    @abc.abstractmethod
+    def acceleration(self, t: Array, q: Array, u: Array) -> Array:
+        """u_dot, the equations of motion solved for the accelerations."""
+
+    def retract(self, q0: Array, xi: Array) -> Array:
+        """The configuration at chart point xi about q0."""
+        return q0 + xi
+
+    def local_rate(self, q0: Array, xi: Array, u: Array) -> Array:
+        """xi_dot at chart point xi about q0 for velocity u."""
+        return self.kinematics(self.retract(q0, xi), u)
+
+    def project(self, q: Array) -> Array:
+        """Map coordinates back to their canonical form (unit quaternion, principal rotation vector)."""
+        return q

@@ -1,0 +1,21 @@
+"""Rotations: the rotation vector, its tangent map Gamma (seed 000 App. A) and quaternions.
+
+Every function is exact and differentiable (to any order) at and near zero rotation.
+"""
+
+from mbjax.lie.quaternion import (
+    quat_conjugate,
+    quat_from_matrix,
+    quat_from_rotvec,
+    quat_multiply,
+    quat_normalize,
+    quat_to_matrix,
+    rotvec_from_quat,
+)
+from mbjax.lie.rotation_vector import det_gamma, exp, gamma, gamma_inv, hat, log, rescale, vee
+
+__all__ = [
+    "det_gamma", "exp", "gamma", "gamma_inv", "hat", "log", "rescale", "vee",
+    "quat_conjugate", "quat_from_matrix", "quat_from_rotvec", "quat_multiply", "quat_normalize",
+    "quat_to_matrix", "rotvec_from_quat",
+]

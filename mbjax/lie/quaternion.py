@@ -1,0 +1,87 @@
+"""Unit quaternions q = (w, x, y, z), w the scalar part, and their conversions.
+
+q = (cos(phi/2), sin(phi/2) e) for the rotation vector r = phi e, so that quat_to_matrix(q) ==
+exp(r). Products follow Hamilton's convention: quat_to_matrix(p * q) == quat_to_matrix(p) @
+quat_to_matrix(q).
+"""
+
+import jax.numpy as jnp
+from jax import Array
+
+from mbjax.lie._series import COS_HALF, SIN_HALF_OVER_PHI, even_series
+
+
+def quat_multiply(p: Array, q: Array) -> Array:
+    """Hamilton product p * q."""
+    pw, pv = p[0], p[1:]
+    qw, qv = q[0], q[1:]
+    return jnp.concatenate([
+        jnp.atleast_1d(pw * qw - jnp.dot(pv, qv)),
+        pw * qv + qw * pv + jnp.cross(pv, qv),
+    ])
+
+
+def quat_conjugate(q: Array) -> Array:
+    """The inverse rotation of a unit quaternion."""
+    return q * jnp.array([1.0, -1.0, -1.0, -1.0], dtype=q.dtype)
+
+
+def quat_normalize(q: Array) -> Array:
+    """Project q onto the unit sphere."""
+    return q / jnp.linalg.norm(q)
+
+
+def quat_to_matrix(q: Array) -> Array:
+    """Rotation matrix of a unit quaternion."""
+    w, x, y, z = q
+    return jnp.array([
+        [1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
+        [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
+        [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)],
+    ])
+
+
+def quat_from_rotvec(r: Array) -> Array:
+    """q = (cos(phi/2), sin(phi/2)/phi r), exact and differentiable at r = 0."""
+    r = jnp.asarray(r)
+    phi2 = jnp.dot(r, r)
+    w = even_series(phi2, lambda p2: jnp.cos(0.5 * jnp.sqrt(p2)), COS_HALF)
+    s = even_series(phi2, lambda p2: jnp.sin(0.5 * jnp.sqrt(p2)) / jnp.sqrt(p2), SIN_HALF_OVER_PHI)
+    return jnp.concatenate([jnp.atleast_1d(w), s * r])
+
+
+def rotvec_from_quat(q: Array) -> Array:
+    """Principal rotation vector (|r| <= pi) of a unit quaternion: r = 2 atan2(|v|, w) v / |v|."""
+    q = jnp.asarray(q)
+    q = jnp.where(q[0] < 0, -q, q)  # q and -q are the same rotation; w >= 0 picks |r| <= pi
+    w, v = q[0], q[1:]
+    s2 = jnp.dot(v, v)
+    # atan2(s, w) / s; below s = 1e-2 its series in s2 / w^2 (arctan(x)/x) is exact to round-off.
+    small = s2 < 1e-4
+    safe_s2 = jnp.where(small, 1.0, s2)
+    x2 = s2 / (w * w)
+    series = 1.0 + x2 * (-1 / 3 + x2 * (1 / 5 + x2 * (-1 / 7 + x2 * (1 / 9 - x2 / 11))))
+    ratio = jnp.where(small, series / w,
+                      jnp.arctan2(jnp.sqrt(safe_s2), w) / jnp.sqrt(safe_s2))
+    return 2.0 * ratio * v
+
+
+def quat_from_matrix(R: Array) -> Array:
+    """Unit quaternion of a rotation matrix by Shepperd's method.
+
+    Of the four equivalent formulas the one with the largest pivot 4 q_k^2 (>= 1) is used, so
+    the square root and the division are always well conditioned; the others are fed a safe
+    value so that their (discarded) derivatives stay finite.
+    """
+    tr = R[0, 0] + R[1, 1] + R[2, 2]
+    d = jnp.array([1 + tr, 1 + 2 * R[0, 0] - tr, 1 + 2 * R[1, 1] - tr, 1 + 2 * R[2, 2] - tr])
+    s = jnp.sqrt(jnp.where(d > 0.1, d, 1.0))  # s_k = 2 |q_k| on the chosen branch (d_k >= 1)
+    a = jnp.array([R[2, 1] - R[1, 2], R[0, 2] - R[2, 0], R[1, 0] - R[0, 1]])  # 4 w (x, y, z)
+    b = jnp.array([R[0, 1] + R[1, 0], R[0, 2] + R[2, 0], R[1, 2] + R[2, 1]])  # 4 (xy, xz, yz)
+    candidates = 0.5 * jnp.array([
+        [s[0], a[0] / s[0], a[1] / s[0], a[2] / s[0]],
+        [a[0] / s[1], s[1], b[0] / s[1], b[1] / s[1]],
+        [a[1] / s[2], b[0] / s[2], s[2], b[2] / s[2]],
+        [a[2] / s[3], b[1] / s[3], b[2] / s[3], s[3]],
+    ])
+    return candidates[jnp.argmax(d)]

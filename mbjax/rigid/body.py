@@ -1,0 +1,159 @@
+"""A single rigid body: free, or turning about a fixed point, under gravity.
+
+Configuration q = (rotation coordinates, x) and velocity u = (Omega, v), angular before linear as
+everywhere in mbjax; Omega is the body-frame angular velocity (R_dot = R (Omega x I)) and v the
+velocity of the centre of mass. A body about a fixed point (a heavy top, or a torque-free body
+turning about its centre of mass) has no translational part.
+
+Rotation coordinates are either unit quaternions (w, x, y, z), q_dot = q * (0, Omega) / 2, or
+rotation vectors r with r_dot = Gamma(r)^-T Omega (seed 000 eqs 2.8, A.21: omega = R Omega =
+Gamma r_dot and Gamma^-1 R = Gamma^-T by eq A.24), rescaled to |r| <= pi after each step
+(eq A.29).
+"""
+
+import equinox as eqx
+import jax
+import jax.numpy as jnp
+import numpy as np
+from jax import Array
+
+from mbjax import lie
+from mbjax.integrate.system import AbstractSystem
+
+ROTATIONS = ("quaternion", "rotvec")
+
+
+def _check_inertia(inertia) -> None:
+    """Concrete validation: symmetric, positive-definite, triangle inequality."""
+    if isinstance(inertia, jax.core.Tracer):
+        return
+    J = np.asarray(inertia)
+    if J.shape != (3, 3):
+        raise ValueError(f"inertia must be a 3x3 matrix, got shape {J.shape}")
+    if not np.allclose(J, J.T, rtol=1e-12, atol=1e-12 * np.abs(J).max()):
+        raise ValueError(f"inertia must be symmetric, got\n{J}")
+    moments = np.linalg.eigvalsh(J)
+    if not moments[0] > 0:
+        raise ValueError(f"inertia must be positive-definite; principal moments {moments}")
+    if moments[0] + moments[1] < moments[2] * (1 - 1e-12):
+        raise ValueError(f"principal moments {moments} violate the triangle inequality "
+                         "J1 + J2 >= J3 that every mass distribution satisfies")
+
+
+class RigidBody(AbstractSystem):
+    """A rigid body of `mass` and body-frame `inertia` under uniform `gravity`.
+
+    fixed_point=False: a free body; `inertia` is about the centre of mass and q = (rot, x).
+    fixed_point=True: the body turns about a fixed point at the origin; `inertia` is about that
+    point, `com` is the centre of mass in the body frame, and q = rot.
+    """
+
+    mass: Array
+    inertia: Array
+    com: Array
+    gravity: Array
+    fixed_point: bool = eqx.field(static=True)
+    rotation: str = eqx.field(static=True)
+
+    def __init__(self, mass, inertia, *, com=(0.0, 0.0, 0.0), gravity=(0.0, 0.0, -9.81),
+                 fixed_point: bool = False, rotation: str = "quaternion"):
+        if rotation not in ROTATIONS:
+            raise ValueError(f"rotation must be one of {ROTATIONS}, got {rotation!r}")
+        _check_inertia(inertia)
+        if not isinstance(mass, jax.core.Tracer) and not float(mass) > 0:
+            raise ValueError(f"mass must be positive, got {mass}")
+        if not fixed_point and not isinstance(com, jax.core.Tracer) and np.any(np.asarray(com)):
+            raise ValueError("a free body is described about its centre of mass: com must be 0")
+        self.mass = jnp.asarray(mass, dtype=float)
+        self.inertia = jnp.asarray(inertia, dtype=float)
+        self.com = jnp.asarray(com, dtype=float)
+        self.gravity = jnp.asarray(gravity, dtype=float)
+        self.fixed_point = fixed_point
+        self.rotation = rotation
+
+    # -- coordinates ---------------------------------------------------------------------------
+
+    @property
+    def n_rot(self) -> int:
+        return 4 if self.rotation == "quaternion" else 3
+
+    def rotation_matrix(self, q: Array) -> Array:
+        """R, body to space."""
+        rot = q[: self.n_rot]
+        return lie.quat_to_matrix(rot) if self.rotation == "quaternion" else lie.exp(rot)
+
+    def position(self, q: Array) -> Array:
+        """Centre of mass in space."""
+        if self.fixed_point:
+            return self.rotation_matrix(q) @ self.com
+        return q[self.n_rot:]
+
+    def initial_state(self, R0, Omega0, x0=(0.0, 0.0, 0.0), v0=(0.0, 0.0, 0.0)):
+        """(q0, u0) from a rotation matrix, body angular velocity and (free body) COM motion."""
+        R0 = jnp.asarray(R0, dtype=float)
+        rot = lie.quat_from_matrix(R0) if self.rotation == "quaternion" else lie.log(R0)
+        Omega0 = jnp.asarray(Omega0, dtype=float)
+        if self.fixed_point:
+            return rot, Omega0
+        return (jnp.concatenate([rot, jnp.asarray(x0, dtype=float)]),
+                jnp.concatenate([Omega0, jnp.asarray(v0, dtype=float)]))
+
+    # -- AbstractSystem ------------------------------------------------------------------------
+
+    def kinematics(self, q, u):
+        rot, Omega = q[: self.n_rot], u[:3]
+        if self.rotation == "quaternion":
+            rot_dot = 0.5 * lie.quat_multiply(rot, jnp.concatenate([jnp.zeros(1, Omega.dtype), Omega]))
+        else:
+            rot_dot = lie.gamma_inv(rot).T @ Omega
+        return rot_dot if self.fixed_point else jnp.concatenate([rot_dot, u[3:]])
+
+    def acceleration(self, t, q, u):
+        """Euler's equations J Omega_dot = tau - Omega x J Omega, solved by Cholesky; the COM
+        falls freely (free body) or gravity gives tau = com x (m R^T g) (fixed point)."""
+        Omega = u[:3]
+        R = self.rotation_matrix(q)
+        tau = jnp.cross(self.com, self.mass * (R.T @ self.gravity))
+        chol = jax.scipy.linalg.cho_factor(self.inertia)
+        Omega_dot = jax.scipy.linalg.cho_solve(chol, tau - jnp.cross(Omega, self.inertia @ Omega))
+        if self.fixed_point:
+            return Omega_dot
+        return jnp.concatenate([Omega_dot, jnp.broadcast_to(self.gravity, (3,))])
+
+    def retract(self, q0, xi):
+        """R = R0 exp(xi_rot) (body-frame increment), x = x0 + xi_x."""
+        rot0 = q0[: self.n_rot]
+        if self.rotation == "quaternion":
+            rot = lie.quat_multiply(rot0, lie.quat_from_rotvec(xi[:3]))
+        else:
+            rot = lie.rotvec_from_quat(
+                lie.quat_multiply(lie.quat_from_rotvec(rot0), lie.quat_from_rotvec(xi[:3])))
+        return rot if self.fixed_point else jnp.concatenate([rot, q0[self.n_rot:] + xi[3:]])
+
+    def local_rate(self, q0, xi, u):
+        """xi_dot = Gamma(xi)^-T Omega, the body-frame dexp^-1 (seed 000 eq 2.8)."""
+        xi_dot = lie.gamma_inv(xi[:3]).T @ u[:3]
+        return xi_dot if self.fixed_point else jnp.concatenate([xi_dot, u[3:]])
+
+    def project(self, q):
+        rot = q[: self.n_rot]
+        rot = lie.quat_normalize(rot) if self.rotation == "quaternion" else lie.rescale(rot)
+        return rot if self.fixed_point else jnp.concatenate([rot, q[self.n_rot:]])
+
+    # -- invariants ----------------------------------------------------------------------------
+
+    def kinetic_energy(self, q, u):
+        Omega = u[:3]
+        T = 0.5 * Omega @ self.inertia @ Omega
+        return T if self.fixed_point else T + 0.5 * self.mass * u[3:] @ u[3:]
+
+    def potential_energy(self, q):
+        return -self.mass * self.gravity @ self.position(q)
+
+    def energy(self, q, u):
+        return self.kinetic_energy(q, u) + self.potential_energy(q)
+
+    def angular_momentum(self, q, u):
+        """Spatial angular momentum about the origin (the fixed point, if any)."""
+        h = self.rotation_matrix(q) @ (self.inertia @ u[:3])
+        return h if self.fixed_point else h + self.mass * jnp.cross(q[self.n_rot:], u[3:])
