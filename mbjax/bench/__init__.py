@@ -1,1 +1,13 @@
-"""bench"""
+"""Benchmark suites for `mbjax bench SUITE` and the shared timing helper.
+
+Each suite is run(out: Path, quick: bool) -> list of records, written as out/SUITE.jsonl and
+out/SUITE.png. Peers (MuJoCo, Pinocchio, exudyn) are measured in the same process when installed.
+"""
+
+from mbjax.bench import integrators
+
+SUITES = {
+    integrators.NAME: integrators.run,
+}
+
+__all__ = ["SUITES"]

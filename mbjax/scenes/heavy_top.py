@@ -18,7 +18,7 @@ W0 = (0.0, 0.0, 50.0)
 DURATION = 10.0
 
 
-def heavy_top(rotation: str = "quaternion"):
+def build(rotation: str = "quaternion"):
     """(body, q0, u0) of the scene."""
     body = RigidBody(MGL / GRAVITY, jnp.diag(jnp.array(INERTIA)), com=(0.0, 0.0, 1.0),
                      gravity=(0.0, 0.0, -GRAVITY), fixed_point=True, rotation=rotation)

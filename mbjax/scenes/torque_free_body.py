@@ -17,7 +17,7 @@ OMEGA0 = (10.0, 0.0, 15.0)  # body frame; the symmetry axis is body z
 DURATION = 6.0
 
 
-def torque_free_body(rotation: str = "quaternion"):
+def build(rotation: str = "quaternion"):
     """(body, q0, u0) of the scene, starting at R0 = I."""
     body = RigidBody(1.0, jnp.diag(jnp.array([J_TRANSVERSE, J_TRANSVERSE, J_AXIAL])),
                      gravity=(0.0, 0.0, 0.0), fixed_point=True, rotation=rotation)

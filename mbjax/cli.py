@@ -1,0 +1,98 @@
+"""The `mbjax` command: the tour of every scene, paper reproductions and benchmark suites.
+
+    mbjax tour [--out DIR] [--quick]
+    mbjax reproduce NAME [--out DIR] [--quick]    |    mbjax reproduce --list
+    mbjax bench SUITE [--out DIR] [--quick]
+
+Unknown names and bad options exit with status 2 and list the valid choices.
+"""
+
+import argparse
+import json
+import sys
+import time
+from pathlib import Path
+
+
+def _parser(reproductions, suites) -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(prog="mbjax", description=__doc__.split("\n\n")[0])
+    commands = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
+
+    tour = commands.add_parser("tour", help="run every scene briefly; figures + summary")
+    tour.add_argument("--out", type=Path, default=Path("mbjax-out"), help="output folder")
+    tour.add_argument("--quick", action="store_true", help="shorter runs (< 5 min on 2 cores)")
+
+    rep = commands.add_parser("reproduce", help="reproduce a paper figure or table")
+    rep.add_argument("name", nargs="?", choices=sorted(reproductions), metavar="NAME",
+                     help=f"one of: {', '.join(sorted(reproductions))}")
+    rep.add_argument("--list", action="store_true", help="list the reproductions")
+    rep.add_argument("--out", type=Path, default=Path("mbjax-out"), help="output folder")
+    rep.add_argument("--quick", action="store_true", help="fewer sample points")
+
+    bench = commands.add_parser("bench", help="run a benchmark suite")
+    bench.add_argument("suite", choices=sorted(suites), metavar="SUITE",
+                       help=f"one of: {', '.join(sorted(suites))}")
+    bench.add_argument("--out", type=Path, default=Path("mbjax-out/bench"), help="output folder")
+    bench.add_argument("--quick", action="store_true", help="fewer configurations")
+    return parser
+
+
+def _tour(out: Path, quick: bool) -> None:
+    from mbjax.progress import progress
+    from mbjax.scenes.tour import TOUR
+
+    out.mkdir(parents=True, exist_ok=True)
+    summary = {"quick": quick, "scenes": {}}
+    for name in progress(TOUR, len(TOUR), "mbjax tour"):
+        start = time.perf_counter()
+        result = TOUR[name](out, quick)
+        result["wall_seconds"] = time.perf_counter() - start
+        summary["scenes"][name] = result
+    (out / "summary.json").write_text(json.dumps(summary, indent=1))
+    (out / "summary.md").write_text(_summary_markdown(summary))
+    print(f"tour written to {out}/: summary.json, summary.md and "
+          f"{', '.join(s['figure'] for s in summary['scenes'].values())}")
+
+
+def _summary_markdown(summary: dict) -> str:
+    lines = ["# mbjax tour" + (" (quick)" if summary["quick"] else ""), ""]
+    for name, scene in summary["scenes"].items():
+        lines += [f"## {name}", "", f"![{name}]({scene['figure']})", ""]
+        rows = scene.get("integrators", {})
+        if rows:
+            keys = list(next(iter(rows.values())))
+            lines += ["| integrator | " + " | ".join(keys) + " |",
+                      "|---" * (len(keys) + 1) + "|"]
+            for integrator, row in rows.items():
+                cells = [f"{v:.3g}" if isinstance(v, float) else str(v) for v in row.values()]
+                lines.append(f"| {integrator} | " + " | ".join(cells) + " |")
+        lines += ["", f"wall time {scene['wall_seconds']:.1f} s", ""]
+    return "\n".join(lines)
+
+
+def main(argv=None) -> int:
+    import jax
+
+    jax.config.update("jax_enable_x64", True)
+    from mbjax.bench import SUITES
+    from mbjax.reproduce import REPRODUCTIONS
+
+    parser = _parser(REPRODUCTIONS, SUITES)
+    args = parser.parse_args(argv)
+    if args.command == "tour":
+        _tour(args.out, args.quick)
+    elif args.command == "reproduce":
+        if args.list:
+            print("\n".join(sorted(REPRODUCTIONS)))
+            return 0
+        if args.name is None:
+            parser.error(f"reproduce needs a NAME, one of: {', '.join(sorted(REPRODUCTIONS))}")
+        REPRODUCTIONS[args.name](args.out, quick=args.quick)
+        print(f"wrote {args.out / (args.name + '.json')} and {args.out / (args.name + '.png')}")
+    elif args.command == "bench":
+        SUITES[args.suite](args.out, quick=args.quick)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

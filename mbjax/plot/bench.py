@@ -1,0 +1,38 @@
+"""Figures of the benchmark suites."""
+
+import numpy as np
+from matplotlib.figure import Figure
+
+from mbjax.plot.style import COLORS, MARKERS
+
+
+def integrators_bench_figure(records: list[dict]) -> Figure:
+    """Left: error at 10 s against run time, mbjax (coloured) and MuJoCo (grey) integrators.
+    Right: steps per second against batch size."""
+    fig = Figure(figsize=(12, 5), layout="constrained")
+    ax_wp, ax_batch = fig.subplots(1, 2)
+    single = [r for r in records if r["batch"] == 1]
+    for engine, integrator in dict.fromkeys((r["engine"], r["integrator"]) for r in single):
+        rows = [r for r in single if r["engine"] == engine and r["integrator"] == integrator]
+        err = np.array([r["error"] for r in rows])
+        ok = np.isfinite(err) & (err < 10)
+        if engine == "mbjax":
+            kw = dict(color=COLORS[integrator], marker=MARKERS[integrator], label=f"mbjax {integrator}")
+        else:
+            kw = dict(color=COLORS["mujoco"], marker="x", ls="--", label=f"MuJoCo {integrator}")
+        ax_wp.loglog(np.array([r["run_s"] for r in rows])[ok], err[ok], **kw)
+    ax_wp.set(xlabel="run time for 10 s [s]", ylabel="rotation error at 10 s [rad]",
+              title="heavy top: speed against accuracy (diverged runs omitted)")
+    batched = [r for r in records if r["batch"] > 1 or r["integrator"] in ("rkmk4", "RK4")]
+    for engine, color in (("mbjax", COLORS["rkmk4"]), ("mujoco", COLORS["mujoco"])):
+        rows = sorted((r for r in batched if r["engine"] == engine and r["dt"] == 2e-3),
+                      key=lambda r: r["batch"])
+        if rows:
+            ax_batch.loglog([r["batch"] for r in rows], [r["steps_per_s"] for r in rows],
+                            marker="o", color=color, label=f"{engine} {rows[0]['integrator']}")
+    ax_batch.set(xlabel="batch size", ylabel="body-steps per second",
+                 title="batched rollouts, dt = 2 ms (CPU)")
+    for ax in (ax_wp, ax_batch):
+        ax.grid(True, which="both", alpha=0.3)
+        ax.legend(fontsize=7)
+    return fig

@@ -1,0 +1,37 @@
+"""Figures of the tour's scenes."""
+
+import numpy as np
+from matplotlib.figure import Figure
+
+from mbjax.plot.style import COLORS, label
+
+
+def error_history_figure(histories: dict, title: str) -> Figure:
+    """Error against time, one line per integrator."""
+    fig = Figure(figsize=(8, 5), layout="constrained")
+    ax = fig.subplots()
+    for name, (ts, err) in histories.items():
+        ax.semilogy(ts, np.maximum(err, 1e-17), color=COLORS[name], label=label(name))
+    ax.set(xlabel="t [s]", ylabel="error [rad]", title=title)
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend(fontsize=8)
+    return fig
+
+
+def heavy_top_figure(runs: dict, title: str) -> Figure:
+    """Left: the tip of the symmetry axis seen from above. Right: |E/E0 - 1| against time."""
+    fig = Figure(figsize=(12, 5), layout="constrained")
+    ax_path, ax_energy = fig.subplots(1, 2)
+    for name, (ts, axis, rel) in runs.items():
+        ok = np.all(np.isfinite(axis), axis=1) & (np.linalg.norm(axis, axis=1) < 2)
+        ax_path.plot(axis[ok, 0], axis[ok, 1], color=COLORS[name], lw=0.8, label=label(name))
+        ax_energy.semilogy(ts, np.maximum(np.abs(rel), 1e-17), color=COLORS[name],
+                           label=label(name))
+    ax_path.set(xlabel="x", ylabel="y", title="tip of the symmetry axis (top view)",
+                aspect="equal")
+    ax_energy.set(xlabel="t [s]", ylabel="|E / E0 - 1|", ylim=(1e-17, 1e3), title="energy error")
+    for ax in (ax_path, ax_energy):
+        ax.grid(True, alpha=0.3)
+        ax.legend(fontsize=8)
+    fig.suptitle(title)
+    return fig
