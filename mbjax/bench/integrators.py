@@ -37,6 +37,9 @@ def run(out: Path, quick: bool = False) -> list[dict]:
     repeats = 3 if quick else 10
 
     def scores(quat, Omega):
+        """Rotation error and energy error at T; NaN for a run that diverged."""
+        if not (np.all(np.isfinite(quat)) and np.all(np.isfinite(Omega))):
+            return float("nan"), float("nan")
         err = float(jnp.linalg.norm(lie.log(lie.quat_to_matrix(lie.quat_normalize(quat)) @ R_ref.T)))
         drift = abs(float(_energy(body, jnp.asarray(quat), jnp.asarray(Omega))) / E0 - 1.0)
         return err, drift
@@ -52,7 +55,8 @@ def run(out: Path, quick: bool = False) -> list[dict]:
             err, drift = scores(sol.qs[-1], sol.us[-1])
             records.append({**common, "engine": "mbjax", "integrator": name, "dt": dt,
                             "batch": 1, "compile_s": timing.compile_s, "run_s": timing.run_s,
-                            "steps_per_s": n / timing.run_s, "error": err, "energy_drift": drift})
+                            "steps_per_s": n / timing.run_s, "error": err, "energy_drift": drift,
+                            "status": sol.messages()[0]})
         if peers.available("mujoco"):
             for name in peers.MUJOCO_INTEGRATORS:
                 model, data = peers.mujoco_heavy_top(float(body.mass), np.asarray(body.inertia),
