@@ -8,6 +8,7 @@ mbjax `jit(vmap(simulate))` against MuJoCo's rollout of the same batch. JSON lin
 """
 
 import platform
+from functools import partial
 from pathlib import Path
 
 import jax
@@ -50,8 +51,8 @@ def run(out: Path, quick: bool = False) -> list[dict]:
     for dt in ((2e-3,) if quick else (4e-3, 2e-3, 1e-3, 5e-4)):
         n = round(T / dt)
         for name, cls in INTEGRATORS.items():
-            sol, timing = measure(lambda: simulate(body, cls(), q0, u0, dt=dt, t1=T,
-                                                   saveat=[T]), repeats=repeats)
+            sol, timing = measure(partial(simulate, body, cls(), q0, u0, dt=dt, t1=T, saveat=[T]),
+                                  repeats=repeats)
             err, drift = scores(sol.qs[-1], sol.us[-1])
             records.append({**common, "engine": "mbjax", "integrator": name, "dt": dt,
                             "batch": 1, "compile_s": timing.compile_s, "run_s": timing.run_s,
@@ -62,7 +63,7 @@ def run(out: Path, quick: bool = False) -> list[dict]:
                 model, data = peers.mujoco_heavy_top(float(body.mass), np.asarray(body.inertia),
                                                      np.asarray(body.com), top.GRAVITY, dt, name)
                 (quat, Omega), timing = measure(
-                    lambda: peers.mujoco_rollout(model, data, np.asarray(q0), np.asarray(u0), n),
+                    partial(peers.mujoco_rollout, model, data, np.asarray(q0), np.asarray(u0), n),
                     repeats=repeats)
                 err, drift = scores(quat[0], Omega[0])
                 records.append({**common, "engine": "mujoco", "integrator": name, "dt": dt,
@@ -86,8 +87,8 @@ def run(out: Path, quick: bool = False) -> list[dict]:
         if peers.available("mujoco"):
             model, data = peers.mujoco_heavy_top(float(body.mass), np.asarray(body.inertia),
                                                  np.asarray(body.com), top.GRAVITY, dt, "RK4")
-            _, timing = measure(lambda: peers.mujoco_rollout(
-                model, data, np.asarray(quats), np.asarray(Omegas), n), repeats=max(3, repeats // 3))
+            _, timing = measure(partial(peers.mujoco_rollout, model, data, np.asarray(quats),
+                                        np.asarray(Omegas), n), repeats=max(3, repeats // 3))
             records.append({**common, "engine": "mujoco", "integrator": "RK4", "dt": dt,
                             "batch": batch, "compile_s": 0.0, "run_s": timing.run_s,
                             "steps_per_s": batch * n / timing.run_s})

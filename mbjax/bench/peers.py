@@ -49,7 +49,7 @@ def mujoco_rollout(model, data, quat0, Omega0, nstep: int):
     Omega0 = np.atleast_2d(Omega0)
     spec = mujoco.mjtState.mjSTATE_FULLPHYSICS
     states = []
-    for q, w in zip(quat0, Omega0):
+    for q, w in zip(quat0, Omega0, strict=True):
         mujoco.mj_resetData(model, data)
         data.qpos[:] = q
         data.qvel[:] = w

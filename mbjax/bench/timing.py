@@ -9,7 +9,7 @@ import json
 import statistics
 import time
 from collections.abc import Callable, Iterable
-from dataclasses import asdict, dataclass
+from dataclasses import dataclass
 from pathlib import Path
 
 import jax
@@ -34,10 +34,6 @@ def measure(fn: Callable, *args, repeats: int = 10) -> tuple[object, Timing]:
         samples.append(time.perf_counter() - start)
     run = statistics.median(samples)
     return out, Timing(compile_s=max(first - run, 0.0), run_s=run, runs=repeats)
-
-
-def timing_fields(timing: Timing) -> dict:
-    return asdict(timing)
 
 
 def write_jsonl(path: Path, records: Iterable[dict]) -> None:

@@ -1,5 +1,6 @@
 """The implicit midpoint rule, solved by Newton's method with an autodiff Jacobian."""
 
+import equinox as eqx
 import jax
 import jax.numpy as jnp
 
@@ -17,8 +18,8 @@ class ImplicitMidpoint(AbstractIntegrator):
     with quadratic convergence the error left after it is then of order rtol^2.
     """
 
-    newton_iterations: int = 6
-    rtol: float | None = None  # default: sqrt(eps) of the state's dtype
+    newton_iterations: int = eqx.field(default=6, static=True)
+    rtol: float | None = eqx.field(default=None, static=True)  # None: sqrt(eps) of the dtype
 
     order = 2
     name = "implicit_midpoint"

@@ -8,6 +8,7 @@
 """
 
 import json
+from functools import partial
 from pathlib import Path
 
 import jax
@@ -65,7 +66,7 @@ def torque_free_sweep(steps: dict, repeats: int) -> list[dict]:
         integrator = INTEGRATORS[name]()
         for dt in dts:
             sol, timing = measure(
-                lambda: simulate(body, integrator, q0, u0, dt=dt, t1=tfb.DURATION, saveat=saveat),
+                partial(simulate, body, integrator, q0, u0, dt=dt, t1=tfb.DURATION, saveat=saveat),
                 repeats=repeats)
             records.append({
                 "integrator": name, "dt": dt,

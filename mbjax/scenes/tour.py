@@ -5,8 +5,9 @@ Each entry takes (out, quick) and returns a summary dict naming the figure it wr
 
 from pathlib import Path
 
+from functools import partial
+
 import jax
-import jax.numpy as jnp
 import numpy as np
 
 from mbjax.bench.timing import measure
@@ -24,8 +25,8 @@ def torque_free_body_tour(out: Path, quick: bool) -> dict:
     saveat = np.linspace(0.0, tfb.DURATION, 121)
     histories, rows = {}, {}
     for name, cls in INTEGRATORS.items():
-        sol, timing = measure(lambda: simulate(body, cls(), q0, u0, dt=dt, t1=tfb.DURATION,
-                                               saveat=saveat), repeats=3)
+        sol, timing = measure(partial(simulate, body, cls(), q0, u0, dt=dt, t1=tfb.DURATION,
+                                      saveat=saveat), repeats=3)
         err = np.asarray(tfb.rotation_errors(body, sol.qs, sol.ts))
         histories[name] = (np.asarray(sol.ts), err)
         rows[name] = {"final_error_rad": float(err[-1]), "seconds": timing.run_s,
@@ -46,8 +47,8 @@ def heavy_top_tour(out: Path, quick: bool) -> dict:
     saveat = np.linspace(0.0, duration, 501)
     runs, rows = {}, {}
     for name, cls in INTEGRATORS.items():
-        sol, timing = measure(lambda: simulate(body, cls(), q0, u0, dt=dt, t1=duration,
-                                               saveat=saveat), repeats=3)
+        sol, timing = measure(partial(simulate, body, cls(), q0, u0, dt=dt, t1=duration,
+                                      saveat=saveat), repeats=3)
         E = np.asarray(jax.vmap(body.energy)(sol.qs, sol.us))
         axis = np.asarray(jax.vmap(lambda q: body.rotation_matrix(q)[:, 2])(sol.qs))
         runs[name] = (np.asarray(sol.ts), axis, E / E[0] - 1.0)

@@ -97,7 +97,7 @@ def test_vmap_over_initial_states_and_parameters():
     run = lambda k, q0: simulate(Oscillator(k=k), RK4(), q0, U0, dt=0.01,  # noqa: E731
                                  t1=1.0, saveat=[1.0]).qs[-1]
     batched = jax.jit(jax.vmap(run))(jnp.array([1.0, 4.0, 9.0]), q0s)
-    for i, (k, q0) in enumerate(zip([1.0, 4.0, 9.0], q0s)):
+    for i, (k, q0) in enumerate(zip([1.0, 4.0, 9.0], q0s, strict=True)):
         np.testing.assert_allclose(batched[i], run(jnp.array(k), q0), atol=1e-14)
 
 
