@@ -17,6 +17,7 @@ from mbjax.lie._series import (
     SIN_PHI_OVER_PHI,
     even_series,
 )
+from mbjax.lie.quaternion import quat_from_matrix, rotvec_from_quat
 
 
 def hat(v: Array) -> Array:
@@ -113,8 +114,6 @@ def log(R: Array) -> Array:
     at every angle, including 0 and pi. A matrix that is not a rotation (R^T R != I or det R != 1
     beyond round-off) raises a clear error, also under `jit`.
     """
-    from mbjax.lie.quaternion import quat_from_matrix, rotvec_from_quat
-
     R = jnp.asarray(R)
     if R.shape != (3, 3):
         raise ValueError(f"log expects a 3x3 rotation matrix, got shape {R.shape}")

@@ -153,6 +153,11 @@ class RigidBody(AbstractSystem):
     def energy(self, q, u):
         return self.kinetic_energy(q, u) + self.potential_energy(q)
 
+    def relative_energy_error(self, qs, us):
+        """E(q_i, u_i) / E(q_0, u_0) - 1 along saved states (non-finite where a run diverged)."""
+        E = jax.vmap(self.energy)(qs, us)
+        return E / E[0] - 1.0
+
     def angular_momentum(self, q, u):
         """Spatial angular momentum about the origin (the fixed point, if any)."""
         h = self.rotation_matrix(q) @ (self.inertia @ u[:3])

@@ -7,10 +7,10 @@ import pytest
 
 from mbjax.integrate import (
     INTEGRATORS,
+    RK4,
     AbstractSystem,
     ExplicitEuler,
     ImplicitMidpoint,
-    RK4,
     Status,
     simulate,
     solve_reference,
