@@ -1,0 +1,248 @@
+"""`Model`: a tree of rigid bodies connected by joints (DESIGN.md "Data model").
+
+Topology, joint types and names are static (hashable; changing them recompiles). Placements, axes,
+masses, centres of mass, inertias and gravity are array leaves with a leading body axis, so they can
+be differentiated, vmapped and swept without recompiling.
+
+Body k hangs from body `parents[k]` (-1: the ground) through joint k. Generalized coordinates q
+(length nq) and velocities v (length nv) are the joints' own, concatenated in body order; bodies are
+numbered depth-first with children in document order, which is Pinocchio's ordering.
+"""
+
+from functools import lru_cache
+
+import equinox as eqx
+import jax
+import jax.numpy as jnp
+import numpy as np
+from jax import Array
+
+from mbjax.model.joints import (
+    JOINT_TYPES,
+    NEUTRAL,
+    joint_calc,
+    joint_local_rate,
+    joint_rate,
+    joint_retract,
+)
+from mbjax.spatial import inertia_matrix
+from mbjax.tree import Topology
+
+
+def check_inertia(inertia, name: str = "body") -> None:
+    """Concrete validation of a 3x3 inertia: symmetric, positive-definite, triangle inequality."""
+    if isinstance(inertia, jax.core.Tracer):
+        return
+    J = np.asarray(inertia, dtype=float)
+    if J.shape != (3, 3):
+        raise ValueError(f"{name}: inertia must be a 3x3 matrix, got shape {J.shape}")
+    if not np.all(np.isfinite(J)):
+        raise ValueError(f"{name}: inertia has non-finite entries\n{J}")
+    if not np.allclose(J, J.T, rtol=1e-12, atol=1e-12 * np.abs(J).max()):
+        raise ValueError(f"{name}: inertia must be symmetric, got\n{J}")
+    moments = np.linalg.eigvalsh(J)
+    if not moments[0] > 0:
+        raise ValueError(f"{name}: inertia must be positive-definite; principal moments {moments}")
+    if moments[0] + moments[1] < moments[2] * (1 - 1e-9):
+        raise ValueError(f"{name}: principal moments {moments} violate the triangle inequality "
+                         "J1 + J2 >= J3 that every mass distribution satisfies")
+
+
+@lru_cache(maxsize=None)
+def _layout(joint_types: tuple[str, ...]):
+    """Static index maps: per-body gathers of q and v (padded, with masks) and the widths."""
+    nqs = [JOINT_TYPES[k].nq for k in joint_types]
+    nvs = [JOINT_TYPES[k].nv for k in joint_types]
+    q0, v0 = np.cumsum([0, *nqs]), np.cumsum([0, *nvs])
+    wq, wv = max(nqs), max(nvs)
+    q_index = np.array([[min(q0[k] + j, q0[-1] - 1) for j in range(wq)] for k in range(len(nqs))])
+    v_index = np.array([[min(v0[k] + j, v0[-1] - 1) for j in range(wv)] for k in range(len(nvs))])
+    v_mask = np.array([[j < nvs[k] for j in range(wv)] for k in range(len(nvs))])
+    q_mask = np.array([[j < nqs[k] for j in range(wq)] for k in range(len(nqs))])
+    groups = {kind: np.array([k for k, t in enumerate(joint_types) if t == kind])
+              for kind in dict.fromkeys(joint_types)}
+    return dict(nq=int(q0[-1]), nv=int(v0[-1]), q_start=tuple(int(x) for x in q0[:-1]),
+                v_start=tuple(int(x) for x in v0[:-1]), q_index=q_index, v_index=v_index,
+                v_mask=v_mask, q_mask=q_mask, width=wv, groups=groups)
+
+
+class Model(eqx.Module):
+    """A rigid-body tree. Build it with `Model(parents, joint_types, ...)`, the builders in
+    `mbjax.model.builders` or `mbjax.load_urdf`.
+
+    Per body k (arrays with leading axis n):
+        placement_rotation (n, 3, 3), placement_translation (n, 3): joint k's frame in body
+            parents[k]'s frame (in the ground frame for a base body);
+        axis, axis2 (n, 3): joint axes in the joint frame (axis2 only for universal joints);
+        mass (n,), com (n, 3) in body k's frame, inertia (n, 3, 3) about the centre of mass;
+        gravity (3,): the ground-frame acceleration of gravity.
+    """
+
+    topology: Topology = eqx.field(static=True)
+    joint_types: tuple[str, ...] = eqx.field(static=True)
+    names: tuple[str, ...] = eqx.field(static=True)
+    placement_rotation: Array
+    placement_translation: Array
+    axis: Array
+    axis2: Array
+    mass: Array
+    com: Array
+    inertia: Array
+    gravity: Array
+
+    def __init__(self, parents, joint_types, *, mass, inertia, com=None, axis=None, axis2=None,
+                 placement_rotation=None, placement_translation=None,
+                 gravity=(0.0, 0.0, -9.81), names=None):
+        self.topology = parents if isinstance(parents, Topology) else Topology(parents)
+        n = self.topology.n
+        joint_types = (joint_types,) * n if isinstance(joint_types, str) else tuple(joint_types)
+        if len(joint_types) != n:
+            raise ValueError(f"{len(joint_types)} joint types for {n} bodies")
+        for k, kind in enumerate(joint_types):
+            if kind not in JOINT_TYPES:
+                raise ValueError(f"body {k}: unknown joint type {kind!r}; choose from "
+                                 f"{sorted(JOINT_TYPES)}")
+        self.joint_types = joint_types
+        self.names = tuple(names) if names is not None else tuple(f"body{k}" for k in range(n))
+        if len(self.names) != n:
+            raise ValueError(f"{len(self.names)} names for {n} bodies")
+
+        def field(value, default, shape, what):
+            value = default if value is None else value
+            arr = jnp.asarray(value, dtype=float)
+            if arr.shape != shape:
+                arr = jnp.broadcast_to(arr, shape) if arr.ndim < len(shape) else arr
+            if arr.shape != shape:
+                raise ValueError(f"{what} must have shape {shape}, got {jnp.shape(value)}")
+            return arr
+
+        self.mass = field(mass, None, (n,), "mass")
+        self.inertia = field(inertia, None, (n, 3, 3), "inertia")
+        self.com = field(com, np.zeros((n, 3)), (n, 3), "com")
+        self.axis = _unit_rows(field(axis, np.tile([0.0, 0.0, 1.0], (n, 1)), (n, 3), "axis"))
+        self.axis2 = _unit_rows(field(axis2, np.tile([0.0, 1.0, 0.0], (n, 1)), (n, 3), "axis2"))
+        self.placement_rotation = field(placement_rotation, np.tile(np.eye(3), (n, 1, 1)),
+                                        (n, 3, 3), "placement_rotation")
+        self.placement_translation = field(placement_translation, np.zeros((n, 3)), (n, 3),
+                                           "placement_translation")
+        self.gravity = field(gravity, None, (3,), "gravity")
+        if not isinstance(self.mass, jax.core.Tracer):
+            mass, inertia = np.asarray(self.mass), np.asarray(self.inertia)
+            for k in range(n):
+                name = f"body {self.names[k]!r}"
+                if mass[k] == 0 and not inertia[k].any():
+                    if not self.topology.distal(k):   # a massless link must carry something
+                        raise ValueError(f"{name} is massless and carries no other body: its "
+                                         "joint would have no inertia to act on")
+                    continue
+                if not mass[k] > 0:
+                    raise ValueError(f"{name}: mass must be positive, got {mass[k]}")
+                check_inertia(inertia[k], name)
+
+    # -- sizes and layout -----------------------------------------------------------------------
+
+    @property
+    def n(self) -> int:
+        return self.topology.n
+
+    @property
+    def nq(self) -> int:
+        return _layout(self.joint_types)["nq"]
+
+    @property
+    def nv(self) -> int:
+        return _layout(self.joint_types)["nv"]
+
+    @property
+    def width(self) -> int:
+        """Columns of the widest joint's motion subspace (1 for revolute/prismatic trees)."""
+        return _layout(self.joint_types)["width"]
+
+    def neutral(self) -> Array:
+        """The zero configuration: zero angles and displacements, identity quaternions."""
+        return jnp.asarray([x for kind in self.joint_types for x in NEUTRAL[kind]], dtype=float)
+
+    def body_v(self, v: Array) -> Array:
+        """Per-body velocities (n, width), zero-padded."""
+        layout = _layout(self.joint_types)
+        return jnp.where(layout["v_mask"], v[layout["v_index"]], 0.0)
+
+    def flat_v(self, per_body: Array) -> Array:
+        """Inverse of body_v: (n, width) -> (nv,)."""
+        layout = _layout(self.joint_types)
+        return per_body[layout["v_mask"]]
+
+    def dof_body(self) -> np.ndarray:
+        """The body each velocity coordinate belongs to."""
+        return np.repeat(np.arange(self.n), [JOINT_TYPES[k].nv for k in self.joint_types])
+
+    # -- joints ---------------------------------------------------------------------------------
+
+    def _per_type(self, fn, q: Array, *vs: Array):
+        """Apply fn(kind, q_k, *v_k, axis_k, axis2_k) to every body, grouped by joint type so each
+        type is one vmapped call (no Python loop over bodies). Each v in vs has length nv."""
+        layout = _layout(self.joint_types)
+        qb, vbs = q[layout["q_index"]], [self.body_v(v) for v in vs]
+        results = None
+        for kind, idx in layout["groups"].items():
+            out = jax.vmap(lambda qk, a, a2, *vk, kind=kind: fn(kind, qk, *vk, a, a2))(
+                qb[idx], self.axis[idx], self.axis2[idx], *[vb[idx] for vb in vbs])
+            if len(layout["groups"]) == 1:
+                return out
+            if results is None:
+                results = jax.tree.map(lambda o: jnp.zeros((self.n, *o.shape[1:]), o.dtype), out)
+            results = jax.tree.map(lambda r, o, idx=idx: r.at[idx].set(o), results, out)
+        return results
+
+    def joints(self, q: Array, v: Array):
+        """Per-body (R, p, S, S_dot): body k's orientation and origin in its proximal body's frame,
+        its motion subspace (n, 6, width) and that subspace's rate, body coordinates."""
+        width = self.width
+        R_J, p_J, S, S_dot = self._per_type(
+            lambda kind, qk, vk, a, a2: joint_calc(kind, qk, vk, a, a2, width), q, v)
+        R = self.placement_rotation @ R_J
+        p = self.placement_translation + jnp.einsum("kij,kj->ki", self.placement_rotation, p_J)
+        return R, p, S, S_dot
+
+    def q_dot(self, q: Array, v: Array) -> Array:
+        """dq/dt for velocity v (equal to v for revolute, prismatic and universal joints)."""
+        return self._flat_q(self._per_type(
+            lambda kind, qk, vk, a, a2: self._pad_q(kind, joint_rate(kind, qk, vk)), q, v))
+
+    def retract(self, q0: Array, xi: Array) -> Array:
+        """The configuration at chart point xi (length nv) about q0 (see joints.joint_retract)."""
+        return self._flat_q(self._per_type(
+            lambda kind, qk, xk, a, a2: self._pad_q(kind, joint_retract(kind, qk, xk)), q0, xi))
+
+    def local_rate(self, q0: Array, xi: Array, v: Array) -> Array:
+        """xi_dot (length nv) at chart point xi about q0 for velocity v."""
+        width = self.width
+        rates = self._per_type(
+            lambda kind, qk, xk, vk, a, a2: jnp.pad(joint_local_rate(kind, qk, xk, vk),
+                                                    (0, width - JOINT_TYPES[kind].nv)), q0, xi, v)
+        return self.flat_v(rates)
+
+    def _pad_q(self, kind: str, qk: Array) -> Array:
+        return jnp.pad(qk, (0, _layout(self.joint_types)["q_index"].shape[1] - qk.shape[0]))
+
+    def _flat_q(self, per_body: Array) -> Array:
+        return per_body[_layout(self.joint_types)["q_mask"]]
+
+    def normalize(self, q: Array) -> Array:
+        """q with every quaternion scaled to unit length."""
+        layout = _layout(self.joint_types)
+        starts = [layout["q_start"][k] + offset for kind, offset in (("spherical", 0), ("free", 3))
+                  for k in layout["groups"].get(kind, ())]
+        if not starts:
+            return q
+        idx = np.asarray(starts)[:, None] + np.arange(4)
+        quats = q[idx]
+        return q.at[idx].set(quats / jnp.linalg.norm(quats, axis=-1, keepdims=True))
+
+    def spatial_inertia(self) -> Array:
+        """(n, 6, 6) spatial inertias about each body's origin, body coordinates."""
+        return inertia_matrix(self.mass, self.com, self.inertia)
+
+
+def _unit_rows(a: Array) -> Array:
+    return a / jnp.linalg.norm(a, axis=-1, keepdims=True)

@@ -1,0 +1,15 @@
+"""6-D spatial algebra with vectors ordered (angular; linear), as in seeds 001 and 002.
+
+A motion vector is (omega; v), a force vector (torque; force). A Plucker transform X from frame A to
+frame B is stored as a 6x6 matrix; X^T maps forces back from B to A.
+"""
+
+from mbjax.spatial.algebra import (
+    cross_force,
+    cross_motion,
+    inertia_matrix,
+    plucker,
+    skew,
+)
+
+__all__ = ["cross_force", "cross_motion", "inertia_matrix", "plucker", "skew"]

@@ -1,0 +1,6 @@
+"""Tree topology (seed 001 §II, seed 002 §2.1) and the tree passes every algorithm runs on."""
+
+from mbjax.tree.passes import backward_pass, forward_pass
+from mbjax.tree.topology import Topology
+
+__all__ = ["Topology", "backward_pass", "forward_pass"]
