@@ -81,6 +81,7 @@ class Model(eqx.Module):
     topology: Topology = eqx.field(static=True)
     joint_types: tuple[str, ...] = eqx.field(static=True)
     names: tuple[str, ...] = eqx.field(static=True)
+    joint_names: tuple[str, ...] = eqx.field(static=True)
     placement_rotation: Array
     placement_translation: Array
     axis: Array
@@ -92,7 +93,7 @@ class Model(eqx.Module):
 
     def __init__(self, parents, joint_types, *, mass, inertia, com=None, axis=None, axis2=None,
                  placement_rotation=None, placement_translation=None,
-                 gravity=(0.0, 0.0, -9.81), names=None):
+                 gravity=(0.0, 0.0, -9.81), names=None, joint_names=None):
         self.topology = parents if isinstance(parents, Topology) else Topology(parents)
         n = self.topology.n
         joint_types = (joint_types,) * n if isinstance(joint_types, str) else tuple(joint_types)
@@ -104,8 +105,11 @@ class Model(eqx.Module):
                                  f"{sorted(JOINT_TYPES)}")
         self.joint_types = joint_types
         self.names = tuple(names) if names is not None else tuple(f"body{k}" for k in range(n))
-        if len(self.names) != n:
-            raise ValueError(f"{len(self.names)} names for {n} bodies")
+        self.joint_names = (tuple(joint_names) if joint_names is not None
+                            else tuple(f"joint{k}" for k in range(n)))
+        if len(self.names) != n or len(self.joint_names) != n:
+            raise ValueError(f"{len(self.names)} names and {len(self.joint_names)} joint names "
+                             f"for {n} bodies")
 
         def field(value, default, shape, what):
             value = default if value is None else value

@@ -1,6 +1,35 @@
-"""Rigid-body dynamics: the single rigid body and its closed-form references."""
+"""Rigid-body dynamics: the single rigid body, and trees by seed 002's O(n) recursion, the RNEA
+and seed 001's transformation operator (velocity and momentum forms, constraint forces)."""
 
+from mbjax.rigid.aba import aba
 from mbjax.rigid.body import RigidBody
+from mbjax.rigid.dense import constraint_forces, dense_forward_dynamics, joint_reactions
+from mbjax.rigid.dynamics import (
+    METHODS,
+    choose_method,
+    forward_dynamics,
+    inverse_dynamics,
+    mass_matrix,
+)
+from mbjax.rigid.energy import energy, kinetic_energy, potential_energy, spatial_momentum
+from mbjax.rigid.kinematics import body_kinematics, forward_kinematics
+from mbjax.rigid.momentum import (
+    constraint_forces_momentum,
+    momentum,
+    momentum_rate,
+    system_momenta,
+    velocity_from_momentum,
+)
+from mbjax.rigid.operator import operator_terms, transformation_operator
+from mbjax.rigid.rnea import joint_wrenches
+from mbjax.rigid.system import MomentumSystem, TreeSystem
 from mbjax.rigid.torque_free import torque_free_motion
 
-__all__ = ["RigidBody", "torque_free_motion"]
+__all__ = [
+    "METHODS", "MomentumSystem", "RigidBody", "TreeSystem", "aba", "body_kinematics",
+    "choose_method", "constraint_forces", "constraint_forces_momentum", "dense_forward_dynamics",
+    "energy", "forward_dynamics", "forward_kinematics", "inverse_dynamics", "joint_reactions",
+    "joint_wrenches", "kinetic_energy", "mass_matrix", "momentum", "momentum_rate",
+    "operator_terms", "potential_energy", "spatial_momentum", "system_momenta",
+    "torque_free_motion", "transformation_operator", "velocity_from_momentum",
+]

@@ -1,0 +1,65 @@
+"""The public dynamics of a tree: `forward_dynamics`, `inverse_dynamics`, `mass_matrix`.
+
+`forward_dynamics(..., method=...)` runs either seed 002's O(n) recursion ("recursive") or seed
+001's transformation operator with a Cholesky solve ("dense", O(n^3)); "auto" picks the cheaper
+for the model's size from the crossover measured by `mbjax bench rigid` (below it the dense form's
+few large array operations beat the recursion's n sequential steps; above it O(n) wins).
+"""
+
+from jax import Array
+
+from mbjax.model import Model
+from mbjax.rigid.aba import aba
+from mbjax.rigid.dense import dense_forward_dynamics
+from mbjax.rigid.operator import mass_matrix as _mass_matrix
+from mbjax.rigid.rnea import inverse_dynamics as _rnea
+
+METHODS = ("auto", "recursive", "dense")
+
+# Degrees of freedom at which the recursion overtakes the dense form, 1 CPU thread, float64
+# (`mbjax bench rigid`, see benchmarks/README.md).
+CROSSOVER_NV = 12
+
+
+def choose_method(model: Model) -> str:
+    """What method="auto" runs for this model."""
+    return "dense" if model.nv < CROSSOVER_NV else "recursive"
+
+
+def _check(model: Model, **arrays) -> None:
+    sizes = {"q": model.nq, "q_dot": model.nv, "tau": model.nv, "q_ddot": model.nv}
+    for name, value in arrays.items():
+        shape = getattr(value, "shape", None)
+        if shape is None or shape[-1:] != (sizes[name],) or len(shape) != 1:
+            raise ValueError(f"{name} must be a vector of length {sizes[name]} for this model "
+                             f"(nq = {model.nq}, nv = {model.nv}), got shape {shape}; "
+                             "use jax.vmap for batches")
+
+
+def forward_dynamics(model: Model, q: Array, q_dot: Array, tau: Array,
+                     method: str = "auto") -> Array:
+    """Joint accelerations at configuration q and velocity q_dot under joint forces tau and gravity.
+
+    q_dot is the generalized velocity v (length nv): the joint rates for revolute, prismatic and
+    universal joints, the body angular velocity (and origin velocity) for spherical and free ones.
+    """
+    if method not in METHODS:
+        raise ValueError(f"method must be one of {METHODS}, got {method!r}")
+    _check(model, q=q, q_dot=q_dot, tau=tau)
+    if method == "auto":
+        method = choose_method(model)
+    if method == "recursive":
+        return aba(model, q, q_dot, tau)
+    return dense_forward_dynamics(model, q, q_dot, tau)
+
+
+def inverse_dynamics(model: Model, q: Array, q_dot: Array, q_ddot: Array) -> Array:
+    """Joint forces that produce accelerations q_ddot at (q, q_dot): the RNEA, O(n)."""
+    _check(model, q=q, q_dot=q_dot, q_ddot=q_ddot)
+    return _rnea(model, q, q_dot, q_ddot)
+
+
+def mass_matrix(model: Model, q: Array) -> Array:
+    """The generalized mass matrix mu_hat_ff (seed 001 eq 55), nv x nv."""
+    _check(model, q=q)
+    return _mass_matrix(model, q)
