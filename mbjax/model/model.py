@@ -166,6 +166,11 @@ class Model(eqx.Module):
         """The zero configuration: zero angles and displacements, identity quaternions."""
         return jnp.asarray([x for kind in self.joint_types for x in NEUTRAL[kind]], dtype=float)
 
+    @property
+    def v_mask(self) -> np.ndarray:
+        """(n, width) static mask: which padded joint columns are real velocity coordinates."""
+        return _layout(self.joint_types)["v_mask"]
+
     def body_v(self, v: Array) -> Array:
         """Per-body velocities (n, width), zero-padded."""
         layout = _layout(self.joint_types)

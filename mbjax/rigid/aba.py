@@ -39,7 +39,7 @@ def aba(model: Model, q: Array, v: Array, tau: Array) -> Array:
     kin = body_kinematics(model, q, v)
     inertia = model.spatial_inertia()
     bias = cross_force(kin.V, jnp.einsum("kij,kj->ki", inertia, kin.V))
-    pad = (1.0 - model.body_v(jnp.ones(model.nv, q.dtype)))       # 1 on padded columns
+    pad = (~model.v_mask).astype(q.dtype)                  # 1 on padded columns
     tau_b = model.body_v(tau)
 
     def triangularize(received, inp):

@@ -56,7 +56,7 @@ def constraint_forces(model: Model, q: Array, v: Array, a: Array) -> Array:
     (orthonormal complements of the joint axes, so this is an orthogonal projection)."""
     terms = operator_terms(model, q, v)
     W = _reactions(terms, v, a)
-    pad = 1.0 - model.body_v(jnp.ones(model.nv, q.dtype))
+    pad = (~model.v_mask).astype(q.dtype)
     gram = jnp.einsum("kaw,kax->kwx", terms.A_hat, terms.A_hat) + jax.vmap(jnp.diag)(pad)
     free = jnp.linalg.solve(gram, jnp.einsum("kaw,ka->kw", terms.A_hat, W)[..., None])[..., 0]
     return W - jnp.einsum("kaw,kw->ka", terms.A_hat, free)

@@ -74,7 +74,7 @@ def path_operator(model: Model) -> Array:
 
 def _free_columns(model: Model) -> np.ndarray:
     """Which of the n * width padded joint columns are real velocity coordinates."""
-    return np.flatnonzero(np.asarray(model.body_v(jnp.ones(model.nv))).reshape(-1))
+    return np.flatnonzero(model.v_mask.reshape(-1))
 
 
 def transformation_operator(model: Model, q: Array) -> tuple[Array, Array]:
