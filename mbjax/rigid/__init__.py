@@ -20,7 +20,12 @@ from mbjax.rigid.momentum import (
     system_momenta,
     velocity_from_momentum,
 )
-from mbjax.rigid.operator import operator_terms, transformation_operator
+from mbjax.rigid.operator import (
+    inverse_operator,
+    operator_terms,
+    primitive_inverse_mass,
+    transformation_operator,
+)
 from mbjax.rigid.rnea import joint_wrenches
 from mbjax.rigid.system import MomentumSystem, TreeSystem
 from mbjax.rigid.torque_free import torque_free_motion
@@ -28,8 +33,9 @@ from mbjax.rigid.torque_free import torque_free_motion
 __all__ = [
     "METHODS", "MomentumSystem", "RigidBody", "TreeSystem", "aba", "body_kinematics",
     "choose_method", "constraint_forces", "constraint_forces_momentum", "dense_forward_dynamics",
-    "energy", "forward_dynamics", "forward_kinematics", "inverse_dynamics", "joint_reactions",
+    "energy", "forward_dynamics", "forward_kinematics", "inverse_dynamics", "inverse_operator",
+    "joint_reactions",
     "joint_wrenches", "kinetic_energy", "mass_matrix", "momentum", "momentum_rate",
-    "operator_terms", "potential_energy", "spatial_momentum", "system_momenta",
+    "operator_terms", "potential_energy", "primitive_inverse_mass", "spatial_momentum", "system_momenta",
     "torque_free_motion", "transformation_operator", "velocity_from_momentum",
 ]

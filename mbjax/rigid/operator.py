@@ -87,6 +87,28 @@ def transformation_operator(model: Model, q: Array) -> tuple[Array, Array]:
     return A, A_hat.reshape(6 * n, n * w)[:, _free_columns(model)]
 
 
+def inverse_operator(model: Model, q: Array) -> Array:
+    """B = A^-1 (seed 001 eqs 15, 17) from the reference matrix rho, explicit 6n x 6n, body-major:
+    Omega^i = sum_j rho_ij omega^j and U^i = sum_j rho_ij (R~_{c_j h_i} omega^j + v_cj), so the
+    (i, j) block is rho_ij [[1, 0], [R~_{c_j h_i}, 1]]. Only 2n - 1 blocks are non-zero: rho is
+    sparser than pi, as the paper notes after eq 26."""
+    R, h = forward_kinematics(model, q)
+    c = h + jnp.einsum("kij,kj->ki", R, model.com)
+    rho = jnp.asarray(model.topology.reference_matrix(), dtype=q.dtype)
+    blocks = rho[:, :, None, None] * _shift(h[:, None, :] - c[None, :, :])   # -R~ with R = h - c
+    return blocks.transpose(0, 2, 1, 3).reshape(6 * model.n, 6 * model.n)
+
+
+def primitive_inverse_mass(terms: OperatorTerms) -> Array:
+    """nu = diag(J_c, W 1) = mu^-1 body by body (seed 001 eq 7b), (n, 6, 6), by 3x3 solves."""
+    I_c, M = terms.mu[:, :3, :3], terms.mu[:, 3, 3]
+    eye = jnp.broadcast_to(jnp.eye(3, dtype=I_c.dtype), I_c.shape)
+    J_c = jnp.linalg.solve(I_c, eye)
+    zero = jnp.zeros_like(J_c)
+    return jnp.concatenate([jnp.concatenate([J_c, zero], -1),
+                            jnp.concatenate([zero, eye / M[:, None, None]], -1)], -2)
+
+
 def operator_terms(model: Model, q: Array, v: Array) -> OperatorTerms:
     """alpha_f = A A_hat_f and its rate from the path matrix, with mu, Y, K and sigma."""
     R, h = forward_kinematics(model, q)
