@@ -104,9 +104,11 @@ class Model(eqx.Module):
                 raise ValueError(f"body {k}: unknown joint type {kind!r}; choose from "
                                  f"{sorted(JOINT_TYPES)}")
         self.joint_types = joint_types
-        self.names = tuple(names) if names is not None else tuple(f"body{k}" for k in range(n))
+        digits = len(str(n - 1))     # zero-padded defaults sort like the body indices (URDF order)
+        self.names = (tuple(names) if names is not None
+                      else tuple(f"body{k:0{digits}d}" for k in range(n)))
         self.joint_names = (tuple(joint_names) if joint_names is not None
-                            else tuple(f"joint{k}" for k in range(n)))
+                            else tuple(f"joint{k:0{digits}d}" for k in range(n)))
         if len(self.names) != n or len(self.joint_names) != n:
             raise ValueError(f"{len(self.names)} names and {len(self.joint_names)} joint names "
                              f"for {n} bodies")
@@ -117,7 +119,7 @@ class Model(eqx.Module):
             if arr.shape != shape:
                 arr = jnp.broadcast_to(arr, shape) if arr.ndim < len(shape) else arr
             if arr.shape != shape:
-                raise ValueError(f"{what} must have shape {shape}, got {jnp.shape(value)}")
+                raise ValueError(f"{what} must have shape {shape}, got {np.shape(value)}")
             return arr
 
         self.mass = field(mass, None, (n,), "mass")
@@ -130,6 +132,14 @@ class Model(eqx.Module):
         self.placement_translation = field(placement_translation, np.zeros((n, 3)), (n, 3),
                                            "placement_translation")
         self.gravity = field(gravity, None, (3,), "gravity")
+        for what, raw, uses in (("axis", axis, ("revolute", "prismatic", "universal")),
+                                ("axis2", axis2, ("universal",))):
+            if raw is not None and not isinstance(raw, jax.core.Tracer):
+                norms = np.linalg.norm(np.broadcast_to(np.asarray(raw, float), (n, 3)), axis=-1)
+                for k, kind in enumerate(joint_types):
+                    if kind in uses and not norms[k] > 0:
+                        raise ValueError(f"body {self.names[k]!r}: the {kind} joint's {what} is "
+                                         f"zero (or not finite); give a nonzero direction")
         if not isinstance(self.mass, jax.core.Tracer):
             mass, inertia = np.asarray(self.mass), np.asarray(self.inertia)
             for k in range(n):

@@ -4,8 +4,11 @@ Links with <inertial> become bodies; revolute and continuous joints become revol
 prismatic joints prismatic ones and floating joints free joints; a fixed joint merges its child
 link (mass, centre of mass and inertia, and the placements of the joints beyond it) into the
 parent body. The root link is welded to the ground unless `floating_base=True` adds a free joint.
-Bodies are numbered depth-first from the root, children in document order (Pinocchio's ordering
-for the same file), so q and v line up with Pinocchio's.
+Bodies are numbered depth-first from the root, as Pinocchio numbers its joints, so q and v line
+up with Pinocchio's. Pinocchio (through urdfdom, which keeps joints in a name-sorted map) visits
+the children of a link in order of joint name; that is the default here. `sibling_order=
+"document"` visits them in document order instead (the two agree when sibling joint names sort
+in document order, as `to_urdf`'s zero-padded defaults do).
 """
 
 import os
@@ -93,8 +96,13 @@ def _merge(a, b):
 
 
 def load_urdf(source: str | os.PathLike, *, floating_base: bool = False,
-              gravity=(0.0, 0.0, -9.81)) -> Model:
-    """A Model from a URDF path or XML string (a string starting with '<' is read as XML)."""
+              gravity=(0.0, 0.0, -9.81), sibling_order: str = "name") -> Model:
+    """A Model from a URDF path or XML string (a string starting with '<' is read as XML).
+
+    sibling_order: "name" (Pinocchio's numbering) or "document" (see the module docstring).
+    """
+    if sibling_order not in ("name", "document"):
+        raise ValueError(f"sibling_order must be 'name' or 'document', got {sibling_order!r}")
     text = str(source)
     if isinstance(source, os.PathLike) or not text.lstrip().startswith("<"):
         path = Path(source)
@@ -118,8 +126,14 @@ def load_urdf(source: str | os.PathLike, *, floating_base: bool = False,
         links[name] = _inertial(link)
     children: dict[str, list] = {name: [] for name in links}
     has_parent: dict[str, str] = {}
+    joint_names = set()
     for joint in robot.findall("joint"):
         name, kind = joint.get("name"), joint.get("type")
+        if not name:
+            raise ValueError("URDF: a <joint> has no name")
+        if name in joint_names:
+            raise ValueError(f"URDF: joint {name!r} is defined twice")
+        joint_names.add(name)
         if kind not in _KINDS:
             raise ValueError(f"URDF: joint {name!r} has unknown or unsupported type {kind!r}; "
                              f"supported: {sorted(_KINDS)}")
@@ -135,6 +149,9 @@ def load_urdf(source: str | os.PathLike, *, floating_base: bool = False,
                              f"({has_parent[child]!r} and {name!r}): a URDF must be a tree")
         has_parent[child] = name
         children[parent].append(joint)
+    if sibling_order == "name":
+        children = {link: sorted(joints, key=lambda j: j.get("name"))
+                    for link, joints in children.items()}
     roots = [name for name in links if name not in has_parent]
     if len(roots) != 1:
         raise ValueError(f"URDF: expected exactly one root link, found {roots or 'none (a cycle)'}")

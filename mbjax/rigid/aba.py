@@ -1,20 +1,22 @@
 """O(n) forward dynamics: seed 002 §2.3, rigid bodies (the articulated-body recursion).
 
-Three tree passes, each a `lax.scan` (compile time flat in n):
+Three tree passes, each a `lax.scan` (compile time flat in n), in ground coordinates at the ground
+origin (see `kinematics`), so no quantity changes frame on its way along the tree:
 
-(i)   outward kinematics: transforms X, velocities V and remainder accelerations c (eqs 20-31);
+(i)   outward kinematics: motion subspaces S (seed 002's partial velocities P, eq 41), velocities
+      V and remainder accelerations c (eqs 20-31);
 (ii)  inward triangularization (eqs 48-50, 80-81): each body starts from its own inertia I_1 and
-      remainder force F_1 = -(V x* I V) (eq 43 with no applied load); it receives its children's
-      articulated inertia I_3 and force F_3, and eliminates its own joint accelerations:
-          U = I_2 P,   D = P^T U,   u = tau - P^T F_2'
-          I_3 = I_2 - U D^-1 U^T,   F_3 = F_2' + I_3 c + U D^-1 u
-      shifted to the parent by the transform X (eq 45's S operator): X^T I_3 X and X^T F_3;
-(iii) outward back-substitution (eqs 82-84): a' = X a_parent + c, u_dot = D^-1 (u - U^T a'),
+      remainder force F_1 = -(V x* I V) (eq 43 with no applied load); it adds its children's
+      articulated inertia I_3 and force F_3 (I_2, F_2) and eliminates its own joint accelerations:
+          U = I_2 P,   D = P^T U,   u = tau - P^T F_2
+          I_3 = I_2 - U D^-1 U^T,   F_3 = F_2 + I_3 c + U D^-1 u
+      which its parent receives as they are (seed 002's shift S of eq 45 is the identity here);
+(iii) outward back-substitution (eqs 82-84): a' = a_parent + c, u_dot = D^-1 (u - U^T a'),
       a = a' + P u_dot. The ground's acceleration is -g, which puts gravity in every body.
 
-P (the partial velocities of eq 41, Featherstone's S) may have several columns for multi-DOF
-joints; D is then a small symmetric positive-definite block solved by Cholesky. Flexible bodies
-(issue "flexible bodies") will enter step (ii) with their modal mass (eqs 51-60).
+P may have several columns for multi-DOF joints; D is then a small symmetric positive-definite
+block solved by Cholesky. Flexible bodies (issue "flexible bodies") will enter step (ii) with their
+modal mass (eqs 51-60).
 """
 
 import jax
@@ -37,31 +39,28 @@ def _solve(D: Array, b: Array) -> Array:
 def aba(model: Model, q: Array, v: Array, tau: Array) -> Array:
     """Joint accelerations (nv,) of the tree at (q, v) under joint forces tau and gravity."""
     kin = body_kinematics(model, q, v)
-    inertia = model.spatial_inertia()
-    bias = cross_force(kin.V, jnp.einsum("kij,kj->ki", inertia, kin.V))
+    bias = cross_force(kin.V, jnp.einsum("kij,kj->ki", kin.I, kin.V))
     pad = (~model.v_mask).astype(q.dtype)                  # 1 on padded columns
-    tau_b = model.body_v(tau)
 
     def triangularize(received, inp):
-        (IA, pA), (X, S, c, t, padding) = received, inp
+        (IA, pA), (S, c, t, padding) = received, inp
         U = IA @ S
         D = S.T @ U + jnp.diag(padding)                 # padded columns: identity, u = 0
         u = t - S.T @ pA
-        Dinv_UT = _solve(D, U.T)
-        Ia = IA - U @ Dinv_UT
+        Ia = IA - U @ _solve(D, U.T)
         pa = pA + Ia @ c + U @ _solve(D, u[:, None])[:, 0]
-        return (U, D, u), (X.T @ Ia @ X, X.T @ pa)
+        return (U, D, u), (Ia, pa)
 
-    (U, D, u), _ = backward_pass(model.topology, triangularize, (inertia, bias),
-                                 (kin.X, kin.S, kin.c, tau_b, pad))
+    (U, D, u), _ = backward_pass(model.topology, triangularize, (kin.I, bias),
+                                 (kin.S, kin.c, model.body_v(tau), pad))
 
     def substitute(parent, inp):
-        (a_parent, _), (X, S, c, U, D, u) = parent, inp
-        a_prime = X @ a_parent + c
+        (a_parent, _), (S, c, U, D, u) = parent, inp
+        a_prime = a_parent + c
         qdd = _solve(D, (u - U.T @ a_prime)[:, None])[:, 0]
         return a_prime + S @ qdd, qdd
 
     _, qdd = forward_pass(model.topology, substitute,
                           (gravity_acceleration(model), jnp.zeros(model.width, q.dtype)),
-                          (kin.X, kin.S, kin.c, U, D, u))
+                          (kin.S, kin.c, U, D, u))
     return model.flat_v(qdd)

@@ -14,8 +14,8 @@ from mbjax.rigid.kinematics import body_kinematics, forward_kinematics
 
 def kinetic_energy(model: Model, q: Array, v: Array) -> Array:
     """1/2 sum_k V_k^T I_k V_k (eq 10)."""
-    V = body_kinematics(model, q, v).V
-    return 0.5 * jnp.einsum("ki,kij,kj->", V, model.spatial_inertia(), V)
+    kin = body_kinematics(model, q, v)
+    return 0.5 * jnp.einsum("ki,kij,kj->", kin.V, kin.I, kin.V)
 
 
 def potential_energy(model: Model, q: Array) -> Array:
@@ -31,9 +31,5 @@ def energy(model: Model, q: Array, v: Array) -> Array:
 
 def spatial_momentum(model: Model, q: Array, v: Array) -> Array:
     """(angular momentum about the ground origin; linear momentum), ground frame."""
-    V = body_kinematics(model, q, v).V
-    R, p = forward_kinematics(model, q)
-    h = jnp.einsum("kij,kj->ki", model.spatial_inertia(), V)      # body frame, about body origin
-    angular = jnp.einsum("kij,kj->ki", R, h[:, :3])
-    linear = jnp.einsum("kij,kj->ki", R, h[:, 3:])
-    return jnp.concatenate([jnp.sum(angular + jnp.cross(p, linear), 0), jnp.sum(linear, 0)])
+    kin = body_kinematics(model, q, v)
+    return jnp.einsum("kij,kj->i", kin.I, kin.V)

@@ -1,41 +1,45 @@
 """Inverse dynamics by the recursive Newton-Euler algorithm (Featherstone, RBDA §5.3).
 
-An outward pass gives body accelerations a[k] = X[k] a[parent] + S[k] q_ddot[k] + c[k] (seed 002
-eqs 25, 27 with the remainder terms of eqs 29, 31; gravity enters as the ground acceleration
--g); each body needs the wrench f[k] = I[k] a[k] + V[k] x* I[k] V[k] (seed 001 eq 9's
+An outward pass gives body accelerations a[k] = a[parent] + S[k] q_ddot[k] + c[k] (seed 002
+eqs 25, 27 with the remainder terms of eqs 29, 31; gravity enters as the ground acceleration -g);
+each body needs the wrench f[k] = I[k] a[k] + V[k] x* I[k] V[k] (seed 001 eq 9's
 mu sigma_dot + Y, per body). An inward pass sums the wrenches of each body's outward set (seed 001
-eq 20: the system j-bar) and projects them on the joint axes: tau[k] = S[k]^T f_bar[k].
+eq 20: the system j-bar) and projects them on the joint axes: tau[k] = S[k]^T f_bar[k]. All in
+ground coordinates at the ground origin (see `kinematics`), so the passes are plain sums.
 """
 
 import jax.numpy as jnp
 from jax import Array
 
 from mbjax.model import Model
-from mbjax.rigid.kinematics import body_kinematics, gravity_acceleration
+from mbjax.rigid.kinematics import Kinematics, body_kinematics, gravity_acceleration
 from mbjax.spatial import cross_force
 from mbjax.tree import backward_pass, forward_pass
 
 
-def _rnea(model: Model, q: Array, v: Array, a: Array) -> tuple[Array, Array]:
+def _rnea(model: Model, q: Array, v: Array, a: Array) -> tuple[Array, Kinematics]:
     kin = body_kinematics(model, q, v)
-    ab = jnp.einsum("kij,kj->ki", kin.S, model.body_v(a)) + kin.c
-    acc = forward_pass(model.topology, lambda a_parent, inp: inp[0] @ a_parent + inp[1],
-                       gravity_acceleration(model), (kin.X, ab))
-    inertia = model.spatial_inertia()
-    f = (jnp.einsum("kij,kj->ki", inertia, acc)
-         + cross_force(kin.V, jnp.einsum("kij,kj->ki", inertia, kin.V)))
-    f_bar, _ = backward_pass(model.topology, lambda f_k, X: (f_k, X.T @ f_k), f, kin.X)
-    return f_bar, kin.S
+    joint_acc = jnp.einsum("kij,kj->ki", kin.S, model.body_v(a)) + kin.c
+    acc = forward_pass(model.topology, lambda a_parent, da: a_parent + da,
+                       gravity_acceleration(model), joint_acc)
+    f = (jnp.einsum("kij,kj->ki", kin.I, acc)
+         + cross_force(kin.V, jnp.einsum("kij,kj->ki", kin.I, kin.V)))
+    f_bar, _ = backward_pass(model.topology, lambda f_k, _: (f_k, f_k), f)
+    return f_bar, kin
 
 
 def joint_wrenches(model: Model, q: Array, v: Array, a: Array) -> Array:
-    """The wrench each joint transmits to its outward system (n, 6), body coordinates about the
-    joint origin, for joint accelerations a (nv,). Its projection on the joint axes is tau; the
-    rest are the constraint forces K_c of seed 001 eq 76."""
-    return _rnea(model, q, v, a)[0]
+    """The wrench each joint transmits to its outward system (n, 6) for joint accelerations a
+    (nv,): (torque about the joint origin; force) in body coordinates. Its projection on the joint
+    axes is tau; the rest are the constraint forces K_c of seed 001 eq 76."""
+    f_bar, kin = _rnea(model, q, v, a)
+    Rt = jnp.swapaxes(kin.R, -1, -2)
+    torque = f_bar[:, :3] - jnp.cross(kin.p, f_bar[:, 3:])         # about the hinge
+    return jnp.concatenate([jnp.einsum("kij,kj->ki", Rt, torque),
+                            jnp.einsum("kij,kj->ki", Rt, f_bar[:, 3:])], -1)
 
 
 def inverse_dynamics(model: Model, q: Array, v: Array, a: Array) -> Array:
     """Joint forces tau (nv,) that give accelerations a at state (q, v) under gravity."""
-    f_bar, S = _rnea(model, q, v, a)
-    return model.flat_v(jnp.einsum("kij,ki->kj", S, f_bar))
+    f_bar, kin = _rnea(model, q, v, a)
+    return model.flat_v(jnp.einsum("kij,ki->kj", kin.S, f_bar))

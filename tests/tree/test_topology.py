@@ -252,15 +252,19 @@ def test_backward_pass_subtree_sizes_and_transported_sums(name):
 
     rng = np.random.default_rng(len(name) + 100)
     w, M = rng.normal(size=(n, 3)), rng.normal(size=(n, 3, 3)) / 2
-    out, ground = backward_pass(top, lambda r, X: (2.0 * r, X @ r), jnp.asarray(w), jnp.asarray(M))
+    # pytree outputs of different shapes; what goes to the parent is transported by M[k]
+    (doubled, norm2), ground = backward_pass(top, lambda r, X: ((2.0 * r, r @ r), X @ r),
+                                             jnp.asarray(w), jnp.asarray(M))
     ref, ref_ground = _python_subtree(parents, w, M)
-    np.testing.assert_allclose(out, 2.0 * ref, rtol=1e-12, atol=1e-12)
+    np.testing.assert_allclose(doubled, 2.0 * ref, rtol=1e-12, atol=1e-12)
+    np.testing.assert_allclose(norm2, np.sum(ref**2, axis=1), rtol=1e-12)
     np.testing.assert_allclose(ground, ref_ground, rtol=1e-12, atol=1e-12)
 
 
-def test_passes_are_differentiable():
+@pytest.mark.parametrize("name", ["chain", "random", "sequential"])
+def test_passes_are_differentiable(name):
     """Reverse mode through both passes matches the plain-Python recursion's derivative."""
-    parents = TREES["random"]
+    parents = TREES[name]
     top, n = Topology(parents), len(parents)
     x = jnp.asarray(np.random.default_rng(0).normal(size=n))
 
@@ -319,6 +323,7 @@ def test_pass_program_size_is_flat_in_n():
     """The traced program of a pass is the same size for a chain of 10 and of 1000 bodies."""
     def size(n):
         top = Topology(np.arange(n) - 1)
-        f = lambda w: backward_pass(top, lambda r, _: (r, r), w)[0]  # noqa: E731
+        def f(w):
+            return backward_pass(top, lambda r, _: (r, r), w)[0]
         return _count_equations(jax.make_jaxpr(f)(jnp.ones(n)).jaxpr)["total"]
     assert size(10) == size(1000)
