@@ -3,10 +3,11 @@
 Each entry is reproduce(out: Path, quick: bool) -> dict (the JSON written).
 """
 
-from mbjax.reproduce import integrators
+from mbjax.reproduce import integrators, tree_scaling
 
 REPRODUCTIONS = {
     integrators.NAME: integrators.reproduce,
+    tree_scaling.NAME: tree_scaling.reproduce,
 }
 
 __all__ = ["REPRODUCTIONS"]

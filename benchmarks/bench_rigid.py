@@ -1,0 +1,16 @@
+"""Forward dynamics of rigid chains (n = 1 ... 1000): seed 002's O(n) recursion against seed 001's
+dense form, Pinocchio and MuJoCo, batched, compile time and the gradient of a rollout, in one
+process.
+
+    python benchmarks/bench_rigid.py [--out DIR] [--quick]
+
+is `mbjax bench rigid`; the suite itself is mbjax/bench/rigid.py, so that the installed `mbjax`
+command runs it too.
+"""
+
+import sys
+
+from mbjax.cli import main
+
+if __name__ == "__main__":
+    sys.exit(main(["bench", "rigid", *sys.argv[1:]]))

@@ -1,0 +1,80 @@
+"""`mbjax reproduce tree-scaling`: CPU time against n for the O(n) and O(n^3) formulations.
+
+In the spirit of seed 002 Fig. 8 (§3.3), where the O(n) recursion and a conventional O(n^3)
+Kane formulation simulate the same chain for 1 s and the CPU time is plotted against the number
+of degrees of freedom n (n = 4 ... 44, a closed (n/2)-body chain of Hooke's joints). Here: an
+open n-link revolute chain (`mbjax.model.chain(n)`, n degrees of freedom; closed loops are a later
+issue), the CPU time of one forward-dynamics evaluation, and n up to 384 so that both asymptotic
+slopes show. An mbjax time is that of one evaluation among many in a jitted loop
+(`mbjax.bench.rigid.looped_fn`; the median of timed loops after a compiling warm-up, over the
+evaluations per loop), as a simulation meets it, free of the per-call dispatch of a lone jitted
+call (tens of microseconds on CPU, which would hide the small-n end of the chart):
+
+- recursive_s: `forward_dynamics(..., method="recursive")`, seed 002 §2.3, O(n);
+- dense_s: `method="dense"`, seed 001's transformation operator and a Cholesky solve, O(n^3);
+- pinocchio_aba_s (when Pinocchio is installed): `pin.aba` on the same chain loaded from
+  `to_urdf`, the median of single calls from Python (so it includes under 1 us of binding).
+
+Writes tree-scaling.json, exactly {"n", "recursive_s", "dense_s", "pinocchio_aba_s"}, and
+tree-scaling.png (log-log, with slope-1 and slope-3 guide lines).
+"""
+
+import json
+import statistics
+import time
+from pathlib import Path
+
+import jax.numpy as jnp
+
+from mbjax.bench import peers
+from mbjax.bench.rigid import loop_length, looped_fn, states, timed
+from mbjax.model import chain
+from mbjax.model.urdf import to_urdf
+
+NAME = "tree-scaling"
+NS = (2, 3, 4, 6, 8, 12, 16, 24, 32, 48, 64, 96, 128, 192, 256, 384)
+QUICK_NS = (2, 16, 128)
+
+
+def pinocchio_aba_time(n: int, repeats: int) -> float:
+    """Median time of one `pin.aba` call on the n-link chain, from Python. (Pinocchio's Data
+    allocates O(n^3) memory: 3.6 GB at n = 384, which bounds NS.)"""
+    import pinocchio as pin
+
+    model = pin.buildModelFromXML(to_urdf(chain(n)))
+    data = model.createData()
+    q, v, tau = (x[0] for x in states(n, 1))
+    pin.aba(model, data, q, v, tau)
+    samples = []
+    for _ in range(repeats):
+        start = time.perf_counter()
+        pin.aba(model, data, q, v, tau)
+        samples.append(time.perf_counter() - start)
+    return statistics.median(samples)
+
+
+def reproduce(out: Path, quick: bool = False) -> dict:
+    """Time every size, write out/tree-scaling.json and out/tree-scaling.png, return the JSON."""
+    from mbjax.plot.trees import tree_scaling_figure
+
+    ns = QUICK_NS if quick else NS
+    repeats, budget = (3, 0.3) if quick else (15, 2.0)
+    data = {"n": list(ns), "recursive_s": [], "dense_s": []}
+    with_pinocchio = peers.available("pinocchio")
+    if with_pinocchio:
+        data["pinocchio_aba_s"] = []
+    for n in ns:
+        model = chain(n)
+        q, v, tau = (jnp.asarray(x[0]) for x in states(n, 1))
+        for method in ("recursive", "dense"):
+            _, timing = timed(looped_fn(method, loop_length(n)), model, q, v, tau, repeats=repeats,
+                              budget_s=budget)
+            data[f"{method}_s"].append(timing.run_s / loop_length(n))
+        if with_pinocchio:
+            data["pinocchio_aba_s"].append(pinocchio_aba_time(n, 20 if quick else 200))
+        print(f"n = {n:4d}: " + "  ".join(f"{k} {data[k][-1] * 1e6:10.1f} us"
+                                           for k in data if k != "n"))
+    out.mkdir(parents=True, exist_ok=True)
+    (out / f"{NAME}.json").write_text(json.dumps(data, indent=1))
+    tree_scaling_figure(data).savefig(out / f"{NAME}.png", dpi=120)
+    return data
