@@ -4,9 +4,10 @@ One run measures, for regular n-link revolute chains (`mbjax.model.chain(n)`, fl
 
 1. One state per call: `jit(forward_dynamics)` with method "recursive" (seed 002's O(n)
    recursion) and "dense" (seed 001's transformation operator + Cholesky, O(n^3)), the model
-   passed as an argument; compile time (first call minus a typical call) and run time. Extra sizes
-   between 2 and 70 resolve the crossover where the recursion overtakes the dense form (the
-   `CROSSOVER_NV` that method="auto" uses) and give the compile time at n = 10.
+   passed as an argument; run time, compile time as the first call minus a typical call and,
+   for the targets, as the time to lower and compile ahead of time (`lower_compile_time`).
+   Extra sizes between 2 and 70 resolve the crossover where the recursion overtakes the dense
+   form (the `CROSSOVER_NV` that method="auto" uses) and give the compile time at n = 10.
 2. Batches: `jit(vmap(forward_dynamics))` over B states; dense only where its (n, n, 6, 6)
    operator blocks fit in memory (B n^2 <= DENSE_MAX_BN2; skipped configurations are recorded
    with the reason).
@@ -89,6 +90,14 @@ def states(n: int, batch: int, seed: int = SEED):
 def single_fn(method: str):
     """One state per call, the model an argument (its parameters are leaves)."""
     return jax.jit(partial(forward_dynamics, method=method))
+
+
+def lower_compile_time(method: str, *args) -> float:
+    """Seconds to trace, lower and compile `single_fn(method)` ahead of time (a fresh jit, so
+    nothing is cached): the compile time alone, without the first call's other costs."""
+    start = time.perf_counter()
+    single_fn(method).lower(*args).compile()
+    return time.perf_counter() - start
 
 
 def batched_fn(method: str):
@@ -225,14 +234,19 @@ def fit_slope(ns, ts) -> float | None:
     return float(np.polyfit(np.log(ns), np.log(ts), 1)[0])
 
 
-def crossover(rows: list[dict], key: str = "run_s") -> int | None:
+def crossover(rows: list[dict], key: str = "run_s", group: str | None = None) -> int | None:
     """The smallest measured n from which on the recursion is faster than the dense form at
-    every measured size; None if it never is."""
+    every measured size (and, with `group`, for every value of that field, e.g. every batch
+    size measured with both methods); None if it never is."""
     by_n = {}
     for r in rows:
-        by_n.setdefault(r["n"], {})[r["method"]] = r[key]
-    ns = sorted(n for n, t in by_n.items() if set(t) >= set(METHODS))
-    faster = [by_n[n]["recursive"] < by_n[n]["dense"] for n in ns]
+        by_n.setdefault((r["n"], r.get(group)), {})[r["method"]] = r[key]
+    wins = {}
+    for (n, _), t in by_n.items():
+        if set(t) >= set(METHODS):
+            wins[n] = wins.get(n, True) and t["recursive"] < t["dense"]
+    ns = sorted(wins)
+    faster = [wins[n] for n in ns]
     for i, n in enumerate(ns):
         if all(faster[i:]):
             return n
@@ -247,7 +261,7 @@ def summarize(records: list[dict], ns, common: dict) -> dict:
     looped = [r for r in records if r["kind"] == "looped"]
     run = {(r["method"], r["n"]): r["run_s"] for r in single}
     per_eval = {(r["method"], r["n"]): r["per_eval_s"] for r in looped}
-    comp = {(r["method"], r["n"]): r["compile_s"] for r in single}
+    comp = {(r["method"], r["n"]): r.get("lower_compile_s", r["compile_s"]) for r in single}
     rec_ns = [n for n in ns if ("recursive", n) in per_eval]
     n_max = max(n for _, n in comp)
     # t = a + b n, fitted in relative terms (weights 1/t) over the sizes from 7 on
@@ -256,24 +270,39 @@ def summarize(records: list[dict], ns, common: dict) -> dict:
     b, a = np.polyfit(fit_ns, fit_t, 1, w=1 / fit_t) if len(fit_ns) >= 2 else (None, None)
     big = [n for n in rec_ns if n >= 100]
     slope_big = fit_slope(big, [per_eval[("recursive", n)] for n in big])
-    compile_ratio = {m: comp[(m, n_max)] / comp[(m, 10)] for m in METHODS
-                     if (m, n_max) in comp and (m, 10) in comp}
+    # n = 10's compile time, as the median over its neighbours 5 <= n <= 20 (one first call per
+    # size is a single, noisy sample)
+    base = {m: float(np.median([t for (mm, n), t in comp.items() if mm == m and 5 <= n <= 20]))
+            for m in METHODS if any(mm == m and 5 <= n <= 20 for mm, n in comp)}
+    compile_ratio = {m: comp[(m, n_max)] / base[m] for m in base if (m, n_max) in comp}
 
     def speedup(table):
         return (table[("dense", 300)] / table[("recursive", 300)]
                 if ("dense", 300) in table and ("recursive", 300) in table else None)
 
     grads = {r["method"]: r["grad_over_forward"] for r in records if r["kind"] == "gradient"}
+    batched = [r for r in records if r["kind"] == "forward" and r["engine"] == "mbjax"
+               and r["batch"] > 1 and "run_s" in r]
+    crossover_looped = crossover(looped, "per_eval_s")
+    crossover_batched = crossover(batched, group="batch")
+    # method="auto" serves simulations and optimisations (loops) and vmapped sweeps (batches): the
+    # recursion from the first size at which it wins in a loop or at every batch size. (Where the
+    # two forms are within noise of each other in a loop, batches decide: the dense form vmaps
+    # badly.)
+    candidates = [c for c in (crossover_looped, crossover_batched) if c is not None]
     summary = {
         **common, "kind": "summary",
         "crossover_nv": crossover(single),
-        "crossover_nv_looped": crossover(looped, "per_eval_s"),
+        "crossover_nv_looped": crossover_looped,
+        "crossover_nv_batched": crossover_batched,
+        "crossover_nv_auto": min(candidates) if candidates else None,
         "recursive_slope": fit_slope([n for n in rec_ns if n >= 30],
                                      [per_eval[("recursive", n)] for n in rec_ns if n >= 30]),
         "recursive_slope_n_ge_100": slope_big,
         "recursive_fixed_s": None if a is None else float(a),
         "recursive_per_body_s": None if b is None else float(b),
         "compile_n_max": n_max,
+        "compile_s_n10": base,
         "compile_ratio_nmax_over_n10": compile_ratio,
         "compile_s_nmax": {m: comp.get((m, n_max)) for m in METHODS},
         "dense_over_recursive_n300": speedup(run),
@@ -338,6 +367,7 @@ def run(out: Path, quick: bool = False) -> list[dict]:
             acc, timing = timed(fns[method], model, q, v, tau, repeats=repeats, budget_s=budget)
             record = {**common, "kind": "forward", "engine": "mbjax", "method": method, "n": n,
                       "batch": 0, "mode": "single", "compile_s": timing.compile_s,
+                      "lower_compile_s": lower_compile_time(method, model, q, v, tau),
                       "run_s": timing.run_s, "per_state_s": timing.run_s, "runs": timing.runs}
             if ref is not None:
                 record |= {"rel_diff": relative_difference(acc, ref), "ref_engine": ref_engine}
@@ -429,7 +459,8 @@ def report(records: list[dict]) -> str:
                          f"{r['grad_compile_s']:.2f} s)")
         if r["kind"] == "summary":
             lines.append(f"crossover (recursive faster from n =): {r['crossover_nv']} one state per call, "
-                         f"{r['crossover_nv_looped']} inside a loop; recursive slope (looped) "
+                         f"{r['crossover_nv_looped']} inside a loop, {r['crossover_nv_batched']} at every batch "
+                         f"size; for method='auto': {r['crossover_nv_auto']}; recursive slope (looped) "
                          f"(n >= 30) {r['recursive_slope']}, (n >= 100) {r['recursive_slope_n_ge_100']}; "
                          f"t = {_us(r['recursive_fixed_s'])} us + {_us(r['recursive_per_body_s'])} us n")
             lines.append(f"compile n_max/n10: {r['compile_ratio_nmax_over_n10']}; dense/recursive at "

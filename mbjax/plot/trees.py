@@ -41,7 +41,11 @@ def rigid_bench_figure(records: list[dict]) -> Figure:
                          mfc="none", color=TREE_COLORS[method],
                          label=f"mbjax {method}, per evaluation in a jitted loop")
         ax_compile.semilogx(*series(rows, key="compile_s"), marker="o", color=TREE_COLORS[method],
-                            label=f"mbjax {method}")
+                            label=f"mbjax {method}: first call minus a typical call")
+        if all("lower_compile_s" in r for r in rows):
+            ax_compile.semilogx(*series(rows, key="lower_compile_s"), marker="s", ls="--",
+                                mfc="none", color=TREE_COLORS[method],
+                                label=f"mbjax {method}: lower + compile ahead of time")
         ax_cross.loglog(*series([r for r in rows if r["n"] <= 100]), marker="o",
                         color=TREE_COLORS[method], label=f"mbjax {method}")
     for engine, method in (("pinocchio", "aba"), ("mujoco", "mj_forward")):
@@ -77,7 +81,7 @@ def rigid_bench_figure(records: list[dict]) -> Figure:
     ax_batch.set(xlabel="links n", ylabel="time per state [s]",
                  title="(b) jit(vmap(...)) over B states (dense only where it fits)")
     ax_compile.set(xlabel="links n", ylabel="compile time [s]", ylim=(0, None),
-                   title="(c) compile time (first call minus a typical call)")
+                   title="(c) compile time against n")
 
     for method in ("recursive", "dense"):
         rows = [r for r in records if r["kind"] == "looped" and r["method"] == method and r["n"] <= 100]
@@ -85,10 +89,11 @@ def rigid_bench_figure(records: list[dict]) -> Figure:
             ax_cross.loglog(*series(rows, key="per_eval_s"), marker="^", ls="--", mfc="none",
                             color=TREE_COLORS[method], label=f"mbjax {method}, per evaluation in a loop")
     summary = next((r for r in records if r["kind"] == "summary"), None)
-    for key, ls, where in (("crossover_nv", ":", "per call"), ("crossover_nv_looped", "-.", "in a loop")):
+    for key, ls, text in (("crossover_nv", ":", "recursive faster from n = {} (per call)"),
+                          ("crossover_nv_looped", "-.", "recursive faster from n = {} (in a loop)"),
+                          ("crossover_nv_auto", "--", "method='auto' switches at n = {}")):
         if summary and summary.get(key) is not None:
-            ax_cross.axvline(summary[key], color="k", ls=ls, lw=1,
-                             label=f"recursive faster from n = {summary[key]} ({where})")
+            ax_cross.axvline(summary[key], color="k", ls=ls, lw=1, label=text.format(summary[key]))
     grads = [r for r in records if r["kind"] == "gradient"]
     note = "\n".join(f"grad / forward, {r['steps']}-step RK4 rollout, {r['n']} links, {r['method']}: "
                      f"{r['grad_over_forward']:.2f}" for r in grads)

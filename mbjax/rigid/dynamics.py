@@ -3,7 +3,8 @@
 `forward_dynamics(..., method=...)` runs either seed 002's O(n) recursion ("recursive") or seed
 001's transformation operator with a Cholesky solve ("dense", O(n^3)); "auto" picks the cheaper
 for the model's size from the crossover measured by `mbjax bench rigid` (below it the dense form's
-few large array operations beat the recursion's n sequential steps; above it O(n) wins).
+few array operations match the recursion's n sequential steps; above it O(n) wins, by 68x at
+n = 300).
 """
 
 from jax import Array
@@ -16,9 +17,11 @@ from mbjax.rigid.rnea import inverse_dynamics as _rnea
 
 METHODS = ("auto", "recursive", "dense")
 
-# Degrees of freedom at which the recursion overtakes the dense form, 1 CPU thread, float64
-# (`mbjax bench rigid`, see benchmarks/README.md).
-CROSSOVER_NV = 12
+# Degrees of freedom from which method="auto" runs the recursion: the summary's
+# "crossover_nv_auto" of `mbjax bench rigid` (float64, 2-core x86_64 CPU; benchmarks/README.md),
+# the first chain size from which the recursion is faster in a jitted loop (10) or at every batch
+# size of jit(vmap(...)) (7). Below it the two forms are within 1.5x of each other in a loop.
+CROSSOVER_NV = 7
 
 
 def choose_method(model: Model) -> str:

@@ -27,7 +27,7 @@ class Kinematics(NamedTuple):
     S: Array      # (n, 6, width) motion subspaces, ground frame at the ground origin
     V: Array      # (n, 6) spatial velocities, ground frame at the ground origin
     c: Array      # (n, 6) remainder (velocity-product) accelerations, same frame
-    I: Array      # (n, 6, 6) spatial inertias about the ground origin, ground frame
+    I: Array      # (n, 6, 6) spatial inertias about the ground origin, ground frame  # noqa: E741 (the papers' name)
     v: Array      # (n, width) joint velocities, zero-padded
 
 

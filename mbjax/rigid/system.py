@@ -2,6 +2,11 @@
 
 `TreeSystem` integrates (q, v) with the velocity form (seed 002's recursion or seed 001 eq 74);
 `MomentumSystem` integrates (q, p) with seed 001's momentum form (eqs 72-73).
+
+Systems are equinox modules (their model and tau are array leaves), so compile their bound
+methods with `eqx.filter_jit(system.energy)`, or pass the system as an argument:
+`jax.jit(TreeSystem.energy)(system, q, u)`. (`jax.jit(system.energy)` fails: a bound method
+holding arrays is not hashable.)
 """
 
 import equinox as eqx
