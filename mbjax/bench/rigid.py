@@ -8,7 +8,8 @@ One run measures, for regular n-link revolute chains (`mbjax.model.chain(n)`, fl
    for the targets, as the time to lower and compile ahead of time (`lower_compile_time`).
    Extra sizes between 2 and 70 resolve the crossover where the recursion overtakes the dense
    form (the `CROSSOVER_NV` that method="auto" uses) and give the compile time at n = 10.
-2. Batches: `jit(vmap(forward_dynamics))` over B states; dense only where its (n, n, 6, 6)
+2. Batches: `jit(vmap(forward_dynamics))` over B states (B = 64 and 1024 at the extra sizes
+   of 1. too, for the batched crossover); dense only where its (n, n, 6, 6)
    operator blocks fit in memory (B n^2 <= DENSE_MAX_BN2; skipped configurations are recorded
    with the reason).
 3. Peers on the same chain (`mbjax.model.urdf.to_urdf`, identical q ordering): Pinocchio's
@@ -65,6 +66,10 @@ PEER_STATES = 64            # states per Python loop for the peers
 GRAD_N, GRAD_DT, GRAD_STEPS = 7, 1e-3, 1000
 # The dense form in a loop stops at n = 300 (one evaluation at n = 1000 takes seconds).
 LOOPED_DENSE_MAX_N = 300
+# Batch sizes also measured at the crossover sizes, so the batched crossover is resolved.
+CROSSOVER_BATCHES = (64, 1024)
+# method="auto" tolerates the recursion being up to this factor slower in a loop (see summarize).
+AUTO_TOLERANCE = 1.5
 SEED = 0
 
 
@@ -234,17 +239,18 @@ def fit_slope(ns, ts) -> float | None:
     return float(np.polyfit(np.log(ns), np.log(ts), 1)[0])
 
 
-def crossover(rows: list[dict], key: str = "run_s", group: str | None = None) -> int | None:
-    """The smallest measured n from which on the recursion is faster than the dense form at
-    every measured size (and, with `group`, for every value of that field, e.g. every batch
-    size measured with both methods); None if it never is."""
+def crossover(rows: list[dict], key: str = "run_s", group: str | None = None,
+              tolerance: float = 1.0) -> int | None:
+    """The smallest measured n from which on the recursion takes less than `tolerance` times the
+    dense form's time at every measured size (and, with `group`, for every value of that field,
+    e.g. every batch size measured with both methods); None if it never does."""
     by_n = {}
     for r in rows:
         by_n.setdefault((r["n"], r.get(group)), {})[r["method"]] = r[key]
     wins = {}
     for (n, _), t in by_n.items():
         if set(t) >= set(METHODS):
-            wins[n] = wins.get(n, True) and t["recursive"] < t["dense"]
+            wins[n] = wins.get(n, True) and t["recursive"] < tolerance * t["dense"]
     ns = sorted(wins)
     faster = [wins[n] for n in ns]
     for i, n in enumerate(ns):
@@ -283,19 +289,19 @@ def summarize(records: list[dict], ns, common: dict) -> dict:
     grads = {r["method"]: r["grad_over_forward"] for r in records if r["kind"] == "gradient"}
     batched = [r for r in records if r["kind"] == "forward" and r["engine"] == "mbjax"
                and r["batch"] > 1 and "run_s" in r]
-    crossover_looped = crossover(looped, "per_eval_s")
     crossover_batched = crossover(batched, group="batch")
-    # method="auto" serves simulations and optimisations (loops) and vmapped sweeps (batches): the
-    # recursion from the first size at which it wins in a loop or at every batch size. (Where the
-    # two forms are within noise of each other in a loop, batches decide: the dense form vmaps
-    # badly.)
-    candidates = [c for c in (crossover_looped, crossover_batched) if c is not None]
+    # method="auto" serves simulations and optimisations (loops) and vmapped sweeps (batches):
+    # the recursion from the first size from which it is never more than AUTO_TOLERANCE times
+    # slower in a loop (where small sizes are within noise of each other) and faster at every
+    # batch size (where the dense form vmaps badly).
+    loose = crossover(looped, "per_eval_s", tolerance=AUTO_TOLERANCE)
     summary = {
         **common, "kind": "summary",
         "crossover_nv": crossover(single),
-        "crossover_nv_looped": crossover_looped,
+        "crossover_nv_looped": crossover(looped, "per_eval_s"),
         "crossover_nv_batched": crossover_batched,
-        "crossover_nv_auto": min(candidates) if candidates else None,
+        "crossover_nv_auto": (None if loose is None or crossover_batched is None
+                              else max(loose, crossover_batched)),
         "recursive_slope": fit_slope([n for n in rec_ns if n >= 30],
                                      [per_eval[("recursive", n)] for n in rec_ns if n >= 30]),
         "recursive_slope_n_ge_100": slope_big,
@@ -374,6 +380,8 @@ def run(out: Path, quick: bool = False) -> list[dict]:
             records.append(record)
 
     configs = [(n, b, m) for n in ns for b in batches for m in METHODS]
+    if not quick:
+        configs += [(n, b, m) for n in CROSSOVER_NS for b in CROSSOVER_BATCHES for m in METHODS]
     for n, batch, method in progress(configs, len(configs), "bench rigid: batches"):
         base = {**common, "kind": "forward", "engine": "mbjax", "method": method, "n": n,
                 "batch": batch, "mode": "batched"}
@@ -428,7 +436,8 @@ def report(records: list[dict]) -> str:
     for n in ns:
         rec, den = get("mbjax", "recursive", n), get("mbjax", "dense", n)
         ratio = f"{den / rec:.3g}" if rec and den else "-"
-        cr, cd = get("mbjax", "recursive", n, key="compile_s"), get("mbjax", "dense", n, key="compile_s")
+        cr, cd = (get("mbjax", m, n, key="lower_compile_s") or get("mbjax", m, n, key="compile_s")
+                  for m in METHODS)
         lines.append(f"| {n} | {_us(rec)} | {_us(den)} | {ratio} | {_us(get('pinocchio', 'aba', n))} | "
                      f"{_us(get('pinocchio', 'aba', n, key='cpp_estimate_s'))} | "
                      f"{_us(get('mujoco', 'mj_forward', n))} | "

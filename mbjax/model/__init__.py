@@ -2,6 +2,6 @@
 
 from mbjax.model.builders import chain, random_tree
 from mbjax.model.joints import JOINT_TYPES
-from mbjax.model.model import Model, check_inertia
+from mbjax.model.model import Model
 
-__all__ = ["JOINT_TYPES", "Model", "chain", "check_inertia", "random_tree"]
+__all__ = ["JOINT_TYPES", "Model", "chain", "random_tree"]

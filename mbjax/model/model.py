@@ -25,27 +25,8 @@ from mbjax.model.joints import (
     joint_rate,
     joint_retract,
 )
-from mbjax.spatial import inertia_matrix
+from mbjax.spatial import check_inertia, inertia_matrix
 from mbjax.tree import Topology
-
-
-def check_inertia(inertia, name: str = "body") -> None:
-    """Concrete validation of a 3x3 inertia: symmetric, positive-definite, triangle inequality."""
-    if isinstance(inertia, jax.core.Tracer):
-        return
-    J = np.asarray(inertia, dtype=float)
-    if J.shape != (3, 3):
-        raise ValueError(f"{name}: inertia must be a 3x3 matrix, got shape {J.shape}")
-    if not np.all(np.isfinite(J)):
-        raise ValueError(f"{name}: inertia has non-finite entries\n{J}")
-    if not np.allclose(J, J.T, rtol=1e-12, atol=1e-12 * np.abs(J).max()):
-        raise ValueError(f"{name}: inertia must be symmetric, got\n{J}")
-    moments = np.linalg.eigvalsh(J)
-    if not moments[0] > 0:
-        raise ValueError(f"{name}: inertia must be positive-definite; principal moments {moments}")
-    if moments[0] + moments[1] < moments[2] * (1 - 1e-9):
-        raise ValueError(f"{name}: principal moments {moments} violate the triangle inequality "
-                         "J1 + J2 >= J3 that every mass distribution satisfies")
 
 
 @lru_cache(maxsize=None)

@@ -17,7 +17,8 @@ from pathlib import Path
 
 import numpy as np
 
-from mbjax.model.model import Model, check_inertia
+from mbjax.model.model import Model
+from mbjax.spatial import check_inertia
 
 _KINDS = {"revolute": "revolute", "continuous": "revolute", "prismatic": "prismatic",
           "floating": "free", "fixed": None}

@@ -19,25 +19,9 @@ from jax import Array
 
 from mbjax import lie
 from mbjax.integrate.system import AbstractSystem
+from mbjax.spatial import check_inertia
 
 ROTATIONS = ("quaternion", "rotvec")
-
-
-def _check_inertia(inertia) -> None:
-    """Concrete validation: symmetric, positive-definite, triangle inequality."""
-    if isinstance(inertia, jax.core.Tracer):
-        return
-    J = np.asarray(inertia)
-    if J.shape != (3, 3):
-        raise ValueError(f"inertia must be a 3x3 matrix, got shape {J.shape}")
-    if not np.allclose(J, J.T, rtol=1e-12, atol=1e-12 * np.abs(J).max()):
-        raise ValueError(f"inertia must be symmetric, got\n{J}")
-    moments = np.linalg.eigvalsh(J)
-    if not moments[0] > 0:
-        raise ValueError(f"inertia must be positive-definite; principal moments {moments}")
-    if moments[0] + moments[1] < moments[2] * (1 - 1e-12):
-        raise ValueError(f"principal moments {moments} violate the triangle inequality "
-                         "J1 + J2 >= J3 that every mass distribution satisfies")
 
 
 class RigidBody(AbstractSystem):
@@ -59,7 +43,7 @@ class RigidBody(AbstractSystem):
                  fixed_point: bool = False, rotation: str = "quaternion"):
         if rotation not in ROTATIONS:
             raise ValueError(f"rotation must be one of {ROTATIONS}, got {rotation!r}")
-        _check_inertia(inertia)
+        check_inertia(inertia, "RigidBody")
         if not isinstance(mass, jax.core.Tracer) and not float(mass) > 0:
             raise ValueError(f"mass must be positive, got {mass}")
         if not fixed_point and not isinstance(com, jax.core.Tracer) and np.any(np.asarray(com)):

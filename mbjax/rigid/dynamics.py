@@ -3,8 +3,8 @@
 `forward_dynamics(..., method=...)` runs either seed 002's O(n) recursion ("recursive") or seed
 001's transformation operator with a Cholesky solve ("dense", O(n^3)); "auto" picks the cheaper
 for the model's size from the crossover measured by `mbjax bench rigid` (below it the dense form's
-few array operations match the recursion's n sequential steps; above it O(n) wins, by 68x at
-n = 300).
+few array operations match the recursion's n sequential steps; above it O(n) wins, by 70x at
+n = 300 in a loop).
 """
 
 from jax import Array
@@ -17,11 +17,12 @@ from mbjax.rigid.rnea import inverse_dynamics as _rnea
 
 METHODS = ("auto", "recursive", "dense")
 
-# Degrees of freedom from which method="auto" runs the recursion: the summary's
-# "crossover_nv_auto" of `mbjax bench rigid` (float64, 2-core x86_64 CPU; benchmarks/README.md),
-# the first chain size from which the recursion is faster in a jitted loop (10) or at every batch
-# size of jit(vmap(...)) (7). Below it the two forms are within 1.5x of each other in a loop.
-CROSSOVER_NV = 7
+# Degrees of freedom from which method="auto" runs the recursion: the "crossover_nv_auto" of
+# `mbjax bench rigid` (benchmarks/README.md; float64, 2-core x86_64 CPU), the first chain size
+# from which the recursion is never more than 1.5x slower than the dense form in a jitted loop
+# and faster at every batch size of jit(vmap(...)). Below it the two are within noise of each
+# other (a few microseconds); from 15 on the recursion wins everywhere, by 70x at n = 300.
+CROSSOVER_NV = 5
 
 
 def choose_method(model: Model) -> str:

@@ -5,6 +5,7 @@ frame B is stored as a 6x6 matrix; X^T maps forces back from B to A.
 """
 
 from mbjax.spatial.algebra import (
+    check_inertia,
     cross_force,
     cross_motion,
     inertia_matrix,
@@ -12,4 +13,4 @@ from mbjax.spatial.algebra import (
     skew,
 )
 
-__all__ = ["cross_force", "cross_motion", "inertia_matrix", "plucker", "skew"]
+__all__ = ["check_inertia", "cross_force", "cross_motion", "inertia_matrix", "plucker", "skew"]

@@ -5,7 +5,9 @@ velocity-product acceleration of a joint is V x (S u) and the Euler-coupling for
 V x* (I V) (seed 001 eq 6: omega x H).
 """
 
+import jax
 import jax.numpy as jnp
+import numpy as np
 from jax import Array
 
 
@@ -48,3 +50,22 @@ def inertia_matrix(mass: Array, com: Array, inertia: Array) -> Array:
     eye = jnp.broadcast_to(jnp.eye(3, dtype=C.dtype), C.shape)
     return jnp.concatenate([jnp.concatenate([inertia - m * C @ C, m * C], -1),
                             jnp.concatenate([-m * C, m * eye], -1)], -2)
+
+
+def check_inertia(inertia, name: str = "body") -> None:
+    """Concrete validation of a 3x3 inertia: symmetric, positive-definite, triangle inequality."""
+    if isinstance(inertia, jax.core.Tracer):
+        return
+    J = np.asarray(inertia, dtype=float)
+    if J.shape != (3, 3):
+        raise ValueError(f"{name}: inertia must be a 3x3 matrix, got shape {J.shape}")
+    if not np.all(np.isfinite(J)):
+        raise ValueError(f"{name}: inertia has non-finite entries\n{J}")
+    if not np.allclose(J, J.T, rtol=1e-12, atol=1e-12 * np.abs(J).max()):
+        raise ValueError(f"{name}: inertia must be symmetric, got\n{J}")
+    moments = np.linalg.eigvalsh(J)
+    if not moments[0] > 0:
+        raise ValueError(f"{name}: inertia must be positive-definite; principal moments {moments}")
+    if moments[0] + moments[1] < moments[2] * (1 - 1e-9):
+        raise ValueError(f"{name}: principal moments {moments} violate the triangle inequality "
+                         "J1 + J2 >= J3 that every mass distribution satisfies")
