@@ -27,8 +27,9 @@ One run measures, for regular n-link revolute chains (`mbjax.model.chain(n)`, fl
 
 Every forward-dynamics record carries the largest difference of its accelerations from
 Pinocchio's (MuJoCo's where Pinocchio is skipped), relative to the largest acceleration.
-JSON lines + PNG; the last record (kind "summary") holds both crossovers, the fitted slope of
-log t against log n (looped, where the overhead does not hide it) and the targets met or missed.
+JSON lines + PNG; the last record (kind "summary") holds the crossovers (per call, in a loop, at
+every batch size, and the one for method="auto"), the fitted slope of log t against log n (looped,
+where the overhead does not hide it) and the targets met or missed.
 """
 
 import os
