@@ -1,0 +1,104 @@
+"""Lagrange time elements and Gauss-Legendre quadrature (seed 000 §5).
+
+An n-node element spans [t_1, t_1 + (n - 1) dt] with its nodes dt apart (dt is "the time between
+nodes" of Tables 1-2). On the unit parameter tau = (t - t_1) / ((n - 1) dt) in [0, 1] the shape
+functions are the Lagrange polynomials through equally spaced nodes, s_k(tau_j) = delta_kj
+(eqs 5.1-5.2); the weak forms are integrated by Gauss-Legendre quadrature with n points ("exact",
+which integrates the element's mass-like products s_dot s_dot exactly) or n - 1 points
+("reduced": one point fewer, the single Gauss point of §7 for the two-node element).
+
+Everything here is static numpy, evaluated once per element type: residuals trace only the
+resulting constant tables.
+"""
+
+from dataclasses import dataclass
+from functools import cached_property
+
+import numpy as np
+
+QUADRATURES = ("exact", "reduced")
+
+
+def gauss_legendre(points: int) -> tuple[np.ndarray, np.ndarray]:
+    """Gauss-Legendre abscissae on [0, 1] and weights summing to 1; exact for polynomials of
+    degree 2 points - 1."""
+    if not (isinstance(points, int | np.integer) and points >= 1):
+        raise ValueError(f"a Gauss rule needs at least one point, got {points!r}")
+    x, w = np.polynomial.legendre.leggauss(int(points))
+    return (x + 1.0) / 2.0, w / 2.0
+
+
+def lagrange(nodes: np.ndarray, tau) -> tuple[np.ndarray, np.ndarray]:
+    """Values s_k(tau) and derivatives ds_k/dtau, each (len(tau), len(nodes)), of the Lagrange
+    polynomials through `nodes` (s_k(nodes_j) = delta_kj)."""
+    nodes = np.asarray(nodes, dtype=float)
+    tau = np.atleast_1d(np.asarray(tau, dtype=float))
+    n = len(nodes)
+    if len(np.unique(nodes)) != n:
+        raise ValueError(f"Lagrange nodes must be distinct, got {nodes}")
+    values = np.ones((len(tau), n))
+    derivatives = np.zeros((len(tau), n))
+    for k in range(n):                       # static tables: a loop over the few nodes is fine
+        others = np.delete(nodes, k)
+        denominator = np.prod(nodes[k] - others)
+        factors = tau[:, None] - others[None, :]                  # (P, n - 1)
+        values[:, k] = np.prod(factors, axis=1) / denominator
+        for m in range(n - 1):               # product rule: drop one factor at a time
+            derivatives[:, k] += np.prod(np.delete(factors, m, axis=1), axis=1) / denominator
+    return values, derivatives
+
+
+@dataclass(frozen=True)
+class Element:
+    """An n-node time element with its quadrature rule (hashable: a static argument).
+
+    Tables on the unit parameter tau in [0, 1]: `s` and `ds` (points, nodes) are the shape
+    functions and their tau-derivatives at the Gauss points `tau` with weights `weights`; with
+    element length h = (nodes - 1) dt, ds/dt = ds / h and the integral over the element of f is
+    h sum_g weights_g f(tau_g).
+    """
+
+    nodes: int = 2
+    quadrature: str = "exact"
+
+    def __post_init__(self):
+        if not (isinstance(self.nodes, int) and self.nodes >= 2):
+            raise ValueError(f"a time element needs at least 2 nodes, got {self.nodes!r}")
+        if self.quadrature not in QUADRATURES:
+            raise ValueError(f"quadrature must be one of {QUADRATURES}, got {self.quadrature!r}")
+
+    @property
+    def points(self) -> int:
+        return self.nodes if self.quadrature == "exact" else self.nodes - 1
+
+    @cached_property
+    def node_tau(self) -> np.ndarray:
+        return np.linspace(0.0, 1.0, self.nodes)
+
+    @cached_property
+    def _rule(self) -> tuple[np.ndarray, np.ndarray]:
+        return gauss_legendre(self.points)
+
+    @property
+    def tau(self) -> np.ndarray:
+        return self._rule[0]
+
+    @property
+    def weights(self) -> np.ndarray:
+        return self._rule[1]
+
+    @cached_property
+    def _tables(self) -> tuple[np.ndarray, np.ndarray]:
+        return lagrange(self.node_tau, self.tau)
+
+    @property
+    def s(self) -> np.ndarray:
+        return self._tables[0]
+
+    @property
+    def ds(self) -> np.ndarray:
+        return self._tables[1]
+
+    def length(self, dt: float) -> float:
+        """The element's time span for node spacing dt."""
+        return (self.nodes - 1) * dt
