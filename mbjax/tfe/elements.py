@@ -76,28 +76,20 @@ class Element:
         return np.linspace(0.0, 1.0, self.nodes)
 
     @cached_property
-    def _rule(self) -> tuple[np.ndarray, np.ndarray]:
-        return gauss_legendre(self.points)
-
-    @property
     def tau(self) -> np.ndarray:
-        return self._rule[0]
-
-    @property
-    def weights(self) -> np.ndarray:
-        return self._rule[1]
+        return gauss_legendre(self.points)[0]
 
     @cached_property
-    def _tables(self) -> tuple[np.ndarray, np.ndarray]:
-        return lagrange(self.node_tau, self.tau)
+    def weights(self) -> np.ndarray:
+        return gauss_legendre(self.points)[1]
 
-    @property
+    @cached_property
     def s(self) -> np.ndarray:
-        return self._tables[0]
+        return lagrange(self.node_tau, self.tau)[0]
 
-    @property
+    @cached_property
     def ds(self) -> np.ndarray:
-        return self._tables[1]
+        return lagrange(self.node_tau, self.tau)[1]
 
     def length(self, dt: float) -> float:
         """The element's time span for node spacing dt."""
