@@ -16,6 +16,15 @@ class Status(enum.IntFlag):
     SOLVER_FAILED = 4      # the adaptive reference solver stopped (step-size underflow, max_steps)
 
 
+def status_messages(status) -> list[str]:
+    """Human-readable `Status` flags for each entry of a (possibly batched) status array."""
+    out = []
+    for code in np.atleast_1d(np.asarray(status)).ravel():
+        flags = [f.name.lower().replace("_", " ") for f in Status if f and Status(int(code)) & f]
+        out.append(", ".join(flags) if flags else "success")
+    return out
+
+
 class Solution(eqx.Module):
     """States saved at times `ts`: `qs[i]`, `us[i]` are q(ts[i]), u(ts[i]).
 
@@ -34,9 +43,4 @@ class Solution(eqx.Module):
 
     def messages(self) -> list[str]:
         """Human-readable status for each (possibly batched) run; needs concrete values."""
-        out = []
-        for code in np.atleast_1d(np.asarray(self.status)).ravel():
-            flags = [f.name.lower().replace("_", " ") for f in Status
-                     if f and Status(int(code)) & f]
-            out.append(", ".join(flags) if flags else "success")
-        return out
+        return status_messages(self.status)

@@ -1,6 +1,26 @@
-"""Time finite elements for rigid-body dynamics (seed 000): elements and quadrature so far; the
-weak forms, Newton per element and the transition matrices are issue 4's remaining work."""
+"""Time finite elements for rigid-body dynamics (seed 000).
 
+Elements and quadrature (`Element`), the body and its reference motion (`Body`, `Reference`),
+the weak forms as residuals (`PrimalUnsymmetric`, `PrimalSymmetric`, `Mixed`, `MixedUnsymmetric`, `ThreeField`),
+Newton per element with implicit-function-theorem gradients (`newton`), time marching
+(`solve_tfe`), and linearized stability by transition matrices (`mbjax.tfe.stability`).
+"""
+
+from mbjax.tfe.body import Body
 from mbjax.tfe.elements import QUADRATURES, Element, gauss_legendre, lagrange
+from mbjax.tfe.form import AbstractForm
+from mbjax.tfe.mixed import Mixed, MixedUnsymmetric
+from mbjax.tfe.newton import NewtonInfo, newton
+from mbjax.tfe.primal import PrimalSymmetric, PrimalUnsymmetric
+from mbjax.tfe.reference import REFERENCES, Reference, make_reference
+from mbjax.tfe.solve import State, TFESolution, element_map, initial_state, solve_tfe
+from mbjax.tfe.three_field import ThreeField
 
-__all__ = ["QUADRATURES", "Element", "gauss_legendre", "lagrange"]
+FORMS = {cls.name: cls for cls in (PrimalUnsymmetric, PrimalSymmetric, Mixed, MixedUnsymmetric, ThreeField)}
+
+__all__ = [
+    "AbstractForm", "Body", "Element", "FORMS", "Mixed", "MixedUnsymmetric", "NewtonInfo", "PrimalSymmetric",
+    "PrimalUnsymmetric", "QUADRATURES", "REFERENCES", "Reference", "State", "TFESolution",
+    "ThreeField", "element_map", "gauss_legendre", "initial_state", "lagrange",
+    "make_reference", "newton", "solve_tfe",
+]

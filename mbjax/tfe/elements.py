@@ -91,6 +91,18 @@ class Element:
     def ds(self) -> np.ndarray:
         return lagrange(self.node_tau, self.tau)[1]
 
+    @cached_property
+    def trial_tau(self) -> np.ndarray:
+        """Nodes of the mixed forms' trial space (§5.2, eq 5.7): n - 1 functions, one node at
+        the middle of each interval between the element's nodes (any basis of the polynomials
+        of degree n - 2 spans the same space)."""
+        return (np.arange(self.nodes - 1) + 0.5) / (self.nodes - 1)
+
+    @cached_property
+    def s_trial(self) -> np.ndarray:
+        """The n - 1 trial functions s_a at the Gauss points, (points, nodes - 1)."""
+        return lagrange(self.trial_tau, self.tau)[0]
+
     def length(self, dt: float) -> float:
         """The element's time span for node spacing dt."""
         return (self.nodes - 1) * dt

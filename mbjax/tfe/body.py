@@ -1,0 +1,84 @@
+"""The rigid body as the weak forms see it (seed 000 §3).
+
+Quantities are referred to a body point O' and ordered (angular; linear) as everywhere in mbjax,
+so the paper's q = (x, r), p_hat = (l, h), f_hat = (b, m) are stored here as (r, x), (h, l),
+(m, b). The generalized mass (eqs 3.8, 3.19) in space is
+
+    M6(R) = [[J, S], [S^T, M I]],   J = R J_bar R^T,  S = M (R c_bar) x I,
+
+with J_bar and c_bar the (constant, eq 3.9) second moment about O' and the centre of mass in the
+body frame. A body about a fixed point (a top: O' is the suspension point) keeps only the
+rotational coordinates; the paper's §7 "eliminating the translational degrees of freedom".
+"""
+
+import equinox as eqx
+import jax
+import jax.numpy as jnp
+import numpy as np
+from jax import Array
+
+from mbjax import lie
+from mbjax.rigid import RigidBody
+from mbjax.spatial import check_inertia
+
+
+class Body(eqx.Module):
+    """A rigid body of `mass` with `inertia` about O' and centre of mass `com` (both in the body
+    frame) under uniform `gravity`. fixed_point=True: O' does not move and q = r_* (3 dof);
+    otherwise q = (r_*, x_*) (6 dof), O' anywhere in the body."""
+
+    mass: Array
+    com: Array
+    inertia: Array
+    gravity: Array
+    fixed_point: bool = eqx.field(static=True)
+
+    def __init__(self, mass, inertia, *, com=(0.0, 0.0, 0.0), gravity=(0.0, 0.0, -9.81),
+                 fixed_point: bool = False):
+        check_inertia(inertia, "tfe.Body")
+        if not isinstance(mass, jax.core.Tracer) and not float(mass) > 0:
+            raise ValueError(f"mass must be positive, got {mass}")
+        if not isinstance(com, jax.core.Tracer) and (
+                np.shape(com) != (3,) or not np.all(np.isfinite(com))):
+            raise ValueError(f"com must be a finite 3-vector, got {com!r}")
+        self.mass = jnp.asarray(mass, dtype=float)
+        self.com = jnp.asarray(com, dtype=float)
+        self.inertia = jnp.asarray(inertia, dtype=float)
+        self.gravity = jnp.asarray(gravity, dtype=float)
+        self.fixed_point = fixed_point
+
+    @classmethod
+    def from_rigid(cls, body: RigidBody) -> "Body":
+        """The same body as an `mbjax.rigid.RigidBody` (O' = its fixed point or its centre of
+        mass)."""
+        return cls(body.mass, body.inertia, com=body.com, gravity=body.gravity,
+                   fixed_point=body.fixed_point)
+
+    @property
+    def nq(self) -> int:
+        """Number of coordinates: 3 (rotation about a fixed point) or 6."""
+        return 3 if self.fixed_point else 6
+
+    def mass_matrix(self, R: Array) -> Array:
+        """M6(R) of eqs 3.8-3.9, (nq, nq)."""
+        J = R @ self.inertia @ R.T
+        if self.fixed_point:
+            return J
+        S = self.mass * lie.hat(R @ self.com)
+        return jnp.block([[J, S], [S.T, self.mass * jnp.eye(3)]])
+
+    def momentum_to_velocity(self, R: Array, p_hat: Array) -> Array:
+        """w_hat = M6^-1 p_hat (eq 3.19), by Cholesky."""
+        return jax.scipy.linalg.cho_solve(jax.scipy.linalg.cho_factor(self.mass_matrix(R)), p_hat)
+
+    def applied(self, R: Array) -> Array:
+        """f_hat = (m, b): gravity's moment about O' and force (eq 3.16)."""
+        b = self.mass * self.gravity
+        m = jnp.cross(R @ self.com, b)
+        return m if self.fixed_point else jnp.concatenate([m, b])
+
+    def energy(self, R: Array, x: Array, p_hat: Array) -> Array:
+        """Kinetic (eq 3.25: p_hat . M6^-1 p_hat / 2) plus potential energy."""
+        centre = R @ self.com + (0.0 if self.fixed_point else x)
+        return (0.5 * p_hat @ self.momentum_to_velocity(R, p_hat)
+                - self.mass * self.gravity @ centre)

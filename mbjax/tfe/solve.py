@@ -1,0 +1,127 @@
+"""Time marching element by element: `solve_tfe` (seed 000 §5).
+
+Each element starts from the converged end state of the previous one. Its reference (§2) is built
+from that state, the incremental coordinates start at zero, Newton solves the element's equations
+(eqs 5.3 / 5.8) and the end state (R_2, x_2, p_hat_2) is carried on. Elements are a `lax.scan`,
+Newton a `lax.while_loop` differentiated by the implicit function theorem, so `jax.grad` of any
+function of the solution with respect to the initial state or the body's parameters is exact
+and cheap.
+"""
+
+from functools import partial
+
+import equinox as eqx
+import jax
+import jax.numpy as jnp
+from jax import Array
+
+from mbjax.integrate.solution import Status, status_messages
+from mbjax.tfe.body import Body
+from mbjax.tfe.elements import Element
+from mbjax.tfe.form import AbstractForm
+from mbjax.tfe.mixed import Mixed
+from mbjax.tfe.newton import NewtonInfo, newton
+from mbjax.tfe.reference import REFERENCES, Reference, configuration, make_reference
+
+
+class State(eqx.Module):
+    """The state at an element boundary: rotation R (body to space), position x of O' and the
+    spatial momentum p_hat = (h, l) about O' (h only, about a fixed point)."""
+
+    R: Array
+    x: Array
+    p_hat: Array
+
+
+def initial_state(body: Body, R0, Omega0, x0=(0.0, 0.0, 0.0), v0=(0.0, 0.0, 0.0)) -> State:
+    """State from a rotation, the body-frame angular velocity Omega0 and (free body) the velocity
+    v0 of O'. The momentum is p_hat = M6 w (eq 3.19) with w = (R0 Omega0, v0)."""
+    R0 = jnp.asarray(R0, dtype=float)
+    w = R0 @ jnp.asarray(Omega0, dtype=float)
+    if not body.fixed_point:
+        w = jnp.concatenate([w, jnp.asarray(v0, dtype=float)])
+    return State(R0, jnp.asarray(x0, dtype=float), body.mass_matrix(R0) @ w)
+
+
+class TFESolution(eqx.Module):
+    """States at the element boundaries ts (n_elements + 1), per-element Newton records and a
+    `Status`: NOT_CONVERGED where an element's Newton missed its tolerance, NONFINITE where the
+    state blew up."""
+
+    ts: Array
+    R: Array
+    x: Array
+    p_hat: Array
+    iterations: Array
+    residual: Array
+    status: Array
+
+    @property
+    def ok(self) -> Array:
+        return self.status == 0
+
+    def messages(self) -> list[str]:
+        return status_messages(self.status)
+
+    def energy(self, body: Body) -> Array:
+        """Total energy at every boundary."""
+        return jax.vmap(body.energy)(self.R, self.x, self.p_hat)
+
+    def angular_momentum(self, body: Body) -> Array:
+        """Spatial angular momentum about the origin, h + x x l (eq 3.2)."""
+        h = self.p_hat[:, :3]
+        return h if body.fixed_point else h + jnp.cross(self.x, self.p_hat[:, 3:])
+
+
+def element_map(form: AbstractForm, body: Body, ref: Reference, element: Element, dt, z1: Array,
+                *, tol=1e-10, max_iter: int = 20) -> tuple[Array, NewtonInfo]:
+    """The end state z_2 = (p_2, q_2) of one element from its start z_1 = (p_1, q_1), both in the
+    form's variables about the reference `ref`. Its Jacobian dz_2/dz_1 (jax.jacfwd, through the
+    implicit function theorem) is the element's transition matrix (eq 6.7)."""
+    U, info = newton(lambda U: form.residual(body, ref, element, dt, U, z1),
+                     form.guess(body, ref, element, z1), tol=tol, max_iter=max_iter)
+    return form.final(body, ref, element, dt, U, z1), info
+
+
+@partial(jax.jit, static_argnames=("form", "element", "n_elements", "reference", "max_iter"))
+def _march(body, state0, dt, tol, *, form, element, n_elements, reference, max_iter):
+    nq = body.nq
+    h = element.length(dt)
+
+    def step(state, _):
+        ref = make_reference(reference, body, state.R, state.x, state.p_hat)
+        q1 = jnp.zeros(nq, state.p_hat.dtype)
+        z1 = jnp.concatenate([form.to_form(body, q1, state.p_hat), q1])
+        z2, info = element_map(form, body, ref, element, dt, z1, tol=tol, max_iter=max_iter)
+        q2 = z2[nq:]
+        R2, x2 = configuration(body, ref, q2, h)
+        new = State(R2, x2, form.from_form(body, q2, z2[:nq]))
+        return new, (new, info.iterations, info.residual, info.converged)
+
+    _, (states, iterations, residual, converged) = jax.lax.scan(step, state0, length=n_elements)
+    join = lambda a, b: jnp.concatenate([a[None], b])  # noqa: E731
+    R, x, p_hat = (join(getattr(state0, k), getattr(states, k)) for k in ("R", "x", "p_hat"))
+    finite = jnp.all(jnp.isfinite(p_hat)) & jnp.all(jnp.isfinite(R))
+    status = (jnp.where(jnp.all(converged), 0, int(Status.NOT_CONVERGED))
+              | jnp.where(finite, 0, int(Status.NONFINITE)))
+    return TFESolution(jnp.arange(n_elements + 1) * h, R, x, p_hat, iterations, residual, status)
+
+
+def solve_tfe(body: Body, state0: State, *, dt, n_elements: int, form: AbstractForm = Mixed(),
+              element: Element = Element(4), reference: str = "constant_velocity", tol=1e-10,
+              max_iter: int = 20) -> TFESolution:
+    """March `n_elements` time elements of `element` (node spacing dt, so each spans
+    (nodes - 1) dt) of the weak `form` from `state0`.
+
+    Jitted once per (form, element, n_elements, reference, max_iter); dt, tol, the body and the
+    state are traced, so sweeps over them do not recompile and they can be differentiated.
+    """
+    if reference not in REFERENCES:
+        raise ValueError(f"reference must be one of {REFERENCES}, got {reference!r}")
+    if not (isinstance(n_elements, int) and n_elements >= 1):
+        raise ValueError(f"n_elements must be a positive int, got {n_elements!r}")
+    if not isinstance(element, Element):
+        raise TypeError(f"element must be a tfe.Element, got {type(element).__name__}")
+    dt = jnp.asarray(dt, dtype=float)
+    return _march(body, state0, dt, jnp.asarray(tol, dtype=float), form=form, element=element,
+                  n_elements=n_elements, reference=reference, max_iter=max_iter)
