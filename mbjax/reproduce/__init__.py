@@ -3,11 +3,13 @@
 Each entry is reproduce(out: Path, quick: bool) -> dict (the JSON written).
 """
 
-from mbjax.reproduce import integrators, tree_scaling
+from mbjax.reproduce import integrators, torque_free_tfe, tree_scaling, vertical_top
 
 REPRODUCTIONS = {
     integrators.NAME: integrators.reproduce,
     tree_scaling.NAME: tree_scaling.reproduce,
+    vertical_top.NAME: vertical_top.reproduce,
+    torque_free_tfe.NAME: torque_free_tfe.reproduce,
 }
 
 __all__ = ["REPRODUCTIONS"]

@@ -30,9 +30,15 @@ def exact_rotation(t):
     return torque_free_motion(J_AXIAL, J_TRANSVERSE, jnp.eye(3), jnp.array(OMEGA0), t)[0]
 
 
+def rotation_error_matrix(R, t):
+    """Angle in radians between a computed rotation R and the exact one (seed 000 Fig. 1's
+    error)."""
+    return jnp.linalg.norm(lie.log(R @ exact_rotation(t).T))
+
+
 def rotation_error(body: RigidBody, q, t):
-    """Angle in radians between the computed and the exact rotation (seed 000 Fig. 1's error)."""
-    return jnp.linalg.norm(lie.log(body.rotation_matrix(q) @ exact_rotation(t).T))
+    """`rotation_error_matrix` of a state q of `body`."""
+    return rotation_error_matrix(body.rotation_matrix(q), t)
 
 
 def rotation_errors(body: RigidBody, qs, ts):

@@ -44,12 +44,13 @@ def newton(F, x0: Array, *, tol, max_iter: int) -> tuple[Array, NewtonInfo]:
         history = jnp.full(max_iter + 1, jnp.nan, x_init.dtype)
         x, k, step, history = jax.lax.while_loop(
             cond, body, (x_init, jnp.array(0), jnp.array(jnp.inf, x_init.dtype), history))
-        return x, (k, step, history)
+        return x, (k.astype(x.dtype), step, history)  # float aux: custom_root needs float tangents
 
     def tangent_solve(g, y):
         return jnp.linalg.solve(jax.jacfwd(g)(y), y)
 
     x, (k, step, history) = jax.lax.custom_root(F, x0, solve, tangent_solve, has_aux=True)
+    k = k.astype(int)
     x_stop = jax.lax.stop_gradient(x)
     residual = jnp.linalg.norm(F(x_stop))
     history = history.at[k].set(residual)
