@@ -15,6 +15,7 @@ from mbjax.tfe.primal import PrimalSymmetric, PrimalUnsymmetric
 from mbjax.tfe.reference import REFERENCES, Reference, make_reference
 from mbjax.tfe.solve import State, TFESolution, element_map, initial_state, solve_tfe
 from mbjax.tfe.three_field import ThreeField
+from mbjax.tfe import stability, tangents
 
 FORMS = {cls.name: cls for cls in (PrimalUnsymmetric, PrimalSymmetric, Mixed, MixedUnsymmetric, ThreeField)}
 
