@@ -3,13 +3,14 @@
 Each entry is reproduce(out: Path, quick: bool) -> dict (the JSON written).
 """
 
-from mbjax.reproduce import integrators, torque_free_tfe, tree_scaling, vertical_top
+from mbjax.reproduce import integrators, top_long_run, torque_free_tfe, tree_scaling, vertical_top
 
 REPRODUCTIONS = {
     integrators.NAME: integrators.reproduce,
     tree_scaling.NAME: tree_scaling.reproduce,
     vertical_top.NAME: vertical_top.reproduce,
     torque_free_tfe.NAME: torque_free_tfe.reproduce,
+    top_long_run.NAME: top_long_run.reproduce,
 }
 
 __all__ = ["REPRODUCTIONS"]

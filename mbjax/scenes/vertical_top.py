@@ -10,6 +10,7 @@ J_t = 1, J_a = 0.4 and m g d = 25/9 here.
 
 import jax.numpy as jnp
 
+from mbjax.rigid import RigidBody
 from mbjax.tfe import Body
 
 GRAVITY = 9.81
@@ -21,10 +22,16 @@ D = OMEGA**2 * J_TRANSVERSE / (MASS * GRAVITY)   # suspension point to centre of
 CRITICAL_SPIN = 2.0 * J_TRANSVERSE * OMEGA / J_AXIAL
 
 
+def rigid_body(rotation: str = "quaternion") -> RigidBody:
+    """The top as a `RigidBody` about its suspension point, centre of mass d above it."""
+    return RigidBody(MASS, jnp.diag(jnp.array([J_TRANSVERSE, J_TRANSVERSE, J_AXIAL])),
+                     com=(0.0, 0.0, D), gravity=(0.0, 0.0, -GRAVITY), fixed_point=True,
+                     rotation=rotation)
+
+
 def build() -> Body:
-    """The top as a `tfe.Body` about its suspension point, centre of mass d above it."""
-    return Body(MASS, jnp.diag(jnp.array([J_TRANSVERSE, J_TRANSVERSE, J_AXIAL])),
-                com=(0.0, 0.0, D), gravity=(0.0, 0.0, -GRAVITY), fixed_point=True)
+    """The top as a `tfe.Body`."""
+    return Body.from_rigid(rigid_body())
 
 
 def exact_boundaries(dt):

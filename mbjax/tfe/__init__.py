@@ -23,5 +23,5 @@ __all__ = [
     "AbstractForm", "Body", "Element", "FORMS", "Mixed", "MixedUnsymmetric", "NewtonInfo", "PrimalSymmetric",
     "PrimalUnsymmetric", "QUADRATURES", "REFERENCES", "Reference", "State", "TFESolution",
     "ThreeField", "element_map", "gauss_legendre", "initial_state", "lagrange",
-    "make_reference", "newton", "solve_tfe",
+    "make_reference", "newton", "solve_tfe", "stability", "tangents",
 ]

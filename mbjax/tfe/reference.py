@@ -3,8 +3,11 @@
 Over an element starting at t_1 the motion is written about a prescribed reference (x_o(t),
 R_o(t)) as x = x_o + x_* and R = R_* R_o with R_* = exp(r_* x I); the unknowns are the incremental
 coordinates q = (r_*, x_*), zero at t_1 when the reference starts from the initial state.
-Two references (§2): "constant" (held at the initial configuration) and "constant_velocity"
-(moving with the initial linear and angular velocity, R_o = exp((t - t_1) omega_o x I) R_1).
+Two references (§2) are built afresh for every element from its initial state: "constant" (held
+at the initial configuration) and "constant_velocity" (moving with the initial linear and angular
+velocity, R_o = exp((t - t_1) omega_o x I) R_1). A march can instead follow one prescribed
+`Reference` throughout, the steady rotation of eq 7.1 say; the incremental coordinates then carry
+over from element to element, as in the linearized analysis of §6 (eq 6.7).
 """
 
 import equinox as eqx
@@ -30,6 +33,11 @@ class Reference(eqx.Module):
         """(R_o(t), x_o(t))."""
         return lie.exp(t * self.omega) @ self.R1, self.x1 + t * self.v
 
+    def shifted(self, t) -> "Reference":
+        """The same motion, its time counted from t."""
+        R, x = self.at(t)
+        return Reference(R, x, self.omega, self.v)
+
 
 def make_reference(kind: str, body: Body, R1: Array, x1: Array, p_hat1: Array) -> Reference:
     """The reference of an element whose initial state is (R1, x1, p_hat1)."""
@@ -47,6 +55,13 @@ def configuration(body: Body, ref: Reference, q: Array, t) -> tuple[Array, Array
     R_o, x_o = ref.at(t)
     R = lie.exp(q[:3]) @ R_o
     return R, (x_o if body.fixed_point else x_o + q[3:])
+
+
+def increment(body: Body, ref: Reference, R: Array, x: Array) -> Array:
+    """The incremental coordinates q = (r_*, x_*) of (R, x) at the reference's start, the inverse
+    of `configuration` at t = 0 (principal rotation vector, |r_*| <= pi)."""
+    r = lie.log(R @ ref.R1.T)
+    return r if body.fixed_point else jnp.concatenate([r, x - ref.x1])
 
 
 def X_matrix(body: Body, q: Array) -> Array:

@@ -1,7 +1,8 @@
 """Time marching element by element: `solve_tfe` (seed 000 §5).
 
 Each element starts from the converged end state of the previous one. Its reference (§2) is built
-from that state, the incremental coordinates start at zero, Newton solves the element's equations
+from that state and the incremental coordinates start at zero; or one prescribed reference motion
+is followed throughout and the increments carry over (§6-7). Newton solves the element's equations
 (eqs 5.3 / 5.8) and the end state (R_2, x_2, p_hat_2) is carried on. Elements are a `lax.scan`,
 Newton a `lax.while_loop` differentiated by the implicit function theorem, so `jax.grad` of any
 function of the solution with respect to the initial state or the body's parameters is exact
@@ -21,7 +22,7 @@ from mbjax.tfe.elements import Element
 from mbjax.tfe.form import AbstractForm
 from mbjax.tfe.mixed import Mixed
 from mbjax.tfe.newton import NewtonInfo, newton
-from mbjax.tfe.reference import REFERENCES, Reference, configuration, make_reference
+from mbjax.tfe.reference import REFERENCES, Reference, configuration, increment, make_reference
 
 
 class State(eqx.Module):
@@ -84,13 +85,17 @@ def element_map(form: AbstractForm, body: Body, ref: Reference, element: Element
 
 
 @partial(jax.jit, static_argnames=("form", "element", "n_elements", "reference", "max_iter"))
-def _march(body, state0, dt, tol, *, form, element, n_elements, reference, max_iter):
+def _march(body, state0, dt, tol, prescribed, *, form, element, n_elements, reference, max_iter):
     nq = body.nq
     h = element.length(dt)
 
-    def step(state, _):
-        ref = make_reference(reference, body, state.R, state.x, state.p_hat)
-        q1 = jnp.zeros(nq, state.p_hat.dtype)
+    def step(state, k):
+        if prescribed is None:
+            ref = make_reference(reference, body, state.R, state.x, state.p_hat)
+            q1 = jnp.zeros(nq, state.p_hat.dtype)
+        else:
+            ref = prescribed.shifted(k * h)
+            q1 = increment(body, ref, state.R, state.x)
         z1 = jnp.concatenate([form.to_form(body, q1, state.p_hat), q1])
         z2, info = element_map(form, body, ref, element, dt, z1, tol=tol, max_iter=max_iter)
         q2 = z2[nq:]
@@ -98,7 +103,7 @@ def _march(body, state0, dt, tol, *, form, element, n_elements, reference, max_i
         new = State(R2, x2, form.from_form(body, q2, z2[:nq]))
         return new, (new, info.iterations, info.residual, info.converged)
 
-    _, (states, iterations, residual, converged) = jax.lax.scan(step, state0, length=n_elements)
+    _, (states, iterations, residual, converged) = jax.lax.scan(step, state0, jnp.arange(n_elements))
     join = lambda a, b: jnp.concatenate([a[None], b])  # noqa: E731
     R, x, p_hat = (join(getattr(state0, k), getattr(states, k)) for k in ("R", "x", "p_hat"))
     finite = jnp.all(jnp.isfinite(p_hat)) & jnp.all(jnp.isfinite(R))
@@ -108,20 +113,28 @@ def _march(body, state0, dt, tol, *, form, element, n_elements, reference, max_i
 
 
 def solve_tfe(body: Body, state0: State, *, dt, n_elements: int, form: AbstractForm = Mixed(),
-              element: Element = Element(4), reference: str = "constant_velocity", tol=1e-10,
-              max_iter: int = 20) -> TFESolution:
+              element: Element = Element(4), reference: str | Reference = "constant_velocity",
+              tol=1e-10, max_iter: int = 20) -> TFESolution:
     """March `n_elements` time elements of `element` (node spacing dt, so each spans
     (nodes - 1) dt) of the weak `form` from `state0`.
+
+    `reference` is one of `REFERENCES`, built afresh for each element from its initial state, or
+    a `Reference` motion (from t = 0) followed by the whole march: the increments then carry over
+    between elements, as in the linearized analysis of §6-7, and must stay below pi in rotation.
 
     Jitted once per (form, element, n_elements, reference, max_iter); dt, tol, the body and the
     state are traced, so sweeps over them do not recompile and they can be differentiated.
     """
-    if reference not in REFERENCES:
-        raise ValueError(f"reference must be one of {REFERENCES}, got {reference!r}")
+    prescribed = reference if isinstance(reference, Reference) else None
+    if prescribed is not None:
+        reference = "prescribed"
+    elif reference not in REFERENCES:
+        raise ValueError(f"reference must be one of {REFERENCES} or a tfe.Reference, "
+                         f"got {reference!r}")
     if not (isinstance(n_elements, int) and n_elements >= 1):
         raise ValueError(f"n_elements must be a positive int, got {n_elements!r}")
     if not isinstance(element, Element):
         raise TypeError(f"element must be a tfe.Element, got {type(element).__name__}")
     dt = jnp.asarray(dt, dtype=float)
-    return _march(body, state0, dt, jnp.asarray(tol, dtype=float), form=form, element=element,
+    return _march(body, state0, dt, jnp.asarray(tol, dtype=float), prescribed, form=form, element=element,
                   n_elements=n_elements, reference=reference, max_iter=max_iter)
