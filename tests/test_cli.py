@@ -69,7 +69,7 @@ def test_reproduce_tree_scaling(tmp_path):
 def test_tour_quick(tmp_path):
     assert main(["tour", "--quick", "--out", str(tmp_path)]) == 0
     summary = json.loads((tmp_path / "summary.json").read_text())
-    assert set(summary["scenes"]) == {"torque-free-body", "heavy-top", "rigid-chain"}
+    assert set(summary["scenes"]) == {"torque-free-body", "heavy-top", "rigid-chain", "time-elements"}
     for scene in summary["scenes"].values():
         assert (tmp_path / scene["figure"]).stat().st_size > 10_000
     markdown = (tmp_path / "summary.md").read_text()
@@ -82,6 +82,14 @@ def test_tour_quick(tmp_path):
     assert all(row["status"] == "success" for row in rows.values())
     # RK4 at 5 ms follows the Dopri8 reference of the falling chain to micro-radians
     assert rows["rk4 dt=5 ms"]["error_rad"] < 1e-5 and rows["rk4 dt=5 ms"]["energy_error"] < 1e-5
+    # time elements on the sleeping top: the primal form's tilt grows at its transition matrix's
+    # rate, the mixed form's stays with the physical one
+    tfe = summary["scenes"]["time-elements"]
+    primal, mixed = tfe["runs"]["primal"], tfe["runs"]["mixed"]
+    assert primal["predicted_growth"] > 0.2
+    assert abs(primal["measured_growth"] / primal["predicted_growth"] - 1) < 0.1
+    assert abs(mixed["predicted_growth"]) < 1e-9 and abs(mixed["measured_growth"]) < 0.02
+    assert mixed["max_tilt"] < 1.1 * tfe["physical_max_tilt"] and primal["max_tilt"] > 10 * mixed["max_tilt"]
 
 
 def test_bench_integrators_quick(tmp_path):
@@ -112,3 +120,83 @@ def test_bench_rigid_quick(tmp_path):
     if peers.available("pinocchio"):
         assert any(r["engine"] == "pinocchio" and "per_state_s" in r for r in records)
     assert (tmp_path / "rigid.png").stat().st_size > 10_000
+
+
+def test_reproduce_vertical_top(tmp_path):
+    """Seed 000 Tables 1-2 (the quick run's rows) to the issue's tolerances, and eq 7.10."""
+    assert main(["reproduce", "vertical-top", "--quick", "--out", str(tmp_path)]) == 0
+    data = json.loads((tmp_path / "vertical-top.json").read_text())
+    assert set(data) >= {"exact", "reduced", "stability_boundary"}
+    for quadrature in ("exact", "reduced"):
+        assert set(data[quadrature]) == {"2", "3", "4"}
+        for nodes, rows in data[quadrature].items():
+            paper = {row["dt"]: row for row in data["paper"][quadrature][nodes]}
+            assert len(rows) >= 3
+            for row in rows:
+                assert set(row) == {"dt", "re", "im"}
+                printed = paper[row["dt"]]
+                assert abs(row["im"] - printed["im"]) < 2e-4
+                if printed["re"] > 1e-4:
+                    assert abs(row["re"] / printed["re"] - 1) < 0.01, (quadrature, nodes, row)
+                else:
+                    assert abs(row["re"]) < 1e-4
+    b = data["stability_boundary"]
+    assert set(b) >= {"omega", "dt", "exact", "reduced", "physical"}
+    assert abs(b["omega"] - 5 / 3) < 1e-12
+    closed = [b["physical"] * math.sqrt(1 + (b["omega"] * dt) ** 2 / 12) for dt in b["dt"]]
+    for found, expected in zip(b["exact"], closed, strict=True):
+        assert abs(found / expected - 1) < 1e-8
+    assert all(abs(found / b["physical"] - 1) < 1e-8 for found in b["reduced"] + b["mixed"])
+    assert (tmp_path / "vertical-top.png").stat().st_size > 10_000
+
+
+def test_reproduce_torque_free_tfe(tmp_path):
+    """Seed 000 Fig. 1 over the quick run's 2 s: the issue's keys, every case converged, errors
+    well below 0.2 rad, and the mixed 4-node element ahead of the primal one at every spacing."""
+    assert main(["reproduce", "torque-free-tfe", "--quick", "--out", str(tmp_path)]) == 0
+    data = json.loads((tmp_path / "torque-free-tfe.json").read_text())
+    cases = {(c["form"], c["nodes"], c["spacing"]): c for c in data["cases"]}
+    assert {(n, s) for _, n, s in cases} == {(2, 0.015), (3, 0.015), (4, 0.015), (4, 0.03), (4, 0.045)}
+    for case in cases.values():
+        assert set(case) >= {"form", "nodes", "spacing", "t", "error", "max_error", "seconds"}
+        assert case["status"] == "success" and case["seconds"] > 0
+        assert len(case["t"]) == len(case["error"]) and case["max_error"] == max(case["error"])
+        assert case["max_error"] < 0.2
+    for spacing in (0.015, 0.03, 0.045):
+        assert cases[("mixed", 4, spacing)]["max_error"] < cases[("primal", 4, spacing)]["max_error"]
+    assert (tmp_path / "torque-free-tfe.png").stat().st_size > 10_000
+
+
+@pytest.mark.slow
+def test_reproduce_top_long_run(tmp_path):
+    """Every run's measured growth matches its one-element map; the mixed form about the steady
+    rotation conserves energy and vertical angular momentum."""
+    assert main(["reproduce", "top-long-run", "--quick", "--out", str(tmp_path)]) == 0
+    data = json.loads((tmp_path / "top-long-run.json").read_text())
+    runs = {(r["form"], r["march"]): r for r in data["runs"]}
+    assert len(runs) == 6 and all(r["status"] == "success" for r in runs.values())
+    for r in runs.values():
+        if r["predicted_growth"] > 0.05:
+            assert abs(r["measured_growth"] / r["predicted_growth"] - 1) < 0.1, r["form"]
+        else:
+            assert abs(r["measured_growth"]) < 0.02
+    mixed = runs[("mixed", "steady")]
+    assert max(map(abs, mixed["energy_error"])) < 1e-12 and max(map(abs, mixed["momentum_error"])) < 1e-12
+    assert runs[("primal", "steady")]["max_tilt"] > 100 * data["tilt0"]
+
+
+@pytest.mark.slow
+def test_bench_tfe_quick(tmp_path):
+    """Every method ran and converged; the 4-node elements beat the 2-node ones in accuracy."""
+    assert main(["bench", "tfe", "--quick", "--out", str(tmp_path)]) == 0
+    records = [json.loads(line) for line in (tmp_path / "tfe.jsonl").read_text().split("\n") if line]
+    assert {r["scene"] for r in records} == {"torque-free body", "heavy top"}
+    assert all(r["status"] == "success" and r["run_s"] > 0 for r in records)
+    for scene in ("torque-free body", "heavy top"):
+        best = {}
+        for r in records:
+            if r["scene"] == scene and r["family"] == "tfe":
+                key = (r["form"], r["nodes"])
+                best[key] = min(best.get(key, math.inf), r["error"])
+        assert all(best[(form, 4)] < best[(form, 2)] / 100 for form in ("primal", "mixed"))
+    assert (tmp_path / "tfe.png").stat().st_size > 10_000

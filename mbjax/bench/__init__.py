@@ -4,11 +4,12 @@ Each suite is run(out: Path, quick: bool) -> list of records, written as out/SUI
 out/SUITE.png. Peers (MuJoCo, Pinocchio, exudyn) are measured in the same process when installed.
 """
 
-from mbjax.bench import integrators, rigid
+from mbjax.bench import integrators, rigid, tfe
 
 SUITES = {
     integrators.NAME: integrators.run,
     rigid.NAME: rigid.run,
+    tfe.NAME: tfe.run,
 }
 
 __all__ = ["SUITES"]

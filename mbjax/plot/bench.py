@@ -36,3 +36,33 @@ def integrators_bench_figure(records: list[dict]) -> Figure:
         ax.grid(True, which="both", alpha=0.3)
         ax.legend(fontsize=7)
     return fig
+
+
+TFE_COLORS = {"2": "#8c564b", "3": "#e377c2", "4": "#17becf"}
+TFE_STYLES = {"primal": "-", "mixed": "--"}
+
+
+def tfe_bench_figure(records: list[dict]) -> Figure:
+    """Rotation error at the end against run time, one panel per scene: time elements (primal
+    solid, mixed dashed, one colour per node count) and the step-by-step integrators."""
+    scenes = list(dict.fromkeys(r["scene"] for r in records))
+    fig = Figure(figsize=(6.5 * len(scenes), 5), layout="constrained")
+    for ax, scene in zip(np.atleast_1d(fig.subplots(1, len(scenes))), scenes):
+        rows = [r for r in records if r["scene"] == scene]
+        for method in dict.fromkeys(r["method"] for r in rows):
+            line = [r for r in rows if r["method"] == method]
+            err = np.array([r["error"] for r in line])
+            ok = np.isfinite(err) & (err < 3.0)
+            first = line[0]
+            if first["family"] == "tfe":
+                kw = dict(color=TFE_COLORS[str(first["nodes"])], ls=TFE_STYLES[first["form"]],
+                          marker="o" if first["form"] == "primal" else "s", mfc="none")
+            else:
+                kw = dict(color=COLORS[method], marker=MARKERS[method], ls=":")
+            ax.loglog(np.array([r["run_s"] for r in line])[ok], err[ok], label=method, **kw)
+        ax.set(xlabel=f"run time for {rows[0]['duration']:g} s [s]",
+               ylabel="rotation error at the end [rad]",
+               title=f"{scene}: speed against accuracy (failed runs omitted)")
+        ax.grid(True, which="both", alpha=0.3)
+        ax.legend(fontsize=7, ncol=2)
+    return fig

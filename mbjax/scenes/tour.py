@@ -106,8 +106,29 @@ def rigid_chain_tour(out: Path, quick: bool) -> dict:
             "reference_status": int(ref.status), "integrators": rows}
 
 
+def time_elements_tour(out: Path, quick: bool) -> dict:
+    """Seed 000's time elements on a sleeping top (`mbjax reproduce top-long-run`, shortened): the
+    primal form of eq 4.1 grows at the rate its transition matrix predicts, the mixed form of eq
+    4.9 keeps the physical tilt."""
+    from mbjax.plot.tfe import top_long_run_figure
+    from mbjax.reproduce import top_long_run as tlr
+
+    duration = 20.0 if quick else 40.0
+    runs = [tlr.run(name, form, quadrature, "steady", duration, repeats=1)
+            for name, form, quadrature in tlr.FORMS if name in ("primal", "mixed")]
+    data = {"scene": f"time elements: vertical top at {tlr.SPIN_RATIO:g} Omega_c, {tlr.NODES}-node "
+                     f"elements {tlr.DT:g} s between nodes, {duration:g} s (seed 000 §6-7)",
+            "physical": tlr.physical(duration), "runs": runs}
+    top_long_run_figure(data).savefig(out / "time-elements.png", dpi=110)
+    return {"figure": "time-elements.png", "duration": duration,
+            "runs": {r["form"]: {k: r[k] for k in ("predicted_growth", "measured_growth", "max_tilt",
+                                                   "seconds", "status")} for r in runs},
+            "physical_max_tilt": float(np.max(data["physical"]["tilt"]))}
+
+
 TOUR = {
     "torque-free-body": torque_free_body_tour,
     "heavy-top": heavy_top_tour,
     "rigid-chain": rigid_chain_tour,
+    "time-elements": time_elements_tour,
 }

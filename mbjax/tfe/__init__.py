@@ -3,7 +3,9 @@
 Elements and quadrature (`Element`), the body and its reference motion (`Body`, `Reference`),
 the weak forms as residuals (`PrimalUnsymmetric`, `PrimalSymmetric`, `Mixed`, `MixedUnsymmetric`, `ThreeField`),
 Newton per element with implicit-function-theorem gradients (`newton`), time marching
-(`solve_tfe`), and linearized stability by transition matrices (`mbjax.tfe.stability`).
+(`solve_tfe`, about references rebuilt per element or one prescribed `Reference`), linearized
+stability by transition matrices (`mbjax.tfe.stability`) and the hand tangents of the paper
+(`mbjax.tfe.tangents`) against which the autodiff ones are checked.
 """
 
 from mbjax.tfe.body import Body
