@@ -68,8 +68,19 @@ class Body(eqx.Module):
         return jnp.block([[J, S], [S.T, self.mass * jnp.eye(3)]])
 
     def momentum_to_velocity(self, R: Array, p_hat: Array) -> Array:
-        """w_hat = M6^-1 p_hat (eq 3.19), by Cholesky."""
-        return jax.scipy.linalg.cho_solve(jax.scipy.linalg.cho_factor(self.mass_matrix(R)), p_hat)
+        """w_hat = M6^-1 p_hat (eq 3.19) in closed form. About a fixed point omega = R J_bar^-1
+        R^T h; for a free body, eliminating v from l = S^T omega + M v leaves J_c omega = h -
+        S l / M with J_c = J - S S^T / M = R J_bar_c R^T, the inertia about the centre of mass
+        (J_bar_c = J_bar + M c_bar x c_bar x), then v = (l - S^T omega) / M. Only 3x3 solves with
+        constant matrices, so derivatives in R stay cheap (no factorization to differentiate)."""
+        if self.fixed_point:
+            return R @ jnp.linalg.solve(self.inertia, R.T @ p_hat)
+        h, linear = p_hat[:3], p_hat[3:]
+        c = R @ self.com
+        c_hat = lie.hat(self.com)
+        J_c = self.inertia + self.mass * c_hat @ c_hat
+        omega = R @ jnp.linalg.solve(J_c, R.T @ (h - jnp.cross(c, linear)))
+        return jnp.concatenate([omega, (linear - self.mass * jnp.cross(omega, c)) / self.mass])
 
     def applied(self, R: Array) -> Array:
         """f_hat = (m, b): gravity's moment about O' and force (eq 3.16)."""
