@@ -58,14 +58,15 @@ def _summary_markdown(summary: dict) -> str:
     lines = ["# mbjax tour" + (" (quick)" if summary["quick"] else ""), ""]
     for name, scene in summary["scenes"].items():
         lines += [f"## {name}", "", f"![{name}]({scene['figure']})", ""]
-        rows = scene.get("integrators", {})
-        if rows:
+        for table, header in (("integrators", "integrator"), ("runs", "run")):
+            rows = scene.get(table, {})
+            if not rows:
+                continue
             keys = list(next(iter(rows.values())))
-            lines += ["| integrator | " + " | ".join(keys) + " |",
-                      "|---" * (len(keys) + 1) + "|"]
-            for integrator, row in rows.items():
+            lines += [f"| {header} | " + " | ".join(keys) + " |", "|---" * (len(keys) + 1) + "|"]
+            for name, row in rows.items():
                 cells = [f"{v:.3g}" if isinstance(v, float) else str(v) for v in row.values()]
-                lines.append(f"| {integrator} | " + " | ".join(cells) + " |")
+                lines.append(f"| {name} | " + " | ".join(cells) + " |")
         lines += ["", f"wall time {scene['wall_seconds']:.1f} s", ""]
     return "\n".join(lines)
 
