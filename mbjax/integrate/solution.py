@@ -16,16 +16,25 @@ class Status(enum.IntFlag):
     SOLVER_FAILED = 4      # the adaptive reference solver stopped (step-size underflow, max_steps)
 
 
-def status_messages(status) -> list[str]:
-    """Human-readable `Status` flags for each entry of a (possibly batched) status array."""
-    out = []
-    for code in np.atleast_1d(np.asarray(status)).ravel():
-        flags = [f.name.lower().replace("_", " ") for f in Status if f and Status(int(code)) & f]
-        out.append(", ".join(flags) if flags else "success")
-    return out
+class WithStatus(eqx.Module):
+    """A result carrying an integer `status` array of `Status` flags (one per run; batched under
+    vmap)."""
+
+    @property
+    def ok(self) -> Array:
+        """True where the run succeeded."""
+        return self.status == 0
+
+    def messages(self) -> list[str]:
+        """Human-readable status for each (possibly batched) run; needs concrete values."""
+        out = []
+        for code in np.atleast_1d(np.asarray(self.status)).ravel():
+            flags = [f.name.lower().replace("_", " ") for f in Status if f and Status(int(code)) & f]
+            out.append(", ".join(flags) if flags else "success")
+        return out
 
 
-class Solution(eqx.Module):
+class Solution(WithStatus):
     """States saved at times `ts`: `qs[i]`, `us[i]` are q(ts[i]), u(ts[i]).
 
     `status` is an integer array of `Status` flags (one per solution; batched under vmap).
@@ -35,12 +44,3 @@ class Solution(eqx.Module):
     qs: Array
     us: Array
     status: Array
-
-    @property
-    def ok(self) -> Array:
-        """True where the run succeeded."""
-        return self.status == 0
-
-    def messages(self) -> list[str]:
-        """Human-readable status for each (possibly batched) run; needs concrete values."""
-        return status_messages(self.status)

@@ -16,7 +16,7 @@ import jax
 import jax.numpy as jnp
 from jax import Array
 
-from mbjax.integrate.solution import Status, status_messages
+from mbjax.integrate.solution import Status, WithStatus
 from mbjax.tfe.body import Body
 from mbjax.tfe.elements import Element
 from mbjax.tfe.form import AbstractForm
@@ -44,7 +44,7 @@ def initial_state(body: Body, R0, Omega0, x0=(0.0, 0.0, 0.0), v0=(0.0, 0.0, 0.0)
     return State(R0, jnp.asarray(x0, dtype=float), body.mass_matrix(R0) @ w)
 
 
-class TFESolution(eqx.Module):
+class TFESolution(WithStatus):
     """States at the element boundaries ts (n_elements + 1), per-element Newton records and a
     `Status`: NOT_CONVERGED where an element's Newton missed its tolerance, NONFINITE where the
     state blew up."""
@@ -56,13 +56,6 @@ class TFESolution(eqx.Module):
     iterations: Array
     residual: Array
     status: Array
-
-    @property
-    def ok(self) -> Array:
-        return self.status == 0
-
-    def messages(self) -> list[str]:
-        return status_messages(self.status)
 
     def energy(self, body: Body) -> Array:
         """Total energy at every boundary."""
