@@ -1,0 +1,68 @@
+"""The constraints of a closed mechanism at position, velocity and acceleration level (seed 002
+eqs 87-88, seed 001 eq 85), all by autodiff of the holonomic residual Phi(q, t):
+
+    Phi(q, t) = 0,    A(q, t) v + B(q, t) = 0,    A(q, t) v_dot + b(q, v, t) = 0,
+
+with A = dPhi/dq . dq/dv (the velocity constraint operator, (m, nv)), B = dPhi/dt and
+b = d/dt (A v + B) at fixed v, the "A_dot u + B_dot" of seed 002 eq 92. Derivatives follow q along
+q_dot = model.q_dot(q, v), so quaternion joints need no special case.
+"""
+
+import equinox as eqx
+import jax
+import jax.numpy as jnp
+from jax import Array
+
+from mbjax.loops.closures import GROUND, CutJoint, Prescribed
+from mbjax.model import Model
+from mbjax.rigid.kinematics import forward_kinematics
+
+
+class Loops(eqx.Module):
+    """A tree `model` closed by cut joints and driven by prescribed motions."""
+
+    model: Model
+    closures: tuple
+
+    def __init__(self, model: Model, closures):
+        closures = tuple(closures)
+        if not closures:
+            raise ValueError("Loops needs at least one cut joint or prescribed motion")
+        for c in closures:
+            if isinstance(c, CutJoint):
+                for body in (c.body_a, c.body_b):
+                    if body != GROUND and not 0 <= body < model.n:
+                        raise ValueError(f"cut joint {c.kind!r}: body {body} is not in the model "
+                                         f"(0 ... {model.n - 1}, or -1 for the ground)")
+            elif isinstance(c, Prescribed):
+                if not c.dof < model.nq or model.nq != model.nv:
+                    raise ValueError(f"prescribed motion of coordinate {c.dof}: the model has "
+                                     f"{model.nq} coordinates (and drives need nq == nv)")
+            else:
+                raise TypeError(f"closures must be CutJoint or Prescribed, got {type(c).__name__}")
+        self.model = model
+        self.closures = closures
+
+    @property
+    def m(self) -> int:
+        """Number of scalar constraint equations (redundant ones included)."""
+        return sum(c.size for c in self.closures)
+
+    def phi(self, q: Array, t=0.0) -> Array:
+        """Phi(q, t), (m,)."""
+        R, p = forward_kinematics(self.model, q)
+        return jnp.concatenate([c.residual(R, p, q, t) for c in self.closures])
+
+    def rate(self, q: Array, v: Array, t=0.0) -> Array:
+        """A v + B = dPhi/dt along the motion."""
+        return jax.jvp(self.phi, (q, jnp.asarray(t, q.dtype)),
+                       (self.model.q_dot(q, v), jnp.ones((), q.dtype)))[1]
+
+    def jacobian(self, q: Array, t=0.0) -> Array:
+        """A (m, nv): the rate is linear in v, A v + B."""
+        return jax.jacfwd(lambda v: self.rate(q, v, t))(jnp.zeros(self.model.nv, q.dtype))
+
+    def acceleration_bias(self, q: Array, v: Array, t=0.0) -> Array:
+        """b = d/dt (A v + B) at fixed v, so that A v_dot + b is the second derivative of Phi."""
+        return jax.jvp(lambda q_, t_: self.rate(q_, v, t_), (q, jnp.asarray(t, q.dtype)),
+                       (self.model.q_dot(q, v), jnp.ones((), q.dtype)))[1]

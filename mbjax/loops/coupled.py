@@ -1,0 +1,55 @@
+"""Coupled free and constrained motion by Lagrange multipliers (seed 001 §VI, eqs 85-93, velocity
+form), with optional Baumgarte stabilization.
+
+With nu = mu^-1 the inverse mass matrix, the unconstrained acceleration a_free = nu (K^a - Y) and
+the constraint rows A v_dot + b = 0 (mbjax.loops.constraints), eqs 89-92 give the multipliers
+K_c from (A nu A^t) K_c = -(A a_free + b) and eq 93 the motion v_dot = a_free + nu A^t K_c.
+Baumgarte's stabilization adds 2 alpha (A v + B) + beta^2 Phi to b, so the constraint errors obey
+e_ddot + 2 alpha e_dot + beta^2 e = 0 instead of drifting.
+
+Redundant constraints (a planar loop closed by a spatial revolute joint) and singular
+configurations make A nu A^t singular. The multipliers are then the Tikhonov-regularized
+least-squares ones, (A nu A^t + rho I) K_c = rhs with rho = 1e-12 trace / m: the same
+accelerations to about 1e-12 relative whenever the equations are consistent, finite always, and
+smooth for gradients; `rank` reports the numerical rank so a status can say so. The mass matrix
+is dense here (O(n^3)); `mbjax.loops.stabilized` is seed 002's O(n + m^3) route.
+"""
+
+import jax
+import jax.numpy as jnp
+from jax import Array
+
+from mbjax.loops.constraints import Loops
+from mbjax.rigid.dynamics import mass_matrix
+from mbjax.rigid.rnea import inverse_dynamics
+
+REGULARIZATION = 1e-12
+RANK_TOL = 1e-9
+
+
+def multipliers(W: Array, rhs: Array) -> tuple[Array, Array]:
+    """Regularized solution of W x = rhs for a symmetric positive semi-definite W, and its
+    numerical rank (eigenvalues above RANK_TOL times the largest)."""
+    m = W.shape[0]
+    rho = REGULARIZATION * jnp.trace(W) / m
+    x = jax.scipy.linalg.cho_solve(jax.scipy.linalg.cho_factor(W + rho * jnp.eye(m, dtype=W.dtype)), rhs)
+    s = jnp.linalg.eigvalsh(jax.lax.stop_gradient(W))
+    return x, jnp.sum(s > RANK_TOL * s[-1])
+
+
+def coupled_acceleration(loops: Loops, q: Array, v: Array, tau: Array, t=0.0,
+                         baumgarte=(0.0, 0.0)) -> tuple[Array, Array, Array]:
+    """(v_dot, K_c, rank) of seed 001 eqs 89-93; K_c are the multipliers of the rows of A, so
+    A^t K_c is the generalized constraint force."""
+    model = loops.model
+    mu = mass_matrix(model, q)
+    bias = inverse_dynamics(model, q, v, jnp.zeros_like(v))        # Y: gravity, velocity terms
+    factor = jax.scipy.linalg.cho_factor(mu)
+    a_free = jax.scipy.linalg.cho_solve(factor, tau - bias)
+    A = loops.jacobian(q, t)
+    alpha, beta = baumgarte
+    b = (loops.acceleration_bias(q, v, t) + 2.0 * alpha * loops.rate(q, v, t)
+         + beta**2 * loops.phi(q, t))
+    nu_At = jax.scipy.linalg.cho_solve(factor, A.T)
+    K_c, rank = multipliers(A @ nu_At, -(A @ a_free + b))
+    return a_free + nu_At @ K_c, K_c, rank

@@ -1,0 +1,111 @@
+"""Loop closures and the coupled Lagrange-multiplier solution (seed 001 eqs 85-93) on a planar
+four-bar, against an independent minimal-coordinate solution (closed-form loop, one-dof
+Lagrangian, scipy's DOP853)."""
+
+import jax
+import jax.numpy as jnp
+import numpy as np
+import pytest
+from scipy.integrate import solve_ivp
+
+from mbjax.integrate import RK4, simulate
+from mbjax.loops import CutJoint, Loops, LoopSystem, Prescribed, coupled_acceleration
+from mbjax.model import Model
+from mbjax.rigid import kinetic_energy, potential_energy
+
+A_, B_, C_, D_ = 0.1, 0.35, 0.25, 0.4          # crank, coupler, rocker, ground link [m]
+LENGTHS, MASSES = np.array([A_, B_, C_]), np.array([0.5, 1.0, 0.8])
+MODEL = Model([-1, 0, -1], "revolute", mass=MASSES,
+              inertia=np.array([np.diag([1e-5, m * L**2 / 12, m * L**2 / 12])
+                                for m, L in zip(MASSES, LENGTHS)]),
+              com=np.stack([LENGTHS / 2, 0 * LENGTHS, 0 * LENGTHS], 1), axis=[0.0, 0.0, 1.0],
+              placement_translation=[[0, 0, 0], [A_, 0, 0], [D_, 0, 0]], gravity=(0.0, -9.81, 0.0))
+LOOPS = Loops(MODEL, [CutJoint("revolute", 1, 2, origin_a=(B_, 0, 0), origin_b=(C_, 0, 0))])
+
+
+def joint_angles(theta):
+    """Tree coordinates of the closed four-bar at crank angle theta (closed-form position
+    analysis, elbow-up branch)."""
+    P = jnp.array([A_ * jnp.cos(theta), A_ * jnp.sin(theta)])
+    e = jnp.array([D_, 0.0]) - P
+    r = jnp.linalg.norm(e)
+    x = (r**2 + B_**2 - C_**2) / (2 * r)
+    u = e / r
+    Q = P + x * u + jnp.sqrt(B_**2 - x**2) * jnp.array([-u[1], u[0]])
+    phi = jnp.arctan2(Q[1] - P[1], Q[0] - P[0])
+    psi = jnp.arctan2(Q[1], Q[0] - D_)
+    return jnp.array([theta, phi - theta, psi])
+
+
+def minimal_rhs(y):
+    """theta_ddot of the one-dof Lagrangian L(theta, omega) = T - V."""
+    def lagrangian(theta, omega):
+        q = joint_angles(theta)
+        return (kinetic_energy(MODEL, q, jax.jacfwd(joint_angles)(theta) * omega)
+                - potential_energy(MODEL, q))
+    theta, omega = y
+    m = jax.grad(jax.grad(lagrangian, 1), 1)(theta, omega)
+    mixed = jax.grad(jax.grad(lagrangian, 1), 0)(theta, omega)
+    return jnp.array([omega, (jax.grad(lagrangian, 0)(theta, omega) - mixed * omega) / m])
+
+
+THETA0, OMEGA0 = 0.3, 2.0
+Q0 = joint_angles(THETA0)
+V0 = jax.jacfwd(joint_angles)(THETA0) * OMEGA0
+
+
+def test_four_bar_matches_minimal_coordinates():
+    rhs = jax.jit(minimal_rhs)
+    ref = solve_ivp(lambda t, y: np.asarray(rhs(jnp.asarray(y))), (0.0, 0.5), [THETA0, OMEGA0],
+                    method="DOP853", rtol=1e-12, atol=1e-12)
+    system = LoopSystem(LOOPS)
+    sol = simulate(system, RK4(), Q0, V0, dt=5e-4, t1=0.5, saveat=[0.5])
+    assert sol.messages() == ["success"]
+    assert abs(float(sol.qs[-1, 0]) - ref.y[0, -1]) < 1e-8
+    assert float(jnp.abs(LOOPS.phi(sol.qs[-1])).max()) < 1e-8
+    E0, E1 = system.energy(Q0, V0), system.energy(sol.qs[-1], sol.us[-1])
+    assert abs(float(E1 / E0) - 1) < 1e-8
+
+
+def test_redundant_planar_closure_is_detected_and_finite():
+    """A spatial revolute cut joint closes a planar loop with 5 equations of rank 2."""
+    v_dot, K_c, rank = coupled_acceleration(LOOPS, Q0, V0, jnp.zeros(3))
+    assert LOOPS.m == 5 and int(rank) == 2
+    assert bool(jnp.all(jnp.isfinite(v_dot)) & jnp.all(jnp.isfinite(K_c)))
+    A = LOOPS.jacobian(Q0)
+    b = LOOPS.acceleration_bias(Q0, V0)
+    np.testing.assert_allclose(A @ v_dot + b, 0.0, atol=1e-10)
+
+
+def test_constraint_derivatives_by_autodiff_match_finite_differences():
+    """A v + B is dPhi/dt and A a + b is d^2 Phi/dt^2 along q(t) = q0 + v t + a t^2 / 2."""
+    loops = Loops(MODEL, [*LOOPS.closures, Prescribed(0, q0=0.1, rate=0.7)])
+    q, v, a, t, h = Q0 + 0.01, V0 + 0.1, jnp.array([0.3, -0.2, 0.5]), 0.2, 1e-4
+    path = lambda s: loops.phi(q + v * s + a * s**2 / 2, t + s)  # noqa: E731
+    np.testing.assert_allclose(loops.rate(q, v, t), (path(h) - path(-h)) / (2 * h), atol=1e-8)
+    np.testing.assert_allclose(loops.jacobian(q, t) @ a + loops.acceleration_bias(q, v, t),
+                               (path(h) - 2 * path(0.0) + path(-h)) / h**2, atol=1e-5)
+
+
+@pytest.mark.slow
+def test_gradient_through_a_constrained_rollout_matches_finite_differences():
+    system = LoopSystem(LOOPS)
+    direction = jax.jacfwd(joint_angles)(THETA0)
+
+    def final_crank(omega):
+        return simulate(system, RK4(), Q0, direction * omega, dt=1e-3, t1=0.1, saveat=[0.1]).qs[-1, 0]
+
+    eps = 1e-5
+    fd = (final_crank(OMEGA0 + eps) - final_crank(OMEGA0 - eps)) / (2 * eps)
+    np.testing.assert_allclose(jax.grad(final_crank)(OMEGA0), fd, rtol=1e-7)
+
+
+def test_ill_posed_closures_get_clear_errors():
+    with pytest.raises(ValueError, match="two different bodies"):
+        CutJoint("revolute", 1, 1)
+    with pytest.raises(ValueError, match="kind must be one of"):
+        CutJoint("hinge", 0, 1)
+    with pytest.raises(ValueError, match="not in the model"):
+        Loops(MODEL, [CutJoint("spherical", 0, 7)])
+    with pytest.raises(ValueError, match="at least one"):
+        Loops(MODEL, [])
