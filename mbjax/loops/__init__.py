@@ -1,15 +1,18 @@
 """Closed loops (seed 001 §VI, seed 002 §2.4): cut joints and prescribed motions as constraints
 on a tree (`CutJoint`, `Prescribed`, `Loops`), the coupled Lagrange-multiplier solution with
-Baumgarte stabilization (`coupled_acceleration`) and `LoopSystem` for `mbjax.simulate`.
+Baumgarte stabilization (`coupled_acceleration`, `LoopSystem`) and seed 002's O(n + m^3)
+stabilization (`stabilized_acceleration`, `StabilizedLoopSystem`).
 
-Work in progress (issue 5): seed 002's O(n + m^3) stabilization, projection and the mechanisms
-of the issue are still to come.
+Work in progress (issue 5): projection, the momentum form and the mechanisms of the issue are
+still to come.
 """
 
 from mbjax.loops.closures import GROUND, CutJoint, Prescribed
 from mbjax.loops.constraints import Loops
-from mbjax.loops.coupled import coupled_acceleration, multipliers
-from mbjax.loops.system import LoopSystem
+from mbjax.loops.coupled import coupled_acceleration, multipliers, numerical_rank
+from mbjax.loops.stabilized import eta_and_gamma, stabilized_acceleration
+from mbjax.loops.system import LoopSystem, StabilizedLoopSystem
 
-__all__ = ["GROUND", "CutJoint", "LoopSystem", "Loops", "Prescribed", "coupled_acceleration",
-           "multipliers"]
+__all__ = ["GROUND", "CutJoint", "LoopSystem", "Loops", "Prescribed", "StabilizedLoopSystem",
+           "coupled_acceleration", "eta_and_gamma", "multipliers", "numerical_rank",
+           "stabilized_acceleration"]

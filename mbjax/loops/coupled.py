@@ -27,14 +27,19 @@ REGULARIZATION = 1e-12
 RANK_TOL = 1e-9
 
 
+def numerical_rank(W: Array) -> Array:
+    """Eigenvalues of the symmetric positive semi-definite W above RANK_TOL times the largest."""
+    s = jnp.linalg.eigvalsh(jax.lax.stop_gradient(W))
+    return jnp.sum(s > RANK_TOL * s[-1])
+
+
 def multipliers(W: Array, rhs: Array) -> tuple[Array, Array]:
-    """Regularized solution of W x = rhs for a symmetric positive semi-definite W, and its
-    numerical rank (eigenvalues above RANK_TOL times the largest)."""
+    """Regularized solution of W x = rhs for a symmetric positive semi-definite W, and the
+    numerical rank of W."""
     m = W.shape[0]
     rho = REGULARIZATION * jnp.trace(W) / m
     x = jax.scipy.linalg.cho_solve(jax.scipy.linalg.cho_factor(W + rho * jnp.eye(m, dtype=W.dtype)), rhs)
-    s = jnp.linalg.eigvalsh(jax.lax.stop_gradient(W))
-    return x, jnp.sum(s > RANK_TOL * s[-1])
+    return x, numerical_rank(W)
 
 
 def coupled_acceleration(loops: Loops, q: Array, v: Array, tau: Array, t=0.0,

@@ -6,6 +6,7 @@ from jax import Array
 from mbjax.integrate.system import AbstractSystem
 from mbjax.loops.constraints import Loops
 from mbjax.loops.coupled import coupled_acceleration
+from mbjax.loops.stabilized import stabilized_acceleration
 from mbjax.rigid.energy import energy
 
 
@@ -39,3 +40,53 @@ class LoopSystem(AbstractSystem):
 
     def energy(self, q, u):
         return energy(self.loops.model, q, u)
+
+
+class StabilizedLoopSystem(AbstractSystem):
+    """Seed 002's O(n + m^3) route (`mbjax.loops.stabilized`). epsilon = 0: u = v and algebraic
+    loads; epsilon > 0: u = (v, f_c), the loads integrated by eq 93 from `initial_loads` (eq 89),
+    so that A v + B = epsilon f_c all along: the velocity constraint holds to O(epsilon), at the
+    price of a stiff load equation (time constant epsilon / eig(A Gamma))."""
+
+    loops: Loops
+    tau: Array
+    epsilon: float
+
+    def __init__(self, loops: Loops, tau=None, epsilon: float = 0.0):
+        if not epsilon >= 0:
+            raise ValueError(f"epsilon must be >= 0, got {epsilon}")
+        self.loops = loops
+        self.tau = jnp.zeros(loops.model.nv) if tau is None else jnp.asarray(tau, dtype=float)
+        self.epsilon = float(epsilon)
+
+    def _v(self, u):
+        return u[:self.loops.model.nv]
+
+    def initial_loads(self, q, v, t=0.0) -> Array:
+        """f_c = (A v + B) / epsilon (eq 89): zero for a state that meets the constraints."""
+        if self.epsilon == 0.0:
+            raise ValueError("epsilon = 0 has no load state: the loads are algebraic")
+        return self.loops.rate(q, v, t) / self.epsilon
+
+    def kinematics(self, q, u):
+        return self.loops.model.q_dot(q, self._v(u))
+
+    def acceleration(self, t, q, u):
+        nv = self.loops.model.nv
+        if self.epsilon == 0.0:
+            return stabilized_acceleration(self.loops, q, u, self.tau, t)[0]
+        v_dot, f_c_dot, _ = stabilized_acceleration(self.loops, q, u[:nv], self.tau, t, f_c=u[nv:],
+                                                    epsilon=self.epsilon)
+        return jnp.concatenate([v_dot, f_c_dot])
+
+    def retract(self, q0, xi):
+        return self.loops.model.retract(q0, xi)
+
+    def local_rate(self, q0, xi, u):
+        return self.loops.model.local_rate(q0, xi, self._v(u))
+
+    def project(self, q):
+        return self.loops.model.normalize(q)
+
+    def energy(self, q, u):
+        return energy(self.loops.model, q, self._v(u))
