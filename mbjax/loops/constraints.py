@@ -59,8 +59,9 @@ class Loops(eqx.Module):
                        (self.model.q_dot(q, v), jnp.ones((), q.dtype)))[1]
 
     def jacobian(self, q: Array, t=0.0) -> Array:
-        """A (m, nv): the rate is linear in v, A v + B."""
-        return jax.jacfwd(lambda v: self.rate(q, v, t))(jnp.zeros(self.model.nv, q.dtype))
+        """A (m, nv): the rate is linear in v, A v + B. Reverse mode, one pass per constraint
+        row, so O(m n) rather than O(n^2) for long chains."""
+        return jax.jacrev(lambda v: self.rate(q, v, t))(jnp.zeros(self.model.nv, q.dtype))
 
     def acceleration_bias(self, q: Array, v: Array, t=0.0) -> Array:
         """b = d/dt (A v + B) at fixed v, so that A v_dot + b is the second derivative of Phi."""
