@@ -112,6 +112,7 @@ def test_ill_posed_closures_get_clear_errors():
         Loops(MODEL, [])
 
 
+@pytest.mark.slow     # the closed chain's test covers the same agreement by default
 def test_order_n_stabilization_agrees_with_the_coupled_solution():
     """Seed 002's eta - Gamma f_c (m + 1 passes of the O(n) recursion) against seed 001's dense
     Lagrange multipliers, the same RK4 steps: the two trajectories agree to round-off."""

@@ -46,7 +46,7 @@ def fitted_order(form, nodes, reference, quadrature="exact"):
 
 
 @pytest.mark.parametrize("nodes", [2, 3, 4])
-@pytest.mark.parametrize("name", ["primal", "mixed"])
+@pytest.mark.parametrize("name", ["primal", pytest.param("mixed", marks=pytest.mark.slow)])
 def test_local_error_order_is_2n_minus_1(name, nodes):
     """End values of an n-node element are superconvergent: global order 2(n - 1), so the error
     of one element is O(h^(2n - 1))."""
@@ -77,7 +77,7 @@ def free_body_closed_form(t, m, c, J_a, J_t, Omega0, x0, v_cm0, g):
     return R, x_cm0 + v_cm0 * t + 0.5 * g * t**2 - R @ c
 
 
-@pytest.mark.parametrize("name", ["primal", "mixed", "three_field"])
+@pytest.mark.parametrize("name", ["primal", "mixed", pytest.param("three_field", marks=pytest.mark.slow)])
 def test_free_body_with_offset_reference_point_matches_closed_form(name):
     """6 dof, S != 0: translation and rotation couple through M6 and S_1 (eqs 3.8, B.8)."""
     m, c, J_a, J_t = 2.0, jnp.array([0.2, -0.1, 0.3]), 0.8, 1.5
