@@ -200,3 +200,18 @@ def test_bench_tfe_quick(tmp_path):
                 best[key] = min(best.get(key, math.inf), r["error"])
         assert all(best[(form, 4)] < best[(form, 2)] / 100 for form in ("primal", "mixed"))
     assert (tmp_path / "tfe.png").stat().st_size > 10_000
+
+
+@pytest.mark.slow
+def test_reproduce_closed_chain(tmp_path):
+    """The issue's keys; the two formulations agree; projection holds the constraints, no
+    stabilization drifts above it."""
+    assert main(["reproduce", "closed-chain", "--quick", "--out", str(tmp_path)]) == 0
+    data = json.loads((tmp_path / "closed-chain.json").read_text())
+    assert set(data) == {"n", "recursive_s", "dense_s", "max_abs_diff", "drift"}
+    assert len({len(data[k]) for k in ("n", "recursive_s", "dense_s", "max_abs_diff")}) == 1
+    assert max(data["max_abs_diff"]) < 1e-8
+    final = {name: rows[-1][1] for name, rows in data["drift"].items()}
+    assert final["projection"] < 1e-10 < final["none"]
+    assert final["baumgarte"] < final["none"]
+    assert (tmp_path / "closed-chain.png").stat().st_size > 10_000

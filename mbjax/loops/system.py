@@ -1,27 +1,36 @@
 """Closed mechanisms as `AbstractSystem`s for `mbjax.simulate`."""
 
+import equinox as eqx
 import jax.numpy as jnp
 from jax import Array
 
 from mbjax.integrate.system import AbstractSystem
+from mbjax.loops.closures import Prescribed
 from mbjax.loops.constraints import Loops
 from mbjax.loops.coupled import coupled_acceleration
+from mbjax.loops.projection import project_configuration
 from mbjax.loops.stabilized import stabilized_acceleration
 from mbjax.rigid.energy import energy
 
 
 class LoopSystem(AbstractSystem):
     """u = v; v_dot from the coupled Lagrange-multiplier equations (seed 001 eqs 89-93), with
-    Baumgarte gains (alpha, beta) (0, 0: none). tau is a constant (nv,) applied force."""
+    Baumgarte gains (alpha, beta) (0, 0: none). tau is a constant (nv,) applied force.
+    projection=True puts the configuration back on Phi = 0 after every step
+    (`mbjax.loops.projection`; time-independent closures only)."""
 
     loops: Loops
     tau: Array
     baumgarte: tuple
+    projection: bool = eqx.field(static=True)
 
-    def __init__(self, loops: Loops, tau=None, baumgarte=(0.0, 0.0)):
+    def __init__(self, loops: Loops, tau=None, baumgarte=(0.0, 0.0), projection: bool = False):
+        if projection and any(isinstance(c, Prescribed) for c in loops.closures):
+            raise ValueError("projection=True needs time-independent closures (no Prescribed)")
         self.loops = loops
         self.tau = jnp.zeros(loops.model.nv) if tau is None else jnp.asarray(tau, dtype=float)
         self.baumgarte = tuple(float(g) for g in baumgarte)
+        self.projection = projection
 
     def kinematics(self, q, u):
         return self.loops.model.q_dot(q, u)
@@ -36,7 +45,8 @@ class LoopSystem(AbstractSystem):
         return self.loops.model.local_rate(q0, xi, u)
 
     def project(self, q):
-        return self.loops.model.normalize(q)
+        q = self.loops.model.normalize(q)
+        return project_configuration(self.loops, q)[0] if self.projection else q
 
     def energy(self, q, u):
         return energy(self.loops.model, q, u)

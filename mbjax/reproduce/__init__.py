@@ -3,7 +3,7 @@
 Each entry is reproduce(out: Path, quick: bool) -> dict (the JSON written).
 """
 
-from mbjax.reproduce import integrators, top_long_run, torque_free_tfe, tree_scaling, vertical_top
+from mbjax.reproduce import closed_chain, integrators, top_long_run, torque_free_tfe, tree_scaling, vertical_top
 
 REPRODUCTIONS = {
     integrators.NAME: integrators.reproduce,
@@ -11,6 +11,7 @@ REPRODUCTIONS = {
     vertical_top.NAME: vertical_top.reproduce,
     torque_free_tfe.NAME: torque_free_tfe.reproduce,
     top_long_run.NAME: top_long_run.reproduce,
+    closed_chain.NAME: closed_chain.reproduce,
 }
 
 __all__ = ["REPRODUCTIONS"]

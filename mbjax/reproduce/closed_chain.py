@@ -1,0 +1,80 @@
+"""`mbjax reproduce closed-chain`: seed 002 §3.3, Fig. 8, and where unstabilized integration fails.
+
+The (n/2)-body chain with both ends fixed (`mbjax.scenes.closed_chain`), simulated for 1 s
+(RK4, 1 ms) by seed 002's O(n + m^3) route (`StabilizedLoopSystem`: the O(n) recursion, m + 1
+passes) and by the coupled Lagrange multipliers with the dense mass matrix, O(n^3)
+(`LoopSystem`, seed 001 eqs 89-93); run time of each after compilation (median of 3 calls), and
+the largest difference between their joint angles over the run.
+
+Then the constraint drift |Phi(q(t))| over 10 s of the 12-dof chain (RK4, 1 ms) for no
+stabilization, Baumgarte's (alpha = beta = 10 / s), seed 002's epsilon-dynamics (loads started by
+eq 89; the load equation is stiff, explicit RK4 needs dt < 2.8 epsilon / max eig(A Gamma) and
+max eig(A Gamma) = 267 / s here, so epsilon = 1 and 0.2) and projection onto Phi = 0 after
+every step.
+
+JSON: {"n": [...], "recursive_s": [...], "dense_s": [...], "max_abs_diff": [...],
+"drift": {"<method>": [[t, residual], ...], ...}}.
+"""
+
+import json
+from functools import partial
+from pathlib import Path
+
+import jax
+import jax.numpy as jnp
+import numpy as np
+
+from mbjax.bench.timing import measure
+from mbjax.integrate import RK4, simulate
+from mbjax.loops import LoopSystem, StabilizedLoopSystem
+from mbjax.scenes import closed_chain
+
+NAME = "closed-chain"
+NS = (4, 12, 20, 28, 36, 44, 100, 200, 400)
+QUICK_NS = (4, 12, 28, 44)
+DRIFT_N = 12
+DRIFT_DURATION = 10.0
+DRIFT_DT = 1e-3
+EPSILONS = (1.0, 0.2)   # RK4 needs dt < 2.8 epsilon / max eig(A Gamma), 267 / s here
+
+
+def timing(n: int, repeats: int) -> tuple[float, float, float]:
+    """(recursive_s, dense_s, max_abs_diff) for 1 s of the n-dof chain."""
+    loops, q0, v0 = closed_chain.build(n)
+    ts = np.linspace(0.0, closed_chain.DURATION, 11)
+    run = partial(simulate, integrator=RK4(), q0=q0, u0=v0, dt=1e-3, t1=closed_chain.DURATION,
+                  saveat=ts)
+    recursive, t_rec = measure(partial(run, StabilizedLoopSystem(loops)), repeats=repeats)
+    dense, t_dense = measure(partial(run, LoopSystem(loops)), repeats=repeats)
+    return t_rec.run_s, t_dense.run_s, float(jnp.abs(recursive.qs - dense.qs).max())
+
+
+def drift(duration: float) -> dict:
+    loops, q0, v0 = closed_chain.build(DRIFT_N)
+    ts = np.linspace(0.0, duration, 101)
+    systems = {"none": LoopSystem(loops), "baumgarte": LoopSystem(loops, baumgarte=(10.0, 10.0)),
+               "projection": LoopSystem(loops, projection=True)}
+    systems |= {f"epsilon={eps:g}": StabilizedLoopSystem(loops, epsilon=eps) for eps in EPSILONS}
+    out = {}
+    for name, system in systems.items():
+        u0 = (jnp.concatenate([v0, system.initial_loads(q0, v0)])
+              if isinstance(system, StabilizedLoopSystem) else v0)
+        sol = simulate(system, RK4(), q0, u0, dt=DRIFT_DT, t1=duration, saveat=ts)
+        residual = jax.vmap(lambda q: jnp.linalg.norm(loops.phi(q)))(sol.qs)
+        out[name] = [[float(t), float(r)] for t, r in zip(sol.ts, residual)]
+    return out
+
+
+def reproduce(out: Path, quick: bool = False) -> dict:
+    """Fig. 8 (quick: n up to 44) and the drift chart (quick: 2 s); writes JSON and PNG."""
+    from mbjax.plot.loops import closed_chain_figure
+
+    ns = QUICK_NS if quick else NS
+    rows = [timing(n, repeats=1 if quick else 3) for n in ns]
+    data = {"n": list(ns), "recursive_s": [r[0] for r in rows], "dense_s": [r[1] for r in rows],
+            "max_abs_diff": [r[2] for r in rows],
+            "drift": drift(2.0 if quick else DRIFT_DURATION)}
+    out.mkdir(parents=True, exist_ok=True)
+    (out / f"{NAME}.json").write_text(json.dumps(data, indent=1))
+    closed_chain_figure(data).savefig(out / f"{NAME}.png", dpi=120)
+    return data
