@@ -124,6 +124,7 @@ def test_order_n_stabilization_agrees_with_the_coupled_solution():
     np.testing.assert_allclose(recursive.us, coupled.us, atol=1e-10)
 
 
+@pytest.mark.slow
 def test_epsilon_dynamics_keeps_the_velocity_error_at_epsilon_times_the_loads():
     """Eqs 89-93: started from f_c = (A v + B) / epsilon, A v + B = epsilon f_c at all times."""
     system = StabilizedLoopSystem(LOOPS, epsilon=1e-2)
