@@ -45,16 +45,17 @@ def multipliers(W: Array, rhs: Array) -> tuple[Array, Array]:
 def coupled_acceleration(loops: Loops, q: Array, v: Array, tau: Array, t=0.0,
                          baumgarte=(0.0, 0.0)) -> tuple[Array, Array, Array]:
     """(v_dot, K_c, rank) of seed 001 eqs 89-93; K_c are the multipliers of the rows of A, so
-    A^t K_c is the generalized constraint force."""
+    A^t K_c is the generalized constraint force. The Baumgarte gains are Python floats."""
     model = loops.model
     mu = mass_matrix(model, q)
     bias = inverse_dynamics(model, q, v, jnp.zeros_like(v))        # Y: gravity, velocity terms
     factor = jax.scipy.linalg.cho_factor(mu)
     a_free = jax.scipy.linalg.cho_solve(factor, tau - bias)
     A = loops.jacobian(q, t)
-    alpha, beta = baumgarte
-    b = (loops.acceleration_bias(q, v, t) + 2.0 * alpha * loops.rate(q, v, t)
-         + beta**2 * loops.phi(q, t))
+    b = loops.acceleration_bias(q, v, t)
+    if tuple(baumgarte) != (0.0, 0.0):        # Python floats: no extra passes when unused
+        alpha, beta = baumgarte
+        b = b + 2.0 * alpha * loops.rate(q, v, t) + beta**2 * loops.phi(q, t)
     nu_At = jax.scipy.linalg.cho_solve(factor, A.T)
     K_c, rank = multipliers(A @ nu_At, -(A @ a_free + b))
     return a_free + nu_At @ K_c, K_c, rank

@@ -49,7 +49,7 @@ class LoopSystem(_Closed):
     projection=True puts the configuration back on Phi = 0 after every step
     (`mbjax.loops.projection`; time-independent closures only)."""
 
-    baumgarte: tuple
+    baumgarte: tuple = eqx.field(static=True)
     projection: bool = eqx.field(static=True)
 
     def __init__(self, loops: Loops, tau=None, baumgarte=(0.0, 0.0), projection: bool = False):
