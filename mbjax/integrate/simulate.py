@@ -63,9 +63,11 @@ def _rollout(system, integrator, q0, u0, t0, dt, block: int, n_blocks: int, keep
         q, u, status = carry
         t = jnp.asarray(t0, dtype) + k * jnp.asarray(dt, dtype)
         q1, u1, converged = integrator.step(system, t, q, u, jnp.asarray(dt, dtype))
+        q1, u1 = system.constrain(t + dt, q1, u1)
         finite = jnp.all(jnp.isfinite(q1)) & jnp.all(jnp.isfinite(u1))
         status = (status | jnp.where(finite, 0, int(Status.NONFINITE))
-                  | jnp.where(converged, 0, int(Status.NOT_CONVERGED)))
+                  | jnp.where(converged, 0, int(Status.NOT_CONVERGED))
+                  | system.check(t + dt, q1, u1))
         return (q1, u1, status), None
 
     def run_block(carry, b):

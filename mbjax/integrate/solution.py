@@ -8,12 +8,20 @@ from jax import Array
 
 
 class Status(enum.IntFlag):
-    """Flags OR-ed into `Solution.status`; 0 means success."""
+    """Flags OR-ed into `Solution.status`; 0 means success without remarks."""
 
     SUCCESS = 0
     NONFINITE = 1          # a state became inf or NaN (the step is beyond the method's stability)
     NOT_CONVERGED = 2      # an implicit step's Newton iteration missed its tolerance
     SOLVER_FAILED = 4      # the adaptive reference solver stopped (step-size underflow, max_steps)
+    CONSTRAINT_VIOLATED = 8  # a closed loop's residual |Phi| grew past the system's tolerance
+    REDUNDANT = 16         # a note, not a failure: the constraint Jacobian lost rank (redundant
+                           # closures or a singular configuration); least-squares loads were used
+
+    @classmethod
+    def failures(cls) -> int:
+        """The flags that make a run fail (`REDUNDANT` only informs)."""
+        return cls.NONFINITE | cls.NOT_CONVERGED | cls.SOLVER_FAILED | cls.CONSTRAINT_VIOLATED
 
 
 class WithStatus(eqx.Module):
@@ -22,8 +30,8 @@ class WithStatus(eqx.Module):
 
     @property
     def ok(self) -> Array:
-        """True where the run succeeded."""
-        return self.status == 0
+        """True where the run succeeded (no failure flag; `Status.REDUNDANT` only informs)."""
+        return (self.status & Status.failures()) == 0
 
     def messages(self) -> list[str]:
         """Human-readable status for each (possibly batched) run; needs concrete values."""

@@ -14,6 +14,7 @@ defaults (retract(q0, xi) = q0 + xi).
 import abc
 
 import equinox as eqx
+import jax.numpy as jnp
 from jax import Array
 
 
@@ -39,3 +40,13 @@ class AbstractSystem(eqx.Module):
     def project(self, q: Array) -> Array:
         """Map coordinates back to their canonical form (unit quaternion, principal rotation vector)."""
         return q
+
+    def constrain(self, t: Array, q: Array, u: Array) -> tuple[Array, Array]:
+        """After each step of `simulate`: put (q, u) back on the system's constraints (a closed
+        loop's projection, `mbjax.loops`). The identity here."""
+        return q, u
+
+    def check(self, t: Array, q: Array, u: Array) -> Array:
+        """`Status` flags for the state after each step of `simulate` (a violated or redundant
+        constraint, `mbjax.loops`); 0 here."""
+        return jnp.array(0, jnp.int32)

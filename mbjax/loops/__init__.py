@@ -9,10 +9,12 @@ still to come.
 
 from mbjax.loops.closures import GROUND, CutJoint, Prescribed
 from mbjax.loops.constraints import Loops
-from mbjax.loops.coupled import coupled_acceleration, multipliers, numerical_rank
+from mbjax.loops.coupled import coupled_acceleration, momentum_rate, multipliers, numerical_rank
 from mbjax.loops.stabilized import eta_and_gamma, stabilized_acceleration
-from mbjax.loops.system import LoopSystem, StabilizedLoopSystem
+from mbjax.loops.projection import project_configuration, project_velocity
+from mbjax.loops.system import LoopSystem, MomentumLoopSystem, StabilizedLoopSystem
 
-__all__ = ["GROUND", "CutJoint", "LoopSystem", "Loops", "Prescribed", "StabilizedLoopSystem",
-           "coupled_acceleration", "eta_and_gamma", "multipliers", "numerical_rank",
+__all__ = ["GROUND", "CutJoint", "LoopSystem", "Loops", "MomentumLoopSystem", "Prescribed",
+           "StabilizedLoopSystem", "coupled_acceleration", "eta_and_gamma", "momentum_rate",
+           "multipliers", "numerical_rank", "project_configuration", "project_velocity",
            "stabilized_acceleration"]

@@ -1,11 +1,16 @@
-"""Coupled free and constrained motion by Lagrange multipliers (seed 001 §VI, eqs 85-93, velocity
-form), with optional Baumgarte stabilization.
+"""Coupled free and constrained motion by Lagrange multipliers (seed 001 §VI: eqs 85-93, the
+velocity form, and eqs 95-98, the momentum form), with optional Baumgarte stabilization.
 
 With nu = mu^-1 the inverse mass matrix, the unconstrained acceleration a_free = nu (K^a - Y) and
 the constraint rows A v_dot + b = 0 (mbjax.loops.constraints), eqs 89-92 give the multipliers
 K_c from (A nu A^t) K_c = -(A a_free + b) and eq 93 the motion v_dot = a_free + nu A^t K_c.
 Baumgarte's stabilization adds 2 alpha (A v + B) + beta^2 Phi to b, so the constraint errors obey
 e_ddot + 2 alpha e_dot + beta^2 e = 0 instead of drifting.
+
+The momentum form integrates G = mu v instead of v: G_dot = K^a - X + A^t K_c (eq 87), with
+X = Y - mu_dot v (eq 99) and the multipliers of eq 98,
+(A nu A^t) K_c = -(A nu (K^a - X) + b + A nu_dot G), nu_dot G = -nu mu_dot v; eq 99 makes them
+equal to eq 92's, which the tests check.
 
 Redundant constraints (a planar loop closed by a spatial revolute joint) and singular
 configurations make A nu A^t singular. The multipliers are then the Tikhonov-regularized
@@ -59,3 +64,19 @@ def coupled_acceleration(loops: Loops, q: Array, v: Array, tau: Array, t=0.0,
     nu_At = jax.scipy.linalg.cho_solve(factor, A.T)
     K_c, rank = multipliers(A @ nu_At, -(A @ a_free + b))
     return a_free + nu_At @ K_c, K_c, rank
+
+
+def momentum_rate(loops: Loops, q: Array, G: Array, tau: Array, t=0.0) -> tuple[Array, Array, Array]:
+    """(G_dot, K_c, rank) of the momentum formulation, seed 001 eqs 95-98, for momenta G = mu v."""
+    model = loops.model
+    mu = mass_matrix(model, q)
+    factor = jax.scipy.linalg.cho_factor(mu)
+    v = jax.scipy.linalg.cho_solve(factor, G)
+    mu_dot_v = jax.jvp(lambda q_: mass_matrix(model, q_), (q,), (model.q_dot(q, v),))[1] @ v
+    X = inverse_dynamics(model, q, v, jnp.zeros_like(v)) - mu_dot_v      # eq 99
+    A = loops.jacobian(q, t)
+    nu_At = jax.scipy.linalg.cho_solve(factor, A.T)
+    nu_dot_G = -jax.scipy.linalg.cho_solve(factor, mu_dot_v)
+    rhs = -(nu_At.T @ (tau - X) + loops.acceleration_bias(q, v, t) + A @ nu_dot_G)  # eq 98
+    K_c, rank = multipliers(A @ nu_At, rhs)
+    return tau - X + A.T @ K_c, K_c, rank

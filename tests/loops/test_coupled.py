@@ -61,7 +61,7 @@ def test_four_bar_matches_minimal_coordinates():
                     method="DOP853", rtol=1e-12, atol=1e-12)
     system = LoopSystem(LOOPS)
     sol = simulate(system, RK4(), Q0, V0, dt=5e-4, t1=0.5, saveat=[0.5])
-    assert sol.messages() == ["success"]
+    assert bool(sol.ok) and sol.messages() == ["redundant"]    # 5 equations of rank 2
     assert abs(float(sol.qs[-1, 0]) - ref.y[0, -1]) < 1e-8
     assert float(jnp.abs(LOOPS.phi(sol.qs[-1])).max()) < 1e-8
     E0, E1 = system.energy(Q0, V0), system.energy(sol.qs[-1], sol.us[-1])
