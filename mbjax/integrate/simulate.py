@@ -44,7 +44,9 @@ def simulate(system: AbstractSystem, integrator: AbstractIntegrator, q0: Array, 
 
     The steps run as a `lax.scan` nested in blocks whose length is the greatest common divisor of
     the save indices, so only saved states are kept (memory O(len(saveat)) for uniform saves).
-    The returned `Solution.status` flags non-finite states and unconverged implicit steps.
+    The returned `Solution.status` flags non-finite states and unconverged implicit steps, and
+    whatever the system's `check` reports at the ends of the blocks (every saved state). The
+    system's `constrain` runs after every step.
     """
     n_steps, idx = _save_indices(float(t0), float(t1), float(dt), saveat)
     block = math.gcd(*idx.tolist(), n_steps)
@@ -66,13 +68,14 @@ def _rollout(system, integrator, q0, u0, t0, dt, block: int, n_blocks: int, keep
         q1, u1 = system.constrain(t + dt, q1, u1)
         finite = jnp.all(jnp.isfinite(q1)) & jnp.all(jnp.isfinite(u1))
         status = (status | jnp.where(finite, 0, int(Status.NONFINITE))
-                  | jnp.where(converged, 0, int(Status.NOT_CONVERGED))
-                  | system.check(t + dt, q1, u1))
+                  | jnp.where(converged, 0, int(Status.NOT_CONVERGED)))
         return (q1, u1, status), None
 
     def run_block(carry, b):
-        carry, _ = jax.lax.scan(step, carry, b * block + jnp.arange(block))
-        return carry, carry[:2]
+        (q, u, status), _ = jax.lax.scan(step, carry, b * block + jnp.arange(block))
+        t = jnp.asarray(t0, dtype) + (b + 1) * block * jnp.asarray(dt, dtype)
+        status = status | system.check(t, q, u)          # at the block ends: the saved states
+        return (q, u, status), (q, u)
 
     init = (q0, u0, jnp.array(0, dtype=jnp.int32))
     final, (qs, us) = jax.lax.scan(run_block, init, jnp.arange(n_blocks))

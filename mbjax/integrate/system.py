@@ -47,6 +47,6 @@ class AbstractSystem(eqx.Module):
         return q, u
 
     def check(self, t: Array, q: Array, u: Array) -> Array:
-        """`Status` flags for the state after each step of `simulate` (a violated or redundant
-        constraint, `mbjax.loops`); 0 here."""
+        """`Status` flags for a state `simulate` saves (a violated or redundant constraint,
+        `mbjax.loops`); 0 here."""
         return jnp.array(0, jnp.int32)

@@ -3,10 +3,11 @@
 Every closed system takes the applied generalized forces as `tau` (a constant (nv,) array) plus
 an optional `force(t, q, v) -> (nv,)` (springs, dampers, motors: any callable, an `eqx.Module`
 if its parameters are to be differentiated or swept). After each step `simulate` calls
-`constrain` (projection onto Phi = 0 and A v + B = 0 when `projection=True`) and `check`, which
-flags `Status.CONSTRAINT_VIOLATED` once |Phi| exceeds `tolerance` and `Status.REDUNDANT` when the
-constraint Jacobian has lost rank (redundant closures, a singular configuration; the least-squares
-loads of `mbjax.loops.coupled.multipliers` keep the run finite).
+`constrain` (projection onto Phi = 0 and A v + B = 0 when `projection=True`), and at every
+saved state `check`, which flags `Status.CONSTRAINT_VIOLATED` once |Phi| exceeds `tolerance`
+and `Status.REDUNDANT` when the constraint Jacobian has lost rank (redundant closures, a
+singular configuration; the least-squares loads of `mbjax.loops.coupled.multipliers` keep the
+run finite).
 """
 
 from collections.abc import Callable
@@ -149,13 +150,19 @@ class StabilizedLoopSystem(_Closed):
     integrator such as `ImplicitMidpoint` takes any epsilon)."""
 
     epsilon: float = eqx.field(static=True)
+    kappa: float = eqx.field(static=True)
 
-    def __init__(self, loops: Loops, tau=None, epsilon: float = 0.0, projection: bool = False,
-                 force: Callable | None = None, tolerance: float = TOLERANCE):
+    def __init__(self, loops: Loops, tau=None, epsilon: float = 0.0, kappa: float = 0.0,
+                 projection: bool = False, force: Callable | None = None,
+                 tolerance: float = TOLERANCE):
         super().__init__(loops, tau, force, projection, tolerance)
-        if not epsilon >= 0:
-            raise ValueError(f"epsilon must be >= 0, got {epsilon}")
+        if not epsilon >= 0 or not kappa >= 0:
+            raise ValueError(f"epsilon and kappa must be >= 0, got {epsilon} and {kappa}")
+        if kappa and not epsilon:
+            raise ValueError("kappa is the position feedback of the epsilon-dynamics: "
+                             "set epsilon > 0 too")
         self.epsilon = float(epsilon)
+        self.kappa = float(kappa)
 
     def velocity(self, q, u):
         return u[:self.loops.model.nv]
@@ -164,14 +171,18 @@ class StabilizedLoopSystem(_Closed):
         return v if self.epsilon == 0.0 else jnp.concatenate([v, u[self.loops.model.nv:]])
 
     def initial_loads(self, q, v, t=0.0, *, consistent: bool = False) -> Array:
-        """The load state at (q, v): eq 89, f_c = (A v + B) / epsilon (zero on the constraints),
+        """The load state at (q, v): eq 89, f_c = (A v + B + kappa Phi) / epsilon (zero on the
+        constraints),
         or with consistent=True the algebraic loads of eq 93 at epsilon = 0, so that the error
         A v + B stays epsilon times the change of the loads rather than epsilon times the loads."""
         if self.epsilon == 0.0:
             raise ValueError("epsilon = 0 has no load state: the loads are algebraic")
         if consistent:
             return stabilized_acceleration(self.loops, q, v, self.applied(t, q, v), t)[1]
-        return self.loops.rate(q, v, t) / self.epsilon
+        error = self.loops.rate(q, v, t)
+        if self.kappa:
+            error = error + self.kappa * self.loops.phi(q, t)
+        return error / self.epsilon
 
     def acceleration(self, t, q, u):
         v = self.velocity(q, u)
@@ -180,7 +191,7 @@ class StabilizedLoopSystem(_Closed):
             return stabilized_acceleration(self.loops, q, v, tau, t)[0]
         v_dot, f_c_dot, _ = stabilized_acceleration(self.loops, q, v, tau, t,
                                                     f_c=u[self.loops.model.nv:],
-                                                    epsilon=self.epsilon)
+                                                    epsilon=self.epsilon, kappa=self.kappa)
         return jnp.concatenate([v_dot, f_c_dot])
 
     def loads(self, t, q, u) -> Array:

@@ -38,9 +38,27 @@ def _solve(D: Array, b: Array) -> Array:
 
 def aba(model: Model, q: Array, v: Array, tau: Array) -> Array:
     """Joint accelerations (nv,) of the tree at (q, v) under joint forces tau and gravity."""
+    return aba_responses(model, q, v, tau, jnp.zeros((0, model.nv), q.dtype))[0]
+
+
+def aba_responses(model: Model, q: Array, v: Array, tau: Array, loads: Array) -> tuple[Array, Array]:
+    """(u_dot, Gamma^T): the accelerations (nv,) under tau and gravity, and the accelerations
+    (m, nv) that each row of `loads` (m, nv) alone produces (no gravity, no velocity), the unit
+    constraint-load responses of seed 002 eqs 101-107.
+
+    The articulated inertias (I_3, U, D) depend on q only, so one triangularization serves every
+    load: the force recursion and the back-substitution run on 1 + m columns at once (seed 002's
+    O(n + m n) for the loads)."""
     kin = body_kinematics(model, q, v)
+    m = loads.shape[0]
     bias = cross_force(kin.V, jnp.einsum("kij,kj->ki", kin.I, kin.V))
     pad = (~model.v_mask).astype(q.dtype)                  # 1 on padded columns
+    # Columns: 0 the motion under tau, gravity and velocity; 1 ... m one load each.
+    zeros = jnp.zeros((model.n, 6, m), q.dtype)
+    F1 = jnp.concatenate([bias[..., None], zeros], -1)
+    c = jnp.concatenate([kin.c[..., None], zeros], -1)
+    t = jnp.concatenate([model.body_v(tau)[..., None],
+                         jax.vmap(model.body_v, out_axes=-1)(loads)], -1)
 
     def triangularize(received, inp):
         (IA, pA), (S, c, t, padding) = received, inp
@@ -48,19 +66,19 @@ def aba(model: Model, q: Array, v: Array, tau: Array) -> Array:
         D = S.T @ U + jnp.diag(padding)                 # padded columns: identity, u = 0
         u = t - S.T @ pA
         Ia = IA - U @ _solve(D, U.T)
-        pa = pA + Ia @ c + U @ _solve(D, u[:, None])[:, 0]
+        pa = pA + Ia @ c + U @ _solve(D, u)
         return (U, D, u), (Ia, pa)
 
-    (U, D, u), _ = backward_pass(model.topology, triangularize, (kin.I, bias),
-                                 (kin.S, kin.c, model.body_v(tau), pad))
+    (U, D, u), _ = backward_pass(model.topology, triangularize, (kin.I, F1), (kin.S, c, t, pad))
 
     def substitute(parent, inp):
         (a_parent, _), (S, c, U, D, u) = parent, inp
         a_prime = a_parent + c
-        qdd = _solve(D, (u - U.T @ a_prime)[:, None])[:, 0]
+        qdd = _solve(D, u - U.T @ a_prime)
         return a_prime + S @ qdd, qdd
 
+    ground = jnp.zeros((6, 1 + m), q.dtype).at[:, 0].set(gravity_acceleration(model))
     _, qdd = forward_pass(model.topology, substitute,
-                          (gravity_acceleration(model), jnp.zeros(model.width, q.dtype)),
-                          (kin.S, kin.c, U, D, u))
-    return model.flat_v(qdd)
+                          (ground, jnp.zeros((model.width, 1 + m), q.dtype)), (kin.S, c, U, D, u))
+    flat = jax.vmap(model.flat_v, in_axes=-1)(qdd)          # (1 + m, nv)
+    return flat[0], flat[1:]
