@@ -69,7 +69,8 @@ def test_reproduce_tree_scaling(tmp_path):
 def test_tour_quick(tmp_path):
     assert main(["tour", "--quick", "--out", str(tmp_path)]) == 0
     summary = json.loads((tmp_path / "summary.json").read_text())
-    assert set(summary["scenes"]) == {"torque-free-body", "heavy-top", "rigid-chain", "time-elements"}
+    assert set(summary["scenes"]) == {"torque-free-body", "heavy-top", "rigid-chain", "time-elements",
+                                      "closed-loops"}
     for scene in summary["scenes"].values():
         assert (tmp_path / scene["figure"]).stat().st_size > 10_000
     markdown = (tmp_path / "summary.md").read_text()
@@ -78,6 +79,9 @@ def test_tour_quick(tmp_path):
     assert rkmk4["final_error_rad"] < 1e-4 and rkmk4["status"] == "success"
     chain = summary["scenes"]["rigid-chain"]
     assert chain["reference_status"] == 0
+    loops = summary["scenes"]["closed-loops"]["integrators"]
+    assert loops["coupled, projection dt=2 ms"]["residual"] < 1e-10
+    assert loops["coupled, none dt=2 ms"]["error_rad"] < 1e-4
     rows = chain["integrators"]
     assert all(row["status"] == "success" for row in rows.values())
     # RK4 at 5 ms follows the Dopri8 reference of the falling chain to micro-radians
