@@ -4,10 +4,11 @@ Each suite is run(out: Path, quick: bool) -> list of records, written as out/SUI
 out/SUITE.png. Peers (MuJoCo, Pinocchio, exudyn) are measured in the same process when installed.
 """
 
-from mbjax.bench import integrators, rigid, tfe
+from mbjax.bench import integrators, loops, rigid, tfe
 
 SUITES = {
     integrators.NAME: integrators.run,
+    loops.NAME: loops.run,
     rigid.NAME: rigid.run,
     tfe.NAME: tfe.run,
 }

@@ -66,3 +66,27 @@ def tfe_bench_figure(records: list[dict]) -> Figure:
         ax.grid(True, which="both", alpha=0.3)
         ax.legend(fontsize=7, ncol=2)
     return fig
+
+
+def loops_bench_figure(records: list[dict]) -> Figure:
+    """`mbjax bench loops`: (a) error against run time per route on the 12-dof closed chain;
+    (b) run time of 1 s of simulation against n, O(n + m^3) against the dense route."""
+    fig = Figure(figsize=(12, 4.6), layout="constrained")
+    ax_w, ax_s = fig.subplots(1, 2)
+    wp = [r for r in records if r["kind"] == "work-precision"]
+    for route in dict.fromkeys(r["route"] for r in wp):
+        rows = [r for r in wp if r["route"] == route]
+        ax_w.loglog([r["run_s"] for r in rows], [r["error"] for r in rows], "o-", label=route)
+    ax_w.set(xlabel="run time [s]", ylabel="max joint-angle error [rad]",
+             title="(a) closed chain, 12 dof, 1 s, RK4")
+    sc = [r for r in records if r["kind"] == "scaling"]
+    for route in dict.fromkeys(r["route"] for r in sc):
+        rows = [r for r in sc if r["route"] == route]
+        ax_s.loglog([r["n"] for r in rows], [r["run_s_per_simulated_s"] for r in rows], "o-",
+                    label=route)
+    ax_s.set(xlabel="n (tree degrees of freedom)", ylabel="run time per simulated second [s]",
+             title="(b) scaling (seed 002 Fig. 8)")
+    for ax in (ax_w, ax_s):
+        ax.grid(alpha=0.3, which="both")
+        ax.legend(fontsize=8)
+    return fig
