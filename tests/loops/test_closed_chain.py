@@ -32,6 +32,10 @@ def test_order_n_route_agrees_with_the_coupled_one_on_the_closed_chain():
     assert dense.messages() == recursive.messages() == ["success"]
     np.testing.assert_allclose(recursive.qs, dense.qs, atol=1e-12)
     assert float(jnp.abs(loops.phi(dense.qs[-1])).max()) < 1e-8
+    # the free chain (gravity only, ideal joints and closure) conserves its energy
+    system = LoopSystem(loops)
+    energies = np.array([system.energy(q, v) for q, v in zip(dense.qs, dense.us)])
+    np.testing.assert_allclose(energies, energies[0], rtol=0, atol=1e-9 * abs(energies[0]))
 
 
 def test_bad_chain_size():
