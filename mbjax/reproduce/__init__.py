@@ -3,7 +3,7 @@
 Each entry is reproduce(out: Path, quick: bool) -> dict (the JSON written).
 """
 
-from mbjax.reproduce import closed_chain, integrators, top_long_run, torque_free_tfe, tree_scaling, vertical_top
+from mbjax.reproduce import andrews_squeezer, closed_chain, integrators, top_long_run, torque_free_tfe, tree_scaling, vertical_top
 
 REPRODUCTIONS = {
     integrators.NAME: integrators.reproduce,
@@ -12,6 +12,7 @@ REPRODUCTIONS = {
     torque_free_tfe.NAME: torque_free_tfe.reproduce,
     top_long_run.NAME: top_long_run.reproduce,
     closed_chain.NAME: closed_chain.reproduce,
+    andrews_squeezer.NAME: andrews_squeezer.reproduce,
 }
 
 __all__ = ["REPRODUCTIONS"]
