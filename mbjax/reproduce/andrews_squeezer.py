@@ -11,9 +11,7 @@ finest run (the self-convergence, which shows RK4's order 4 without the floor be
 against the reference stops falling near 1e-9 rad: integrating the test set's own index-1
 equations with scipy's DOP853 (rtol = atol = 1e-13 ... 3e-14) and with RK4 at dt = 1e-6 gives the
 same end state to about 1e-11, which differs from the published reference by 1.4e-9 in beta and
-Theta (1e-10 relative); mbjax's multipliers are Tikhonov-regularized (rho = 1e-12 trace / m in
-`mbjax.loops.coupled.multipliers`), which here biases the accelerations by about 1e-10 relative
-and the end state by about 2e-9 (with rho = 0 the converged state matches DOP853's to 1e-11).
+Theta (1e-10 relative), the floor of the published values.
 
 Full run: dt = DT (5 us) and the study STEPS, plus the same run by projection after every step
 (`LoopSystem(projection=True)`) and by seed 002's O(n + m^3) route (`StabilizedLoopSystem`);
