@@ -11,31 +11,13 @@ from scipy.integrate import solve_ivp
 from mbjax.integrate import RK4, simulate
 from mbjax.loops import (CutJoint, Loops, LoopSystem, Prescribed, StabilizedLoopSystem,
                          coupled_acceleration)
-from mbjax.model import Model
 from mbjax.rigid import kinetic_energy, potential_energy
+from mbjax.scenes import four_bar
+from mbjax.scenes.four_bar import OMEGA0, THETA0, joint_angles
 
-A_, B_, C_, D_ = 0.1, 0.35, 0.25, 0.4          # crank, coupler, rocker, ground link [m]
-LENGTHS, MASSES = np.array([A_, B_, C_]), np.array([0.5, 1.0, 0.8])
-MODEL = Model([-1, 0, -1], "revolute", mass=MASSES,
-              inertia=np.array([np.diag([1e-5, m * L**2 / 12, m * L**2 / 12])
-                                for m, L in zip(MASSES, LENGTHS)]),
-              com=np.stack([LENGTHS / 2, 0 * LENGTHS, 0 * LENGTHS], 1), axis=[0.0, 0.0, 1.0],
-              placement_translation=[[0, 0, 0], [A_, 0, 0], [D_, 0, 0]], gravity=(0.0, -9.81, 0.0))
-LOOPS = Loops(MODEL, [CutJoint("revolute", 1, 2, origin_a=(B_, 0, 0), origin_b=(C_, 0, 0))])
-
-
-def joint_angles(theta):
-    """Tree coordinates of the closed four-bar at crank angle theta (closed-form position
-    analysis, elbow-up branch)."""
-    P = jnp.array([A_ * jnp.cos(theta), A_ * jnp.sin(theta)])
-    e = jnp.array([D_, 0.0]) - P
-    r = jnp.linalg.norm(e)
-    x = (r**2 + B_**2 - C_**2) / (2 * r)
-    u = e / r
-    Q = P + x * u + jnp.sqrt(B_**2 - x**2) * jnp.array([-u[1], u[0]])
-    phi = jnp.arctan2(Q[1] - P[1], Q[0] - P[0])
-    psi = jnp.arctan2(Q[1], Q[0] - D_)
-    return jnp.array([theta, phi - theta, psi])
+# the four-bar scene closed by the spatial revolute cut joint: 5 equations of rank 2
+LOOPS, Q0, V0 = four_bar.build(closure="revolute")
+MODEL = LOOPS.model
 
 
 def minimal_rhs(y):
@@ -48,11 +30,6 @@ def minimal_rhs(y):
     m = jax.grad(jax.grad(lagrangian, 1), 1)(theta, omega)
     mixed = jax.grad(jax.grad(lagrangian, 1), 0)(theta, omega)
     return jnp.array([omega, (jax.grad(lagrangian, 0)(theta, omega) - mixed * omega) / m])
-
-
-THETA0, OMEGA0 = 0.3, 2.0
-Q0 = joint_angles(THETA0)
-V0 = jax.jacfwd(joint_angles)(THETA0) * OMEGA0
 
 
 def test_four_bar_matches_minimal_coordinates():
