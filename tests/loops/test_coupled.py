@@ -96,7 +96,7 @@ def test_order_n_stabilization_agrees_with_the_coupled_solution():
     ts = np.linspace(0.0, 0.5, 6)
     coupled = simulate(LoopSystem(LOOPS), RK4(), Q0, V0, dt=1e-3, t1=0.5, saveat=ts)
     recursive = simulate(StabilizedLoopSystem(LOOPS), RK4(), Q0, V0, dt=1e-3, t1=0.5, saveat=ts)
-    assert recursive.messages() == ["success"]
+    assert recursive.messages() == coupled.messages() == ["redundant"]
     np.testing.assert_allclose(recursive.qs, coupled.qs, atol=1e-12)
     np.testing.assert_allclose(recursive.us, coupled.us, atol=1e-10)
 
@@ -107,7 +107,8 @@ def test_epsilon_dynamics_keeps_the_velocity_error_at_epsilon_times_the_loads():
     system = StabilizedLoopSystem(LOOPS, epsilon=1e-2)
     u0 = jnp.concatenate([V0, system.initial_loads(Q0, V0)])
     sol = simulate(system, RK4(), Q0, u0, dt=5e-4, t1=0.2, saveat=np.linspace(0.0, 0.2, 5))
-    assert sol.messages() == ["success"]
+    # the velocity error epsilon f_c moves Phi past the default tolerance: the status says so
+    assert sol.messages() == ["constraint violated, redundant"]
     rates = jax.vmap(LOOPS.rate)(sol.qs, sol.us[:, :3])
     np.testing.assert_allclose(rates, 1e-2 * sol.us[:, 3:], atol=1e-9)
     assert float(jnp.abs(sol.us[-1, 3:]).max()) > 1.0        # the loads did act
