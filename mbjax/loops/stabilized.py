@@ -6,7 +6,8 @@ gravity and no velocity gives the columns of Gamma (eqs 102-107: zeta = -Gamma f
 
     u_dot + Gamma f_c = eta                                                   (eq 108)
 
-costs one triangularization and m + 1 force passes of O(n) (`mbjax.rigid.aba.aba_responses`). The constraint loads f_c follow from A u_dot + b = 0:
+costs one triangularization and m + 1 force passes of O(n) (`mbjax.rigid.aba.aba_responses`).
+The constraint loads f_c follow from A u_dot + b = 0:
 
 - epsilon = 0: (A Gamma) f_c = A eta + b, an m x m solve, O(m^3) (regularized and rank-checked
   as in `mbjax.loops.coupled.multipliers`);
