@@ -1,0 +1,86 @@
+"""Geometrically nonlinear ANCF references for seed 002's flexible examples (§3.1, §3.2), to
+validate the modal model with geometric stiffening (seed 002 eqs 32-33). Parameterised: nothing
+here is a stored result.
+"""
+
+from typing import NamedTuple
+
+import jax
+import jax.numpy as jnp
+import numpy as np
+
+from mbjax.flex.ancf import AncfBeam, AncfSolution, simulate
+
+INCH = 0.0254
+
+
+def spin_up_theta(t, T_s=15.0, omega_s=6.0):
+    """Base angle of Kane's spin-up (seed 002 eq 109, here for any T_s, omega_s): the integral of
+    omega(t) = (omega_s / T_s) (t - (T_s / 2 pi) sin(2 pi t / T_s)) for t < T_s, omega_s after."""
+    c = T_s / (2 * np.pi)
+    ramp = lambda t: omega_s / T_s * (t**2 / 2 + c**2 * (jnp.cos(t / c) - 1))
+    return jnp.where(t < T_s, ramp(t), ramp(T_s) + omega_s * (t - T_s))
+
+
+class SpinUpResult(NamedTuple):
+    ts: jax.Array
+    tip_deflection: jax.Array   # along the rotating y axis (-sin theta, cos theta), m; < 0 lagging
+    tip_axial: jax.Array        # along (cos theta, sin theta), minus L, m
+    solution: AncfSolution
+
+
+def spin_up_beam_reference(n_elements=8, ts=None, *, dt=None, safety=0.5, length=10.0, E=7.0e10,
+                           A=4.0e-4, I=2.0e-7, mass=12.0, T_s=15.0, omega_s=6.0) -> SpinUpResult:
+    """Kane's spin-up beam (seed 002 §3.2, eq 109; Kane, Ryan & Banerjee 1987) as an ANCF beam in
+    the x-y plane: node 0 clamped on the axis (position 0, slope (cos theta, sin theta)
+    prescribed), starting straight along x at rest. ts defaults to 0 ... 20 s every 0.1 s.
+    The unit-length root slope also fixes the axial strain at the root to 0, an O(element)
+    error in the axial response that vanishes with the mesh (the transverse one is unaffected)."""
+    ts = np.linspace(0.0, 20.0, 201) if ts is None else np.asarray(ts, float)
+    beam = AncfBeam(length, E * A, E * I, mass / length, n_elements)
+    theta = lambda t: spin_up_theta(t, T_s, omega_s)
+    e_p = lambda t: jnp.stack([0.0 * t, 0.0 * t, jnp.cos(theta(t)), jnp.sin(theta(t))])
+    e0 = beam.initial_coordinates()
+    sol = simulate(beam, e0, jnp.zeros_like(e0), ts, prescribed=range(4), e_p=e_p, dt=dt,
+                   safety=safety)
+    tip, th = sol.e[:, -4:-2], theta(sol.ts)
+    return SpinUpResult(sol.ts, -jnp.sin(th) * tip[:, 0] + jnp.cos(th) * tip[:, 1],
+                        jnp.cos(th) * tip[:, 0] + jnp.sin(th) * tip[:, 1] - length, sol)
+
+
+class SliderCrankResult(NamedTuple):
+    ts: jax.Array
+    midpoint_deflection: jax.Array   # inches, from chord PQ, + away from O at t = 0
+    solution: AncfSolution
+
+
+def slider_crank_reference(n_elements=4, ts=None, *, dt=None, safety=0.5, crank=6 * INCH,
+                           rod=12 * INCH, diameter=0.25 * INCH, E=3.0e7 * 4.4482216152605 / INCH**2,
+                           mass=0.1667 * 0.45359237, Omega=125.6) -> SliderCrankResult:
+    """Seed 002 §3.1 flexible slider-crank (SI inside, deflection reported in inches): rigid crank
+    O-P at constant Omega counter-clockwise from P(0) = (0, crank); elastic rod P-Q as an ANCF
+    beam with P's position prescribed and Q's y prescribed 0 (massless slider on the x axis), both
+    slopes and Q's x free. Initial state: the rigid mechanism's rod, straight and unstrained, with
+    the velocities of the rigid mechanism (jax.jvp of its coordinates in time; at t = 0 a pure
+    translation with P's velocity). ts defaults to 0 ... 0.15 s every 0.5 ms."""
+    ts = np.linspace(0.0, 0.15, 301) if ts is None else np.asarray(ts, float)
+    area, inertia = np.pi * diameter**2 / 4, np.pi * diameter**4 / 64
+    beam = AncfBeam(rod, E * area, E * inertia, mass / rod, n_elements)
+    P = lambda t: crank * jnp.stack([jnp.cos(np.pi / 2 + Omega * t), jnp.sin(np.pi / 2 + Omega * t)])
+
+    def rigid(t):
+        """Coordinates of the rigid rod from P(t) to Q(t) = (P_x + sqrt(rod^2 - P_y^2), 0)."""
+        p = P(t)
+        q = jnp.stack([p[0] + jnp.sqrt(rod**2 - p[1] ** 2), 0.0 * t])
+        return beam.initial_coordinates(p, jnp.arctan2(q[1] - p[1], q[0] - p[0]))
+
+    e0, e_dot0 = jax.jvp(rigid, (jnp.array(0.0),), (jnp.array(1.0),))
+    q_y = 4 * n_elements + 1
+    sol = simulate(beam, e0, e_dot0, ts, prescribed=(0, 1, q_y), dt=dt, safety=safety,
+                   e_p=lambda t: jnp.concatenate([P(t), jnp.zeros(1) * t]))
+    p, q = sol.e[:, :2], sol.e[:, q_y - 1:q_y + 1]
+    u = (q - p) / jnp.linalg.norm(q - p, axis=1, keepdims=True)
+    mid = jax.vmap(beam.position, (0, None))(sol.e, rod / 2)
+    # n = u rotated by +90 deg points away from O at t = 0 (and keeps n_y > 0 since Q_x > P_x)
+    d = jnp.sum((mid - p) * jnp.stack([-u[:, 1], u[:, 0]], 1), axis=1)
+    return SliderCrankResult(sol.ts, d / INCH, sol)
