@@ -297,7 +297,8 @@ def _eigh(A):
     """`jnp.linalg.eigh` whose eigenvector tangent drops the 1/(lam_j - lam_i) terms of (numerically)
     equal eigenvalues. A symmetric perturbation of a symmetric structure (both bending planes of a
     round section) does not couple such a pair, so the dropped term is 0 * inf, not information."""
-    return jnp.linalg.eigh(A)
+    lam, V = jnp.linalg.eigh(A)
+    return lam, V
 
 
 @_eigh.defjvp
