@@ -22,10 +22,11 @@ with the "elastic line" strain measures of Gerstmayr & Irschik (J. Sound Vib. 31
 Dynamics with prescribed coordinates (`simulate`): coordinates split into free f and prescribed p
 (static index sets), e_p(t) a user function of time whose velocities and accelerations come from
 `jax.jvp`; M_ff e_f'' = -dU/de_f - M_fp e_p''(t) + Q_f (gravity, applied generalized forces).
-No damping. Time stepping is classical RK4 in one jitted `lax.scan` with a step set by the
-highest frequency of the linearised system (`stable_step`). On this 2-core CPU it reached the
-converged spin-up response faster than diffrax's implicit Kvaerno5 (numbers in the module's
-report, `mbjax/flex/references.py`).
+`simulate_embedded` generalises this to e = embed(t, q) affine in q (e.g. a clamp that prescribes
+the slope's direction but not its length). No damping. Time stepping is classical RK4 in one
+jitted `lax.scan`, the step set by the highest frequency of the linearised system (`stable_step`,
+the axial modes: omega_max ~ 49 n sqrt(EA / rhoA) / L). The cost grows as n^2 (steps ~ n, work per
+step ~ n): the 20 s spin-up takes ~30 s at 4 elements, ~90 s at 8 on a shared 2-core CPU.
 """
 
 from collections.abc import Callable
@@ -158,57 +159,54 @@ def _split(n, prescribed):
     return np.setdiff1d(np.arange(n), p), p
 
 
-def _prescribed(e_p, t):
-    """(e_p, e_p', e_p'') at t by nested forward-mode derivatives of the user's t -> e_p(t)."""
-    v = lambda t_: jax.jvp(e_p, (t_,), (jnp.ones_like(t_),))
-    (x, xd), (_, xdd) = jax.jvp(v, (t,), (jnp.ones_like(t),))
-    return x, xd, xdd
+def _kinematics(embed, t, q, q_dot):
+    """(e, e_dot, G = de/dq, c) for e = embed(t, q) affine in q, so that e_ddot = G q_ddot + c
+    with c = d^2/dtau^2 embed(t + tau, q + tau q_dot) at tau = 0 (nested jax.jvp)."""
+    path = lambda tau: embed(t + tau, q + tau * q_dot)
+    one = jnp.ones_like(t)
+    (e, e_dot), (_, c) = jax.jvp(lambda tau: jax.jvp(path, (tau,), (one,)), (0.0 * t,), (one,))
+    return e, e_dot, jax.jacfwd(embed, argnums=1)(t, q), c
 
 
-def stable_step(beam: AncfBeam, e, prescribed=(), safety=0.5) -> float:
-    """RK4 step safety * 2.83 / omega_max, omega_max the highest frequency of the linearised free
-    coordinates at e (generalised eigenproblem K_ff x = omega^2 M_ff x, K = hessian of U). RK4's
-    stability interval on the imaginary axis is |omega dt| < 2 sqrt 2."""
-    f, _ = _split(beam.n_coordinates, prescribed)
-    K = jax.hessian(beam.elastic_energy)(jnp.asarray(e))[np.ix_(f, f)]
-    Lc = jnp.linalg.cholesky(beam.mass_matrix()[np.ix_(f, f)])
+def stable_step(beam: AncfBeam, e, prescribed=(), safety=0.5, G=None) -> float:
+    """RK4 step safety * 2.83 / omega_max, omega_max the highest frequency of the linearised
+    system at e: K_q x = omega^2 M_q x with K_q = G^T K G, M_q = G^T M G, K the hessian of U and G
+    the free columns (or a given de/dq). RK4's stability interval on the imaginary axis is
+    |omega dt| < 2 sqrt 2."""
+    G = np.eye(beam.n_coordinates)[:, _split(beam.n_coordinates, prescribed)[0]] if G is None else G
+    K = G.T @ jax.jit(jax.hessian(beam.elastic_energy))(jnp.asarray(e)) @ G
+    Lc = jnp.linalg.cholesky(G.T @ beam.mass_matrix() @ G)
     A = jax.scipy.linalg.solve_triangular(Lc, jax.scipy.linalg.solve_triangular(Lc, K, lower=True).T,
                                           lower=True)
     omega_max = float(jnp.sqrt(jnp.max(jnp.linalg.eigvalsh((A + A.T) / 2))))
     return safety * 2.0 * np.sqrt(2.0) / omega_max
 
 
-def simulate(beam: AncfBeam, e0, e_dot0, ts, *, prescribed=(), e_p: Callable | None = None,
-             dt: float | None = None, safety: float = 0.5, gravity=None,
-             force: Callable | None = None) -> AncfSolution:
-    """Integrate M_ff e_f'' = -dU/de_f - M_fp e_p''(t) + Q_f from (e0, e_dot0) at ts[0], saving at
-    the concrete, increasing times ts. `prescribed`: static global indices; `e_p(t)` returns their
-    values (positions only; velocities and accelerations by jax.jvp). Q = M e_g for `gravity` g
-    (2-vector) plus `force(t, e, e_dot)` (generalized forces, full length). Classical RK4 in one
-    jitted lax.scan, each save interval split into the same number of equal steps <= dt; dt
-    defaults to `stable_step` at e0. The free entries of e0, e_dot0 are the initial state; the
-    prescribed ones are overwritten by e_p."""
+def simulate_embedded(beam: AncfBeam, embed: Callable, q0, q_dot0, ts, *, dt: float | None = None,
+                      safety: float = 0.5, gravity=None, force: Callable | None = None,
+                      constant_mass: bool = False) -> AncfSolution:
+    """Beam coordinates given by generalized coordinates q through e = embed(t, q), affine in q
+    (prescribed coordinates, a prescribed slope direction with free magnitude, ...). Lagrange's
+    equations: (G^T M G) q_ddot = G^T (Q - M c), G = de/dq, c as in `_kinematics`, Q = -dU/de +
+    M e_g (`gravity` g) + `force(t, e, e_dot)`. Classical RK4 in one jitted lax.scan; each interval
+    of the concrete, increasing save times ts is split into the same number of equal steps <= dt,
+    dt defaulting to `stable_step` at t = ts[0]. `constant_mass`: G does not depend on t, so
+    G^T M G is factored once."""
     ts = np.asarray(ts, float)
-    f, p = _split(beam.n_coordinates, prescribed)
-    if len(p) and e_p is None:
-        raise ValueError("prescribed coordinates need e_p(t)")
-    e_p = e_p if len(p) else (lambda t: jnp.zeros(0))
-    dt = stable_step(beam, e0, p, safety) if dt is None else float(dt)
+    q0, q_dot0 = jnp.asarray(q0, float), jnp.asarray(q_dot0, float)
+    G0 = jax.jacfwd(embed, argnums=1)(jnp.asarray(ts[0]), q0)
+    dt = stable_step(beam, embed(jnp.asarray(ts[0]), q0), safety=safety, G=G0) if dt is None else float(dt)
     m = max(1, int(np.ceil(np.max(np.diff(ts), initial=0.0) / dt)))
     M = beam.mass_matrix()
-    Lff, Mfp = jnp.linalg.cholesky(M[np.ix_(f, f)]), M[np.ix_(f, p)]
     Qg = jnp.zeros(beam.n_coordinates) if gravity is None else beam.gravity_force(gravity)
-
-    def full(t, x, v):
-        ep, vp, ap = _prescribed(e_p, t)
-        return (jnp.zeros(beam.n_coordinates).at[f].set(x).at[p].set(ep),
-                jnp.zeros(beam.n_coordinates).at[f].set(v).at[p].set(vp), ap)
+    L0 = jnp.linalg.cholesky(G0.T @ M @ G0)
 
     def rhs(t, y):
-        x, v = y
-        e, e_dot, ap = full(t, x, v)
+        q, q_dot = y
+        e, e_dot, G, c = _kinematics(embed, t, q, q_dot)
         Q = beam.elastic_force(e) + Qg + (0.0 if force is None else force(t, e, e_dot))
-        return v, jax.scipy.linalg.cho_solve((Lff, True), Q[f] - Mfp @ ap)
+        Lq = L0 if constant_mass else jnp.linalg.cholesky(G.T @ M @ G)
+        return q_dot, jax.scipy.linalg.cho_solve((Lq, True), G.T @ (Q - M @ c))
 
     def rk4(carry, _):
         (t, y), h = carry
@@ -219,17 +217,34 @@ def simulate(beam: AncfBeam, e0, e_dot0, ts, *, prescribed=(), e_p: Callable | N
         y = jax.tree.map(lambda a, b1, b2, b3, b4: a + h / 6 * (b1 + 2 * b2 + 2 * b3 + b4), y, k1, k2, k3, k4)
         return ((t + h, y), h), None
 
+    def save(t, y):
+        e, e_dot, _, _ = _kinematics(embed, t, *y)
+        return e, e_dot
+
     def interval(y, t01):
         ((_, y), _), _ = jax.lax.scan(rk4, ((t01[0], y), (t01[1] - t01[0]) / m), None, length=m)
-        e, e_dot, _ = full(t01[1], *y)
-        return y, (e, e_dot)
+        return y, save(t01[1], y)
 
     @jax.jit
-    def run(e0, e_dot0):
-        y0 = (jnp.asarray(e0, float)[f], jnp.asarray(e_dot0, float)[f])
+    def run(y0):
         _, (es, eds) = jax.lax.scan(interval, y0, jnp.stack([ts[:-1], ts[1:]], 1))
-        e_0, ed_0, _ = full(ts[0], *y0)
+        e_0, ed_0 = save(jnp.asarray(ts[0]), y0)
         return jnp.concatenate([e_0[None], es]), jnp.concatenate([ed_0[None], eds])
 
-    es, eds = run(e0, e_dot0)
+    es, eds = run((q0, q_dot0))
     return AncfSolution(jnp.asarray(ts), es, eds, dt)
+
+
+def simulate(beam: AncfBeam, e0, e_dot0, ts, *, prescribed=(), e_p: Callable | None = None,
+             **kwargs) -> AncfSolution:
+    """M_ff e_f'' = -dU/de_f - M_fp e_p''(t) + Q_f from (e0, e_dot0) at ts[0]: `prescribed` static
+    global indices whose values the user's `e_p(t)` gives (positions only; velocities and
+    accelerations by jax.jvp), the rest free. The prescribed entries of e0, e_dot0 are ignored.
+    Keyword arguments (dt, safety, gravity, force) as in `simulate_embedded`."""
+    f, p = _split(beam.n_coordinates, prescribed)
+    if len(p) and e_p is None:
+        raise ValueError("prescribed coordinates need e_p(t)")
+    embed = lambda t, q: jnp.zeros(beam.n_coordinates, q.dtype).at[f].set(q).at[p].set(
+        e_p(t) if len(p) else jnp.zeros(0))
+    return simulate_embedded(beam, embed, jnp.asarray(e0, float)[f], jnp.asarray(e_dot0, float)[f], ts,
+                             constant_mass=True, **kwargs)

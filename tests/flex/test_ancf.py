@@ -1,0 +1,134 @@
+"""Planar ANCF beam (mbjax.flex.ancf) and the seed 002 §3.1 / §3.2 references built on it."""
+
+import jax
+import jax.numpy as jnp
+import numpy as np
+import pytest
+import scipy.linalg
+
+from mbjax.flex import AncfBeam, simulate_ancf, slider_crank_reference, spin_up_beam_reference
+from mbjax.flex.references import INCH
+
+L, EA, EI, RHOA = 10.0, 2.8e7, 1.4e4, 1.2   # the spin-up beam (seed 002 §3.2)
+
+
+def clamped(beam):
+    """Linearised cantilever at the straight state, K_ff and M_ff: node 0's position and transverse
+    slope dy/ds fixed, its dx/ds (the axial strain at the root) free."""
+    f = np.setdiff1d(np.arange(beam.n_coordinates), [0, 1, 3])
+    K = jax.jit(jax.hessian(beam.elastic_energy))(beam.initial_coordinates())
+    return np.asarray(K)[np.ix_(f, f)], np.asarray(beam.mass_matrix())[np.ix_(f, f)]
+
+
+@pytest.mark.parametrize("origin, angle", [((0.0, 0.0), 0.0), ((1.5, -2.0), 0.7), ((-3.0, 4.0), -2.9)])
+def test_rigid_motion_is_strain_free(origin, angle):
+    beam = AncfBeam(L, EA, EI, RHOA, 3)
+    e = beam.initial_coordinates(origin, angle)
+    assert abs(beam.elastic_energy(e)) < 1e-20
+    np.testing.assert_allclose(beam.elastic_force(e), 0.0, atol=1e-14 * EA)  # round-off of EA eps
+    np.testing.assert_allclose(beam.position(e, 0.37 * L), jnp.asarray(origin) + 0.37 * L * jnp.stack(
+        [jnp.cos(angle), jnp.sin(angle)]), atol=1e-12)
+
+
+def test_mass_matrix_mass_and_moments():
+    beam = AncfBeam(L, EA, EI, RHOA, 4)
+    M, e = beam.mass_matrix(), beam.initial_coordinates((0.0, 0.0), 0.0)
+    ux = jnp.tile(jnp.array([1.0, 0.0, 0.0, 0.0]), 5)           # unit rigid translation along x
+    np.testing.assert_allclose(M, M.T, atol=0)
+    np.testing.assert_allclose(ux @ M @ ux, RHOA * L, rtol=1e-13)          # total mass
+    np.testing.assert_allclose(ux @ M @ e, RHOA * L**2 / 2, rtol=1e-13)    # first moment
+    np.testing.assert_allclose(e @ M @ e, RHOA * L**3 / 3, rtol=1e-13)     # second moment
+    assert np.all(np.linalg.eigvalsh(np.asarray(M)) > 0)
+
+
+def test_cantilever_frequencies_match_euler_bernoulli():
+    K, M = clamped(AncfBeam(L, EA, EI, RHOA, 6))
+    w = np.sqrt(scipy.linalg.eigh(K, M, eigvals_only=True))
+    bending = np.array([1.8751, 4.6941, 7.8548]) ** 2 * np.sqrt(EI / (RHOA * L**4))
+    np.testing.assert_allclose(w[:3], bending, rtol=2e-4)
+    axial = np.pi / 2 * np.sqrt(EA / RHOA) / L
+    assert np.min(np.abs(w / axial - 1)) < 1e-5
+
+
+def test_static_tip_deflection():
+    """Small tip load: Newton on the nonlinear equilibrium, tip deflection vs P L^3 / (3 EI)."""
+    beam = AncfBeam(L, EA, EI, RHOA, 2)
+    P, f = 1e-3, np.setdiff1d(np.arange(beam.n_coordinates), [0, 1, 3])
+    hessian = jax.jit(jax.hessian(beam.elastic_energy))
+    Q = jnp.zeros(beam.n_coordinates).at[-3].set(P)
+    e = beam.initial_coordinates()
+    for _ in range(3):
+        r = (beam.elastic_force(e) + Q)[f]
+        K = hessian(e)[np.ix_(f, f)]
+        e = e.at[f].add(jnp.linalg.solve(K, r))
+    np.testing.assert_allclose(e[-3], P * L**3 / (3 * EI), rtol=1e-7)
+
+
+def test_free_oscillation_conserves_energy():
+    beam = AncfBeam(1.0, 1e4, 10.0, 1.0, 3)
+    e0 = beam.initial_coordinates((0.0, 0.0), 0.3)
+    s = jnp.repeat(jnp.linspace(0.0, 1.0, 4), 4)
+    e_dot0 = jnp.where(jnp.arange(16) % 4 == 1, 2.0 * s**2, 0.0) + jnp.where(jnp.arange(16) % 4 == 0, 0.5, 0.0)
+    sol = simulate_ancf(beam, e0, e_dot0, np.linspace(0.0, 1.0, 11))
+    H = jax.vmap(lambda e, v: beam.elastic_energy(e) + beam.kinetic_energy(v))(sol.e, sol.e_dot)
+    assert float(jnp.max(jax.vmap(beam.elastic_energy)(sol.e))) > 0.01 * float(H[0])
+    np.testing.assert_allclose(H, H[0], rtol=1e-6)
+    # momentum of the free beam: M e_dot summed over the node positions' x and y
+    p = sol.e_dot @ beam.mass_matrix()
+    np.testing.assert_allclose(p[:, 0::4].sum(1), p[0, 0::4].sum(), atol=1e-9)
+
+
+def test_spin_up_converges_with_mesh_and_step():
+    ts = np.linspace(0.0, 2.0, 5)
+    ref = spin_up_beam_reference(4, ts).tip_deflection
+    finer = spin_up_beam_reference(8, ts).tip_deflection
+    smaller = spin_up_beam_reference(4, ts, safety=0.25).tip_deflection
+    assert -0.2 < float(ref[-1]) < -0.01                   # lags the rotation
+    np.testing.assert_allclose(finer, ref, rtol=1e-3, atol=1e-6)
+    np.testing.assert_allclose(smaller, ref, rtol=1e-6, atol=1e-9)
+
+
+def test_slider_crank_stays_on_its_constraints():
+    r = slider_crank_reference(2, np.linspace(0.0, 0.05, 51))      # one crank revolution
+    e, ts = r.solution.e, r.ts
+    P = 6 * INCH * jnp.stack([jnp.cos(np.pi / 2 + 125.6 * ts), jnp.sin(np.pi / 2 + 125.6 * ts)], 1)
+    np.testing.assert_allclose(e[:, :2], P, atol=1e-14)
+    np.testing.assert_allclose(e[:, 9], 0.0, atol=1e-14)
+    # rigid-mechanism start: pure translation with P's velocity, undeformed
+    np.testing.assert_allclose(r.solution.e_dot[0, 0::4], -6 * INCH * 125.6, rtol=1e-12)
+    np.testing.assert_allclose(r.solution.e_dot[0, 1::4], 0.0, atol=1e-12)
+    np.testing.assert_allclose(r.solution.e_dot[0, 2::4], 0.0, atol=1e-12)
+    assert r.midpoint_deflection[0] == pytest.approx(0.0, abs=1e-12)
+    assert 1e-3 < float(jnp.max(jnp.abs(r.midpoint_deflection))) < 0.5
+    # Q slides: the rod's length between its ends stays close to 12 in (axially stiff)
+    chord = jnp.linalg.norm(e[:, 8:10] - e[:, :2], axis=1)
+    np.testing.assert_allclose(chord, 12 * INCH, rtol=1e-3)
+
+
+@pytest.mark.slow
+def test_slider_crank_periodic_and_mesh_converged():
+    ts = np.linspace(0.0, 0.15, 151)
+    d2 = np.asarray(slider_crank_reference(2, ts).midpoint_deflection)
+    d4 = np.asarray(slider_crank_reference(4, ts).midpoint_deflection)
+    peaks = np.abs(d4[1:]).reshape(3, 50).max(1)                     # per crank revolution
+    assert peaks.max() < 1.5 * peaks.min()
+    assert np.max(np.abs(d4 - d2)) < 0.05 * np.max(np.abs(d4))
+
+
+@pytest.mark.slow
+def test_spin_up_full_run_peak_converges():
+    ts = np.linspace(0.0, 20.0, 2001)
+    peaks = []
+    for n in (4, 8):
+        d = np.asarray(spin_up_beam_reference(n, ts).tip_deflection)
+        peaks.append(np.max(np.abs(d)))
+    assert peaks[1] < 1.0
+    assert abs(peaks[1] - peaks[0]) < 1e-3 * peaks[1]
+
+
+def test_spin_up_root_clamp_variants_agree_transversally():
+    """Prescribing the root slope's length too (eps(0) = 0) changes the tip deflection little."""
+    ts = np.linspace(0.0, 1.0, 3)
+    a = spin_up_beam_reference(2, ts).tip_deflection
+    b = spin_up_beam_reference(2, ts, free_root_stretch=False).tip_deflection
+    np.testing.assert_allclose(a, b, rtol=1e-3)
