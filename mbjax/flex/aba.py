@@ -1,0 +1,148 @@
+"""O(n) forward dynamics of rigid and modal flexible bodies: seed 002 §2.3(ii)-(iii), eqs 48-86.
+
+The three passes of `mbjax.rigid.aba`, with each body a (6 + mu)-block: its rigid frame's
+spatial acceleration A and its modal accelerations u_dot.
+
+(ii) inward, per body k (eqs 48-81): the body's own generalized mass and remainder force (the
+     `ModalBody` in its frame, moved to ground components: I = X^-T M X^-1), its elastic force
+     K q + D u and the geometric stiffening K_G q = G_s A + g_s (eqs 32-33, 46-47), plus what its
+     children sent. The modal accelerations are eliminated first (eq 53's inverse of the modal
+     mass M^{B^k}, now including the children's articulated inertia):
+
+         u_dot = -Y_A A - Y_p,   [Y_A, Y_p] = IA_ff^-1 [IA_fA, pA_f - Q_f]
+         I6 = IA_AA - IA_Af Y_A, p6 = pA_A - IA_Af Y_p
+
+     then the joint's, exactly as for a rigid body (U = I6 S, D = S^T I6 S, ...). The child hands
+     its articulated inertia Ia and force pa to its parent through the attachment (eq 47):
+
+         parent += L Ia [1, G],   L pa,   L = [1; G^T - Kd T_h]
+
+     where G are the attachment's partial velocities and Kd T_h the distal-load stiffening of the
+     parent (eq 33's F^J terms: the child's reaction at grid point h, parent-frame components).
+     Stiffening makes the blocks unsymmetric, so the eliminations use general solves.
+(iii) outward (eqs 82-86): A' = A_parent + G u_dot_parent + c, q_ddot = D^-1 (u - S^T I6 A'),
+     A = A' + S q_ddot, u_dot = -Y_A A - Y_p.
+
+Like `mbjax.rigid.aba.aba_responses`, one triangularization serves any number of extra load
+columns (seed 002's unit constraint loads, eqs 101-107), which the stabilized loop route uses.
+"""
+
+import jax
+import jax.numpy as jnp
+import numpy as np
+from jax import Array
+
+from mbjax.flex.body import inertial_stiffening, mass_matrix, velocity_terms
+from mbjax.flex.kinematics import flex_kinematics
+from mbjax.flex.model import FlexibleModel
+from mbjax.rigid.kinematics import gravity_acceleration
+from mbjax.spatial import skew
+from mbjax.tree import backward_pass, forward_pass
+
+
+def _solve(D: Array, b: Array) -> Array:
+    if D.shape[-1] == 1:
+        return b / D[..., 0, :]
+    return jnp.linalg.solve(D, b)
+
+
+def _inverse_motion(X: Array) -> Array:
+    """X^-1 for X = [[R, 0], [p~ R, R]]: [[R^T, 0], [-R^T p~, R^T]] (no general inverse)."""
+    R, pR = X[:3, :3], X[3:, :3]
+    Rt = R.T
+    zero = jnp.zeros_like(R)
+    return jnp.block([[Rt, zero], [-Rt @ pR @ Rt, Rt]])
+
+
+def body_blocks(model: FlexibleModel, kin) -> tuple[Array, Array]:
+    """Per body, the (6 + mu)-block mass M_g (with the stiffening's acceleration coupling) and the
+    remainder force b_g (velocity terms, elastic and damping forces, stiffening's velocity part),
+    ground components at the ground origin for the rigid rows and columns."""
+    def one(body, X, V, q, u):
+        Xi = _inverse_motion(X)
+        Vb = Xi @ V
+        M = mass_matrix(body, q)
+        b = velocity_terms(body, q, jnp.concatenate([Vb, u]))
+        G_s, g_s = inertial_stiffening(body, q, Vb)
+        mu = q.shape[0]
+        left = jax.scipy.linalg.block_diag(Xi.T, jnp.eye(mu, dtype=q.dtype))
+        right = jax.scipy.linalg.block_diag(Xi, jnp.eye(mu, dtype=q.dtype))
+        M_g = left @ M @ right
+        M_g = M_g.at[6:, :6].add(G_s @ Xi)
+        b_g = left @ b + jnp.concatenate([jnp.zeros(6, q.dtype),
+                                          body.stiffness @ q + body.damping @ u + g_s])
+        return M_g, b_g
+
+    return jax.vmap(one)(model.bodies, kin.X, kin.V, kin.q, kin.u)
+
+
+def _distal(model: FlexibleModel, kin) -> Array:
+    """Per body k: Kd T_h (mu, 6), the stiffening of k's parent by k's reaction at grid point h:
+    T_h takes the reaction (ground components at the ground origin) to (force; moment about the
+    grid point) in the parent's frame, the order of eq 33's distal unit loads."""
+    parents = np.asarray(model.model.topology.parents)
+    parent, h = np.maximum(parents, 0), np.maximum(np.asarray(model.attach), 0)
+    has = np.asarray(model.attach) >= 0
+    Kd = jnp.einsum("kjst,kt->ksj", model.bodies.distal_stiffening[parent, h], kin.q_parent)
+    Rt = jnp.swapaxes(kin.R[parent], -1, -2)
+    T = jnp.concatenate([jnp.concatenate([jnp.zeros_like(Rt), Rt], -1),
+                         jnp.concatenate([Rt, -Rt @ skew(kin.x_node)], -1)], -2)
+    return jnp.where(has[:, None, None], Kd @ T, 0.0)
+
+
+def flexible_aba_responses(model: FlexibleModel, q: Array, v: Array, tau: Array,
+                           loads: Array) -> tuple[Array, Array]:
+    """(v_dot (nv,), responses (m, nv)): the accelerations under tau, gravity, velocity and
+    elasticity, and those each row of `loads` (m, nv) alone produces (no gravity, velocity or
+    elasticity); O(n) in the bodies, O(n m) in the loads."""
+    kin = flex_kinematics(model, q, v)
+    n, mu, m = model.n, model.mu, loads.shape[0]
+    dtype = q.dtype
+    M_g, b_g = body_blocks(model, kin)
+    KdT = _distal(model, kin)
+    pad = (~model.model.v_mask).astype(dtype)
+    cols = 1 + m
+    tau_cols = jnp.concatenate([tau[None], loads])                         # (cols, nv)
+    tj, tf = jax.vmap(model.split)(tau_cols)                               # (cols, *), (cols, n, mu)
+    t_joint = jnp.moveaxis(jax.vmap(model.model.body_v)(tj), 0, -1)        # (n, width, cols)
+    t_modal = jnp.moveaxis(tf, 0, -1)                                      # (n, mu, cols)
+    own_p = jnp.zeros((n, 6 + mu, cols), dtype).at[:, :, 0].set(b_g).at[:, 6:, :].add(-t_modal)
+    c = jnp.zeros((n, 6, cols), dtype).at[:, :, 0].set(kin.c)
+
+    def triangularize(received, inp):
+        (IA, pA), (S, c, t, padding, G, KdT) = received, inp
+        Y = jnp.linalg.solve(IA[6:, 6:], jnp.concatenate([IA[6:, :6], pA[6:]], -1))
+        Y_A, Y_p = Y[:, :6], Y[:, 6:]
+        I6 = IA[:6, :6] - IA[:6, 6:] @ Y_A
+        p6 = pA[:6] - IA[:6, 6:] @ Y_p
+        U, W = I6 @ S, S.T @ I6
+        D = W @ S + jnp.diag(padding)
+        u = t - S.T @ p6
+        Ia = I6 - U @ _solve(D, W)
+        pa = p6 + Ia @ c + U @ _solve(D, u)
+        L = jnp.concatenate([jnp.eye(6, dtype=dtype), G.T - KdT])
+        right = jnp.concatenate([jnp.eye(6, dtype=dtype), G], -1)
+        return (Y_A, Y_p, W, D, u), (L @ Ia @ right, L @ pa)
+
+    (Y_A, Y_p, W, D, u), _ = backward_pass(model.model.topology, triangularize, (M_g, own_p),
+                                           (kin.S, c, t_joint, pad, kin.G, KdT))
+
+    def substitute(parent, inp):
+        (A_parent, u_dot_parent, _), (S, c, G, Y_A, Y_p, W, D, u) = parent, inp
+        A_prime = A_parent + G @ u_dot_parent + c
+        qdd = _solve(D, u - W @ A_prime)
+        A = A_prime + S @ qdd
+        return A, -(Y_A @ A + Y_p), qdd
+
+    ground = (jnp.zeros((6, cols), dtype).at[:, 0].set(gravity_acceleration(model.model)),
+              jnp.zeros((mu, cols), dtype), jnp.zeros((model.model.width, cols), dtype))
+    _, u_dot, qdd = forward_pass(model.model.topology, substitute, ground,
+                                 (kin.S, c, kin.G, Y_A, Y_p, W, D, u))
+    flat = jax.vmap(lambda a, b: model.join(model.model.flat_v(a), b), in_axes=(-1, -1))(qdd, u_dot)
+    return flat[0], flat[1:]
+
+
+def flexible_aba(model: FlexibleModel, q: Array, v: Array, tau: Array) -> Array:
+    """v_dot (nv,) of the flexible tree at (q, v) under generalized forces tau (joint forces, then
+    modal forces) and gravity: seed 002's O(n) recursion."""
+    return flexible_aba_responses(model, q, v, tau, jnp.zeros((0, model.nv), q.dtype))[0]
