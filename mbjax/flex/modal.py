@@ -96,7 +96,9 @@ def craig_bampton(beam: Beam, *, clamped_node=0, interface_nodes=(), n_modes=Non
     kinds = ("normal",) * k + ("constraint",) * len(b) + ("static",) * len(s)
     if not kinds:
         raise ValueError("craig_bampton: empty basis (no normal, constraint or static modes)")
-    rotate = bool(orthonormalize) and len(kinds) > k
+    if len(kinds) == k:
+        return ModalBasis(X[:, :k], w[:k], kinds)
+    rotate = bool(orthonormalize)
     shapes, freqs = _assemble_basis(beam, w, X, k, tuple(i.tolist()), tuple(b.tolist()), tuple(s.tolist()),
                                     rotate)
     if rotate:
@@ -111,7 +113,7 @@ def _assemble_basis(beam, w, X, k, i, b, s, rotate):
     """Columns [normal, constraint, static] and, with `rotate`, the reduced-eigenproblem rotation."""
     M, K = beam.matrices()
     i, b, s = np.array(i, dtype=int), np.array(b, dtype=int), np.array(s, dtype=int)
-    cols = [X[:, :k]]
+    cols = [X[:, :k]]  # k static: one compilation per basis layout
     Kii = jax.scipy.linalg.cho_factor(K[np.ix_(i, i)], lower=True)
     if len(b):  # constraint modes: x_i = -K_ii^-1 K_ib for x_b = I
         Psi = jnp.zeros((beam.n_dofs, len(b))).at[b, np.arange(len(b))].set(1.0)

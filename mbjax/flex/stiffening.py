@@ -42,7 +42,7 @@ def _acceleration_basis(rho):
     z, o = jnp.zeros_like(r1), jnp.ones_like(r1)
     cols = [jnp.stack(c) for c in (
         (o, z, z), (z, o, z), (z, z, o),                                     # a
-        (z, r3, -r2), (-r3, z, r1), (r2, -r1, z),                            # alpha x rho
+        (z, -r3, r2), (r3, z, -r1), (-r2, r1, z),                            # alpha x rho
         (z, -r2, -r3), (r2, r1, z), (r3, z, r1),                             # w1^2, w1 w2, w1 w3
         (-r1, z, -r3), (z, r3, r2), (-r1, -r2, z))]                          # w2^2, w2 w3, w3^2
     return jnp.stack(cols, axis=1)
