@@ -14,11 +14,14 @@ axis is the frame's z axis. Its residual, from the poses of the two frames (grou
     point_on_line  (p_A - p_B) . x_B, (p_A - p_B) . y_B  (p_A on the line z_B)   2
 
 A `Prescribed` motion drives one velocity coordinate, q_j = q0 + rate t (a rheonomic constraint,
-e.g. a crank turning at constant speed).
+e.g. a crank turning at constant speed), or q_j = motion(t) for any differentiable motion (a
+spin-up profile): its velocity and acceleration terms come from autodiff in t.
 
 Planar mechanisms built from revolute cut joints carry redundant equations (a planar loop needs
 only two); the solvers detect the rank and report it, see `mbjax.loops.coupled`.
 """
+
+from collections.abc import Callable
 
 import equinox as eqx
 import jax.numpy as jnp
@@ -95,22 +98,29 @@ class CutJoint(eqx.Module):
 
 
 class Prescribed(eqx.Module):
-    """Velocity coordinate `dof` (a 1-dof joint's angle or slide) driven as q0 + rate t."""
+    """Velocity coordinate `dof` (a 1-dof joint's angle or slide) driven as q0 + rate t, or as
+    motion(t) (a differentiable callable of time) when `motion` is given."""
 
     dof: int = eqx.field(static=True)
     q0: Array
     rate: Array
+    motion: Callable | None
 
-    def __init__(self, dof: int, q0=0.0, rate=0.0):
+    def __init__(self, dof: int, q0=0.0, rate=0.0, motion: Callable | None = None):
         if not isinstance(dof, int | np.integer) or dof < 0:
             raise ValueError(f"dof must be a non-negative int, got {dof!r}")
+        if motion is not None and not callable(motion):
+            raise TypeError("motion must be a callable t -> coordinate")
         self.dof = int(dof)
         self.q0 = jnp.asarray(q0, float)
         self.rate = jnp.asarray(rate, float)
+        self.motion = motion
 
     @property
     def size(self) -> int:
         return 1
 
     def residual(self, R: Array, p: Array, q: Array, t) -> Array:
+        if self.motion is not None:
+            return (q[self.dof] - self.motion(t))[None]
         return (q[self.dof] - self.q0 - self.rate * t)[None]

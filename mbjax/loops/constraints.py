@@ -13,27 +13,40 @@ import jax
 import jax.numpy as jnp
 from jax import Array
 
+from mbjax.flex.kinematics import frame_poses
+from mbjax.flex.model import FlexibleModel
 from mbjax.loops.closures import GROUND, CutJoint, Prescribed
 from mbjax.model import Model
 from mbjax.rigid.kinematics import forward_kinematics
 
 
-class Loops(eqx.Module):
-    """A tree `model` closed by cut joints and driven by prescribed motions."""
+def frames(model: Model | FlexibleModel, q: Array) -> tuple[Array, Array]:
+    """(R, p) of every frame a cut joint can use: the bodies, and for a `FlexibleModel` its
+    markers at grid points (frame n + i), deformation included."""
+    if isinstance(model, FlexibleModel):
+        R, p, R_markers, p_markers = frame_poses(model, q)
+        return jnp.concatenate([R, R_markers]), jnp.concatenate([p, p_markers])
+    return forward_kinematics(model, q)
 
-    model: Model
+
+class Loops(eqx.Module):
+    """A tree `model` (rigid, or a `mbjax.flex.FlexibleModel` whose markers are frames n, n + 1,
+    ...) closed by cut joints and driven by prescribed motions."""
+
+    model: Model | FlexibleModel
     closures: tuple
 
-    def __init__(self, model: Model, closures):
+    def __init__(self, model: Model | FlexibleModel, closures):
         closures = tuple(closures)
         if not closures:
             raise ValueError("Loops needs at least one cut joint or prescribed motion")
+        n_frames = getattr(model, "n_frames", model.n)
         for c in closures:
             if isinstance(c, CutJoint):
                 for body in (c.body_a, c.body_b):
-                    if body != GROUND and not 0 <= body < model.n:
+                    if body != GROUND and not 0 <= body < n_frames:
                         raise ValueError(f"cut joint {c.kind!r}: body {body} is not in the model "
-                                         f"(0 ... {model.n - 1}, or -1 for the ground)")
+                                         f"(0 ... {n_frames - 1}, or -1 for the ground)")
             elif isinstance(c, Prescribed):
                 if not c.dof < model.nq or model.nq != model.nv:
                     raise ValueError(f"prescribed motion of coordinate {c.dof}: the model has "
@@ -50,7 +63,7 @@ class Loops(eqx.Module):
 
     def phi(self, q: Array, t=0.0) -> Array:
         """Phi(q, t), (m,)."""
-        R, p = forward_kinematics(self.model, q)
+        R, p = frames(self.model, q)
         return jnp.concatenate([c.residual(R, p, q, t) for c in self.closures])
 
     def rate(self, q: Array, v: Array, t=0.0) -> Array:

@@ -29,6 +29,8 @@ Total cost O(n m + m^3) = O(n + m^3) for a fixed number of loops. Here f_c = -K_
 
 from jax import Array
 
+from mbjax.flex.aba import flexible_aba_responses
+from mbjax.flex.model import FlexibleModel
 from mbjax.loops.constraints import Loops
 from mbjax.loops.coupled import multipliers, numerical_rank
 from mbjax.rigid.aba import aba_responses
@@ -39,7 +41,9 @@ def eta_and_gamma(loops: Loops, q: Array, v: Array, tau: Array, t=0.0) -> tuple[
     back-substitution passes for tau (eta, eq 101) and for the m unit loads, the rows of A
     (Gamma, eqs 102-107)."""
     A = loops.jacobian(q, t)
-    eta, Gamma_t = aba_responses(loops.model, q, v, tau, A)
+    responses = (flexible_aba_responses if isinstance(loops.model, FlexibleModel)
+                 else aba_responses)                  # flexible bodies: eqs 94-100 in the recursion
+    eta, Gamma_t = responses(loops.model, q, v, tau, A)
     return eta, Gamma_t.T, A
 
 

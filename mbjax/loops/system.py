@@ -17,6 +17,8 @@ import jax
 import jax.numpy as jnp
 from jax import Array
 
+from mbjax.flex.lagrange import energy as flexible_energy
+from mbjax.flex.model import FlexibleModel
 from mbjax.integrate.solution import Status
 from mbjax.integrate.system import AbstractSystem
 from mbjax.loops.constraints import Loops
@@ -77,8 +79,11 @@ class _Closed(AbstractSystem):
         return self.loops.model.normalize(q)
 
     def energy(self, q, u):
-        """Kinetic plus gravitational energy (the work of `force` and `tau` not included)."""
-        return energy(self.loops.model, q, self.velocity(q, u))
+        """Kinetic plus gravitational (and, for flexible bodies, strain) energy; the work of
+        `force` and `tau` is not included."""
+        model = self.loops.model
+        return (flexible_energy if isinstance(model, FlexibleModel) else energy)(
+            model, q, self.velocity(q, u))
 
     def constrain(self, t, q, u):
         if not self.projection:
@@ -99,6 +104,13 @@ class _Closed(AbstractSystem):
                 | jnp.where(redundant, int(Status.REDUNDANT), 0)).astype(jnp.int32)
 
 
+def _rigid_only(loops: Loops, name: str) -> None:
+    if isinstance(loops, Loops) and isinstance(loops.model, FlexibleModel):
+        raise TypeError(f"{name} solves seed 001's multipliers with a symmetric mass matrix; "
+                        "flexible bodies (whose stiffening makes it unsymmetric) close loops "
+                        "through seed 002's route, StabilizedLoopSystem")
+
+
 class LoopSystem(_Closed):
     """u = v; v_dot from the coupled Lagrange-multiplier equations (seed 001 eqs 89-93), with
     Baumgarte gains (alpha, beta) (0, 0: none)."""
@@ -107,6 +119,7 @@ class LoopSystem(_Closed):
 
     def __init__(self, loops: Loops, tau=None, baumgarte=(0.0, 0.0), projection: bool = False,
                  force: Callable | None = None, tolerance: float = TOLERANCE):
+        _rigid_only(loops, "LoopSystem")
         super().__init__(loops, tau, force, projection, tolerance)
         self.baumgarte = tuple(float(g) for g in baumgarte)
         if len(self.baumgarte) != 2 or min(self.baumgarte) < 0:
@@ -123,6 +136,11 @@ class LoopSystem(_Closed):
 class MomentumLoopSystem(_Closed):
     """u = G = mu v, the generalized momenta; G_dot = K^a - X + A^t K_c with the multipliers of
     seed 001 eq 98 (the momentum formulation, eqs 95-98). `momenta(q, v)` makes u from v."""
+
+    def __init__(self, loops: Loops, tau=None, projection: bool = False,
+                 force: Callable | None = None, tolerance: float = TOLERANCE):
+        _rigid_only(loops, "MomentumLoopSystem")
+        super().__init__(loops, tau, force, projection, tolerance)
 
     def acceleration(self, t, q, u):
         return momentum_rate(self.loops, q, u, self.applied(t, q, self.velocity(q, u)), t)[0]
