@@ -89,7 +89,8 @@ def craig_bampton(beam: Beam, *, clamped_node=0, interface_nodes=(), n_modes=Non
         k = int(n_modes)
     else:
         if isinstance(w, jax.core.Tracer):
-            raise ValueError("craig_bampton: cutoff needs concrete beam parameters; use n_modes under jit/grad")
+            raise ValueError("craig_bampton: cutoff needs concrete beam parameters; "
+                             "use n_modes under jit/grad")
         if not cutoff > 0:
             raise ValueError(f"craig_bampton: cutoff must be positive, got {cutoff!r}")
         k = int(np.sum(np.asarray(w) <= cutoff))

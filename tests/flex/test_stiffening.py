@@ -9,7 +9,6 @@ tests use 5 and 10 elements, bound the error by 0.3 / n^2 and check the ratio (s
 
 import jax.numpy as jnp
 import numpy as np
-import pytest
 import scipy.linalg
 
 from mbjax.flex.beam import Beam, geometric_stiffness
