@@ -12,6 +12,7 @@ axis is the frame's z axis. Its residual, from the poses of the two frames (grou
     weld           p_A - p_B, vee(R_B^T R_A - R_A^T R_B) / 2                      6
     prismatic      (p_A - p_B) . x_B, (p_A - p_B) . y_B, vee(...) / 2  (along z_B) 5
     point_on_line  (p_A - p_B) . x_B, (p_A - p_B) . y_B  (p_A on the line z_B)   2
+    point_on_plane (p_A - p_B) . z_B                     (p_A on the plane z_B)  1
 
 A `Prescribed` motion drives one velocity coordinate, q_j = q0 + rate t (a rheonomic constraint,
 e.g. a crank turning at constant speed), or q_j = motion(t) for any differentiable motion (a
@@ -30,7 +31,7 @@ from jax import Array
 
 GROUND = -1
 SIZES = {"spherical": 3, "revolute": 5, "universal": 4, "weld": 6, "prismatic": 5,
-         "point_on_line": 2}
+         "point_on_line": 2, "point_on_plane": 1}
 
 
 def _vee_antisym(R: Array) -> Array:
@@ -82,6 +83,8 @@ class CutJoint(eqx.Module):
         d = pA - pB
         x_A, y_A, z_A = RA.T
         x_B, y_B, z_B = RB.T
+        if self.kind == "point_on_plane":       # a massless slider pinned to a planar mechanism
+            return (d @ z_B)[None]
         orientation = _vee_antisym(RB.T @ RA)
         if self.kind == "spherical":
             return d
