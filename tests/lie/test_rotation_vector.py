@@ -127,22 +127,30 @@ FUNCTIONS = {
 }
 
 
+# Each function and its derivatives jitted once per module: the parametrized tests below (three
+# points near zero, three angles) then share one compilation per (function, derivative) instead
+# of compiling it per case (the Hessian of log(exp(r)) alone takes seconds to compile).
+JITTED = {name: jax.jit(f) for name, f in FUNCTIONS.items()}
+DERIVATIVES = {name: (jax.jit(jax.jacfwd(f)), jax.jit(jax.jacrev(f)),
+                      jax.jit(jax.jacfwd(jax.jacrev(f))))
+               for name, f in FUNCTIONS.items()}
+
+
 @pytest.mark.parametrize("name", FUNCTIONS)
 @pytest.mark.parametrize("r", [jnp.zeros(3), jnp.array([1e-9, 0.0, 0.0]),
                                jnp.array([1e-9, -2e-9, 5e-10])])
 def test_derivatives_finite_at_zero(name, r):
-    f = FUNCTIONS[name]
-    for derivative in (jax.jacfwd(f), jax.jacrev(f), jax.jacfwd(jax.jacrev(f))):
-        assert bool(jnp.all(jnp.isfinite(jax.jit(derivative)(r)))), name
+    for derivative in DERIVATIVES[name]:
+        assert bool(jnp.all(jnp.isfinite(derivative(r)))), name
 
 
 def test_derivatives_at_zero_are_exact():
     E = jnp.stack([lie.hat(e) for e in jnp.eye(3)], axis=-1)  # d (r x I) / d r
     z = jnp.zeros(3)
-    np.testing.assert_allclose(jax.jacfwd(lie.exp)(z), E, atol=0)
-    np.testing.assert_allclose(jax.jacfwd(lie.gamma)(z), 0.5 * E, atol=0)
-    np.testing.assert_allclose(jax.jacfwd(lie.gamma_inv)(z), -0.5 * E, atol=0)
-    np.testing.assert_allclose(jax.jacfwd(lambda r: lie.log(lie.exp(r)))(z), jnp.eye(3), atol=0)
+    np.testing.assert_allclose(DERIVATIVES["exp"][0](z), E, atol=0)
+    np.testing.assert_allclose(DERIVATIVES["gamma"][0](z), 0.5 * E, atol=0)
+    np.testing.assert_allclose(DERIVATIVES["gamma_inv"][0](z), -0.5 * E, atol=0)
+    np.testing.assert_allclose(DERIVATIVES["log_exp"][0](z), jnp.eye(3), atol=0)
     grad_R = jax.grad(lambda R: jnp.sum(lie.log(R)))(jnp.eye(3))
     assert bool(jnp.all(jnp.isfinite(grad_R)))
 
@@ -150,10 +158,11 @@ def test_derivatives_at_zero_are_exact():
 @pytest.mark.parametrize("angle", [1e-4, 0.3, 2.0])
 def test_gradients_against_finite_differences(angle):
     r = random_rotvec(angle)
-    for f in (lie.exp, lie.gamma, lie.gamma_inv, lambda r: lie.log(lie.exp(r))):
-        check_grads(f, (r,), order=1, modes=("fwd", "rev"), atol=1e-6, rtol=1e-6)
+    for name in ("exp", "gamma", "gamma_inv", "log_exp"):
+        # first derivatives of the jitted function (one compile of its jvp and vjp per module)
+        check_grads(JITTED[name], (r,), order=1, modes=("fwd", "rev"), atol=1e-6, rtol=1e-6)
         # second derivatives: central differences of the (jitted) Jacobian
-        J, H = jax.jit(jax.jacfwd(f)), jax.jit(jax.jacfwd(jax.jacrev(f)))
+        J, _, H = DERIVATIVES[name]
         h = 1e-5
         for i in range(3):
             dr = jnp.zeros(3).at[i].set(h)

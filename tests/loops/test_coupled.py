@@ -32,6 +32,9 @@ def minimal_rhs(y):
     return jnp.array([omega, (jax.grad(lagrangian, 0)(theta, omega) - mixed * omega) / m])
 
 
+@pytest.mark.slow     # by default the redundant closure's motion is covered by Bricard's benchmark
+                      # (5 equations of rank 4, against its one-dof reference) and the four-bar
+                      # against DOP853 by test_mechanisms' planar-pin closure
 def test_four_bar_matches_minimal_coordinates():
     rhs = jax.jit(minimal_rhs)
     ref = solve_ivp(lambda t, y: np.asarray(rhs(jnp.asarray(y))), (0.0, 0.5), [THETA0, OMEGA0],
@@ -47,11 +50,15 @@ def test_four_bar_matches_minimal_coordinates():
 
 def test_redundant_planar_closure_is_detected_and_finite():
     """A spatial revolute cut joint closes a planar loop with 5 equations of rank 2."""
-    v_dot, K_c, rank = coupled_acceleration(LOOPS, Q0, V0, jnp.zeros(3))
+
+    @jax.jit                  # one compilation (op-by-op dispatch of the passes takes far longer)
+    def solved(q, v):
+        v_dot, K_c, rank = coupled_acceleration(LOOPS, q, v, jnp.zeros(3))
+        return v_dot, K_c, rank, LOOPS.jacobian(q), LOOPS.acceleration_bias(q, v)
+
+    v_dot, K_c, rank, A, b = solved(Q0, V0)
     assert LOOPS.m == 5 and int(rank) == 2
     assert bool(jnp.all(jnp.isfinite(v_dot)) & jnp.all(jnp.isfinite(K_c)))
-    A = LOOPS.jacobian(Q0)
-    b = LOOPS.acceleration_bias(Q0, V0)
     np.testing.assert_allclose(A @ v_dot + b, 0.0, atol=1e-10)
 
 
@@ -59,10 +66,16 @@ def test_constraint_derivatives_by_autodiff_match_finite_differences():
     """A v + B is dPhi/dt and A a + b is d^2 Phi/dt^2 along q(t) = q0 + v t + a t^2 / 2."""
     loops = Loops(MODEL, [*LOOPS.closures, Prescribed(0, q0=0.1, rate=0.7)])
     q, v, a, t, h = Q0 + 0.01, V0 + 0.1, jnp.array([0.3, -0.2, 0.5]), 0.2, 1e-4
-    path = lambda s: loops.phi(q + v * s + a * s**2 / 2, t + s)  # noqa: E731
-    np.testing.assert_allclose(loops.rate(q, v, t), (path(h) - path(-h)) / (2 * h), atol=1e-8)
-    np.testing.assert_allclose(loops.jacobian(q, t) @ a + loops.acceleration_bias(q, v, t),
-                               (path(h) - 2 * path(0.0) + path(-h)) / h**2, atol=1e-5)
+
+    @jax.jit                  # one compilation (op-by-op dispatch of the passes takes far longer)
+    def derivatives(q, v, a, t):
+        path = jax.vmap(lambda s: loops.phi(q + v * s + a * s**2 / 2, t + s))
+        return (loops.rate(q, v, t), loops.jacobian(q, t) @ a + loops.acceleration_bias(q, v, t),
+                path(jnp.array([-h, 0.0, h])))
+
+    rate, second, (down, mid, up) = derivatives(q, v, a, t)
+    np.testing.assert_allclose(rate, (up - down) / (2 * h), atol=1e-8)
+    np.testing.assert_allclose(second, (up - 2 * mid + down) / h**2, atol=1e-5)
 
 
 @pytest.mark.slow

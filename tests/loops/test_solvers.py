@@ -23,11 +23,17 @@ def test_momentum_form_multipliers_equal_the_velocity_forms():
     """Eq 98 (momentum form) and eq 92 (velocity form) give the same multipliers (eq 99), and
     G_dot = d/dt (mu v) = mu v_dot + mu_dot v."""
     model = LOOPS.model
-    v_dot, K_c, _ = coupled_acceleration(LOOPS, Q0, V0, TAU)
-    mu = mass_matrix(model, Q0)
-    G_dot, K_c_momentum, rank = momentum_rate(LOOPS, Q0, mu @ V0, TAU)
+
+    @jax.jit                  # one compilation (op-by-op dispatch of the passes takes far longer)
+    def both_forms(q, v, tau):
+        v_dot, K_c, _ = coupled_acceleration(LOOPS, q, v, tau)
+        mu = mass_matrix(model, q)
+        G_dot, K_c_momentum, rank = momentum_rate(LOOPS, q, mu @ v, tau)
+        mu_dot = jax.jvp(lambda q_: mass_matrix(model, q_), (q,), (model.q_dot(q, v),))[1]
+        return v_dot, K_c, mu, G_dot, K_c_momentum, rank, mu_dot
+
+    v_dot, K_c, mu, G_dot, K_c_momentum, rank, mu_dot = both_forms(Q0, V0, TAU)
     np.testing.assert_allclose(K_c_momentum, K_c, rtol=1e-10, atol=1e-10 * np.abs(K_c).max())
-    mu_dot = jax.jvp(lambda q: mass_matrix(model, q), (Q0,), (model.q_dot(Q0, V0),))[1]
     np.testing.assert_allclose(G_dot, mu @ v_dot + mu_dot @ V0, atol=1e-10 * np.abs(G_dot).max())
     assert int(rank) == LOOPS.m
 
@@ -49,12 +55,17 @@ def test_one_triangularization_gives_the_unit_load_responses():
     """eta and the columns of Gamma (seed 002 eqs 101-107) against the dense forward dynamics,
     Gamma under the rows of A with no gravity and no velocity."""
     model = LOOPS.model
-    eta, Gamma, A = eta_and_gamma(LOOPS, Q0, V0, TAU)
-    np.testing.assert_allclose(eta, forward_dynamics(model, Q0, V0, TAU, method="dense"),
-                               rtol=1e-10, atol=1e-10)
-    unloaded = eqx.tree_at(lambda m: m.gravity, model, jnp.zeros(3))
-    dense = jax.vmap(lambda load: forward_dynamics(unloaded, Q0, jnp.zeros(6), load,
-                                                   method="dense"))(A).T
+
+    @jax.jit
+    def loads_and_dense(q, v, tau):
+        eta, Gamma, A = eta_and_gamma(LOOPS, q, v, tau)
+        unloaded = eqx.tree_at(lambda m: m.gravity, model, jnp.zeros(3))
+        dense = jax.vmap(lambda load: forward_dynamics(unloaded, q, jnp.zeros(6), load,
+                                                       method="dense"))(A).T
+        return eta, Gamma, forward_dynamics(model, q, v, tau, method="dense"), dense
+
+    eta, Gamma, eta_dense, dense = loads_and_dense(Q0, V0, TAU)
+    np.testing.assert_allclose(eta, eta_dense, rtol=1e-10, atol=1e-10)
     np.testing.assert_allclose(Gamma, dense, rtol=1e-10, atol=1e-10 * np.abs(dense).max())
 
 
@@ -69,8 +80,8 @@ def test_projection_after_every_step_holds_a_driven_loop_on_its_constraints():
     projected = simulate(LoopSystem(loops, projection=True, tolerance=1e-10), RK4(), q0, v0,
                          dt=2e-3, t1=0.3, saveat=ts)
     assert projected.messages() == ["success"]
-    phi = jax.vmap(loops.phi)(projected.qs, projected.ts)
-    rate = jax.vmap(loops.rate)(projected.qs, projected.us, projected.ts)
+    phi = jax.jit(jax.vmap(loops.phi))(projected.qs, projected.ts)
+    rate = jax.jit(jax.vmap(loops.rate))(projected.qs, projected.us, projected.ts)
     assert float(jnp.abs(phi).max()) < 1e-10 and float(jnp.abs(rate).max()) < 1e-10
     free = simulate(LoopSystem(loops, tolerance=1e-10), RK4(), q0, v0, dt=2e-3, t1=0.3, saveat=ts)
     assert free.messages() == ["constraint violated"] and not bool(free.ok)

@@ -87,11 +87,12 @@ def test_model_parameters_are_differentiable_leaves():
     """Masses are array leaves: a traced mass skips the concrete checks, and a gradient flows."""
     model = chain(3, seed=0)
 
+    @jax.jit
     def kinetic(mass):
         m = eqx.tree_at(lambda m: m.mass, model, mass)
         return rigid.kinetic_energy(m, jnp.zeros(model.nq), jnp.ones(model.nv))
 
-    grad = jax.grad(kinetic)(model.mass)
+    grad = jax.jit(jax.grad(kinetic))(model.mass)
     assert grad.shape == (3,) and np.all(np.isfinite(grad)) and np.all(grad > 0)
     # kinetic energy is linear in the masses at fixed centres of mass and inertias
     np.testing.assert_allclose(jnp.dot(grad, model.mass) + kinetic(jnp.zeros(3)),
@@ -277,6 +278,14 @@ def _symmetric(M):
     return np.triu(M) + np.triu(M, 1).T          # Pinocchio's crba fills the upper triangle
 
 
+@eqx.filter_jit
+def _dynamics(model, q, v, tau):
+    """Both forward-dynamics routes and the mass matrix in one compiled call per model."""
+    return (rigid.forward_dynamics(model, q, v, tau, method="recursive"),
+            rigid.forward_dynamics(model, q, v, tau, method="dense"),
+            rigid.mass_matrix(model, q))
+
+
 def _compare_with_pinocchio(model, pin_model, seed):
     import pinocchio as pin
 
@@ -285,12 +294,10 @@ def _compare_with_pinocchio(model, pin_model, seed):
     q, v, tau = _random_state(model, seed)
     qp, vp, tp = to_pin(q), np.zeros(model.nv), np.zeros(model.nv)
     vp[vi], tp[vi] = v, tau
-    fd = jax.jit(rigid.forward_dynamics, static_argnames="method")
-    for method in ("recursive", "dense"):
-        a = fd(model, jnp.asarray(q), jnp.asarray(v), jnp.asarray(tau), method=method)
+    *accelerations, M = _dynamics(model, jnp.asarray(q), jnp.asarray(v), jnp.asarray(tau))
+    for a in accelerations:                                  # recursive, dense
         np.testing.assert_allclose(a, pin.aba(pin_model, data, qp, vp, tp)[vi], rtol=1e-10,
                                    atol=1e-10)
-    M = jax.jit(rigid.mass_matrix)(model, jnp.asarray(q))
     M_pin = _symmetric(pin.crba(pin_model, data, qp))[np.ix_(vi, vi)]
     np.testing.assert_allclose(M, M_pin, rtol=1e-10, atol=1e-12 * np.abs(M_pin).max())
 
@@ -314,12 +321,13 @@ def test_fixed_joint_urdf_against_mujoco():
     q, v, tau = _random_state(model, seed=1)
     data.qpos[:], data.qvel[:], data.qfrc_applied[:] = q, v, tau
     mujoco.mj_forward(mj, data)
-    a = jax.jit(rigid.forward_dynamics)(model, jnp.asarray(q), jnp.asarray(v), jnp.asarray(tau))
-    np.testing.assert_allclose(a, data.qacc, rtol=1e-10, atol=1e-10)
+    # the same compiled call as the Pinocchio test's (same model)
+    *accelerations, M_ours = _dynamics(model, jnp.asarray(q), jnp.asarray(v), jnp.asarray(tau))
+    for a in accelerations:                                  # recursive, dense
+        np.testing.assert_allclose(a, data.qacc, rtol=1e-10, atol=1e-10)
     M = np.zeros((mj.nv, mj.nv))
     mujoco.mj_fullM(mj, data, M)                        # MuJoCo >= 3.3 signature
-    np.testing.assert_allclose(jax.jit(rigid.mass_matrix)(model, jnp.asarray(q)), M, rtol=1e-10,
-                               atol=1e-14)
+    np.testing.assert_allclose(M_ours, M, rtol=1e-10, atol=1e-14)
 
 
 def test_floating_base_against_pinocchio_free_flyer():
