@@ -15,8 +15,12 @@ from mbjax.tfe import (FORMS, Element, element_map, initial_state, make_referenc
                        stability)
 
 
+# The 2-node rows by default; the 3- and 4-node elements (a compilation each) run with -m slow,
+# and by default test_cli's vertical-top reproduction checks every table's rows (every 3rd dt)
+# to the same tolerances.
 @pytest.mark.parametrize("quadrature", ["exact", "reduced"])
-@pytest.mark.parametrize("nodes", [2, 3, 4])
+@pytest.mark.parametrize("nodes", [2, pytest.param(3, marks=pytest.mark.slow),
+                                   pytest.param(4, marks=pytest.mark.slow)])
 def test_tables_1_and_2(quadrature, nodes):
     """Imaginary parts within 2e-4; real parts within 1 % where the table prints more than 1e-4,
     below 1e-4 where it prints less (the paper's round-off floor)."""
@@ -77,6 +81,7 @@ def test_paper_transition_matrix_equals_the_implicit_function_jacobian(name):
     assert abs(float(jnp.linalg.det(T)) - 1.0) < 1e-10
 
 
+@pytest.mark.slow     # test_cli's vertical-top reproduction checks the same boundaries by default
 def test_stability_boundaries_of_eq_7_10():
     dts = [0.05, 0.4, 1.0]
     exact = rep.boundary(FORMS["primal"](), Element(2, "exact"), dts)
@@ -86,7 +91,11 @@ def test_stability_boundaries_of_eq_7_10():
                                    vt.CRITICAL_SPIN, rtol=1e-9)
 
 
-@pytest.mark.parametrize("name, march", [("primal", "steady"), ("mixed", "steady"),
+# primal about the steady rotation by default; the mixed form's bounded march (which test_cli's
+# tour checks by default: predicted and measured growth about 0) and the per-element references
+# run with -m slow
+@pytest.mark.parametrize("name, march", [("primal", "steady"),
+                                         pytest.param("mixed", "steady", marks=pytest.mark.slow),
                                          pytest.param("mixed", "constant_velocity",
                                                       marks=pytest.mark.slow)])
 def test_long_march_follows_its_one_element_map(name, march):
