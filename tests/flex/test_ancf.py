@@ -85,6 +85,7 @@ def test_free_oscillation_conserves_energy():
     assert drift[0] < 1e-3 and drift[1] < drift[0] / 3
 
 
+@pytest.mark.slow
 def test_spin_up_converges_with_mesh_and_step():
     ts = np.linspace(0.0, 2.0, 5)
     ref = spin_up_beam_reference(4, ts).tip_deflection
@@ -133,6 +134,7 @@ def test_spin_up_full_run_peak_converges():
     assert abs(peaks[1] - peaks[0]) < 1e-3 * peaks[1]
 
 
+@pytest.mark.slow
 def test_spin_up_root_clamp_variants_agree_transversally():
     """Prescribing the root slope's length too (eps(0) = 0) changes the tip deflection little."""
     ts = np.linspace(0.0, 1.0, 3)

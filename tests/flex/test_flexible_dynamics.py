@@ -1,0 +1,190 @@
+"""Flexible bodies in the tree dynamics (seed 002 eqs 20-86): the modal body's coefficients
+against direct sums over its mass points, the O(n) recursion against the dense Lagrangian route
+(an independent derivation from the energies), energy conservation, gradients through a rollout
+against finite differences, and the bad-input errors."""
+
+import equinox as eqx
+import jax
+import jax.numpy as jnp
+import numpy as np
+import pytest
+
+from mbjax.flex import (Beam, FlexibleModel, FlexibleSystem, ModalBody, beam_body, craig_bampton,
+                        dense_forward_dynamics, energy, flexible_aba)
+from mbjax.flex.body import mass_matrix
+from mbjax.integrate import RK4, simulate
+from mbjax.lie import exp
+from mbjax.loops import LoopSystem, Loops, Prescribed, StabilizedLoopSystem
+from mbjax.model import Model
+from mbjax.spatial import skew
+
+
+class Points(eqx.Module):
+    mass: jax.Array
+    position: jax.Array
+    phi: jax.Array
+    psi: jax.Array
+    inertia: jax.Array
+
+
+def random_points(key, P=6, mu=3):
+    k = jax.random.split(key, 5)
+    return Points(jax.random.uniform(k[0], (P,), minval=0.5, maxval=1.5),
+                  jax.random.normal(k[1], (P, 3)) * 0.3 + jnp.array([0.5, 0.0, 0.0]),
+                  jax.random.normal(k[2], (P, 3, mu)) * 0.2, jax.random.normal(k[3], (P, 3, mu)) * 0.2,
+                  jnp.broadcast_to(jnp.diag(jnp.array([0.01, 0.02, 0.03])), (P, 3, 3)))
+
+
+def random_body(key, P=6, mu=3, H=2, stiffening=True):
+    k = jax.random.split(key, 6)
+    Kr = jax.random.normal(k[0], (mu, mu))
+    Ks = jax.random.normal(k[1], (21, mu, mu)) * 0.1
+    nodes = (jax.random.normal(k[2], (H, 3)) * 0.3, jax.random.normal(k[3], (H, 3, mu)) * 0.2,
+             jax.random.normal(k[4], (H, 3, mu)) * 0.2)
+    return ModalBody.from_points(random_points(k[5], P, mu), Kr @ Kr.T + mu * jnp.eye(mu),
+                                 inertial_stiffening=Ks + jnp.swapaxes(Ks, 1, 2) if stiffening else None,
+                                 nodes=nodes, damping=0.1 * jnp.eye(mu))
+
+
+def random_tree(stiffening=True, gravity=(0.0, 0.0, -9.81)):
+    """Revolute, prismatic, universal joints; bodies 1 and 3 flexible (3 and 2 modes), bodies 2, 3
+    and 4 attached at grid points of flexible parents."""
+    rng = np.random.default_rng(0)
+    parents, n = (-1, 0, 1, 1, 3), 5
+    rigid = Model(parents, ("revolute", "revolute", "prismatic", "revolute", "universal"),
+                  mass=np.ones(n), inertia=np.tile(np.eye(3) * 0.1, (n, 1, 1)),
+                  com=rng.normal(size=(n, 3)) * 0.2, axis=rng.normal(size=(n, 3)),
+                  axis2=rng.normal(size=(n, 3)), placement_translation=rng.normal(size=(n, 3)) * 0.5,
+                  placement_rotation=np.stack([np.asarray(exp(jnp.asarray(rng.normal(size=3))))
+                                               for _ in range(n)]), gravity=gravity)
+    k1, k2 = jax.random.split(jax.random.PRNGKey(1))
+    return FlexibleModel(rigid, {1: random_body(k1, 6, 3, 2, stiffening),
+                                 3: random_body(k2, 5, 2, 2, stiffening)},
+                         attach={2: 0, 3: 1, 4: 1})
+
+
+def test_modal_mass_matrix_is_the_sum_over_mass_points():
+    """M(q) from the time-invariant coefficients equals sum_p L_p^T m_p L_p + J_p^T I_p J_p with
+    each point's velocity Jacobian built directly (v_p = v - xi_p~ omega + phi_p u,
+    omega_p = omega + psi_p u, xi_p = rho_p + phi_p q)."""
+    pts = random_points(jax.random.PRNGKey(3), P=7, mu=4)
+    body = ModalBody.from_points(pts, jnp.eye(4))
+    q = jnp.array([0.3, -0.2, 0.5, 0.1])
+    xi = pts.position + jnp.einsum("pis,s->pi", pts.phi, q)
+    eye = jnp.broadcast_to(jnp.eye(3), (7, 3, 3))
+    L = jnp.concatenate([-skew(xi), eye, pts.phi], -1)
+    J = jnp.concatenate([eye, jnp.zeros((7, 3, 3)), pts.psi], -1)
+    direct = (jnp.einsum("p,pia,pib->ab", pts.mass, L, L)
+              + jnp.einsum("pia,pij,pjb->ab", J, pts.inertia, J))
+    np.testing.assert_allclose(mass_matrix(body, q), direct, rtol=0, atol=1e-13)
+
+
+@pytest.mark.parametrize("stiffening", [True, False])
+def test_recursion_matches_the_lagrangian_route(stiffening):
+    """Seed 002's O(n) recursion with modal blocks, attachments and Table 1 stiffening against
+    Lagrange's equations from the energies (no shared partial velocities), at a random state."""
+    model = random_tree(stiffening)
+    rng = np.random.default_rng(1)
+    q = jnp.asarray(rng.normal(size=model.nq)) * 0.5
+    v, tau = jnp.asarray(rng.normal(size=model.nv)), jnp.asarray(rng.normal(size=model.nv))
+    recursive = jax.jit(flexible_aba)(model, q, v, tau)
+    dense = jax.jit(dense_forward_dynamics)(model, q, v, tau)
+    np.testing.assert_allclose(recursive, dense, rtol=1e-11, atol=1e-11)
+
+
+@pytest.mark.slow          # 45-100 s of compilation on 2 cores
+def test_energy_is_conserved_without_stiffening():
+    """Gravity, elasticity and the coupling of the swinging beam and its tip pendulum conserve
+    T + V (geometric stiffening, a linearized prestress, is not conservative); RK4's energy error
+    falls like dt^4."""
+    model = cantilever().without_stiffening()
+    system = FlexibleSystem(model)
+    q0 = model.neutral().at[0].set(0.3).at[1].set(-0.5)
+    errors = []
+    for dt in (5e-4, 2.5e-4):
+        sol = simulate(system, RK4(), q0, jnp.zeros(model.nv), dt=dt, t1=0.1, saveat=[0.0, 0.1])
+        E = jax.jit(jax.vmap(energy, (None, 0, 0)))(model, sol.qs, sol.us)
+        errors.append(abs(float(E[1] - E[0])) / abs(float(E[0])))
+    assert errors[1] < 1e-7 and 10 < errors[0] / errors[1] < 25      # fourth order: ratio ~ 16
+
+
+def cantilever(E=7e10, n_elements=4, n_modes=2):
+    """A 1 m aluminium cantilever on a revolute hinge (about y), with a rigid pendulum attached at
+    its last grid point through a revolute joint (about y); its fastest mode is 1.7e3 rad/s, so
+    RK4 needs dt < 1.6 ms."""
+    structure = Beam.round(1.0, 0.02, E, 2700.0, nu=0.33, n_elements=n_elements)
+    basis = craig_bampton(structure, n_modes=n_modes, planar="xz")
+    body = beam_body(structure, basis, nodes=(n_elements,))
+    rigid = Model([-1, 0], ["revolute", "revolute"], mass=[0.85, 0.5],
+                  com=[[0.5, 0, 0], [0.05, 0, 0]],
+                  inertia=[np.diag([1e-5, 0.07, 0.07]), np.diag([1e-4, 1e-3, 1e-3])],
+                  axis=[[0, 1, 0], [0, 1, 0]], placement_translation=[[0, 0, 0], [1.0, 0, 0]])
+    return FlexibleModel(rigid, {0: body}, attach={1: 0})
+
+
+@pytest.mark.slow          # 45-100 s of compilation on 2 cores
+def test_gradient_through_a_flexible_rollout_matches_finite_differences():
+    """d(tip angle at 0.1 s)/dE through the whole pipeline: beam matrices, the eigenproblem, the
+    modal coefficients and the geometric stiffening (distal load of the tip body), the recursion
+    and the rollout."""
+    def tip(E):
+        model = cantilever(E)
+        q0 = model.neutral().at[0].set(0.2)
+        sol = simulate(FlexibleSystem(model), RK4(), q0, jnp.zeros(model.nv), dt=5e-4, t1=0.1,
+                       saveat=[0.1])
+        return sol.qs[-1, 1]
+
+    E, h = 7e10, 7e5
+    grad = jax.grad(tip)(E)
+    fd = (tip(E + h) - tip(E - h)) / (2 * h)
+    assert np.isfinite(grad) and grad != 0
+    np.testing.assert_allclose(grad, fd, rtol=1e-5)
+
+
+@pytest.mark.slow          # 45-100 s of compilation on 2 cores
+def test_distal_stiffening_equals_the_reaction_of_the_child():
+    """The recursion's distal-load stiffening (eq 33's F^J terms) is K_G(F) q with F the child's
+    reaction at the grid point: add that generalized force to the Lagrangian route (which has no
+    joint reactions) and it agrees with the recursion."""
+    model = cantilever()
+    rng = np.random.default_rng(2)
+    q = model.neutral().at[0].set(0.4).at[1].set(-0.3).at[2:].set(jnp.asarray(rng.normal(size=2)) * 1e-3)
+    v = jnp.asarray(rng.normal(size=model.nv))
+    tau = jnp.zeros(model.nv)
+    v_dot = flexible_aba(model, q, v, tau)
+    # The child's reaction from Newton-Euler on the tip body alone (independent of the recursion).
+    from mbjax.flex.lagrange import _body_motion
+    R, p, omega, velocity, alpha, a = _body_motion(model, q, v, v_dot)
+    child = model.model
+    m, c, Ic = child.mass[1], child.com[1], child.inertia[1]
+    w, al, acc = omega[1], alpha[1], a[1]                     # body-frame, gravity folded into a
+    a_com = acc + jnp.cross(al, c) + jnp.cross(w, jnp.cross(w, c))
+    force_on_child = m * a_com                                # body 1's frame
+    moment_on_child = Ic @ al + jnp.cross(w, Ic @ w) + jnp.cross(c, m * a_com)   # about its origin
+    R_rel = R[0].T @ R[1]
+    F = jnp.concatenate([-R_rel @ force_on_child, -R_rel @ moment_on_child])   # on the beam, beam frame
+    qf = q[model.modal_slice(0)]
+    K_G = jnp.einsum("j,jst->st", F, model.bodies.distal_stiffening[0, 0])
+    from mbjax.flex.lagrange import residual
+    r = residual(model, q, v, v_dot, tau).at[model.modal_slice(0)].add(K_G @ qf)
+    np.testing.assert_allclose(r, 0.0, atol=1e-9 * float(jnp.max(jnp.abs(v_dot))))
+    assert float(jnp.max(jnp.abs(K_G))) > 0                   # the tip load does stiffen the beam
+
+
+def test_bad_input_is_a_clear_error():
+    rigid = Model([-1, 0], "revolute", mass=[1.0, 1.0], inertia=[np.eye(3), np.eye(3)])
+    body = random_body(jax.random.PRNGKey(0), H=1)
+    with pytest.raises(ValueError, match="attach"):
+        FlexibleModel(rigid, {0: body})
+    with pytest.raises(ValueError, match="grid point 3"):
+        FlexibleModel(rigid, {0: body}, attach={1: 3})
+    with pytest.raises(ValueError, match="no flexible body"):
+        FlexibleModel(rigid, {})
+    with pytest.raises(ValueError, match="marker"):
+        FlexibleModel(rigid, {0: body}, attach={1: 0}, markers=((1, 0),))
+    model = FlexibleModel(rigid, {0: body}, attach={1: 0})
+    with pytest.raises(TypeError, match="StabilizedLoopSystem"):
+        LoopSystem(Loops(model, [Prescribed(0)]))
+    StabilizedLoopSystem(Loops(model, [Prescribed(0)]))
+    with pytest.raises(ValueError, match="method"):
+        FlexibleSystem(model, method="fast")
