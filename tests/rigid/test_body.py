@@ -27,7 +27,9 @@ def test_closed_form_satisfies_euler_equations():
         np.testing.assert_allclose(R @ J @ Omega, R0 @ J @ jnp.array(tfb.OMEGA0), atol=1e-12)
 
 
-@pytest.mark.parametrize("rotation", ["quaternion", "rotvec"])
+# quaternions by default; rotation-vector coordinates (their own compilation) run with -m slow
+# and are covered by default by test_quaternion_and_rotation_vector_coordinates_agree
+@pytest.mark.parametrize("rotation", ["quaternion", pytest.param("rotvec", marks=pytest.mark.slow)])
 def test_torque_free_body_converges_to_closed_form(rotation):
     """RKMK4 approaches eqs 8.7-8.8 at fourth order over the whole 6 s (about 100 rad)."""
     body, q0, u0 = tfb.build(rotation)
