@@ -3,7 +3,8 @@
 Each entry is reproduce(out: Path, quick: bool) -> dict (the JSON written).
 """
 
-from mbjax.reproduce import andrews_squeezer, closed_chain, integrators, top_long_run, torque_free_tfe, tree_scaling, vertical_top
+from mbjax.reproduce import (andrews_squeezer, closed_chain, flexible_slider_crank, integrators, spin_up_beam,
+                             top_long_run, torque_free_tfe, tree_scaling, vertical_top)
 
 REPRODUCTIONS = {
     integrators.NAME: integrators.reproduce,
@@ -13,6 +14,8 @@ REPRODUCTIONS = {
     top_long_run.NAME: top_long_run.reproduce,
     closed_chain.NAME: closed_chain.reproduce,
     andrews_squeezer.NAME: andrews_squeezer.reproduce,
+    spin_up_beam.NAME: spin_up_beam.reproduce,
+    flexible_slider_crank.NAME: flexible_slider_crank.reproduce,
 }
 
 __all__ = ["REPRODUCTIONS"]
