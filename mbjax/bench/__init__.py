@@ -4,9 +4,10 @@ Each suite is run(out: Path, quick: bool) -> list of records, written as out/SUI
 out/SUITE.png. Peers (MuJoCo, Pinocchio, exudyn) are measured in the same process when installed.
 """
 
-from mbjax.bench import integrators, loops, rigid, tfe
+from mbjax.bench import flexible, integrators, loops, rigid, tfe
 
 SUITES = {
+    flexible.NAME: flexible.run,
     integrators.NAME: integrators.run,
     loops.NAME: loops.run,
     rigid.NAME: rigid.run,

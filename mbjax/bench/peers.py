@@ -60,3 +60,56 @@ def mujoco_rollout(model, data, quat0, Omega0, nstep: int):
     final = out[:, -1]
     # FULLPHYSICS layout: time, qpos, qvel, ...
     return final[:, 1:1 + model.nq], final[:, 1 + model.nq:1 + model.nq + model.nv]
+
+
+def exudyn_spin_up_beam(n_elements: int, dt: float, ts, *, length=10.0, E=7.0e10, A=4.0e-4,
+                        I=2.0e-7, mass=12.0, T_s=15.0, omega_s=6.0, spectral_radius=1.0):
+    """Kane's spin-up beam (as `mbjax.flex.references.spin_up_beam_reference`) in exudyn: n
+    `ObjectANCFCable2D` elements along x, the root's position fixed and its slope direction
+    prescribed by theta(t) through a `GenericJoint` (x, y and the rotation about z locked) with an
+    offset user function, so the root's stretch stays free; implicit generalized-alpha at fixed
+    step dt (Newton's absolute tolerance raised to 1e-6 N: with EA = 2.8e7 N the default 1e-10
+    stalls in round-off). Returns the tip deflection along the rotating y axis at the times ts
+    (multiples of the sensor period ts[1] - ts[0])."""
+    import exudyn as exu
+    from exudyn.itemInterface import (GenericJoint, MarkerBodyRigid, NodePoint2DSlope1,
+                                      ObjectANCFCable2D, ObjectGround, SensorNode)
+
+    c = T_s / (2 * np.pi)
+    ramp = lambda t: omega_s / T_s * (t**2 / 2 + c**2 * (np.cos(t / c) - 1))
+    theta = lambda t: ramp(t) if t < T_s else ramp(T_s) + omega_s * (t - T_s)
+
+    ts = np.asarray(ts, float)
+    sc = exu.SystemContainer()
+    mbs = sc.AddSystem()
+    le = length / n_elements
+    nodes = [mbs.AddNode(NodePoint2DSlope1(referenceCoordinates=[i * le, 0.0, 1.0, 0.0]))
+             for i in range(n_elements + 1)]
+    cables = [mbs.AddObject(ObjectANCFCable2D(length=le, massPerLength=mass / length,
+                                              bendingStiffness=E * I, axialStiffness=E * A,
+                                              nodeNumbers=[nodes[i], nodes[i + 1]]))
+              for i in range(n_elements)]
+    ground = mbs.AddMarker(MarkerBodyRigid(bodyNumber=mbs.AddObject(ObjectGround())))
+    root = mbs.AddMarker(MarkerBodyRigid(bodyNumber=cables[0], localPosition=[0.0, 0.0, 0.0]))
+    mbs.AddObject(GenericJoint(markerNumbers=[ground, root], constrainedAxes=[1, 1, 0, 0, 0, 1],
+                               offsetUserFunction=lambda mbs, t, item, p: [0, 0, 0, 0, 0, theta(t)]))
+    sensor = mbs.AddSensor(SensorNode(nodeNumber=nodes[-1], storeInternal=True,
+                                      outputVariableType=exu.OutputVariableType.Coordinates))
+    mbs.Assemble()
+
+    settings = exu.SimulationSettings()
+    settings.timeIntegration.endTime = float(ts[-1])
+    settings.timeIntegration.numberOfSteps = int(round(ts[-1] / dt))
+    settings.timeIntegration.generalizedAlpha.spectralRadius = spectral_radius
+    settings.timeIntegration.adaptiveStep = False
+    settings.timeIntegration.newton.absoluteTolerance = 1e-6
+    settings.timeIntegration.verboseMode = 0
+    settings.solution.file.write = False
+    settings.solution.sensors.writePeriod = float(ts[1] - ts[0])
+    mbs.SolveDynamic(settings)
+
+    data = mbs.GetSensorStoredData(sensor)        # t, displacements (x, y, x', y') of the tip
+    t = data[:, 0]
+    th = np.array([theta(s) for s in t])
+    deflection = -np.sin(th) * (length + data[:, 1]) + np.cos(th) * data[:, 2]
+    return np.interp(ts, t, deflection)

@@ -90,3 +90,44 @@ def loops_bench_figure(records: list[dict]) -> Figure:
         ax.grid(alpha=0.3, which="both")
         ax.legend(fontsize=8)
     return fig
+
+
+def flexible_bench_figure(records: list[dict]) -> Figure:
+    """`mbjax bench flexible`: max tip-deflection error against run time on Kane's spin-up beam.
+    One line per bending-mode count (stiffened modal model, the two steps), open markers without
+    geometric stiffening, squares for mbjax's ANCF beams (the reference drawn as a vertical line:
+    its error is zero by definition), crosses for exudyn's ANCF cable."""
+    fig = Figure(figsize=(7.5, 5.2), layout="constrained")
+    ax = fig.subplots()
+    pos = lambda v: v is not None and np.isfinite(v) and v > 0
+    modal = [r for r in records if r["kind"] == "modal"]
+    colors = dict(zip(sorted({r["n_bending"] for r in modal}),
+                      ("#1f77b4", "#ff7f0e", "#2ca02c", "#d62728", "#9467bd", "#8c564b")))
+    for nb, color in colors.items():
+        rows = sorted((r for r in modal if r["n_bending"] == nb and r["stiffening"]),
+                      key=lambda r: r["run_s"])
+        rows = [r for r in rows if pos(r["error"])]
+        if rows:
+            ax.loglog([r["run_s"] for r in rows], [r["error"] for r in rows], "o-", color=color,
+                      label=f"modal, {nb} bending + 1 axial")
+        for r in (r for r in modal if r["n_bending"] == nb and not r["stiffening"]):
+            if pos(r["error"]):
+                ax.loglog(r["run_s"], r["error"], "o", mfc="none", ms=10, color=color,
+                          label=f"modal, {nb} bending + 1 axial, no stiffening")
+    for r in (r for r in records if r["kind"] == "ancf"):
+        if r.get("reference"):
+            ax.axvline(r["run_s"], color="k", ls=":",
+                       label=f"ANCF {r['n_elements']} el (reference), {r['run_s']:.3g} s")
+        elif pos(r["error"]):
+            ax.loglog(r["run_s"], r["error"], "ks", label=f"ANCF {r['n_elements']} el (mbjax)")
+    peer = sorted((r for r in records if r["kind"] == "peer" and pos(r.get("error"))),
+                  key=lambda r: r["run_s"])
+    if peer:
+        ax.loglog([r["run_s"] for r in peer], [r["error"] for r in peer], "x--", color="0.4",
+                  label=f"exudyn ANCF cable {peer[0]['n_elements']} el")
+    duration = records[0]["duration"]
+    ax.set(xlabel=f"run time for {duration:g} s [s]", ylabel="max |tip deflection - reference| [m]",
+           title=f"spin-up beam, 0-{duration:g} s: speed against accuracy")
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend(fontsize=7)
+    return fig
