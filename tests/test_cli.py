@@ -295,3 +295,28 @@ def test_reproduce_flexible_slider_crank(tmp_path):
     assert abs(peak - ref_peak) < abs(one - ref_peak)
     assert all(s == "success" for s in data["status"].values())
     assert (tmp_path / "flexible-slider-crank.png").stat().st_size > 10_000
+
+
+@pytest.mark.slow
+def test_bench_flexible_quick(tmp_path):
+    """Spin-up beam, 0-8 s against a 4-element ANCF beam (a few minutes on 2 cores, mostly
+    compilation): more modes are more accurate; without geometric stiffening the error is orders
+    of magnitude larger; exudyn's ANCF cable agrees with mbjax's ANCF beam, or says why not."""
+    assert main(["bench", "flexible", "--quick", "--out", str(tmp_path)]) == 0
+    records = [json.loads(line) for line in (tmp_path / "flexible.jsonl").read_text().split("\n") if line]
+    assert {r["kind"] for r in records} >= {"ancf", "modal", "peer"}
+    modal = {(r["n_bending"], r["stiffening"]): r for r in records if r["kind"] == "modal"}
+    assert set(modal) == {(1, True), (4, True), (4, False)}
+    assert all(r["status"] == "success" and r["run_s"] > 0 for r in modal.values())
+    assert modal[4, True]["error"] < modal[1, True]["error"] / 2
+    assert modal[4, True]["error"] < 0.01                    # m, peak deflection ~0.57 m
+    assert modal[4, False]["error"] > 100 * modal[4, True]["error"]
+    ancf = [r for r in records if r["kind"] == "ancf"]
+    assert [r["n_elements"] for r in ancf] == [4, 2] and ancf[0]["error"] == 0.0
+    assert -0.58 < ancf[0]["peak"] < -0.56
+    exudyn = [r for r in records if r["kind"] == "peer"]
+    if peers.available("exudyn"):
+        assert all(r["status"] == "success" and r["error"] < 0.01 for r in exudyn)
+    else:
+        assert exudyn[0]["status"].startswith("unavailable")
+    assert (tmp_path / "flexible.png").stat().st_size > 10_000

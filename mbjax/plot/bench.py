@@ -2,6 +2,7 @@
 
 import numpy as np
 from matplotlib.figure import Figure
+from matplotlib.ticker import NullFormatter
 
 from mbjax.plot.style import COLORS, MARKERS
 
@@ -128,6 +129,7 @@ def flexible_bench_figure(records: list[dict]) -> Figure:
     duration = records[0]["duration"]
     ax.set(xlabel=f"run time for {duration:g} s [s]", ylabel="max |tip deflection - reference| [m]",
            title=f"spin-up beam, 0-{duration:g} s: speed against accuracy")
+    ax.xaxis.set_minor_formatter(NullFormatter())
     ax.grid(True, which="both", alpha=0.3)
     ax.legend(fontsize=7)
     return fig
