@@ -268,9 +268,12 @@ def test_reproduce_spin_up_beam(tmp_path):
     assert all(math.isfinite(x) and x <= 1e-6 for x in tip)         # the tip lags throughout
     assert data["status"] == "success"
     assert free[-1] > 20 * max(abs(x) for x in tip)
-    # the centrifugal stretch: positive, below the rigid bound m omega^2 L^2 / (3 E A) = 0.5 mm
-    axial = data["axial_tip_displacement"]
-    assert 0.0 < axial[-1] < 5.2e-4
+    # the centrifugal stretch: positive, below the rigid bound m omega^2 L^2 / (3 E A) = 0.5 mm;
+    # the tip's axial displacement is dominated by the bending's foreshortening, as in the ANCF beam
+    assert 0.0 < data["axial_stretch"][-1] < 5.2e-4
+    k = tip.index(peak)
+    axial, ref_axial = data["axial_tip_displacement"][k], ref["tip_axial"][k]
+    assert ref_axial < -0.01 and abs(axial - ref_axial) < 0.05 * abs(ref_axial)
     assert (tmp_path / "spin-up-beam.png").stat().st_size > 10_000
 
 
