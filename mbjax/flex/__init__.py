@@ -3,7 +3,7 @@ body's time-invariant coefficients and geometric stiffening, flexible bodies in 
 recursion, and a geometrically nonlinear ANCF beam as the independent reference."""
 
 from mbjax.flex.aba import flexible_aba, flexible_aba_responses
-from mbjax.flex.ancf import AncfBeam, AncfSolution, simulate as simulate_ancf, stable_step
+from mbjax.flex.ancf import AncfBeam, AncfSolution, simulate as simulate_ancf, simulate_embedded, stable_step
 from mbjax.flex.beam import Beam, eigenmodes, free_dofs, geometric_stiffness
 from mbjax.flex.body import ModalBody
 from mbjax.flex.builders import beam_body
@@ -21,6 +21,5 @@ __all__ = ["AncfBeam", "AncfSolution", "Beam", "FlexibleModel", "FlexibleSystem"
            "distal_stiffening", "eigenmodes", "energy", "flex_kinematics", "flexible_aba",
            "flexible_aba_responses", "frame_poses", "free_dofs", "geometric_stiffness",
            "inertial_stiffening", "mass_points", "node_shapes", "reduced", "shape_at",
-           "simulate_ancf", "slider_crank_reference", "spin_up_beam_reference", "spin_up_theta",
+           "simulate_ancf", "simulate_embedded", "slider_crank_reference", "spin_up_beam_reference", "spin_up_theta",
            "stable_step"]
-from mbjax.flex.ancf import simulate_embedded  # noqa: E402

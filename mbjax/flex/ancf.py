@@ -39,7 +39,7 @@ import numpy as np
 from jax import Array
 
 
-def _hermite(xi, l):
+def _hermite(xi, l):  # noqa: E741 (the element length, as in the ANCF papers)
     """Cubic Hermite shape functions h(xi) and their s-derivatives, xi in [0, 1], element length l.
     Returns (h, h_s, h_ss), each (..., 4) in the order (r_A, r_A', r_B, r_B')."""
     h = jnp.stack([1 - 3 * xi**2 + 2 * xi**3, l * (xi - 2 * xi**2 + xi**3), 3 * xi**2 - 2 * xi**3,
@@ -162,7 +162,8 @@ def _split(n, prescribed):
 def _kinematics(embed, t, q, q_dot):
     """(e, e_dot, G = de/dq, c) for e = embed(t, q) affine in q, so that e_ddot = G q_ddot + c
     with c = d^2/dtau^2 embed(t + tau, q + tau q_dot) at tau = 0 (nested jax.jvp)."""
-    path = lambda tau: embed(t + tau, q + tau * q_dot)
+    def path(tau):
+        return embed(t + tau, q + tau * q_dot)
     one = jnp.ones_like(t)
     (e, e_dot), (_, c) = jax.jvp(lambda tau: jax.jvp(path, (tau,), (one,)), (0.0 * t,), (one,))
     return e, e_dot, jax.jacfwd(embed, argnums=1)(t, q), c
@@ -244,7 +245,8 @@ def simulate(beam: AncfBeam, e0, e_dot0, ts, *, prescribed=(), e_p: Callable | N
     f, p = _split(beam.n_coordinates, prescribed)
     if len(p) and e_p is None:
         raise ValueError("prescribed coordinates need e_p(t)")
-    embed = lambda t, q: jnp.zeros(beam.n_coordinates, q.dtype).at[f].set(q).at[p].set(
-        e_p(t) if len(p) else jnp.zeros(0))
+    def embed(t, q):
+        return jnp.zeros(beam.n_coordinates, q.dtype).at[f].set(q).at[p].set(
+            e_p(t) if len(p) else jnp.zeros(0))
     return simulate_embedded(beam, embed, jnp.asarray(e0, float)[f], jnp.asarray(e_dot0, float)[f], ts,
                              constant_mass=True, **kwargs)

@@ -88,7 +88,7 @@ class Beam(eqx.Module):
         _check_positive("diameter", diameter)
         d = jnp.asarray(diameter, dtype=jnp.float64)
         G = jnp.asarray(E, dtype=jnp.float64) / (2.0 * (1.0 + nu)) if G is None else G
-        I = math.pi * d**4 / 64.0
+        I = math.pi * d**4 / 64.0  # noqa: E741 (the second moment of area)
         return cls(L, E, G, rho, math.pi * d**2 / 4.0, I, I, 2.0 * I, n_elements,
                    timoshenko=timoshenko, kappa=kappa)
 

@@ -52,7 +52,7 @@ def _mass_points(beam, basis, n_gauss):
     Pe = basis.shapes[beam.element_dofs()]  # (E, 12, mu)
     phi = jnp.einsum("gik,ekm->egim", Nt, Pe).reshape(-1, 3, basis.mu)
     psi = jnp.einsum("gik,ekm->egim", Nr, Pe).reshape(-1, 3, basis.mu)
-    n_e, n_g = beam.n_elements, len(w)
+    n_e, _n_g = beam.n_elements, len(w)
     x = ((jnp.arange(n_e)[:, None] + xi[None, :]) * beam.Le).reshape(-1)
     position = jnp.stack([x, jnp.zeros_like(x), jnp.zeros_like(x)], axis=-1)
     wl = jnp.tile(w, n_e) * beam.Le

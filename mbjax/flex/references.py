@@ -18,7 +18,8 @@ def spin_up_theta(t, T_s=15.0, omega_s=6.0):
     """Base angle of Kane's spin-up (seed 002 eq 109, here for any T_s, omega_s): the integral of
     omega(t) = (omega_s / T_s) (t - (T_s / 2 pi) sin(2 pi t / T_s)) for t < T_s, omega_s after."""
     c = T_s / (2 * np.pi)
-    ramp = lambda t: omega_s / T_s * (t**2 / 2 + c**2 * (jnp.cos(t / c) - 1))
+    def ramp(t):
+        return omega_s / T_s * (t**2 / 2 + c**2 * (jnp.cos(t / c) - 1))
     return jnp.where(t < T_s, ramp(t), ramp(T_s) + omega_s * (t - T_s))
 
 
@@ -30,7 +31,7 @@ class SpinUpResult(NamedTuple):
 
 
 def spin_up_beam_reference(n_elements=8, ts=None, *, dt=None, safety=0.5, length=10.0, E=7.0e10,
-                           A=4.0e-4, I=2.0e-7, mass=12.0, T_s=15.0, omega_s=6.0,
+                           A=4.0e-4, I=2.0e-7, mass=12.0, T_s=15.0, omega_s=6.0,  # noqa: E741
                            free_root_stretch=True) -> SpinUpResult:
     """Kane's spin-up beam (seed 002 §3.2, eq 109; Kane, Ryan & Banerjee 1987) as an ANCF beam in
     the x-y plane: node 0 clamped on the axis (position 0, slope (cos theta, sin theta)
@@ -41,16 +42,19 @@ def spin_up_beam_reference(n_elements=8, ts=None, *, dt=None, safety=0.5, length
     only as O(element length) (the centrifugal tension at the root is what stiffens the beam)."""
     ts = np.linspace(0.0, 20.0, 201) if ts is None else np.asarray(ts, float)
     beam = AncfBeam(length, E * A, E * I, mass / length, n_elements)
-    theta = lambda t: spin_up_theta(t, T_s, omega_s)
+    def theta(t):
+        return spin_up_theta(t, T_s, omega_s)
     e0 = beam.initial_coordinates()
     if free_root_stretch:
         # q = (lambda, coordinates of nodes 1 ... n)
-        embed = lambda t, q: jnp.concatenate([jnp.zeros(2), q[0] * jnp.stack([jnp.cos(theta(t)),
-                                                                              jnp.sin(theta(t))]), q[1:]])
+        def embed(t, q):
+            root = q[0] * jnp.stack([jnp.cos(theta(t)), jnp.sin(theta(t))])
+            return jnp.concatenate([jnp.zeros(2), root, q[1:]])
         q0 = jnp.concatenate([jnp.ones(1), e0[4:]])
         sol = simulate_embedded(beam, embed, q0, jnp.zeros_like(q0), ts, dt=dt, safety=safety)
     else:
-        e_p = lambda t: jnp.stack([0.0 * t, 0.0 * t, jnp.cos(theta(t)), jnp.sin(theta(t))])
+        def e_p(t):
+            return jnp.stack([0.0 * t, 0.0 * t, jnp.cos(theta(t)), jnp.sin(theta(t))])
         sol = simulate(beam, e0, jnp.zeros_like(e0), ts, prescribed=range(4), e_p=e_p, dt=dt,
                        safety=safety)
     tip, th = sol.e[:, -4:-2], theta(sol.ts)
@@ -76,7 +80,8 @@ def slider_crank_reference(n_elements=4, ts=None, *, dt=None, safety=0.5, crank=
     ts = np.linspace(0.0, 0.15, 301) if ts is None else np.asarray(ts, float)
     area, inertia = np.pi * diameter**2 / 4, np.pi * diameter**4 / 64
     beam = AncfBeam(rod, E * area, E * inertia, mass / rod, n_elements)
-    P = lambda t: crank * jnp.stack([jnp.cos(np.pi / 2 + Omega * t), jnp.sin(np.pi / 2 + Omega * t)])
+    def P(t):
+        return crank * jnp.stack([jnp.cos(np.pi / 2 + Omega * t), jnp.sin(np.pi / 2 + Omega * t)])
 
     def rigid(t):
         """Coordinates of the rigid rod from P(t) to Q(t) = (P_x + sqrt(rod^2 - P_y^2), 0)."""

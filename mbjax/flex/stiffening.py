@@ -48,7 +48,7 @@ def _acceleration_basis(rho):
     return jnp.stack(cols, axis=1)
 
 
-def _moment_basis(I):
+def _moment_basis(I):  # noqa: E741 (seed 002 eq 37)
     """H (3, 9) with I alpha + omega x I omega = H @ s[12:21], Table 1 rows 13-21."""
     e = jnp.eye(3)
     pairs = [(0, 0), (0, 1), (0, 2), (1, 1), (1, 2), (2, 2)]

@@ -88,7 +88,7 @@ def test_load_basis_matches_table_1():
     rng = np.random.default_rng(0)
     a, al, om, rho = rng.normal(size=(4, 3))
     Q = rng.normal(size=(3, 3))
-    I = Q @ Q.T
+    I = Q @ Q.T  # noqa: E741 (the inertia)
     s = inertial_scalars(a, al, om)
     np.testing.assert_allclose(_acceleration_basis(jnp.asarray(rho)) @ s[:12],
                                a + np.cross(al, rho) + np.cross(om, np.cross(om, rho)), atol=1e-12)
