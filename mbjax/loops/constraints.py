@@ -63,7 +63,10 @@ class Loops(eqx.Module):
 
     def phi(self, q: Array, t=0.0) -> Array:
         """Phi(q, t), (m,)."""
-        R, p = frames(self.model, q)
+        if any(isinstance(c, CutJoint) for c in self.closures):
+            R, p = frames(self.model, q)
+        else:                         # prescribed motions only: no kinematics to trace
+            R = p = None
         return jnp.concatenate([c.residual(R, p, q, t) for c in self.closures])
 
     def rate(self, q: Array, v: Array, t=0.0) -> Array:
