@@ -18,7 +18,7 @@ ANCF beam and exudyn.
 - exudyn (optional peer, same process): the same beam as `ObjectANCFCable2D` elements (as many as
   the reference), the root's position fixed and its slope direction (free magnitude, as in the
   reference) prescribed through a `GenericJoint` with an offset user function, exudyn's implicit
-  generalized-alpha solver (spectral radius 1, fixed steps), at several steps; run_s is the median
+  generalized-alpha solver (spectral radius 0.8, fixed steps), at several steps; run_s is the median
   wall time of building and solving (the offset is a Python user function, called from C++).
 
 Modal run times: median after warm-up (`mbjax.bench.timing.measure`), compile time apart.
