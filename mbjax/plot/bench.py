@@ -93,6 +93,9 @@ def loops_bench_figure(records: list[dict]) -> Figure:
     return fig
 
 
+CEILING = 3.0   # m: errors above are drawn here (marked ^) with their value
+
+
 def flexible_bench_figure(records: list[dict]) -> Figure:
     """`mbjax bench flexible`: max tip-deflection error against run time on Kane's spin-up beam.
     One line per bending-mode count (stiffened modal model, the two steps), open markers without
@@ -112,9 +115,12 @@ def flexible_bench_figure(records: list[dict]) -> Figure:
             ax.loglog([r["run_s"] for r in rows], [r["error"] for r in rows], "o-", color=color,
                       label=f"modal, {nb} bending + 1 axial")
         for r in (r for r in modal if r["n_bending"] == nb and not r["stiffening"]):
-            if pos(r["error"]):
-                ax.loglog(r["run_s"], r["error"], "o", mfc="none", ms=10, color=color,
+            if pos(r["error"]):   # diverged runs (errors up to 1e20 m) drawn at the 3 m ceiling
+                ax.loglog(r["run_s"], min(r["error"], CEILING), "^" if r["error"] > CEILING else "o",
+                          mfc="none", ms=10, color=color,
                           label=f"modal, {nb} bending + 1 axial, no stiffening")
+                ax.annotate(f"{r['error']:.2g} m", (r["run_s"], min(r["error"], CEILING)),
+                            textcoords="offset points", xytext=(8, -4), fontsize=7, color=color)
     for r in (r for r in records if r["kind"] == "ancf"):
         if r.get("reference"):
             ax.axvline(r["run_s"], color="k", ls=":",
@@ -129,6 +135,7 @@ def flexible_bench_figure(records: list[dict]) -> Figure:
     duration = records[0]["duration"]
     ax.set(xlabel=f"run time for {duration:g} s [s]", ylabel="max |tip deflection - reference| [m]",
            title=f"spin-up beam, 0-{duration:g} s: speed against accuracy")
+    ax.set_ylim(top=2 * CEILING)
     ax.xaxis.set_minor_formatter(NullFormatter())
     ax.grid(True, which="both", alpha=0.3)
     ax.legend(fontsize=7)
