@@ -63,7 +63,8 @@ def mujoco_rollout(model, data, quat0, Omega0, nstep: int):
 
 
 def exudyn_spin_up_beam(n_elements: int, dt: float, ts, *, length=10.0, E=7.0e10, A=4.0e-4,
-                        I=2.0e-7, mass=12.0, T_s=15.0, omega_s=6.0, spectral_radius=0.8):
+                        I=2.0e-7, mass=12.0, T_s=15.0, omega_s=6.0,  # noqa: E741 (the paper's I)
+                        spectral_radius=0.8):
     """Kane's spin-up beam (as `mbjax.flex.references.spin_up_beam_reference`) in exudyn: n
     `ObjectANCFCable2D` elements along x, the root's position fixed and its slope direction
     prescribed by theta(t) through a `GenericJoint` (x, y and the rotation about z locked) with an
@@ -77,8 +78,12 @@ def exudyn_spin_up_beam(n_elements: int, dt: float, ts, *, length=10.0, E=7.0e10
                                       ObjectANCFCable2D, ObjectGround, SensorNode)
 
     c = T_s / (2 * np.pi)
-    ramp = lambda t: omega_s / T_s * (t**2 / 2 + c**2 * (np.cos(t / c) - 1))
-    theta = lambda t: ramp(t) if t < T_s else ramp(T_s) + omega_s * (t - T_s)
+
+    def ramp(t):   # NumPy, not spin_up_theta's jnp: exudyn calls it per Newton iteration
+        return omega_s / T_s * (t**2 / 2 + c**2 * (np.cos(t / c) - 1))
+
+    def theta(t):
+        return ramp(t) if t < T_s else ramp(T_s) + omega_s * (t - T_s)
 
     ts = np.asarray(ts, float)
     sc = exu.SystemContainer()

@@ -103,7 +103,10 @@ def flexible_bench_figure(records: list[dict]) -> Figure:
     its error is zero by definition), crosses for exudyn's ANCF cable."""
     fig = Figure(figsize=(7.5, 5.2), layout="constrained")
     ax = fig.subplots()
-    pos = lambda v: v is not None and np.isfinite(v) and v > 0
+
+    def pos(v):
+        return v is not None and np.isfinite(v) and v > 0
+
     modal = [r for r in records if r["kind"] == "modal"]
     colors = dict(zip(sorted({r["n_bending"] for r in modal}),
                       ("#1f77b4", "#ff7f0e", "#2ca02c", "#d62728", "#9467bd", "#8c564b")))
