@@ -41,6 +41,7 @@ import jax.numpy as jnp
 import numpy as np
 from jax import Array
 
+from mbjax.flex.stiffening import inertial_scalars
 from mbjax.spatial import cross_force, skew
 
 # d s / d A for the 21 temporal scalars of Table 1 (`mbjax.flex.stiffening` order): s[0:3] = a
@@ -53,12 +54,6 @@ _DS_DA[0:3, 3:6] = _DS_DA[3:6, 0:3] = _DS_DA[12:15, 0:3] = np.eye(3)
 _EPS = np.zeros((3, 3, 3))                                   # the Levi-Civita symbol
 for i, j, k in ((0, 1, 2), (1, 2, 0), (2, 0, 1)):
     _EPS[i, j, k], _EPS[i, k, j] = 1.0, -1.0
-
-
-def omega_products(w: Array) -> Array:
-    """(w1^2, w1 w2, w1 w3, w2^2, w2 w3, w3^2), Table 1's centrifugal scalars."""
-    return jnp.stack([w[0] * w[0], w[0] * w[1], w[0] * w[2], w[1] * w[1], w[1] * w[2],
-                      w[2] * w[2]])
 
 
 class ModalBody(eqx.Module):
@@ -201,6 +196,5 @@ def inertial_stiffening(body: ModalBody, q: Array, V: Array) -> tuple[Array, Arr
     Table 1, linear in A."""
     Kq = jnp.einsum("qst,t->sq", body.inertial_stiffening, q)           # (mu, 21)
     w, v = V[:3], V[3:]
-    wp = omega_products(w)
-    s0 = jnp.concatenate([jnp.cross(w, v), jnp.zeros(3, q.dtype), wp, jnp.zeros(3, q.dtype), wp])
+    s0 = inertial_scalars(jnp.cross(w, v), jnp.zeros(3, q.dtype), w)     # A = 0
     return Kq @ jnp.asarray(_DS_DA, q.dtype), Kq @ s0

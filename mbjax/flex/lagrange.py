@@ -19,9 +19,9 @@ import jax.numpy as jnp
 from jax import Array
 
 from mbjax.flex.body import kinetic_energy as body_kinetic_energy
-from mbjax.flex.body import omega_products
 from mbjax.flex.kinematics import frame_poses
 from mbjax.flex.model import FlexibleModel
+from mbjax.flex.stiffening import inertial_scalars
 from mbjax.lie import vee
 
 
@@ -84,8 +84,7 @@ def residual(model: FlexibleModel, q: Array, v: Array, v_dot: Array, tau: Array)
     _, qf = model.split(q)
     _, uf = model.split(v)
     b = model.bodies
-    wp = jax.vmap(omega_products)(omega)
-    s = jnp.concatenate([a, alpha, wp, alpha, wp], -1)                     # Table 1's scalars
+    s = jax.vmap(inertial_scalars)(a, alpha, omega)                        # Table 1's scalars
     modal = (jnp.einsum("kq,kqst,kt->ks", s, b.inertial_stiffening, qf)
              + jnp.einsum("kst,kt->ks", b.damping, uf))
     return generalized + model.join(jnp.zeros(model.model.nv, q.dtype), modal)
