@@ -26,7 +26,7 @@ from jax import Array
 
 from mbjax.flex.model import FlexibleModel
 from mbjax.lie import exp, gamma
-from mbjax.rigid.kinematics import to_ground
+from mbjax.rigid.kinematics import _compose, to_ground
 from mbjax.spatial import cross_motion, skew
 from mbjax.tree import forward_pass
 
@@ -72,15 +72,6 @@ def _partial_velocities(psi: Array, phi: Array, rho: Array, q: Array) -> Array:
     return jnp.concatenate([Gw, phi + skew(rho + phi @ q) @ Gw])
 
 
-def _compose(model: FlexibleModel, R: Array, p: Array):
-    def compose(parent, local):
-        (R_parent, p_parent), (R_local, p_local) = parent, local
-        return R_parent @ R_local, p_parent + R_parent @ p_local
-
-    return forward_pass(model.model.topology, compose,
-                        (jnp.eye(3, dtype=R.dtype), jnp.zeros(3, R.dtype)), (R, p))
-
-
 def frame_poses(model: FlexibleModel, q: Array) -> tuple[Array, Array, Array, Array]:
     """(R, p) of every body frame, and (R, p) of every marker (`FlexibleModel.markers`)."""
     R, p, _ = _poses(model, q, jnp.zeros(model.nv, q.dtype))
@@ -95,8 +86,7 @@ def _poses(model: FlexibleModel, q: Array, v: Array):
     parent, has_parent = _parents(model)
     q_parent = jnp.where(has_parent[:, None], qf[parent], 0.0)
     E, o, rho, psi, phi = attachment(model, q_parent)
-    R, p = _compose(model, E @ R_local,
-                    o + jnp.einsum("kij,kj->ki", E, p_local - rho))
+    R, p = _compose(model.model, E @ R_local, o + jnp.einsum("kij,kj->ki", E, p_local - rho))
     return R, p, (S_local, S_dot_local, q_parent, psi, phi, rho, parent, has_parent)
 
 
