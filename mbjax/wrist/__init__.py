@@ -1,0 +1,11 @@
+"""The Carpal Wrist parallel robot (seed 003): closed-form kinematics, forward and inverse
+dynamics from an autodiff Lagrangian, an independent Newton-Euler route, and a `simulate`-ready
+system."""
+
+from mbjax.wrist.kinematics import Pose, SingularityMeasures, pose_error, rotation_angle
+from mbjax.wrist.model import CarpalWrist
+from mbjax.wrist.system import WristSystem
+from mbjax.wrist.torques import Servo, ZeroTorque
+
+__all__ = ["CarpalWrist", "Pose", "Servo", "SingularityMeasures", "WristSystem", "ZeroTorque",
+           "pose_error", "rotation_angle"]

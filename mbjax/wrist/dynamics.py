@@ -1,0 +1,95 @@
+"""Carpal Wrist dynamics from its Lagrangian by autodiff (seed 003 §6.3).
+
+L(theta, theta_dot) = T - V (eq 6.7) is written once, in the input angles theta (the chapter's
+generalized coordinates), from the closed-form kinematics:
+
+    T = 1/2 m v_G . v_G + 1/2 omega . (R I_G R^T) omega,     V = m g x_G . e3,
+
+with v_G and R_dot from one forward-mode derivative of the pose along theta_dot and
+[omega]x = R_dot R^T. (Eq 6.7 prints omega_i R_ij I_jk omega_k; the inertia in B is R I R^T.)
+Lagrange's equations (eq 6.5) then give eq 6.16, tau = A(theta) theta_ddot + B(theta, theta_dot)
++ C(theta), with
+
+    A = d^2 T / d theta_dot^2,   B = (d^2 T / d theta_dot d theta) theta_dot - dT/d theta,
+    C = dV / d theta,
+
+all by autodiff: none of the chapter's hand expansions (eqs 6.8-6.15, 6.22-6.42) is needed. The
+legs are massless, so A is singular where a leg is (the inverse singularity, the workspace
+boundary); inside the workspace it is positive definite and eq 6.21 is solved by Cholesky.
+"""
+
+import jax
+import jax.numpy as jnp
+import jax.scipy.linalg as jsl
+from jax import Array
+
+from mbjax.wrist.kinematics import forward_kinematics
+
+
+def _vee(W: Array) -> Array:
+    """The axial vector of the skew part of W."""
+    return 0.5 * jnp.array([W[2, 1] - W[1, 2], W[0, 2] - W[2, 0], W[1, 0] - W[0, 1]])
+
+
+def tool_velocity(wrist, theta: Array, theta_dot: Array) -> tuple[Array, Array]:
+    """(v_G, omega) in B: the tool's centre-of-mass velocity and angular velocity, from the
+    derivative of the pose along theta_dot ([omega]x = R_dot R^T; eq 6.2 for the chapter's R)."""
+    def com_and_rotation(th):
+        pose = forward_kinematics(wrist, th)
+        return pose.com, pose.rotation
+    (_, R), (v, R_dot) = jax.jvp(com_and_rotation, (theta,), (theta_dot,))
+    return v, _vee(R_dot @ R.T)
+
+
+def kinetic_energy(wrist, theta: Array, theta_dot: Array) -> Array:
+    """T of eq 6.7."""
+    R = forward_kinematics(wrist, theta).rotation
+    v, omega = tool_velocity(wrist, theta, theta_dot)
+    return 0.5 * wrist.tool_mass * v @ v + 0.5 * omega @ (R @ (wrist.tool_inertia @ (R.T @ omega)))
+
+
+def potential_energy(wrist, theta: Array) -> Array:
+    """V of eq 6.7: m g (p + R33 p + R3j G_j) = m g x_G . e3."""
+    return wrist.tool_mass * wrist.gravity * forward_kinematics(wrist, theta).com[2]
+
+
+def lagrangian(wrist, theta: Array, theta_dot: Array) -> Array:
+    """L = T - V (eq 6.6)."""
+    return kinetic_energy(wrist, theta, theta_dot) - potential_energy(wrist, theta)
+
+
+def energy(wrist, theta: Array, theta_dot: Array) -> Array:
+    """T + V, conserved with zero motor torque."""
+    return kinetic_energy(wrist, theta, theta_dot) + potential_energy(wrist, theta)
+
+
+def eom_terms(wrist, theta: Array, theta_dot: Array) -> tuple[Array, Array, Array]:
+    """(A, B, C) of eq 6.16: tau = A theta_ddot + B + C."""
+    theta, theta_dot = jnp.asarray(theta), jnp.asarray(theta_dot)
+    dT_dqd = jax.grad(kinetic_energy, argnums=2)
+    A = jax.jacfwd(dT_dqd, argnums=2)(wrist, theta, theta_dot)
+    mixed = jax.jvp(lambda th: dT_dqd(wrist, th, theta_dot), (theta,), (theta_dot,))[1]
+    B = mixed - jax.grad(kinetic_energy, argnums=1)(wrist, theta, theta_dot)
+    C = jax.grad(potential_energy, argnums=1)(wrist, theta)
+    return A, B, C
+
+
+def mass_matrix(wrist, theta: Array) -> Array:
+    """A(theta) of eq 6.16, the Hessian of T in theta_dot."""
+    theta = jnp.asarray(theta)
+    return eom_terms(wrist, theta, jnp.zeros_like(theta))[0]
+
+
+def forward_dynamics(wrist, theta: Array, theta_dot: Array, torque: Array) -> Array:
+    """theta_ddot = A^-1 (tau - B - C) (eqs 6.17-6.21), by Cholesky."""
+    A, B, C = eom_terms(wrist, theta, theta_dot)
+    return jsl.cho_solve(jsl.cho_factor(A), jnp.asarray(torque) - B - C)
+
+
+def inverse_dynamics(wrist, theta: Array, theta_dot: Array, theta_ddot: Array) -> Array:
+    """tau = d/dt(dL/d theta_dot) - dL/d theta (eq 6.5): one forward-mode derivative of
+    dL/d theta_dot along (theta_dot, theta_ddot), no mass matrix formed."""
+    theta, theta_dot, theta_ddot = (jnp.asarray(x) for x in (theta, theta_dot, theta_ddot))
+    dL_dqd = jax.grad(lagrangian, argnums=2)
+    ddt = jax.jvp(lambda th, thd: dL_dqd(wrist, th, thd), (theta, theta_dot), (theta_dot, theta_ddot))[1]
+    return ddt - jax.grad(lagrangian, argnums=1)(wrist, theta, theta_dot)
