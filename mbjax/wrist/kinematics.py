@@ -56,9 +56,27 @@ def _knee_matrix(wrist, theta: Array) -> Array:
     return jnp.concatenate([jnp.ones((3, 1), theta.dtype), rho[:, None] * leg_directions(wrist)], axis=1)
 
 
+def _dot(a: Array, b: Array) -> Array:
+    """Contraction over the last axis, written elementwise: with 3-vectors a LAPACK/dot kernel per
+    product (and per derivative of it) costs far more than the arithmetic, which XLA fuses."""
+    return jnp.sum(a * b, axis=-1)
+
+
+def _matmul(A: Array, B: Array) -> Array:
+    """A @ B for small matrices, elementwise (see `_dot`)."""
+    return jnp.sum(A[..., :, :, None] * B[..., None, :, :], axis=-2)
+
+
+def _inverse3(K: Array) -> Array:
+    """K^-1 of a 3x3 matrix from its rows' cross products (columns k2 x k3, k3 x k1, k1 x k2 over
+    det K): elementwise arithmetic that XLA fuses, where a LAPACK call per derivative would not."""
+    adj = jnp.stack([jnp.cross(K[1], K[2]), jnp.cross(K[2], K[0]), jnp.cross(K[0], K[1])], axis=1)
+    return adj / _dot(K[0], adj[:, 0])
+
+
 def midplane(wrist, theta: Array) -> tuple[Array, Array]:
-    """(p, g): plunge and slope of the plane through the three knees."""
-    sol = jnp.linalg.solve(_knee_matrix(wrist, theta), wrist.link_length * jnp.sin(theta))
+    """(p, g): plunge and slope of the plane through the three knees, (p, g) = K^-1 z."""
+    sol = _dot(_inverse3(_knee_matrix(wrist, theta)), wrist.link_length * jnp.sin(theta))
     return sol[0], sol[1:]
 
 
@@ -79,7 +97,7 @@ def _safe_azimuth(v: Array) -> tuple[Array, Array]:
 
 def normal_from_slope(g: Array) -> Array:
     """N = (-gx, -gy, 1) / sqrt(1 + |g|^2): the midplane normal, N_z > 0."""
-    return jnp.concatenate([-g, jnp.ones(1, g.dtype)]) / jnp.sqrt(1.0 + g @ g)
+    return jnp.concatenate([-g, jnp.ones(1, g.dtype)]) / jnp.sqrt(1.0 + _dot(g, g))
 
 
 def rotation_from_slope(g: Array, variant: str = "physical") -> Array:
@@ -92,10 +110,10 @@ def rotation_from_slope(g: Array, variant: str = "physical") -> Array:
     """
     if variant == "physical":
         N = normal_from_slope(g)
-        return (jnp.eye(3, dtype=g.dtype) - 2 * jnp.outer(N, N)) * jnp.array([1.0, 1.0, -1.0], g.dtype)
+        return (jnp.eye(3, dtype=g.dtype) - 2 * N[:, None] * N[None, :]) * jnp.array([1.0, 1.0, -1.0], g.dtype)
     if variant == "chapter":
         ca, sa = _safe_azimuth(-g)
-        t2 = g @ g                                   # tan^2(beta / 2)
+        t2 = _dot(g, g)                                # tan^2(beta / 2)
         cb, sb = (1 - t2) / (1 + t2), 2 * _safe_norm(g) / (1 + t2)
         z = jnp.zeros((), g.dtype)
         return jnp.array([[ca * cb, -sa, ca * sb], [sa * cb, ca, sa * sb], [-sb, z, cb]])
@@ -109,7 +127,16 @@ def pose_from_chart(wrist, plunge: Array, g: Array) -> Pose:
     ca, sa = _safe_azimuth(-g)
     centre = 2 * plunge * N[2] * N
     return Pose(alpha=jnp.arctan2(sa, ca), beta=2 * jnp.arctan(_safe_norm(g)), plunge=plunge,
-                slope=g, normal=N, rotation=R, centre=centre, com=centre + R @ wrist.tool_com)
+                slope=g, normal=N, rotation=R, centre=centre, com=centre + _dot(R, wrist.tool_com))
+
+
+def com_and_rotation(wrist, theta: Array) -> tuple[Array, Array]:
+    """(x_G, R): just the tool's centre of mass and rotation, the part of the pose the dynamics
+    differentiates (three times: a lean graph compiles faster)."""
+    p, g = midplane(wrist, theta)
+    N = normal_from_slope(g)
+    R = rotation_from_slope(g, wrist.rotation_model)
+    return 2 * p * N[2] * N + _dot(R, wrist.tool_com), R
 
 
 def forward_kinematics(wrist, theta: Array) -> Pose:
@@ -126,7 +153,7 @@ def slope_from_angles(alpha: Array, beta: Array) -> Array:
 
 def _ik_argument(wrist, plunge: Array, g: Array) -> tuple[Array, Array]:
     """(k_i, a_i): k_i = c_i . g, a_i = (p + rb k_i) / (l sqrt(1 + k_i^2)); reachable iff |a_i| <= 1."""
-    k = leg_directions(wrist) @ g
+    k = _dot(leg_directions(wrist), g)
     return k, (plunge + wrist.base_radius * k) / (wrist.link_length * jnp.sqrt(1 + k * k))
 
 
@@ -155,9 +182,9 @@ def inverse_kinematics(wrist, alpha, beta, plunge) -> Array:
 def chart_jacobian(wrist, theta: Array) -> Array:
     """d(p, gx, gy)/d theta = K^-1 D in closed form."""
     p, g = midplane(wrist, theta)
-    k = leg_directions(wrist) @ g
+    k = _dot(leg_directions(wrist), g)
     D = wrist.link_length * (jnp.cos(theta) - k * jnp.sin(theta))
-    return jnp.linalg.solve(_knee_matrix(wrist, theta), jnp.diag(D))
+    return _inverse3(_knee_matrix(wrist, theta)) * D
 
 
 def _normal_plunge(wrist, theta: Array) -> Array:
@@ -200,7 +227,7 @@ def singularity_measures(wrist, theta: Array) -> SingularityMeasures:
     """Both singularity distances and the Jacobian's inverse condition number at theta."""
     theta = jnp.asarray(theta)
     _, g = midplane(wrist, theta)
-    k = leg_directions(wrist) @ g
+    k = _dot(leg_directions(wrist), g)
     leg = (jnp.cos(theta) - k * jnp.sin(theta)) / jnp.sqrt(1 + k * k)
     rho = wrist.base_radius - wrist.link_length * jnp.cos(theta)
     direct = (rho[0] * rho[1] + rho[1] * rho[2] + rho[2] * rho[0]) / jnp.sum(rho * rho)

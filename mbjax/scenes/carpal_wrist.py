@@ -1,0 +1,66 @@
+"""A Carpal Wrist carrying a tool: the robot of seed 003 at the scale of a surgical or small
+industrial wrist, with the scenarios the tests, the tour, the reproduction and the notebooks use.
+
+The tool's centre of mass sits off the axis (TOOL_COM) and its inertia is not axisymmetric, so the
+physical mirror plate and the chapter's printed rotation give different dynamics.
+
+- `free_motion`: zero torque, no gravity, released with THETA_DOT0 from HOME: energy is conserved
+  and the motion stays inside the workspace for FREE_DURATION (the integrator accuracy study).
+- `servo`: a joint PD servo (stiffness SERVO_K, damping SERVO_D, gravity feed-forward) holding
+  HOME, released from HOME + SERVO_OFFSET under gravity: the step-size stability study.
+- START and GOAL: two tool poses (plunge, slope) for trajectory synthesis, DURATION apart.
+"""
+
+import jax.numpy as jnp
+import numpy as np
+
+from mbjax.wrist import CarpalWrist, Servo, WristSystem, ZeroTorque
+
+BASE_RADIUS = 0.06                           # [m]
+LINK_LENGTH = 0.10                           # [m]
+TOOL_MASS = 1.5                              # [kg]
+TOOL_INERTIA = np.diag([4e-3, 3e-3, 1e-3])   # [kg m^2] about the tool's centre of mass, in D
+TOOL_COM = np.array([0.01, -0.005, 0.08])    # [m] from the distal-plate centre, in D
+HOME_PLUNGE = 0.075                          # [m]: theta_i = pi/2 + acos(0.75) = 2.29 rad
+
+THETA_DOT0 = np.array([0.6, -0.4, 0.16])     # [rad/s]
+FREE_DURATION = 0.5                          # [s]
+SERVO_K = 60.0                               # [N m / rad]
+SERVO_D = 0.4                                # [N m s / rad]
+SERVO_OFFSET = np.array([0.05, -0.03, 0.02])  # [rad]
+SERVO_DURATION = 1.0                         # [s]
+
+START = (0.070, np.array([0.25, -0.10]))     # (plunge [m], slope): beta = 30.8 deg
+GOAL = (0.080, np.array([-0.20, 0.25]))      # beta = 35.5 deg, on the other side
+DURATION = 0.5                               # [s]
+TORQUE_LIMIT = 4.0                           # [N m]
+
+
+def wrist(rotation_model: str = "physical", gravity: float = 9.81) -> CarpalWrist:
+    """The scene's wrist."""
+    return CarpalWrist(BASE_RADIUS, LINK_LENGTH, tool_mass=TOOL_MASS, tool_inertia=TOOL_INERTIA,
+                       tool_com=TOOL_COM, gravity=gravity, rotation_model=rotation_model)
+
+
+def home(w: CarpalWrist | None = None) -> jnp.ndarray:
+    """theta at the home pose (beta = 0, plunge HOME_PLUNGE)."""
+    w = wrist() if w is None else w
+    return w.solve_inverse_kinematics(HOME_PLUNGE, jnp.zeros(2))[0]
+
+
+def free_motion(rotation_model: str = "physical"):
+    """(system, theta0, theta_dot0): torque-free, gravity-free motion from HOME."""
+    w = wrist(rotation_model, gravity=0.0)
+    return WristSystem(w, ZeroTorque()), home(w), jnp.asarray(THETA_DOT0)
+
+
+def servo():
+    """(system, theta0, theta_dot0): the servoed wrist under gravity, offset from HOME."""
+    w = wrist()
+    law = Servo(theta_ref=home(w), stiffness=jnp.asarray(SERVO_K), damping=jnp.asarray(SERVO_D))
+    return WristSystem(w, law), home(w) + jnp.asarray(SERVO_OFFSET), jnp.zeros(3)
+
+
+def build():
+    """The scene's default (system, theta0, theta_dot0): the free motion."""
+    return free_motion()
