@@ -33,7 +33,7 @@ SERVO_DURATION = 1.0                         # [s]
 START = (0.070, np.array([0.25, -0.10]))     # (plunge [m], slope): beta = 30.8 deg
 GOAL = (0.080, np.array([-0.20, 0.25]))      # beta = 35.5 deg, on the other side
 DURATION = 0.5                               # [s]
-TORQUE_LIMIT = 4.0                           # [N m]
+TORQUE_LIMIT = 1.8                           # [N m]: below the baseline's peak (1.96 N m)
 
 
 def wrist(rotation_model: str = "physical", gravity: float = 9.81) -> CarpalWrist:
