@@ -3,7 +3,7 @@
 Each entry is reproduce(out: Path, quick: bool) -> dict (the JSON written).
 """
 
-from mbjax.reproduce import (andrews_squeezer, closed_chain, flexible_slider_crank, integrators, spin_up_beam,
+from mbjax.reproduce import (andrews_squeezer, carpal_wrist, closed_chain, flexible_slider_crank, integrators, spin_up_beam,
                              top_long_run, torque_free_tfe, tree_scaling, vertical_top)
 
 REPRODUCTIONS = {
@@ -16,6 +16,7 @@ REPRODUCTIONS = {
     andrews_squeezer.NAME: andrews_squeezer.reproduce,
     spin_up_beam.NAME: spin_up_beam.reproduce,
     flexible_slider_crank.NAME: flexible_slider_crank.reproduce,
+    carpal_wrist.NAME: carpal_wrist.reproduce,
 }
 
 __all__ = ["REPRODUCTIONS"]

@@ -24,7 +24,7 @@ TOOL_COM = np.array([0.01, -0.005, 0.08])    # [m] from the distal-plate centre,
 HOME_PLUNGE = 0.075                          # [m]: theta_i = pi/2 + acos(0.75) = 2.29 rad
 
 THETA_DOT0 = np.array([0.6, -0.4, 0.16])     # [rad/s]
-FREE_DURATION = 0.5                          # [s]
+FREE_DURATION = 0.4                          # [s]
 SERVO_K = 60.0                               # [N m / rad]
 SERVO_D = 0.4                                # [N m s / rad]
 SERVO_OFFSET = np.array([0.05, -0.03, 0.02])  # [rad]
