@@ -143,3 +143,31 @@ def flexible_bench_figure(records: list[dict]) -> Figure:
     ax.grid(True, which="both", alpha=0.3)
     ax.legend(fontsize=7)
     return fig
+
+
+def wrist_bench_figure(records: list[dict]) -> Figure:
+    """`mbjax bench wrist`: (a) RK4 error against run time, (b) time per call and per batched
+    state of each dynamics route, (c) sweep time per variant of each layout."""
+    fig = Figure(figsize=(14, 4.6), layout="constrained")
+    ax_wp, ax_routes, ax_sweep = fig.subplots(1, 3)
+    wp = [r for r in records if r["kind"] == "work-precision"]
+    ax_wp.loglog([r["run_s"] for r in wp], [max(r["error"], 1e-16) for r in wp], "o-",
+                 color=COLORS["rk4"], label="RK4")
+    for r in wp:
+        ax_wp.annotate(f"{r['dt'] * 1e3:g} ms", (r["run_s"], max(r["error"], 1e-16)), fontsize=7)
+    ax_wp.set(xlabel="run time [s]", ylabel="max joint-angle error [rad]",
+              title=f"torque-free tool, {wp[0]['duration']} s")
+    ax_wp.legend()
+    routes = [r for r in records if r["kind"] == "route"]
+    y = np.arange(len(routes))
+    ax_routes.barh(y - 0.2, [r["run_s"] * 1e6 for r in routes], 0.4, label="one call")
+    ax_routes.barh(y + 0.2, [r["batch_us_per_state"] for r in routes], 0.4,
+                   label=f"per state, batch of {routes[0]['batch']}")
+    ax_routes.set_yticks(y, [r["route"] for r in routes], fontsize=8)
+    ax_routes.set_xscale("log")
+    ax_routes.set(xlabel="us", title="dynamics routes (jit, CPU)")
+    ax_routes.legend(fontsize=8)
+    sw = [r for r in records if r["kind"] == "sweep"]
+    ax_sweep.bar([r["layout"] for r in sw], [r["us_per_variant"] for r in sw])
+    ax_sweep.set(ylabel="us per variant", title=f"peak-torque sweep, {sw[0]['variants']} variants")
+    return fig

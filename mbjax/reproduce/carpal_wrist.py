@@ -12,7 +12,8 @@ synthesis), and the Newton-Euler check, on the scene `mbjax.scenes.carpal_wrist`
    matrix of each method, spectral radius 1) are reported beside them.
 2. Trajectory synthesis: the START -> GOAL move in DURATION with |tau| <= TORQUE_LIMIT. The
    baseline is the inverse-dynamics feed-forward along a minimum-jerk tool path; its peak torque
-   exceeds the limit, and clipped to it the tool misses. Gradient descent (Adam through the RK4
+   exceeds the limit, and clipped to it the tool misses (both played back as 12-knot splines
+   fitted to it, so every rollout here shares one compiled simulator). Gradient descent (Adam through the RK4
    simulator) from the clipped baseline gives torques inside the limit that reach the goal; the
    final pose error is measured by re-simulating them with RK4 at a 10x finer step.
 3. `newton_euler_max_diff`: the largest |tau_Lagrange - tau_Newton-Euler| over random states.
@@ -31,9 +32,10 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
+from mbjax.bench.timing import measure
 from mbjax.integrate import INTEGRATORS, RK4, simulate
 from mbjax.scenes import carpal_wrist as scene
-from mbjax.trajopt.baseline import FeedForward, ToolPath, feedforward_torques
+from mbjax.trajopt.baseline import ToolPath, feedforward_torques
 from mbjax.trajopt.splines import TorqueSpline
 from mbjax.trajopt.synthesis import goal_pose, rollout, synthesize
 from mbjax.wrist import kinematics
@@ -46,10 +48,12 @@ REFERENCE_DT = 1e-4
 ITERATIONS, QUICK_ITERATIONS = 400, 60
 
 
-def masked_rollout(system, integrator, q0, u0, dts, duration: float, monitor):
+def masked_rollout(system, integrator, q0, u0, dts, duration: float, monitor, timings: dict | None = None):
     """Run `system` to `duration` at every step in `dts` in one compiled call: a scan of the
     largest step count, vmapped over dt, in which steps past each run's own count leave the
-    state alone. Returns (q, u) at the end and max over the steps of monitor(q, u)."""
+    state alone. Returns (q, u) at the end and max over the steps of monitor(q, u). With a
+    `timings` dict, the call is repeated once compiled and timings["run_s"], ["compile_s"],
+    ["steps"] (the scan length) are filled in."""
     dts = jnp.asarray(dts)
     counts = jnp.round(duration / dts).astype(jnp.int32)
     n_max = int(np.max(np.round(duration / np.asarray(dts))))
@@ -63,7 +67,12 @@ def masked_rollout(system, integrator, q0, u0, dts, duration: float, monitor):
             return (q1, u1, jnp.maximum(worst, jnp.where(live, monitor(q1, u1), 0.0))), None
         (q, u, worst), _ = jax.lax.scan(step, (q0, u0, monitor(q0, u0)), jnp.arange(n_max))
         return q, u, worst
-    return jax.jit(jax.vmap(run))(dts, counts)
+    fn = jax.jit(jax.vmap(run))
+    if timings is None:
+        return fn(dts, counts)
+    out, timing = measure(fn, dts, counts, repeats=1)
+    timings.update(run_s=timing.run_s, compile_s=timing.compile_s, steps=n_max)
+    return out
 
 
 def linear_critical_steps(system, q_eq, u_eq) -> dict:
@@ -105,7 +114,9 @@ def linear_critical_steps(system, q_eq, u_eq) -> dict:
     return out
 
 
-def integrator_study(steps) -> tuple[list[dict], dict]:
+def integrator_study(steps, seconds: dict | None = None) -> tuple[list[dict], dict]:
+    """The rows of the JSON's "integrators" and the predicted critical steps; with a `seconds`
+    dict, each method's run time per step of the vmapped free-motion runs is stored in it."""
     free, q0, u0 = scene.free_motion()
     servo, s0, v0 = scene.servo()
     ref = simulate(free, RK4(), q0, u0, dt=REFERENCE_DT, t1=scene.FREE_DURATION,
@@ -120,8 +131,11 @@ def integrator_study(steps) -> tuple[list[dict], dict]:
     rows = []
     for name in METHODS:
         integrator = INTEGRATORS[name]()
+        timings = {} if seconds is not None else None
         q, _, drift = masked_rollout(free, integrator, q0, u0, steps, scene.FREE_DURATION,
-                                     lambda q, u: jnp.abs(free.wrist.energy(q, u) - E0) / E0)
+                                     lambda q, u: jnp.abs(free.wrist.energy(q, u) - E0) / E0, timings)
+        if seconds is not None:
+            seconds[name] = timings["run_s"] / timings["steps"]
         qs, us, _ = masked_rollout(servo, integrator, s0, v0, steps, scene.SERVO_DURATION, lambda q, u: 0.0)
         final = jax.vmap(servo_energy)(qs, us)
         stable = np.isfinite(np.asarray(final)) & (np.asarray(final) < float(servo_energy(s0, v0)))
@@ -168,7 +182,8 @@ def trajectory_study(iterations: int) -> dict:
         "baseline": {"effort": float(np.trapezoid(np.sum(tau_ff**2, axis=1), ts)),
                      "peak_torque": float(np.abs(tau_ff).max()),
                      "pose_error_clipped": miss(init, 500),
-                     "pose_error_unclipped": miss(FeedForward(path), 500)},
+                     "pose_error_unclipped": miss(TorqueSpline.fit(ts, tau_ff, 12, scene.DURATION,
+                                                                   10 * scene.TORQUE_LIMIT), 500)},
         "_curves": {"t": ts, "tau_ff": tau_ff, "tau_syn": tau_syn},
     }
 

@@ -231,6 +231,22 @@ def flexible_bodies_tour(out: Path, quick: bool) -> dict:
             "runs": rows}
 
 
+def carpal_wrist_tour(out: Path, quick: bool) -> dict:
+    """The Carpal Wrist (seed 003 §6.4): the chapter's explicit Euler (eq 6.45) and the foundation's
+    integrators on the torque-free tool (error against RK4 at 0.1 ms, energy drift) and on the
+    servoed wrist under gravity (stable or not), against the step; the run time of each method is
+    per step of the free-motion runs (all steps vmapped in one call)."""
+    from mbjax.plot.wrist import integrator_figure
+    from mbjax.reproduce import carpal_wrist as cwr
+
+    seconds = {}
+    rows, critical = cwr.integrator_study(cwr.QUICK_STEPS if quick else cwr.STEPS, seconds)
+    fig = integrator_figure(rows, critical, seconds)
+    fig.savefig(out / "carpal-wrist.png", dpi=110)
+    return {"figure": "carpal-wrist.png", "integrators": rows, "critical_dt": critical,
+            "seconds_per_step": seconds}
+
+
 TOUR = {
     "torque-free-body": torque_free_body_tour,
     "heavy-top": heavy_top_tour,
@@ -238,4 +254,5 @@ TOUR = {
     "time-elements": time_elements_tour,
     "closed-loops": closed_loops_tour,
     "flexible-bodies": flexible_bodies_tour,
+    "carpal-wrist": carpal_wrist_tour,
 }
