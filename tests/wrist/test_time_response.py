@@ -66,6 +66,8 @@ def test_stability_boundaries_match_the_linearization():
         E = np.asarray(jax.vmap(servo_energy)(q, u))
         measured = tuple(bool(np.isfinite(e) and e < E0) for e in E)
         assert measured == stable, (name, E / E0)
-        # stable runs have settled (the servo is damped), unstable ones have grown past the start
+        # clear verdicts: the stable runs lose at least 95 % of the energy in the second (explicit
+        # Euler at 5 ms, near its 6.7 ms boundary, the least: its anti-damping eats into the
+        # servo's), the unstable ones overflow or gain tenfold
         for e, s in zip(E, stable):
-            assert (e < 1e-2 * E0) if s else not (e < E0)
+            assert (e < 0.05 * E0) if s else not (e < 10 * E0)
