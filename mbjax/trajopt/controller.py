@@ -50,7 +50,7 @@ class NeuralController(eqx.Module):
     omega_scale: float = eqx.field(static=True, default=5.0)
     neural: bool = eqx.field(static=True, default=True)
 
-    def __init__(self, key, limit: float, theta_centre, width: int = 32, depth: int = 2, kp: float = 8.0,
+    def __init__(self, key, limit: float, theta_centre, width: int = 8, depth: int = 1, kp: float = 8.0,
                  kd: float = 0.4, omega_scale: float = 5.0, neural: bool = True):
         mlp = eqx.nn.MLP(9, 3, width, depth, activation=jnp.tanh, key=key)
         last = mlp.layers[-1]           # zero output layer: the untrained controller is the servo
