@@ -82,19 +82,19 @@ def linear_critical_steps(system, q_eq, u_eq) -> dict:
     J = np.asarray(jax.jacfwd(lambda y: jnp.concatenate(
         [system.kinematics(y[:n], y[n:]), system.acceleration(0.0, y[:n], y[n:])]))(
         jnp.concatenate([q_eq, u_eq])))
-    I = np.eye(2 * n)
+    eye = np.eye(2 * n)
     Aq, Au = J[n:, :n], J[n:, n:]
 
     def amplification(name, h):
         if name == "explicit_euler":
-            return I + h * J
+            return eye + h * J
         if name == "semi_implicit_euler":
             In = np.eye(n)
             return np.block([[In + h * h * Aq, h * (In + h * Au)], [h * Aq, In + h * Au]])
         if name == "rk4":
             Z = h * J
-            return I + Z + Z @ Z / 2 + Z @ Z @ Z / 6 + Z @ Z @ Z @ Z / 24
-        return np.linalg.solve(I - h * J / 2, I + h * J / 2)          # implicit midpoint
+            return eye + Z + Z @ Z / 2 + Z @ Z @ Z / 6 + Z @ Z @ Z @ Z / 24
+        return np.linalg.solve(eye - h * J / 2, eye + h * J / 2)          # implicit midpoint
 
     def radius(name, h):
         return np.max(np.abs(np.linalg.eigvals(amplification(name, h))))

@@ -26,10 +26,10 @@ import jax
 import jax.flatten_util
 import jax.numpy as jnp
 import numpy as np
-import optax
 from jax import Array
 
 from mbjax.integrate import RK4, simulate
+from mbjax.trajopt.descent import adam_descent
 from mbjax.wrist import WristSystem, kinematics
 
 
@@ -154,15 +154,8 @@ def train_controller(controller: NeuralController, wrist, episodes: Episodes, *,
         costs, _ = jax.vmap(lambda *e: episode_cost(c, wrist, *e, **cost_kw))(*_batch(episodes))
         return jnp.mean(costs)
 
-    optimizer = optax.adam(optax.cosine_decay_schedule(learning_rate, iterations, alpha=0.05))
-
-    def descend(carry, _):
-        x, state = carry
-        value, grad = loss(x), jax.jacfwd(loss)(x)
-        updates, state = optimizer.update(grad, state, x)
-        return (optax.apply_updates(x, updates), state), value
-
-    (weights, _), losses = jax.lax.scan(descend, (weights, optimizer.init(weights)), None, length=iterations)
+    weights, losses = adam_descent(loss, weights, learning_rate=learning_rate, iterations=iterations,
+                                   final_fraction=0.05)
     return with_weights(weights), losses
 
 

@@ -10,7 +10,7 @@ the goal pose at rest at t = duration:
         + w int |tau|^2 dt / (limit^2 T),
 
 with (p, g) the midplane chart of the final pose. Each evaluation of J runs the simulator
-(`simulate`, RK4); its gradient is reverse mode through the rollout's `lax.scan`; optax's Adam
+(`simulate`, RK4); its gradient is forward mode through the rollout's `lax.scan`; optax's Adam
 takes the steps, and the whole descent is one `lax.scan`, so `synthesize` compiles once.
 """
 
@@ -18,11 +18,11 @@ import equinox as eqx
 import jax
 import jax.numpy as jnp
 import numpy as np
-import optax
 from jax import Array
 
 from mbjax.integrate import RK4, simulate
 from mbjax.integrate.solution import WithStatus
+from mbjax.trajopt.descent import adam_descent
 from mbjax.trajopt.splines import TorqueSpline
 from mbjax.wrist import WristSystem, kinematics
 
@@ -98,16 +98,8 @@ def synthesize(wrist, theta0: Array, goal, *, duration: float, torque_limit: flo
         work = effort(spline, duration)[0] / (init.limit**2 * duration)
         return miss + rest + effort_weight * work
 
-    optimizer = optax.adam(optax.cosine_decay_schedule(learning_rate, iterations, alpha=0.1))
-
-    def descend(carry, _):
-        x, state = carry
-        loss, grad = objective(x), jax.jacfwd(objective)(x)
-        updates, state = optimizer.update(grad, state, x)
-        return (optax.apply_updates(x, updates), state), loss
-
-    x0 = init.knots.ravel()
-    (x, _), losses = jax.lax.scan(descend, (x0, optimizer.init(x0)), None, length=iterations)
+    x, losses = adam_descent(objective, init.knots.ravel(), learning_rate=learning_rate,
+                             iterations=iterations, final_fraction=0.1)
     spline = spline_of(x)
     theta, theta_dot, status = rollout(wrist, spline, theta0, duration, steps, integrator)
     work, peak = effort(spline, duration)
