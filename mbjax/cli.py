@@ -1,6 +1,6 @@
 """The `mbjax` command: the tour of every scene, paper reproductions and benchmark suites.
 
-    mbjax tour [--out DIR] [--quick]
+    mbjax tour [--out DIR] [--quick] [--scene NAME ...]
     mbjax reproduce NAME [--out DIR] [--quick]    |    mbjax reproduce --list
     mbjax bench SUITE [--out DIR] [--quick]
 
@@ -14,13 +14,15 @@ import time
 from pathlib import Path
 
 
-def _parser(reproductions, suites) -> argparse.ArgumentParser:
+def _parser(reproductions, suites, scenes) -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(prog="mbjax", description=__doc__.split("\n\n")[0])
     commands = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
 
     tour = commands.add_parser("tour", help="run every scene briefly; figures + summary")
     tour.add_argument("--out", type=Path, default=Path("mbjax-out"), help="output folder")
     tour.add_argument("--quick", action="store_true", help="shorter runs (< 5 min on 2 cores)")
+    tour.add_argument("--scene", action="append", choices=list(scenes), metavar="NAME",
+                      help=f"run only this scene (repeatable), one of: {', '.join(scenes)}")
 
     rep = commands.add_parser("reproduce", help="reproduce a paper figure or table")
     rep.add_argument("name", nargs="?", choices=sorted(reproductions), metavar="NAME",
@@ -37,13 +39,14 @@ def _parser(reproductions, suites) -> argparse.ArgumentParser:
     return parser
 
 
-def _tour(out: Path, quick: bool) -> None:
+def _tour(out: Path, quick: bool, scenes=None) -> None:
     from mbjax.progress import progress
     from mbjax.scenes.tour import TOUR
 
+    names = [name for name in TOUR if not scenes or name in scenes]
     out.mkdir(parents=True, exist_ok=True)
     summary = {"quick": quick, "scenes": {}}
-    for name in progress(TOUR, len(TOUR), "mbjax tour"):
+    for name in progress(names, len(names), "mbjax tour"):
         start = time.perf_counter()
         result = TOUR[name](out, quick)
         result["wall_seconds"] = time.perf_counter() - start
@@ -78,10 +81,12 @@ def main(argv=None) -> int:
     from mbjax.bench import SUITES
     from mbjax.reproduce import REPRODUCTIONS
 
-    parser = _parser(REPRODUCTIONS, SUITES)
+    from mbjax.scenes.tour import TOUR
+
+    parser = _parser(REPRODUCTIONS, SUITES, TOUR)
     args = parser.parse_args(argv)
     if args.command == "tour":
-        _tour(args.out, args.quick)
+        _tour(args.out, args.quick, args.scene)
     elif args.command == "reproduce":
         if args.list:
             print("\n".join(sorted(REPRODUCTIONS)))

@@ -37,6 +37,7 @@ def test_reproduce_list(capsys):
     assert "integrators" in capsys.readouterr().out.split()
 
 
+@pytest.mark.slow
 def test_reproduce_integrators(tmp_path):
     """The JSON of the issue, with fitted orders matching theory (1, 1, 4, 2, 4)."""
     assert main(["reproduce", "integrators", "--quick", "--out", str(tmp_path)]) == 0
@@ -66,43 +67,81 @@ def test_reproduce_tree_scaling(tmp_path):
     assert (tmp_path / "tree-scaling.png").stat().st_size > 10_000
 
 
-def test_tour_quick(tmp_path):
-    assert main(["tour", "--quick", "--out", str(tmp_path)]) == 0
+# The tour's scenes in three groups of similar cost, so the two xdist workers share them.
+TOUR_GROUPS = {
+    "rigid": ("torque-free-body", "heavy-top", "rigid-chain", "closed-loops"),
+    "time-elements": ("time-elements", "flexible-bodies"),
+    "carpal-wrist": ("carpal-wrist",),
+}
+
+
+def test_tour_groups_cover_every_scene():
+    from mbjax.scenes.tour import TOUR
+
+    assert sorted(s for group in TOUR_GROUPS.values() for s in group) == sorted(TOUR)
+    assert set(TOUR) == {"torque-free-body", "heavy-top", "rigid-chain", "time-elements",
+                         "closed-loops", "flexible-bodies", "carpal-wrist"}
+
+
+def test_tour_rejects_an_unknown_scene(capsys):
+    with pytest.raises(SystemExit) as exit_info:
+        main(["tour", "--scene", "no-such-scene"])
+    assert exit_info.value.code == 2 and "carpal-wrist" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("group", list(TOUR_GROUPS))
+def test_tour_quick(tmp_path, group):
+    scenes = TOUR_GROUPS[group]
+    assert main(["tour", "--quick", "--out", str(tmp_path),
+                 *[arg for scene in scenes for arg in ("--scene", scene)]]) == 0
     summary = json.loads((tmp_path / "summary.json").read_text())
-    assert set(summary["scenes"]) == {"torque-free-body", "heavy-top", "rigid-chain", "time-elements",
-                                      "closed-loops", "flexible-bodies", "carpal-wrist"}
+    assert set(summary["scenes"]) == set(scenes)
     for scene in summary["scenes"].values():
         assert (tmp_path / scene["figure"]).stat().st_size > 10_000
     markdown = (tmp_path / "summary.md").read_text()
-    assert "torque-free-body" in markdown and "rigid-chain" in markdown
-    rkmk4 = summary["scenes"]["torque-free-body"]["integrators"]["rkmk4"]
+    assert all(f"## {scene}" in markdown for scene in scenes)
+    TOUR_CHECKS[group](summary["scenes"])
+
+
+def _check_rigid(scenes):
+    rkmk4 = scenes["torque-free-body"]["integrators"]["rkmk4"]
     assert rkmk4["final_error_rad"] < 1e-4 and rkmk4["status"] == "success"
-    chain = summary["scenes"]["rigid-chain"]
+    chain = scenes["rigid-chain"]
     assert chain["reference_status"] == 0
-    loops = summary["scenes"]["closed-loops"]["integrators"]
+    loops = scenes["closed-loops"]["integrators"]
     assert loops["coupled, projection dt=2 ms"]["residual"] < 1e-10
     assert loops["coupled, none dt=2 ms"]["error_rad"] < 1e-4
     rows = chain["integrators"]
     assert all(row["status"] == "success" for row in rows.values())
     # RK4 at 5 ms follows the Dopri8 reference of the falling chain to micro-radians
     assert rows["rk4 dt=5 ms"]["error_rad"] < 1e-5 and rows["rk4 dt=5 ms"]["energy_error"] < 1e-5
+
+
+def _check_time_elements(scenes):
     # time elements on the sleeping top: the primal form's tilt grows at its transition matrix's
     # rate, the mixed form's stays with the physical one
-    tfe = summary["scenes"]["time-elements"]
+    tfe = scenes["time-elements"]
     primal, mixed = tfe["runs"]["primal"], tfe["runs"]["mixed"]
     assert primal["predicted_growth"] > 0.2
     assert abs(primal["measured_growth"] / primal["predicted_growth"] - 1) < 0.1
     assert abs(mixed["predicted_growth"]) < 1e-9 and abs(mixed["measured_growth"]) < 0.02
     assert mixed["max_tilt"] < 1.1 * tfe["physical_max_tilt"] and primal["max_tilt"] > 10 * mixed["max_tilt"]
     # the spin-up beam: the stiffened modal tip follows the ANCF beam, the unstiffened one runs away
-    flex = summary["scenes"]["flexible-bodies"]["runs"]
+    flex = scenes["flexible-bodies"]["runs"]
     assert flex["2 modes, stiffened"]["peak_relative_error"] < 5e-3
     assert flex["2 modes, stiffened"]["max_error_m"] < 0.02
     assert (flex["2 modes, no stiffening"]["max_error_m"] or math.inf) > 1.0
+
+
+def _check_carpal_wrist(scenes):
     # the Carpal Wrist: the chapter's explicit Euler fails first, where the others hold
-    wrist = summary["scenes"]["carpal-wrist"]["integrators"]
+    wrist = scenes["carpal-wrist"]["integrators"]
     assert not wrist["explicit_euler dt=10 ms"]["stable"] and wrist["semi_implicit_euler dt=10 ms"]["stable"]
     assert wrist["rk4 dt=10 ms"]["stable"] and wrist["implicit_midpoint dt=40 ms"]["stable"]
+
+
+TOUR_CHECKS = {"rigid": _check_rigid, "time-elements": _check_time_elements,
+               "carpal-wrist": _check_carpal_wrist}
 
 
 def test_bench_integrators_quick(tmp_path):
@@ -163,6 +202,7 @@ def test_reproduce_vertical_top(tmp_path):
     assert (tmp_path / "vertical-top.png").stat().st_size > 10_000
 
 
+@pytest.mark.slow
 def test_reproduce_torque_free_tfe(tmp_path):
     """Seed 000 Fig. 1 over the quick run's 2 s: the issue's keys, every case converged, errors
     well below 0.2 rad, and the mixed 4-node element ahead of the primal one at every spacing."""
