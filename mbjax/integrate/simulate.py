@@ -35,7 +35,7 @@ def _save_indices(t0: float, t1: float, dt: float, saveat) -> tuple[int, np.ndar
 
 
 def simulate(system: AbstractSystem, integrator: AbstractIntegrator, q0: Array, u0: Array, *,
-             dt: float, t1: float, t0: float = 0.0, saveat=None) -> Solution:
+             dt: float, t1: float, t0: float = 0.0, saveat=None, checkpoint: bool = False) -> Solution:
     """Integrate `system` from (q0, u0) at t0 to t1 with fixed steps dt.
 
     `saveat` is None (every step) or an array of times on the grid t0 + k dt. dt, t0, t1 and
@@ -47,18 +47,30 @@ def simulate(system: AbstractSystem, integrator: AbstractIntegrator, q0: Array, 
     The returned `Solution.status` flags non-finite states and unconverged implicit steps, and
     whatever the system's `check` reports at the ends of the blocks (every saved state). The
     system's `constrain` runs after every step.
+
+    checkpoint=True is for reverse-mode gradients of long rollouts: each block's steps run as a scan
+    over segments of about sqrt(block) steps under `jax.checkpoint`, so `jax.grad` keeps the states
+    at the segment ends and recomputes one segment at a time: memory grows like sqrt(T) rather than
+    T, for about one more forward pass. The values computed are the same.
     """
     n_steps, idx = _save_indices(float(t0), float(t1), float(dt), saveat)
     block = math.gcd(*idx.tolist(), n_steps)
     q0 = jnp.asarray(q0)
     u0 = jnp.asarray(u0)
     qs, us, status = _rollout(system, integrator, q0, u0, float(t0), float(dt), block,
-                              n_steps // block, tuple((idx // block).tolist()))
+                              n_steps // block, tuple((idx // block).tolist()),
+                              _segment(block) if checkpoint else block)
     return Solution(ts=jnp.asarray(t0 + idx * dt, dtype=q0.dtype), qs=qs, us=us, status=status)
 
 
+def _segment(block: int) -> int:
+    """The divisor of `block` nearest sqrt(block) from below: the checkpointed segment length."""
+    return max(k for k in range(1, math.isqrt(block) + 1) if block % k == 0)
+
+
 @eqx.filter_jit
-def _rollout(system, integrator, q0, u0, t0, dt, block: int, n_blocks: int, keep: tuple):
+def _rollout(system, integrator, q0, u0, t0, dt, block: int, n_blocks: int, keep: tuple,
+             segment: int):
     dtype = q0.dtype
 
     def step(carry, k):
@@ -71,8 +83,15 @@ def _rollout(system, integrator, q0, u0, t0, dt, block: int, n_blocks: int, keep
                   | jnp.where(converged, 0, int(Status.NOT_CONVERGED)))
         return (q1, u1, status), None
 
+    def run_segment(carry, ks):
+        return jax.lax.scan(step, carry, ks)[0], None
+
+    if segment < block:                      # checkpoint=True: only segment ends are kept
+        run_segment = jax.checkpoint(run_segment)
+
     def run_block(carry, b):
-        (q, u, status), _ = jax.lax.scan(step, carry, b * block + jnp.arange(block))
+        ks = (b * block + jnp.arange(block)).reshape(block // segment, segment)
+        (q, u, status), _ = jax.lax.scan(run_segment, carry, ks)
         t = jnp.asarray(t0, dtype) + (b + 1) * block * jnp.asarray(dt, dtype)
         status = status | system.check(t, q, u)          # at the block ends: the saved states
         return (q, u, status), (q, u)

@@ -2,6 +2,7 @@
 and seed 001's transformation operator (velocity and momentum forms, constraint forces)."""
 
 from mbjax.rigid.aba import aba
+from mbjax.rigid.batched import batch_aba, batched_forward_dynamics
 from mbjax.rigid.body import RigidBody
 from mbjax.rigid.dense import constraint_forces, dense_forward_dynamics, joint_reactions
 from mbjax.rigid.dynamics import (
@@ -27,11 +28,12 @@ from mbjax.rigid.operator import (
     transformation_operator,
 )
 from mbjax.rigid.rnea import joint_wrenches
-from mbjax.rigid.system import MomentumSystem, TreeSystem
+from mbjax.rigid.system import BatchTreeSystem, MomentumSystem, TreeSystem
 from mbjax.rigid.torque_free import torque_free_motion
 
 __all__ = [
-    "METHODS", "MomentumSystem", "RigidBody", "TreeSystem", "aba", "body_kinematics",
+    "METHODS", "BatchTreeSystem", "MomentumSystem", "RigidBody", "TreeSystem", "aba", "batch_aba",
+    "batched_forward_dynamics", "body_kinematics",
     "choose_method", "constraint_forces", "constraint_forces_momentum", "dense_forward_dynamics",
     "energy", "forward_dynamics", "forward_kinematics", "inverse_dynamics", "inverse_operator",
     "joint_reactions",

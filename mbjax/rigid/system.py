@@ -16,6 +16,7 @@ from jax import Array
 
 from mbjax.integrate.system import AbstractSystem
 from mbjax.model import Model
+from mbjax.rigid.batched import batch_aba
 from mbjax.rigid.dynamics import METHODS, forward_dynamics
 from mbjax.rigid.energy import energy
 from mbjax.rigid.momentum import momentum_rate, velocity_from_momentum
@@ -60,6 +61,26 @@ class TreeSystem(_Tree):
         """(E(t) - E(0)) / |E(0)| along a saved trajectory."""
         E = jax.vmap(self.energy)(qs, us)
         return (E - E[0]) / jnp.abs(E[0])
+
+
+class BatchTreeSystem(AbstractSystem):
+    """B copies of a tree of revolute and prismatic joints in one system, batch last: q and u are
+    (nv, B) and u_dot = `batch_aba(model, q, u, tau)`. `simulate` integrates all of them in one
+    scan, with the throughput layout of `mbjax.rigid.batched` (the same trajectories as
+    `jax.vmap` of a `TreeSystem` simulation). tau is (nv,) for every copy or (nv, B)."""
+
+    model: Model
+    tau: Array
+
+    def __init__(self, model: Model, tau=None):
+        self.model = model
+        self.tau = jnp.zeros(model.nv) if tau is None else jnp.asarray(tau)
+
+    def kinematics(self, q, u):
+        return u
+
+    def acceleration(self, t, q, u):
+        return batch_aba(self.model, q, u, self.tau)
 
 
 class MomentumSystem(_Tree):
