@@ -4,7 +4,7 @@ Each suite is run(out: Path, quick: bool) -> list of records, written as out/SUI
 out/SUITE.png. Peers (MuJoCo, Pinocchio, exudyn) are measured in the same process when installed.
 """
 
-from mbjax.bench import flexible, integrators, loops, rigid, tfe, wrist
+from mbjax.bench import flexible, integrators, loops, rigid, tfe, throughput, wrist
 
 SUITES = {
     flexible.NAME: flexible.run,
@@ -12,6 +12,7 @@ SUITES = {
     loops.NAME: loops.run,
     rigid.NAME: rigid.run,
     tfe.NAME: tfe.run,
+    throughput.NAME: throughput.run,
     wrist.NAME: wrist.run,
 }
 

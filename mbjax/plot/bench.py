@@ -171,3 +171,79 @@ def wrist_bench_figure(records: list[dict]) -> Figure:
     ax_sweep.bar([r["layout"] for r in sw], [r["us_per_variant"] for r in sw])
     ax_sweep.set(ylabel="us per variant", title=f"peak-torque sweep, {sw[0]['variants']} variants")
     return fig
+
+
+def throughput_figure(records: list[dict]) -> Figure:
+    """`mbjax bench throughput`: forward dynamics per state against batch size (every engine, every
+    chain size), rollout steps per second against batch size, the rollout gradient's memory
+    against the number of steps, and float32's accuracy."""
+    fig = Figure(figsize=(13, 9), layout="constrained")
+    (ax_fd, ax_roll), (ax_mem, ax_acc) = fig.subplots(2, 2)
+    forward = [r for r in records if r["kind"] == "forward"]
+    ns = sorted({r["n"] for r in forward})
+    styles = {7: "-", 30: "--", 100: ":"}
+    series = (("mbjax", "batch_aba", "float64", COLORS.get("rk4", "C0"), "mbjax batch_aba"),
+              ("mbjax", "batch_aba sharded", "float64", "C5", "mbjax batch_aba, one device per core"),
+              ("mbjax", "batch_aba", "float32", "C2", "mbjax batch_aba float32"),
+              ("mbjax", "vmap", "float64", "C1", "mbjax jit(vmap(forward_dynamics))"),
+              ("pinocchio", "abaInParallel", "float64", "C3", "Pinocchio abaInParallel"))
+    for n in ns:
+        ls = styles.get(n, "-.")
+        for engine, method, dtype, color, label in series:
+            rows = sorted((r for r in forward if r["n"] == n and r["engine"] == engine
+                           and r["method"] == method and r["dtype"] == dtype), key=lambda r: r["batch"])
+            if rows:
+                ax_fd.loglog([r["batch"] for r in rows], [r["per_state_s"] * 1e6 for r in rows],
+                             ls=ls, color=color, marker="o", ms=3,
+                             label=f"{label}" if n == ns[0] else None)
+        pin = [r for r in forward if r["n"] == n and r["engine"] == "pinocchio" and r["method"] == "aba"]
+        if pin:
+            ax_fd.axhline(pin[0]["per_state_s"] * 1e6, color=COLORS.get("mujoco", "grey"), ls=ls,
+                          lw=1, label="Pinocchio aba per call from Python" if n == ns[0] else None)
+        ax_fd.annotate(f"n = {n}", (1, min(r["per_state_s"] for r in forward if r["n"] == n) * 1e6),
+                       fontsize=8)
+    ax_fd.set(xlabel="batch size B", ylabel="time per state [us]",
+              title="forward dynamics of n-link chains (solid 7, dashed 30, dotted 100)")
+    ax_fd.legend(fontsize=7)
+
+    rollout = [r for r in records if r["kind"] == "rollout"]
+    for engine, color, label in (("mbjax", COLORS.get("rk4", "C0"), "mbjax simulate(BatchTreeSystem)"),
+                                 ("mujoco", COLORS.get("mujoco", "grey"), "mujoco.rollout"),
+                                 ("mjx", "C4", "MJX jit(vmap)")):
+        for n in sorted({r["n"] for r in rollout}):
+            rows = sorted((r for r in rollout if r["engine"] == engine and r["n"] == n),
+                          key=lambda r: r["batch"])
+            if rows:
+                ax_roll.loglog([r["batch"] for r in rows], [r["steps_per_s"] for r in rows],
+                               ls=styles.get(n, "-."), color=color, marker="o" if len(rows) > 1 else "*",
+                               ms=4 if len(rows) > 1 else 12, label=label if n == 7 else None)
+    ax_roll.set(xlabel="batch size B", ylabel="RK4 steps per second (B x steps / run time)",
+                title="rollouts, dt = 1 ms (solid 7, dashed 30, dotted 100 links)")
+    ax_roll.legend(fontsize=7)
+
+    for r in (r for r in records if r["kind"] == "gradient"):
+        label = ("jax.jacfwd" if r.get("mode") == "jacfwd" else
+                 "jax.grad, checkpoint=True" if r["checkpoint"] else "jax.grad, plain")
+        ax_mem.loglog(r["memory_steps"], np.array(r["grad_temp_bytes"]) / 1e6, marker="o",
+                      label=f"{label} (slope {r['memory_slope']:.2f}; "
+                            f"{r['grad_over_forward']:.1f}x forward time)")
+        if r.get("mode") == "grad" and not r["checkpoint"]:
+            ax_mem.loglog(r["memory_steps"], np.array(r["forward_temp_bytes"]) / 1e6, marker="s",
+                          color="grey", label="forward rollout")
+    ax_mem.set(xlabel="rollout steps T", ylabel="XLA temporary memory [MB]",
+               title="gradient of sum q(T)^2 through an RK4 rollout (7 links)")
+    ax_mem.legend(fontsize=7)
+
+    for dtype, key, color in (("float32", "rel_diff_float64", "C2"),
+                              ("float64", "rel_diff_pinocchio", COLORS.get("rk4", "C0"))):
+        rows = [r for r in forward if r["engine"] == "mbjax" and r["method"] == "batch_aba"
+                and r["dtype"] == dtype and key in r]
+        by_n = {n: max(r[key] for r in rows if r["n"] == n) for n in sorted({r["n"] for r in rows})}
+        if by_n:
+            ax_acc.semilogy(list(by_n), list(by_n.values()), marker="o", color=color,
+                            label=f"batch_aba {dtype}: " + ("against float64" if dtype == "float32"
+                                                            else "against Pinocchio"))
+    ax_acc.set(xlabel="links n", ylabel="max |a - a_ref| / max |a_ref|",
+               title="accuracy of the accelerations")
+    ax_acc.legend(fontsize=7)
+    return fig
