@@ -14,10 +14,10 @@ the mean of the tracking cost
         + w mean_k |tau(t_k)|^2 / limit^2,
 
 y = (p / l, g) the pose in the midplane chart, t_k the saved times (weighted towards the end: the
-start is far from the target by construction): reverse mode through the
-rollouts (`jax.jacfwd` over the few hundred weights of a small network: forward mode compiles
-in a fraction of reverse mode's time through these third-order autodiff dynamics), one jitted
-`lax.scan` over the iterations. Success on held-out targets: the final pose
+start is far from the target by construction). The gradient is reverse mode through the rollouts
+by default (`jax.value_and_grad`: a few forward passes for the network's hundred-odd weights,
+where `jax.jacfwd` would carry one tangent per weight), one jitted `lax.scan` over the
+iterations. Success on held-out targets: the final pose
 within `kinematics.pose_error` < `success_tolerance`.
 """
 
@@ -139,8 +139,10 @@ def _batch(episodes: Episodes):
 def train_controller(controller: NeuralController, wrist, episodes: Episodes, *, iterations: int = 300,
                      learning_rate: float = 3e-3, duration: float = 0.6, steps: int = 30, saves: int = 10,
                      pose_tolerance: float = 0.02, speed_tolerance: float = 1.0,
-                     effort_weight: float = 0.1):
-    """(trained controller, loss per iteration): Adam on the batch-mean episode cost."""
+                     effort_weight: float = 0.1, gradient: str = "reverse"):
+    """(trained controller, loss per iteration): Adam on the batch-mean episode cost, with
+    reverse-mode gradients by default (the network's weights outnumber what forward mode does
+    cheaply; see `adam_descent`)."""
     weights, rebuild = jax.flatten_util.ravel_pytree(eqx.filter(controller.mlp, eqx.is_inexact_array))
     static_mlp = eqx.filter(controller.mlp, eqx.is_inexact_array, inverse=True)
     cost_kw = dict(duration=duration, steps=steps, saves=saves, pose_tolerance=pose_tolerance,
@@ -155,7 +157,7 @@ def train_controller(controller: NeuralController, wrist, episodes: Episodes, *,
         return jnp.mean(costs)
 
     weights, losses = adam_descent(loss, weights, learning_rate=learning_rate, iterations=iterations,
-                                   final_fraction=0.05)
+                                   final_fraction=0.05, gradient=gradient)
     return with_weights(weights), losses
 
 

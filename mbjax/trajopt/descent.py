@@ -5,16 +5,25 @@ import optax
 from jax import Array
 
 
-def adam_descent(loss, x0: Array, *, learning_rate: float, iterations: int, final_fraction: float):
+def adam_descent(loss, x0: Array, *, learning_rate: float, iterations: int, final_fraction: float,
+                 gradient: str = "forward"):
     """(x, loss per iteration): `iterations` Adam steps on loss(x), the learning rate
-    cosine-decayed to `final_fraction` of itself, as one `lax.scan`. The gradient is forward mode
-    (`jax.jacfwd`): for the tens to hundreds of parameters here it compiles several times faster
-    than reverse mode through the simulator's third-order autodiff dynamics."""
+    cosine-decayed to `final_fraction` of itself, as one `lax.scan`.
+
+    gradient="forward" (`jax.jacfwd`) compiles several times faster than reverse mode through the
+    simulator's third-order autodiff dynamics and wins for tens of parameters (the torque splines);
+    gradient="reverse" (`jax.value_and_grad`) costs a few forward passes whatever the parameter
+    count, so it wins for a network's hundred-odd weights once compiled."""
+    if gradient not in ("forward", "reverse"):
+        raise ValueError(f"gradient must be 'forward' or 'reverse', got {gradient!r}")
     optimizer = optax.adam(optax.cosine_decay_schedule(learning_rate, iterations, alpha=final_fraction))
 
     def step(carry, _):
         x, state = carry
-        value, grad = loss(x), jax.jacfwd(loss)(x)
+        if gradient == "forward":
+            value, grad = loss(x), jax.jacfwd(loss)(x)
+        else:
+            value, grad = jax.value_and_grad(loss)(x)
         updates, state = optimizer.update(grad, state, x)
         return (optax.apply_updates(x, updates), state), value
 
