@@ -388,3 +388,26 @@ def test_reproduce_carpal_wrist(tmp_path):
     assert set(trajectory) >= {"final_pose_error", "effort", "iterations"}
     assert trajectory["final_pose_error"] < 0.2 * baseline["pose_error_clipped"]
     assert trajectory["peak_torque"] <= data["torque_limit"] < baseline["peak_torque"]
+
+
+@pytest.mark.slow
+def test_bench_throughput_quick(tmp_path):
+    """About three minutes on 2 cores: every record kind, the peers' agreement and the targets."""
+    assert main(["bench", "throughput", "--quick", "--out", str(tmp_path)]) == 0
+    records = [json.loads(line) for line in (tmp_path / "throughput.jsonl").read_text().splitlines()]
+    kinds = {r["kind"] for r in records}
+    assert kinds == {"forward", "rollout", "gradient", "summary"}
+    ours = [r for r in records if r["kind"] == "forward" and r["engine"] == "mbjax"]
+    if peers.available("pinocchio"):
+        assert all(r["rel_diff_pinocchio"] < (1e-5 if r["dtype"] == "float32" else 1e-12) for r in ours)
+    if peers.available("mujoco"):
+        rollouts = [r for r in records if r["kind"] == "rollout" and r["engine"] == "mbjax"]
+        assert all(r["max_diff_mujoco_rad"] < 1e-8 for r in rollouts)
+    grads = {(r["mode"], r["checkpoint"]): r for r in records if r["kind"] == "gradient"}
+    assert all(r["finite"] for r in grads.values())
+    assert grads[("grad", True)]["memory_slope"] < 0.7 < grads[("grad", False)]["memory_slope"]
+    targets = records[-1]["targets"]
+    assert {"forward_vs_pinocchio_per_call", "rollout_vs_mujoco", "gradient_over_forward",
+            "gpu_forward_evals_per_s"} <= set(targets)
+    assert all(t["met"] in (True, False, None) for t in targets.values())
+    assert (tmp_path / "throughput.png").stat().st_size > 10_000
