@@ -1,14 +1,5 @@
-import os
-
-# The suite is correctness, not speed, and most of its time is compilation: LLVM's cheapest
-# optimization level saves about a fifth of it (IEEE semantics are unchanged; benchmarks, which
-# are scripts, keep the default). Set before JAX starts its backend; notebook kernels and
-# subprocesses inherit it.
-os.environ["XLA_FLAGS"] = " ".join(filter(None, [os.environ.get("XLA_FLAGS"),
-                                                 "--xla_backend_optimization_level=0"]))
-
-import jax  # noqa: E402
-import pytest  # noqa: E402
+import jax
+import pytest
 
 # Accuracy work is float64 (DESIGN.md); the library itself never flips this flag.
 jax.config.update("jax_enable_x64", True)
