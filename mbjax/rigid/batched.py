@@ -169,10 +169,11 @@ def _mat(x: Array):
     return tuple(tuple(x[:, i, j, None] for j in range(3)) for i in range(3))
 
 
-def joint_transforms(model: Model, q: Array):
+def _joint_transforms(model: Model, revolute: np.ndarray, q: Array):
     """(R, p, s) for q (n, B): every body's orientation R and origin p in its parent (placement
-    times joint motion, as `Model.joints`) and its motion subspace s in body coordinates."""
-    revolute = jnp.asarray(_check_joints(model))[:, None]
+    times joint motion, as `Model.joints`) and its motion subspace s in body coordinates;
+    `revolute` is `_check_joints`'s mask."""
+    revolute = jnp.asarray(revolute)[:, None]
     a = _vec(model.axis)
     zero = jnp.zeros_like(a[0])
     angle = jnp.where(revolute, q, 0.0)
@@ -196,7 +197,7 @@ def joint_transforms(model: Model, q: Array):
 def batch_aba(model: Model, q: Array, v: Array, tau: Array) -> Array:
     """Joint accelerations (n, B) of B states (q, v, tau), each (n, B), batch last; gravity from
     the model. tau may also be (n,) or (n, 1), the same for every state."""
-    _check_joints(model)
+    revolute = _check_joints(model)
     q = jnp.asarray(q)
     if q.ndim != 2 or q.shape[0] != model.nv:
         raise ValueError(f"batch_aba takes (nv, B) = ({model.nv}, B) arrays, batch last; got q of "
@@ -206,7 +207,7 @@ def batch_aba(model: Model, q: Array, v: Array, tau: Array) -> Array:
                          model)
     v = jnp.broadcast_to(jnp.asarray(v, dtype), q.shape)
     tau = jnp.broadcast_to(jnp.reshape(jnp.asarray(tau, dtype), (n, -1)), q.shape)
-    R, p, s = joint_transforms(model, q)
+    R, p, s = _joint_transforms(model, revolute, q)
     sv = (_scale(s[0], v), _scale(s[1], v))
     inertia = model.spatial_inertia()
     blocks = (_mat(inertia[:, :3, :3]), _mat(inertia[:, :3, 3:]), _mat(inertia[:, 3:, 3:]))

@@ -14,16 +14,15 @@ tracking cost
     J = sum_k (t_k / T)^e |y(t_k) - y*|^2 / (tol^2 sum_k (t_k / T)^e) + |theta_dot(T)|^2 / omega_tol^2
         + w mean_k |tau(t_k)|^2 / limit^2,
 
-y = (p / l, g) the pose in the midplane chart, t_k the saved times (weighted towards the end by
-(t_k / T)^e, e = end_power = 2: the start is far from the target by construction). The logarithm keeps a
-few far-off episodes from dominating the mean, which otherwise trades the many near misses for
-them: on 64 held-out targets, 150 iterations on 32 episodes of the plain mean (learning rate
-3e-3) left the median final pose error at
-0.035 (servo alone 0.040), of the logarithm (1e-2) at 0.025. The gradient is reverse mode through the rollouts
-by default (`jax.value_and_grad`: a few forward passes for the network's hundred-odd weights,
-where `jax.jacfwd` would carry one tangent per weight), one jitted `lax.scan` over the
-iterations. Success on held-out targets: the final pose
-within `kinematics.pose_error` < `success_tolerance`.
+y = (p / l, g) the pose in the midplane chart, t_k the saved times, weighted towards the end by
+(t_k / T)^e, e = end_power = 2 (the start is far from the target by construction). The logarithm
+keeps a few far-off episodes from dominating the mean, which otherwise trades the many near misses
+for them: on 64 held-out targets, 150 iterations on 32 episodes left the median final pose error
+at 0.035 with the plain mean (learning rate 3e-3) and at 0.025 with the logarithm (1e-2); servo
+alone 0.040. The gradient is reverse mode through the rollouts by default (`jax.value_and_grad`:
+a few forward passes for the network's hundred-odd weights, where `jax.jacfwd` would carry one
+tangent per weight), one jitted `lax.scan` over the iterations. Success on held-out targets: the
+final pose within `kinematics.pose_error` < `success_tolerance`.
 """
 
 import equinox as eqx
@@ -151,8 +150,8 @@ def train_controller(controller: NeuralController, wrist, episodes: Episodes, *,
     cheaply; see `adam_descent`)."""
     weights, rebuild = jax.flatten_util.ravel_pytree(eqx.filter(controller.mlp, eqx.is_inexact_array))
     static_mlp = eqx.filter(controller.mlp, eqx.is_inexact_array, inverse=True)
-    cost_kw = dict(end_power=end_power, duration=duration, steps=steps, saves=saves, pose_tolerance=pose_tolerance,
-                   speed_tolerance=speed_tolerance, effort_weight=effort_weight)
+    cost_kw = dict(duration=duration, steps=steps, saves=saves, pose_tolerance=pose_tolerance,
+                   speed_tolerance=speed_tolerance, effort_weight=effort_weight, end_power=end_power)
 
     def with_weights(x):
         return eqx.tree_at(lambda c: c.mlp, controller, eqx.combine(rebuild(x), static_mlp))
