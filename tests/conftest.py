@@ -1,8 +1,24 @@
-import jax
-import pytest
+import os
+import tempfile
+from pathlib import Path
+
+# One persistent XLA compilation cache for the whole run, shared by both xdist workers, the
+# notebook kernels and the CLI subprocesses they start (they inherit the environment): the tour,
+# the reproductions, the notebooks and the unit tests build many of the same scenes, and on the
+# CI machine compiling them is most of the suite's time. A cached executable is the same binary.
+_RUN = os.environ.get("PYTEST_XDIST_TESTRUNUID", str(os.getpid()))
+os.environ.setdefault("JAX_COMPILATION_CACHE_DIR", str(Path(tempfile.gettempdir()) / f"mbjax-xla-cache-{_RUN}"))
+os.environ.setdefault("JAX_PERSISTENT_CACHE_MIN_COMPILE_TIME_SECS", "0.3")
+
+import jax  # noqa: E402  (after the cache's environment, which jax reads on import)
+import pytest  # noqa: E402
 
 # Accuracy work is float64 (DESIGN.md); the library itself never flips this flag.
 jax.config.update("jax_enable_x64", True)
+# (again in case a plugin imported jax before this file set the environment)
+jax.config.update("jax_compilation_cache_dir", os.environ["JAX_COMPILATION_CACHE_DIR"])
+jax.config.update("jax_persistent_cache_min_compile_time_secs",
+                  float(os.environ["JAX_PERSISTENT_CACHE_MIN_COMPILE_TIME_SECS"]))
 
 
 @pytest.fixture(autouse=True, scope="module")

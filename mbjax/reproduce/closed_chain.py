@@ -72,7 +72,7 @@ def drift(duration: float, stiff: bool) -> dict:
         u0 = (jnp.concatenate([v0, system.initial_loads(q0, v0, consistent=bool(system.kappa))])
               if isinstance(system, StabilizedLoopSystem) else v0)
         sol = simulate(system, integrator, q0, u0, dt=DRIFT_DT, t1=duration, saveat=ts)
-        residual = jax.vmap(lambda q: jnp.linalg.norm(loops.phi(q)))(sol.qs)
+        residual = jax.jit(jax.vmap(lambda q: jnp.linalg.norm(loops.phi(q))))(sol.qs)
         out[name] = [[float(t), float(r)] for t, r in zip(sol.ts, residual)]
     return out
 

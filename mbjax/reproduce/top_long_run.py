@@ -148,7 +148,7 @@ def physical(duration: float) -> dict:
     ts = jnp.linspace(0.0, duration, int(duration * 10) + 1)
     sol = solve_reference(body, q0, u0, ts, rtol=1e-11, atol=1e-11)
     return {"t": np.asarray(ts).tolist(),
-            "tilt": tilt_of(jax.vmap(body.rotation_matrix)(sol.qs)).tolist()}
+            "tilt": tilt_of(jax.jit(jax.vmap(body.rotation_matrix))(sol.qs)).tolist()}
 
 
 def reproduce(out: Path, quick: bool = False) -> dict:

@@ -43,7 +43,7 @@ def run_case(form_name: str, nodes: int, spacing: float, repeats: int = 3,
     sol, timing = measure(lambda: solve_tfe(body, state0, dt=spacing, n_elements=n_elements,
                                             form=FORMS[form_name], element=element,
                                             reference=REFERENCE), repeats=repeats)
-    error = np.asarray(jax.vmap(tfb.rotation_error_matrix)(sol.R, sol.ts))
+    error = np.asarray(jax.jit(jax.vmap(tfb.rotation_error_matrix))(sol.R, sol.ts))
     return {"form": form_name, "nodes": nodes, "spacing": spacing,
             "t": np.asarray(sol.ts).tolist(), "error": error.tolist(),
             "max_error": float(error.max()), "seconds": timing.run_s,

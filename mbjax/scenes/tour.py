@@ -52,7 +52,7 @@ def heavy_top_tour(out: Path, quick: bool) -> dict:
         sol, timing = measure(partial(simulate, body, cls(), q0, u0, dt=dt, t1=duration,
                                       saveat=saveat), repeats=3)
         rel = np.asarray(body.relative_energy_error(sol.qs, sol.us))
-        axis = np.asarray(jax.vmap(lambda q: body.rotation_matrix(q)[:, 2])(sol.qs))
+        axis = np.asarray(jax.jit(jax.vmap(lambda q: body.rotation_matrix(q)[:, 2]))(sol.qs))
         runs[name] = (np.asarray(sol.ts), axis, rel)
         rows[name] = {"energy_drift": float(np.max(np.abs(rel))),
                       "seconds": timing.run_s, "status": sol.messages()[0]}

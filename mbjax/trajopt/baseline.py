@@ -61,6 +61,7 @@ class FeedForward(eqx.Module):
         return wrist.inverse_dynamics(q, q_dot, q_ddot)
 
 
+@eqx.filter_jit
 def feedforward_torques(wrist, path: ToolPath, ts: Array) -> Array:
     """tau_ff at times ts, shape (len(ts), 3); raises if the path leaves the workspace."""
     q, q_dot, q_ddot, ok = jax.vmap(lambda t: path.joint_motion(wrist, t))(jnp.asarray(ts, dtype=float))

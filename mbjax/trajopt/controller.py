@@ -106,12 +106,12 @@ class Episodes(eqx.Module):
 def make_episodes(wrist, key, n: int, plunge_range=(0.068, 0.082), max_slope: float = 0.3) -> Episodes:
     """Random start and target poses in the workspace (knees-out inverse kinematics)."""
     k1, k2 = jax.random.split(key)
-    ik = jax.vmap(lambda p, g: kinematics.solve_inverse_kinematics(wrist, p, g))
+    ik = jax.jit(jax.vmap(lambda p, g: kinematics.solve_inverse_kinematics(wrist, p, g)))
     (p0, g0), (p1, g1) = sample_poses(k1, n, plunge_range, max_slope), sample_poses(k2, n, plunge_range, max_slope)
     (start, ok0), (target, ok1) = ik(p0, g0), ik(p1, g1)
     if not bool(jnp.all(ok0 & ok1)):
         raise ValueError("sampled poses outside the workspace: narrow plunge_range or max_slope")
-    gravity = jax.vmap(lambda q: wrist.eom_terms(q, jnp.zeros_like(q))[2])(target)
+    gravity = jax.jit(jax.vmap(lambda q: wrist.eom_terms(q, jnp.zeros_like(q))[2]))(target)
     return Episodes(start=start, target=target, target_plunge=p1, target_slope=g1, gravity_torque=gravity)
 
 

@@ -24,7 +24,7 @@ def minimal_rhs(y):
     """theta_ddot of the one-dof Lagrangian L(theta, omega) = T - V."""
     def lagrangian(theta, omega):
         q = joint_angles(theta)
-        return (kinetic_energy(MODEL, q, jax.jacfwd(joint_angles)(theta) * omega)
+        return (kinetic_energy(MODEL, q, jax.jit(jax.jacfwd(joint_angles))(theta) * omega)
                 - potential_energy(MODEL, q))
     theta, omega = y
     m = jax.grad(jax.grad(lagrangian, 1), 1)(theta, omega)
@@ -81,7 +81,7 @@ def test_constraint_derivatives_by_autodiff_match_finite_differences():
 @pytest.mark.slow
 def test_gradient_through_a_constrained_rollout_matches_finite_differences():
     system = LoopSystem(LOOPS)
-    direction = jax.jacfwd(joint_angles)(THETA0)
+    direction = jax.jit(jax.jacfwd(joint_angles))(THETA0)
 
     def final_crank(omega):
         return simulate(system, RK4(), Q0, direction * omega, dt=1e-3, t1=0.1, saveat=[0.1]).qs[-1, 0]
@@ -122,6 +122,6 @@ def test_epsilon_dynamics_keeps_the_velocity_error_at_epsilon_times_the_loads():
     sol = simulate(system, RK4(), Q0, u0, dt=5e-4, t1=0.2, saveat=np.linspace(0.0, 0.2, 5))
     # the velocity error epsilon f_c moves Phi past the default tolerance: the status says so
     assert sol.messages() == ["constraint violated, redundant"]
-    rates = jax.vmap(LOOPS.rate)(sol.qs, sol.us[:, :3])
+    rates = jax.jit(jax.vmap(LOOPS.rate))(sol.qs, sol.us[:, :3])
     np.testing.assert_allclose(rates, 1e-2 * sol.us[:, 3:], atol=1e-9)
     assert float(jnp.abs(sol.us[-1, 3:]).max()) > 1.0        # the loads did act

@@ -47,7 +47,7 @@ def test_momentum_form_follows_the_same_motion():
     velocity = simulate(LoopSystem(LOOPS, TAU), RK4(), Q0, V0, dt=1e-3, t1=0.2, saveat=ts)
     assert momentum.messages() == velocity.messages() == ["success"]
     np.testing.assert_allclose(momentum.qs, velocity.qs, atol=1e-9)
-    v_end = jax.vmap(system.velocity)(momentum.qs, momentum.us)
+    v_end = jax.jit(jax.vmap(system.velocity))(momentum.qs, momentum.us)
     np.testing.assert_allclose(v_end, velocity.us, atol=1e-8)
 
 
@@ -60,8 +60,8 @@ def test_one_triangularization_gives_the_unit_load_responses():
     def loads_and_dense(q, v, tau):
         eta, Gamma, A = eta_and_gamma(LOOPS, q, v, tau)
         unloaded = eqx.tree_at(lambda m: m.gravity, model, jnp.zeros(3))
-        dense = jax.vmap(lambda load: forward_dynamics(unloaded, q, jnp.zeros(6), load,
-                                                       method="dense"))(A).T
+        dense = jax.jit(jax.vmap(lambda load: forward_dynamics(unloaded, q, jnp.zeros(6), load,
+                                                       method="dense")))(A).T
         return eta, Gamma, forward_dynamics(model, q, v, tau, method="dense"), dense
 
     eta, Gamma, eta_dense, dense = loads_and_dense(Q0, V0, TAU)
@@ -129,5 +129,5 @@ def test_epsilon_dynamics_with_position_feedback_keeps_its_invariant():
     def invariant(q, u):
         return LOOPS.rate(q, u[:6]) + kappa * LOOPS.phi(q) - eps * u[6:]
 
-    values = jax.vmap(invariant)(sol.qs, sol.us)
+    values = jax.jit(jax.vmap(invariant))(sol.qs, sol.us)
     np.testing.assert_allclose(values, values[0] + 0 * values, atol=1e-8 * np.abs(values).max())

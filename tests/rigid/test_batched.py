@@ -35,7 +35,7 @@ def _relative(a, ref):
 def test_batched_equals_the_one_state_recursion(name):
     model = MODELS[name]()
     q, v, tau = _states(model, 33)
-    reference = jax.vmap(forward_dynamics, in_axes=(None, 0, 0, 0))(model, q, v, tau)
+    reference = jax.jit(jax.vmap(forward_dynamics, in_axes=(None, 0, 0, 0)))(model, q, v, tau)
     assert _relative(jax.jit(batched_forward_dynamics)(model, q, v, tau), reference) < 1e-12
 
 
@@ -86,8 +86,8 @@ def test_batch_rollout_equals_vmapped_rollouts():
     tau = jnp.linspace(-1.0, 1.0, model.nv)
     batch = simulate(BatchTreeSystem(model, tau), RK4(), q.T, v.T, dt=2e-3, t1=0.2,
                      saveat=np.array([0.1, 0.2]))
-    one = jax.vmap(lambda q0, v0: simulate(TreeSystem(model, tau), RK4(), q0, v0, dt=2e-3, t1=0.2,
-                                           saveat=np.array([0.1, 0.2])))(q, v)
+    one = jax.jit(jax.vmap(lambda q0, v0: simulate(TreeSystem(model, tau), RK4(), q0, v0, dt=2e-3, t1=0.2,
+                                           saveat=np.array([0.1, 0.2]))))(q, v)
     assert _relative(batch.qs, jnp.moveaxis(one.qs, 0, -1)) < 1e-11
     assert _relative(batch.us, jnp.moveaxis(one.us, 0, -1)) < 1e-11
     assert int(batch.status) == 0

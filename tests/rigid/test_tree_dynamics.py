@@ -97,11 +97,11 @@ def _dynamics(model: Model, q, v, tau, a):
     out["fd_of_id"] = rigid.forward_dynamics(model, q, v, tau_a, method="recursive")
 
     out["M"] = M = rigid.mass_matrix(model, q)
-    out["M_hessian"] = jax.hessian(lambda v_: rigid.kinetic_energy(model, q, v_))(v)
+    out["M_hessian"] = jax.jit(jax.hessian(lambda v_: rigid.kinetic_energy(model, q, v_)))(v)
     # At v = 0 without gravity the RNEA of a unit acceleration is a column of M.
     no_gravity = eqx.tree_at(lambda m: m.gravity, model, jnp.zeros(3))
     zero = jnp.zeros(model.nv)
-    out["M_rnea"] = jax.vmap(lambda e: rigid.inverse_dynamics(no_gravity, q, zero, e))(
+    out["M_rnea"] = jax.jit(jax.vmap(lambda e: rigid.inverse_dynamics(no_gravity, q, zero, e)))(
         jnp.eye(model.nv)).T
 
     # Momentum form (seed 001 eqs 72-73): d/dt (M v) along the motion under tau.
@@ -399,8 +399,8 @@ def test_floating_base_conserves_momentum():
 
     @jax.jit
     def invariants(qs, us):
-        return (jax.vmap(rigid.spatial_momentum, (None, 0, 0))(model, qs, us),
-                jax.vmap(rigid.energy, (None, 0, 0))(model, qs, us))
+        return (jax.jit(jax.vmap(rigid.spatial_momentum, (None, 0, 0)))(model, qs, us),
+                jax.jit(jax.vmap(rigid.energy, (None, 0, 0)))(model, qs, us))
 
     h, E = invariants(sol.qs, sol.us)
     np.testing.assert_allclose(h, np.broadcast_to(h[0], h.shape), rtol=0,

@@ -18,8 +18,8 @@ def _states(w, n=24, seed=0):
 def test_lagrangian_and_newton_euler_torques_agree():
     w = cw.wrist()
     theta, theta_dot, theta_ddot = _states(w)
-    lagrange = jax.vmap(w.inverse_dynamics)(theta, theta_dot, theta_ddot)
-    newton = jax.vmap(w.newton_euler_torques)(theta, theta_dot, theta_ddot)
+    lagrange = jax.jit(jax.vmap(w.inverse_dynamics))(theta, theta_dot, theta_ddot)
+    newton = jax.jit(jax.vmap(w.newton_euler_torques))(theta, theta_dot, theta_ddot)
     assert np.abs(lagrange).max() > 1.0                 # torques of order N m, not all gravity
     np.testing.assert_allclose(lagrange, newton, rtol=0, atol=1e-10)
 
@@ -27,19 +27,19 @@ def test_lagrangian_and_newton_euler_torques_agree():
 def test_eom_terms_reassemble_the_inverse_dynamics_and_invert_the_forward():
     w = cw.wrist()
     theta, theta_dot, theta_ddot = _states(w, n=8, seed=1)
-    A, B, C = jax.vmap(w.eom_terms)(theta, theta_dot)
-    tau = jax.vmap(w.inverse_dynamics)(theta, theta_dot, theta_ddot)
+    A, B, C = jax.jit(jax.vmap(w.eom_terms))(theta, theta_dot)
+    tau = jax.jit(jax.vmap(w.inverse_dynamics))(theta, theta_dot, theta_ddot)
     np.testing.assert_allclose(jnp.einsum("nij,nj->ni", A, theta_ddot) + B + C, tau, atol=1e-11)
-    np.testing.assert_allclose(jax.vmap(w.forward_dynamics)(theta, theta_dot, tau), theta_ddot,
+    np.testing.assert_allclose(jax.jit(jax.vmap(w.forward_dynamics))(theta, theta_dot, tau), theta_ddot,
                                rtol=1e-11, atol=1e-9)
     # A symmetric positive definite, B quadratic in theta_dot, C = dV/dtheta = gravity only
     np.testing.assert_allclose(A, np.swapaxes(A, 1, 2), atol=1e-15)
     assert np.all(np.linalg.eigvalsh(np.asarray(A)) > 0)
-    B2 = jax.vmap(lambda q, v: w.eom_terms(q, 2 * v)[1])(theta, theta_dot)
+    B2 = jax.jit(jax.vmap(lambda q, v: w.eom_terms(q, 2 * v)[1]))(theta, theta_dot)
     np.testing.assert_allclose(B2, 4 * B, rtol=1e-12, atol=1e-12)
-    C0 = jax.vmap(lambda q: CarpalWrist(w.base_radius, w.link_length, tool_mass=w.tool_mass,
+    C0 = jax.jit(jax.vmap(lambda q: CarpalWrist(w.base_radius, w.link_length, tool_mass=w.tool_mass,
                                         tool_inertia=w.tool_inertia, tool_com=w.tool_com,
-                                        gravity=0.0).eom_terms(q, jnp.zeros(3))[2])(theta)
+                                        gravity=0.0).eom_terms(q, jnp.zeros(3))[2]))(theta)
     np.testing.assert_allclose(C0, 0.0, atol=1e-15)
 
 
@@ -49,7 +49,7 @@ def test_mass_matrix_is_the_jacobians_inertia():
     from mbjax.wrist.kinematics import forward_kinematics
     w = cw.wrist()
     theta = cw.home(w) + jnp.array([0.2, -0.1, 0.3])
-    J_v, J_w = jax.jacfwd(lambda v: newton_euler.tool_velocity(w, theta, v))(jnp.zeros(3))
+    J_v, J_w = jax.jit(jax.jacfwd(lambda v: newton_euler.tool_velocity(w, theta, v)))(jnp.zeros(3))
     R = forward_kinematics(w, theta).rotation
     A = w.tool_mass * J_v.T @ J_v + J_w.T @ R @ w.tool_inertia @ R.T @ J_w
     np.testing.assert_allclose(w.mass_matrix(theta), A, rtol=1e-12, atol=1e-16)
@@ -100,6 +100,6 @@ def test_gradients_of_the_dynamics_in_parameters_are_finite_and_match_finite_dif
         w = CarpalWrist(cw.BASE_RADIUS, cw.LINK_LENGTH, tool_mass=mass, tool_inertia=cw.TOOL_INERTIA,
                         tool_com=cw.TOOL_COM)
         return w.forward_dynamics(theta, theta_dot, tau)
-    g = jax.jacfwd(accel)(1.5)
+    g = jax.jit(jax.jacfwd(accel))(1.5)
     h = 1e-6
     np.testing.assert_allclose(g, (accel(1.5 + h) - accel(1.5 - h)) / (2 * h), rtol=1e-6, atol=1e-7)

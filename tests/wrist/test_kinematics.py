@@ -57,14 +57,14 @@ def test_fk_of_ik_is_the_identity_over_the_workspace():
     w = cw.wrist()
     alpha, beta, plunge = _workspace_samples(w)
     assert len(alpha) > 500
-    theta = jax.vmap(w.inverse_kinematics)(alpha, beta, plunge)
-    pose = jax.vmap(w.forward_kinematics)(theta)
+    theta = jax.jit(jax.vmap(w.inverse_kinematics))(alpha, beta, plunge)
+    pose = jax.jit(jax.vmap(w.forward_kinematics))(theta)
     np.testing.assert_allclose(pose.plunge, plunge, rtol=0, atol=1e-12)
     np.testing.assert_allclose(pose.beta, beta, rtol=0, atol=1e-12)
     np.testing.assert_allclose(np.angle(np.exp(1j * (np.asarray(pose.alpha) - alpha))), 0.0, atol=1e-12)
     # and IK(FK(theta)) == theta on the knees-out branch
-    theta2 = jax.vmap(lambda t: w.solve_inverse_kinematics(*(lambda p: (p.plunge, p.slope))(
-        w.forward_kinematics(t)))[0])(theta)
+    theta2 = jax.jit(jax.vmap(lambda t: w.solve_inverse_kinematics(*(lambda p: (p.plunge, p.slope))(
+        w.forward_kinematics(t)))[0]))(theta)
     np.testing.assert_allclose(theta2, theta, rtol=0, atol=1e-11)
 
 
@@ -75,16 +75,16 @@ def test_home_pose_is_regular_and_differentiable():
     home = cw.home(w)
     pose = w.forward_kinematics(home)
     assert float(pose.beta) == 0.0 and float(pose.alpha) == 0.0
-    grads = jax.jacfwd(lambda t: jnp.concatenate([w.forward_kinematics(t).centre,
+    grads = jax.jit(jax.jacfwd(lambda t: jnp.concatenate([w.forward_kinematics(t).centre,
                                                   w.forward_kinematics(t).rotation.ravel(),
                                                   jnp.stack([w.forward_kinematics(t).beta,
-                                                             w.forward_kinematics(t).alpha])]))(home)
+                                                             w.forward_kinematics(t).alpha])])))(home)
     assert np.all(np.isfinite(grads))
     rev = jax.grad(lambda t: w.forward_kinematics(t).beta + w.forward_kinematics(t).com.sum())(home)
     assert np.all(np.isfinite(rev))
     theta0, ok = w.solve_inverse_kinematics(cw.HOME_PLUNGE, jnp.zeros(2))
     assert bool(ok)
-    g = jax.jacfwd(lambda s: w.solve_inverse_kinematics(cw.HOME_PLUNGE, s)[0])(jnp.zeros(2))
+    g = jax.jit(jax.jacfwd(lambda s: w.solve_inverse_kinematics(cw.HOME_PLUNGE, s)[0]))(jnp.zeros(2))
     assert np.all(np.isfinite(g))
 
 
@@ -139,7 +139,7 @@ def test_unreachable_pose_raises_and_the_status_route_stays_finite():
         jax.block_until_ready(eqx.filter_jit(w.inverse_kinematics)(0.0, 0.4, 0.12))
     theta, ok = w.solve_inverse_kinematics(0.2, jnp.array([0.5, 0.0]))
     assert not bool(ok) and np.all(np.isfinite(theta))
-    assert np.all(np.isfinite(jax.jacfwd(lambda p: w.solve_inverse_kinematics(p, jnp.array([0.5, 0.0]))[0])(0.2)))
+    assert np.all(np.isfinite(jax.jit(jax.jacfwd(lambda p: w.solve_inverse_kinematics(p, jnp.array([0.5, 0.0]))[0]))(0.2)))
     assert not bool(w.reachable(0.0, 0.0, 0.11)) and bool(w.reachable(0.0, 0.0, 0.09))
 
 

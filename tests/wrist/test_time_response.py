@@ -27,7 +27,7 @@ def test_energy_is_conserved_and_rk4_converges_at_order_four():
     for dt in (0.02, 0.01, 0.005):
         sol = simulate(system, RK4(), q0, u0, dt=dt, t1=T, saveat=np.linspace(0, T, 11))
         assert sol.messages() == ["success"]
-        E = jax.vmap(system.wrist.energy)(sol.qs, sol.us)
+        E = jax.jit(jax.vmap(system.wrist.energy))(sol.qs, sol.us)
         drifts.append(float(jnp.max(jnp.abs(E - E0)) / E0))
         ends.append(np.asarray(sol.qs[-1]))
     ref = np.asarray(simulate(system, RK4(), q0, u0, dt=1e-3, t1=T, saveat=[T]).qs[-1])
@@ -36,7 +36,7 @@ def test_energy_is_conserved_and_rk4_converges_at_order_four():
     assert np.all(np.abs(orders - 4) < 0.3), orders
     assert drifts[-1] < 1e-10 and drifts[0] / drifts[-1] > 100
     # the motion stays well inside the workspace (the study is not near a singularity)
-    m = jax.vmap(system.wrist.singularity_measures)(sol.qs)
+    m = jax.jit(jax.vmap(system.wrist.singularity_measures))(sol.qs)
     assert float(m.inverse.min()) > 0.5 and float(m.direct.min()) > 0.9
 
 
@@ -57,13 +57,14 @@ def test_stability_boundaries_match_the_linearization():
         e = q - law.theta_ref
         return 0.5 * law.stiffness * e @ e + 0.5 * u @ system.wrist.mass_matrix(q) @ u
 
-    E0 = float(servo_energy(q0, u0))
+    energies = jax.jit(jax.vmap(servo_energy))
+    E0 = float(jax.jit(servo_energy)(q0, u0))
     dts = (0.005, 0.01, 0.02)
     expected = {"explicit_euler": (True, False, False), "semi_implicit_euler": (True, True, False),
                 "rk4": (True, True, True), "implicit_midpoint": (True, True, True)}
     for name, stable in expected.items():
         q, u, _ = masked_rollout(system, INTEGRATORS[name](), q0, u0, dts, cw.SERVO_DURATION, lambda q, u: 0.0)
-        E = np.asarray(jax.vmap(servo_energy)(q, u))
+        E = np.asarray(energies(q, u))
         measured = tuple(bool(np.isfinite(e) and e < E0) for e in E)
         assert measured == stable, (name, E / E0)
         # clear verdicts: the stable runs lose at least 95 % of the energy in the second (explicit
