@@ -41,3 +41,6 @@ def pytest_collection_modifyitems(config, items):
         return _LONG_FIRST.index(name) if name in _LONG_FIRST else len(_LONG_FIRST)
 
     items.sort(key=rank)          # stable: the order within each group is kept
+    for item in items:            # the slow tests (full-length runs) get an hour, not the default
+        if item.get_closest_marker("slow") and not item.get_closest_marker("timeout"):
+            item.add_marker(pytest.mark.timeout(3600))

@@ -122,7 +122,7 @@ def integrator_study(steps, seconds: dict | None = None) -> tuple[list[dict], di
     servo, s0, v0 = scene.servo()
     ref = simulate(free, RK4(), q0, u0, dt=REFERENCE_DT, t1=scene.FREE_DURATION,
                    saveat=np.array([scene.FREE_DURATION])).qs[-1]
-    E0 = jax.jit(free.wrist.energy)(q0, u0)
+    E0 = jax.jit(lambda q, u: free.wrist.energy(q, u))(q0, u0)
     law = servo.torque
 
     @jax.jit
