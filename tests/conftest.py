@@ -6,8 +6,10 @@ from pathlib import Path
 # notebook kernels and the CLI subprocesses they start (they inherit the environment): the tour,
 # the reproductions, the notebooks and the unit tests build many of the same scenes, and on the
 # CI machine compiling them is most of the suite's time. A cached executable is the same binary.
-_RUN = os.environ.get("PYTEST_XDIST_TESTRUNUID", str(os.getpid()))
-os.environ.setdefault("JAX_COMPILATION_CACHE_DIR", str(Path(tempfile.gettempdir()) / f"mbjax-xla-cache-{_RUN}"))
+# The first process to import this file (the xdist controller) names the folder; the workers it
+# starts inherit the variable, so setdefault keeps that one name for the whole run.
+os.environ.setdefault("JAX_COMPILATION_CACHE_DIR",
+                      str(Path(tempfile.gettempdir()) / f"mbjax-xla-cache-{os.getpid()}"))
 os.environ.setdefault("JAX_PERSISTENT_CACHE_MIN_COMPILE_TIME_SECS", "0.3")
 
 import jax  # noqa: E402  (after the cache's environment, which jax reads on import)

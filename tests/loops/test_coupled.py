@@ -24,7 +24,7 @@ def minimal_rhs(y):
     """theta_ddot of the one-dof Lagrangian L(theta, omega) = T - V."""
     def lagrangian(theta, omega):
         q = joint_angles(theta)
-        return (kinetic_energy(MODEL, q, jax.jit(jax.jacfwd(joint_angles))(theta) * omega)
+        return (kinetic_energy(MODEL, q, jax.jacfwd(joint_angles)(theta) * omega)
                 - potential_energy(MODEL, q))
     theta, omega = y
     m = jax.grad(jax.grad(lagrangian, 1), 1)(theta, omega)

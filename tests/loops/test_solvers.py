@@ -61,7 +61,7 @@ def test_one_triangularization_gives_the_unit_load_responses():
         eta, Gamma, A = eta_and_gamma(LOOPS, q, v, tau)
         unloaded = eqx.tree_at(lambda m: m.gravity, model, jnp.zeros(3))
         dense = jax.jit(jax.vmap(lambda load: forward_dynamics(unloaded, q, jnp.zeros(6), load,
-                                                       method="dense")))(A).T
+                                                               method="dense")))(A).T
         return eta, Gamma, forward_dynamics(model, q, v, tau, method="dense"), dense
 
     eta, Gamma, eta_dense, dense = loads_and_dense(Q0, V0, TAU)

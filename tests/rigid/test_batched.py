@@ -87,7 +87,7 @@ def test_batch_rollout_equals_vmapped_rollouts():
     batch = simulate(BatchTreeSystem(model, tau), RK4(), q.T, v.T, dt=2e-3, t1=0.2,
                      saveat=np.array([0.1, 0.2]))
     one = jax.jit(jax.vmap(lambda q0, v0: simulate(TreeSystem(model, tau), RK4(), q0, v0, dt=2e-3, t1=0.2,
-                                           saveat=np.array([0.1, 0.2]))))(q, v)
+                                                   saveat=np.array([0.1, 0.2]))))(q, v)
     assert _relative(batch.qs, jnp.moveaxis(one.qs, 0, -1)) < 1e-11
     assert _relative(batch.us, jnp.moveaxis(one.us, 0, -1)) < 1e-11
     assert int(batch.status) == 0
