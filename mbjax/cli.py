@@ -41,7 +41,7 @@ def _parser(reproductions, suites, scenes) -> argparse.ArgumentParser:
 
 def _tour(out: Path, quick: bool, scenes=None) -> None:
     from mbjax.progress import progress
-    from mbjax.scenes.tour import TOUR
+    from mbjax.tour import TOUR
 
     names = [name for name in TOUR if not scenes or name in scenes]
     out.mkdir(parents=True, exist_ok=True)
@@ -94,7 +94,7 @@ def main(argv=None) -> int:
     from mbjax.bench import SUITES
     from mbjax.reproduce import REPRODUCTIONS
 
-    from mbjax.scenes.tour import TOUR
+    from mbjax.tour import TOUR
 
     parser = _parser(REPRODUCTIONS, SUITES, TOUR)
     args = parser.parse_args(argv)

@@ -76,7 +76,7 @@ TOUR_GROUPS = {
 
 
 def test_tour_groups_cover_every_scene():
-    from mbjax.scenes.tour import TOUR
+    from mbjax.tour import TOUR
 
     assert sorted(s for group in TOUR_GROUPS.values() for s in group) == sorted(TOUR)
     assert set(TOUR) == {"torque-free-body", "heavy-top", "rigid-chain", "time-elements",

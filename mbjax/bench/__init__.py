@@ -1,4 +1,4 @@
-"""Benchmark suites for `mbjax bench SUITE` and the shared timing helper.
+"""Benchmark suites for `mbjax bench SUITE` (their timing helper is `mbjax.timing`).
 
 Each suite is run(out: Path, quick: bool) -> list of records, written as out/SUITE.jsonl and
 out/SUITE.png. Peers (MuJoCo, Pinocchio, exudyn) are measured in the same process when installed.

@@ -21,7 +21,7 @@ ANCF beam and exudyn.
   generalized-alpha solver (spectral radius 0.8, fixed steps), at several steps; run_s is the median
   wall time of building and solving (the offset is a Python user function, called from C++).
 
-Modal run times: median after warm-up (`mbjax.bench.timing.measure`), compile time apart.
+Modal run times: median after warm-up (`mbjax.timing.measure`), compile time apart.
 JSON lines + PNG.
 """
 
@@ -34,7 +34,7 @@ import jax
 import numpy as np
 
 from mbjax.bench import peers
-from mbjax.bench.timing import measure, write_jsonl
+from mbjax.timing import measure, write_jsonl
 from mbjax.integrate import RK4, simulate
 
 NAME = "flexible"

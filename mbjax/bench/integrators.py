@@ -17,7 +17,7 @@ import numpy as np
 
 from mbjax import lie
 from mbjax.bench import peers
-from mbjax.bench.timing import measure, write_jsonl
+from mbjax.timing import measure, write_jsonl
 from mbjax.integrate import INTEGRATORS, RKMK4, simulate, solve_reference
 from mbjax.scenes import heavy_top as top
 

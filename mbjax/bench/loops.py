@@ -21,9 +21,9 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from mbjax.bench.timing import measure, write_jsonl
+from mbjax.timing import measure, write_jsonl
 from mbjax.integrate import RK4, simulate, solve_reference
-from mbjax.loops import LoopSystem, MomentumLoopSystem, StabilizedLoopSystem
+from mbjax.loops import ClosedSystem, Coupled, Momentum, Stabilized
 from mbjax.scenes import closed_chain
 
 NAME = "loops"
@@ -31,25 +31,26 @@ STEPS = (4e-3, 2e-3, 1e-3, 5e-4)
 NS = (12, 28, 44, 100, 200, 400)
 
 
-def routes(loops) -> dict:
-    return {"coupled": LoopSystem(loops),
-            "coupled + baumgarte": LoopSystem(loops, baumgarte=(10.0, 10.0)),
-            "coupled + projection": LoopSystem(loops, projection=True),
-            "momentum form": MomentumLoopSystem(loops),
-            "O(n + m^3)": StabilizedLoopSystem(loops)}
+def routes(chain: ClosedSystem) -> dict:
+    tree, closures = chain.tree, chain.closures
+    return {"coupled": ClosedSystem(tree, closures, Coupled()),
+            "coupled + baumgarte": ClosedSystem(tree, closures, Coupled(baumgarte=(10.0, 10.0))),
+            "coupled + projection": ClosedSystem(tree, closures, Coupled(), projection=True),
+            "momentum form": ClosedSystem(tree, closures, Momentum()),
+            "O(n + m^3)": ClosedSystem(tree, closures, Stabilized())}
 
 
 def work_precision(repeats: int, steps, names, common: dict) -> list[dict]:
-    loops, q0, v0 = closed_chain.build(12)
+    chain, q0, v0 = closed_chain.build(12)
     T = closed_chain.DURATION
     saveat = np.linspace(0.0, T, 21)
-    ref = solve_reference(LoopSystem(loops), q0, v0, jnp.asarray(saveat), rtol=1e-12, atol=1e-12)
-    residual = jax.jit(jax.vmap(lambda q: jnp.linalg.norm(loops.phi(q))))
+    ref = solve_reference(chain, q0, v0, jnp.asarray(saveat), rtol=1e-12, atol=1e-12)
+    residual = jax.jit(jax.vmap(lambda q: jnp.linalg.norm(chain.loops.phi(q))))
     records = []
-    for name, system in routes(loops).items():
+    for name, system in routes(chain).items():
         if name not in names:
             continue
-        u0 = system.momenta(q0, v0) if isinstance(system, MomentumLoopSystem) else v0
+        u0 = system.initial_state(q0, v0)
         for dt in steps:
             sol, timing = measure(partial(simulate, system, RK4(), q0, u0, dt=dt, t1=T,
                                           saveat=saveat), repeats=repeats)
@@ -64,11 +65,11 @@ def work_precision(repeats: int, steps, names, common: dict) -> list[dict]:
 def scaling(repeats: int, ns, common: dict) -> list[dict]:
     records = []
     for n in ns:
-        loops, q0, v0 = closed_chain.build(n)
+        chain, q0, v0 = closed_chain.build(n)
         window = 1.0 if n <= 44 else 0.1
         qs = {}
         for name in ("O(n + m^3)", "coupled"):
-            system = routes(loops)[name]
+            system = routes(chain)[name]
             sol, timing = measure(partial(simulate, system, RK4(), q0, v0, dt=1e-3, t1=window,
                                           saveat=[window]), repeats=repeats)
             qs[name] = sol.qs[-1]

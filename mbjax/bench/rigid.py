@@ -43,7 +43,7 @@ import jax.numpy as jnp
 import numpy as np
 
 from mbjax.bench import peers
-from mbjax.bench.timing import Timing, measure, write_jsonl
+from mbjax.timing import Timing, measure, write_jsonl
 from mbjax.integrate import RK4, simulate
 from mbjax.model import chain
 from mbjax.model.urdf import to_urdf

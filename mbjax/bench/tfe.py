@@ -22,7 +22,7 @@ import jax.numpy as jnp
 import numpy as np
 
 from mbjax import lie
-from mbjax.bench.timing import measure, write_jsonl
+from mbjax.timing import measure, write_jsonl
 from mbjax.integrate import INTEGRATORS, simulate, solve_reference
 from mbjax.scenes import heavy_top, torque_free_body
 from mbjax.tfe import Body, Element, Mixed, PrimalUnsymmetric, initial_state, solve_tfe

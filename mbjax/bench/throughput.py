@@ -38,7 +38,7 @@ import numpy as np
 
 from mbjax.bench import peers
 from mbjax.bench.rigid import pinocchio_loop, relative_difference, states, timed
-from mbjax.bench.timing import write_jsonl
+from mbjax.timing import write_jsonl
 from mbjax.integrate import RK4, simulate
 from mbjax.model import chain
 from mbjax.model.urdf import to_urdf

@@ -23,7 +23,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from mbjax.bench.timing import measure, write_jsonl
+from mbjax.timing import measure, write_jsonl
 from mbjax.integrate import RK4, simulate
 from mbjax.scenes import carpal_wrist as cw
 from mbjax.trajopt import sweeps

@@ -33,10 +33,10 @@ import numpy as np
 from jax import Array
 
 from mbjax.flex.body import inertial_stiffening, mass_matrix, velocity_terms
-from mbjax.flex.kinematics import flex_kinematics
+from mbjax.flex.kinematics import flex_kinematics, inverse_motion
 from mbjax.flex.model import FlexibleModel
 from mbjax.rigid.kinematics import gravity_acceleration
-from mbjax.spatial import skew
+from mbjax.spatial import shift_force, skew
 from mbjax.tree import backward_pass, forward_pass
 
 
@@ -46,20 +46,12 @@ def _solve(D: Array, b: Array) -> Array:
     return jnp.linalg.solve(D, b)
 
 
-def _inverse_motion(X: Array) -> Array:
-    """X^-1 for X = [[R, 0], [p~ R, R]]: [[R^T, 0], [-R^T p~, R^T]] (no general inverse)."""
-    R, pR = X[:3, :3], X[3:, :3]
-    Rt = R.T
-    zero = jnp.zeros_like(R)
-    return jnp.block([[Rt, zero], [-Rt @ pR @ Rt, Rt]])
-
-
 def body_blocks(model: FlexibleModel, kin) -> tuple[Array, Array]:
     """Per body, the (6 + mu)-block mass M_g (with the stiffening's acceleration coupling) and the
     remainder force b_g (velocity terms, elastic and damping forces, stiffening's velocity part),
     ground components at the ground origin for the rigid rows and columns."""
     def one(body, X, V, q, u):
-        Xi = _inverse_motion(X)
+        Xi = inverse_motion(X)
         Vb = Xi @ V
         M = mass_matrix(body, q)
         b = velocity_terms(body, q, jnp.concatenate([Vb, u]))
@@ -91,10 +83,13 @@ def _distal(model: FlexibleModel, kin) -> Array:
 
 
 def flexible_aba_responses(model: FlexibleModel, q: Array, v: Array, tau: Array,
-                           loads: Array) -> tuple[Array, Array]:
-    """(v_dot (nv,), responses (m, nv)): the accelerations under tau, gravity, velocity and
-    elasticity, and those each row of `loads` (m, nv) alone produces (no gravity, velocity or
-    elasticity); O(n) in the bodies, O(n m) in the loads."""
+                           loads: Array, f_ext: Array | None = None) -> tuple[Array, Array]:
+    """(v_dot (nv,), responses (m, nv)): the accelerations under tau, gravity, velocity,
+    elasticity and the external wrenches f_ext (n, 6) (world frame, (torque about body k's frame
+    origin; force), or None), and those each row of `loads` (m, nv) alone produces (no gravity,
+    velocity, elasticity or wrench); O(n) in the bodies, O(n m) in the loads. A wrench acts on a
+    body's reference frame (its joint grid J^k, where the modes are clamped), so it enters the
+    rigid rows of the body's own force and loads no mode directly."""
     kin = flex_kinematics(model, q, v)
     n, mu, m = model.n, model.mu, loads.shape[0]
     dtype = q.dtype
@@ -106,6 +101,8 @@ def flexible_aba_responses(model: FlexibleModel, q: Array, v: Array, tau: Array,
     tj, tf = jax.vmap(model.split)(tau_cols)                               # (cols, *), (cols, n, mu)
     t_joint = jnp.moveaxis(jax.vmap(model.model.body_v)(tj), 0, -1)        # (n, width, cols)
     t_modal = jnp.moveaxis(tf, 0, -1)                                      # (n, mu, cols)
+    if f_ext is not None:
+        b_g = b_g.at[:, :6].add(-shift_force(f_ext, kin.p))
     own_p = jnp.zeros((n, 6 + mu, cols), dtype).at[:, :, 0].set(b_g).at[:, 6:, :].add(-t_modal)
     c = jnp.zeros((n, 6, cols), dtype).at[:, :, 0].set(kin.c)
 
@@ -142,7 +139,8 @@ def flexible_aba_responses(model: FlexibleModel, q: Array, v: Array, tau: Array,
     return flat[0], flat[1:]
 
 
-def flexible_aba(model: FlexibleModel, q: Array, v: Array, tau: Array) -> Array:
+def flexible_aba(model: FlexibleModel, q: Array, v: Array, tau: Array,
+                 f_ext: Array | None = None) -> Array:
     """v_dot (nv,) of the flexible tree at (q, v) under generalized forces tau (joint forces, then
-    modal forces) and gravity: seed 002's O(n) recursion."""
-    return flexible_aba_responses(model, q, v, tau, jnp.zeros((0, model.nv), q.dtype))[0]
+    modal forces), gravity and external wrenches f_ext: seed 002's O(n) recursion."""
+    return flexible_aba_responses(model, q, v, tau, jnp.zeros((0, model.nv), q.dtype), f_ext)[0]

@@ -105,6 +105,22 @@ def _markers(model: FlexibleModel, R: Array, p: Array, qf: Array):
     return R[body] @ E, p[body] + jnp.einsum("kij,kj->ki", R[body], o)
 
 
+def inverse_motion(X: Array) -> Array:
+    """X^-1 for X = [[R, 0], [p~ R, R]]: [[R^T, 0], [-R^T p~, R^T]] (no general inverse)."""
+    R, pR = X[:3, :3], X[3:, :3]
+    Rt = R.T
+    zero = jnp.zeros_like(R)
+    return jnp.block([[Rt, zero], [-Rt @ pR @ Rt, Rt]])
+
+
+def body_velocities(model: FlexibleModel, q: Array, v: Array) -> Array:
+    """(n, 6 + mu): per body its frame's (omega; v) in body components and its modal rates, the
+    w of seed 002 eq 34, from the recursion's velocities (any joint type)."""
+    kin = flex_kinematics(model, q, v)
+    Vb = jnp.einsum("kij,kj->ki", jax.vmap(inverse_motion)(kin.X), kin.V)
+    return jnp.concatenate([Vb, kin.u], -1)
+
+
 def motion_transform(R: Array, p: Array) -> Array:
     """(n, 6, 6) X: body-frame motion vectors at the body origin -> ground frame at the ground
     origin, [[R, 0], [p~ R, R]]."""

@@ -90,12 +90,27 @@ def residual(model: FlexibleModel, q: Array, v: Array, v_dot: Array, tau: Array)
     return generalized + model.join(jnp.zeros(model.model.nv, q.dtype), modal)
 
 
-def dense_forward_dynamics(model: FlexibleModel, q: Array, v: Array, tau: Array) -> Array:
-    """v_dot from Lagrange's equations (the residual's Jacobian in v_dot solved densely).
+def external_forces(model: FlexibleModel, q: Array, f_ext: Array) -> Array:
+    """The generalized forces (nv,) of world-frame wrenches f_ext (n, 6) (torque about each body
+    frame's origin; force): the gradient in v of their power n . omega + f . p_dot."""
+    def power(v):
+        R, _, omega, velocity, _, _ = _body_motion(model, q, v, jnp.zeros_like(v))
+        return (jnp.sum(f_ext[:, :3] * jnp.einsum("kij,kj->ki", R, omega))
+                + jnp.sum(f_ext[:, 3:] * jnp.einsum("kij,kj->ki", R, velocity)))
+
+    return jax.grad(power)(jnp.zeros(model.nv, q.dtype))
+
+
+def dense_forward_dynamics(model: FlexibleModel, q: Array, v: Array, tau: Array,
+                           f_ext: Array | None = None) -> Array:
+    """v_dot from Lagrange's equations (the residual's Jacobian in v_dot solved densely), under
+    generalized forces tau and external wrenches f_ext (as `external_forces`).
 
     Distal-load stiffening (the reactions of child bodies, eq 33's second sum) is not in this
     route: it needs the joint reactions, which the recursion has and the energies do not."""
     _check(model)
+    if f_ext is not None:
+        tau = tau + external_forces(model, q, f_ext)
     zero = jnp.zeros_like(v)
     r0 = residual(model, q, v, zero, tau)
     M = jax.jacfwd(lambda a: residual(model, q, v, a, tau))(zero)

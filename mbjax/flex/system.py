@@ -1,48 +1,85 @@
-"""Flexible trees as `AbstractSystem`s for `mbjax.simulate`.
+"""Flexible trees as systems for `mbjax.simulate` and `mbjax.loops.ClosedSystem`.
 
 `FlexibleSystem` integrates (q, v) = (joint and modal coordinates, their rates) with seed 002's
 O(n) recursion ("recursive", `mbjax.flex.aba`) or the dense Lagrangian route ("dense",
-`mbjax.flex.lagrange`). Closed loops and prescribed motions go through
-`mbjax.loops.StabilizedLoopSystem` with a `FlexibleModel` in the `Loops`.
+`mbjax.flex.lagrange`). Closed loops and prescribed motions wrap it in
+`mbjax.loops.ClosedSystem(..., method=Stabilized())`, with cut joints at the model's markers.
 """
 
+from typing import ClassVar
+
 import equinox as eqx
+import jax
 import jax.numpy as jnp
 from jax import Array
 
-from mbjax.flex.aba import flexible_aba
-from mbjax.flex.lagrange import dense_forward_dynamics, energy
+from mbjax.control import AbstractControl, as_control
+from mbjax.control.applied import check_actuation, check_points
+from mbjax.flex.aba import flexible_aba_responses
+from mbjax.flex.body import kinetic_energy as body_kinetic_energy
+from mbjax.flex.kinematics import body_velocities, frame_poses
+from mbjax.flex.lagrange import dense_forward_dynamics, potential_energy
 from mbjax.flex.model import FlexibleModel
-from mbjax.integrate.system import AbstractSystem
+from mbjax.integrate.tree_system import AbstractTreeSystem
 
 METHODS = ("recursive", "dense")
 
 
-class FlexibleSystem(AbstractSystem):
-    """u = v; u_dot from the flexible tree's forward dynamics under constant tau (nv,)."""
+class FlexibleSystem(AbstractTreeSystem):
+    """u = v; v_dot from the flexible tree's forward dynamics under gravity, elasticity, the
+    control and the external wrenches (as `mbjax.rigid.TreeSystem`; a wrench acts on a body's
+    reference frame, the joint grid where its modes are clamped, and external_point is a point
+    fixed in that frame). The control drives joint and modal coordinates alike (`actuation`
+    picks some). Geometric stiffening adds acceleration-dependent loads, so the equations are
+    not M v_dot + bias = 0 with a symmetric M (`symmetric_dynamics` is False): closed loops go
+    through `mbjax.loops.Stabilized`."""
 
     model: FlexibleModel
-    tau: Array
+    control: AbstractControl | None
+    external: AbstractControl | None
+    external_point: Array | None
+    actuation: tuple[int, ...] | None = eqx.field(static=True)
     method: str = eqx.field(static=True)
+    symmetric_dynamics: ClassVar[bool] = False
 
-    def __init__(self, model: FlexibleModel, tau=None, method: str = "recursive"):
+    def __init__(self, model: FlexibleModel, control=None, *, external=None, external_point=None,
+                 actuation=None, method: str = "recursive"):
         if not isinstance(model, FlexibleModel):
             raise TypeError(f"model must be a FlexibleModel, got {type(model).__name__}")
         if method not in METHODS:
             raise ValueError(f"method must be one of {METHODS}, got {method!r}")
         self.model = model
-        self.tau = jnp.zeros(model.nv) if tau is None else jnp.asarray(tau, dtype=float)
-        if self.tau.shape != (model.nv,):
-            raise ValueError(f"tau must have shape ({model.nv},), got {self.tau.shape}")
+        self.actuation = check_actuation(actuation, model.nv)
+        self.control = as_control(control)
+        n_act = model.nv if self.actuation is None else len(self.actuation)
+        value = getattr(self.control, "value", None)
+        if value is not None and value.shape != (n_act,):
+            raise ValueError(f"the constant control (tau) must have shape ({n_act},), got {value.shape}")
+        self.external = as_control(external)
+        self.external_point = check_points(external_point, model.n)
         self.method = method
 
-    def kinematics(self, q, u):
-        return self.model.q_dot(q, u)
+    @property
+    def n(self):
+        return self.model.n
 
-    def acceleration(self, t, q, u):
-        if self.method == "dense":
-            return dense_forward_dynamics(self.model, q, u, self.tau)
-        return flexible_aba(self.model, q, u, self.tau)
+    @property
+    def nq(self):
+        return self.model.nq
+
+    @property
+    def nv(self):
+        return self.model.nv
+
+    @property
+    def n_frames(self):
+        return self.model.n_frames
+
+    def neutral(self):
+        return self.model.neutral()
+
+    def q_dot(self, q, v):
+        return self.model.q_dot(q, v)
 
     def retract(self, q0, xi):
         return self.model.retract(q0, xi)
@@ -50,9 +87,34 @@ class FlexibleSystem(AbstractSystem):
     def local_rate(self, q0, xi, u):
         return self.model.local_rate(q0, xi, u)
 
-    def project(self, q):
+    def normalize(self, q):
         return self.model.normalize(q)
 
-    def energy(self, q, u):
+    def frames(self, q):
+        """Body frames (joint grids), then the markers at grid points, deformation included."""
+        R, p, R_markers, p_markers = frame_poses(self.model, q)
+        return jnp.concatenate([R, R_markers]), jnp.concatenate([p, p_markers])
+
+    def kinetic_energy(self, q, v):
+        """T = sum_k w_k^T M_k(q_k) w_k / 2 (seed 002 eq 34), w from the recursion's velocities."""
+        w = body_velocities(self.model, q, v)
+        qf = self.model.split(q)[1]
+        return jnp.sum(jax.vmap(body_kinetic_energy)(self.model.bodies, qf, w))
+
+    def energy(self, q, v):
         """Kinetic, gravitational and modal strain energy."""
-        return energy(self.model, q, u)
+        return self.kinetic_energy(q, v) + potential_energy(self.model, q)
+
+    def mass_matrix(self, q):
+        """d^2 T / dv^2: symmetric; the equations of motion add stiffening to it."""
+        zero = jnp.zeros(self.nv, q.dtype)
+        return jax.jacfwd(jax.grad(self.kinetic_energy, argnums=1), argnums=1)(q, zero)
+
+    def responses(self, t, q, v, loads):
+        tau, f = self.applied(t, q, v), self.wrenches(t, q, v)
+        if self.method == "dense":
+            if loads.shape[0]:
+                raise ValueError("the dense flexible route gives no load responses: use the "
+                                 "recursion (method='recursive') in closed loops")
+            return dense_forward_dynamics(self.model, q, v, tau, f), loads
+        return flexible_aba_responses(self.model, q, v, tau, loads, f)

@@ -45,8 +45,9 @@ def simulate(system: AbstractSystem, integrator: AbstractIntegrator, q0: Array, 
     The steps run as a `lax.scan` nested in blocks whose length is the greatest common divisor of
     the save indices, so only saved states are kept (memory O(len(saveat)) for uniform saves).
     The returned `Solution.status` flags non-finite states and unconverged implicit steps, and
-    whatever the system's `check` reports at the ends of the blocks (every saved state). The
-    system's `constrain` runs after every step.
+    whatever the system's `check` reports at the ends of the blocks (every saved state). Each step
+    runs the system as `system.hold(t, q, u)` gives it (sampled controls frozen at the step's
+    start), and the system's `constrain` after it.
 
     checkpoint=True is for reverse-mode gradients of long rollouts: each block's steps run as a scan
     over segments of about sqrt(block) steps under `jax.checkpoint`, so `jax.grad` keeps the states
@@ -76,7 +77,8 @@ def _rollout(system, integrator, q0, u0, t0, dt, block: int, n_blocks: int, keep
     def step(carry, k):
         q, u, status = carry
         t = jnp.asarray(t0, dtype) + k * jnp.asarray(dt, dtype)
-        q1, u1, converged = integrator.step(system, t, q, u, jnp.asarray(dt, dtype))
+        # sampled controls take their value at the step's start for all of its stages
+        q1, u1, converged = integrator.step(system.hold(t, q, u), t, q, u, jnp.asarray(dt, dtype))
         q1, u1 = system.constrain(t + dt, q1, u1)
         finite = jnp.all(jnp.isfinite(q1)) & jnp.all(jnp.isfinite(u1))
         status = (status | jnp.where(finite, 0, int(Status.NONFINITE))
@@ -86,18 +88,28 @@ def _rollout(system, integrator, q0, u0, t0, dt, block: int, n_blocks: int, keep
     def run_segment(carry, ks):
         return jax.lax.scan(step, carry, ks)[0], None
 
-    if segment < block:                      # checkpoint=True: only segment ends are kept
-        run_segment = jax.checkpoint(run_segment)
-
     def run_block(carry, b):
-        ks = (b * block + jnp.arange(block)).reshape(block // segment, segment)
-        (q, u, status), _ = jax.lax.scan(run_segment, carry, ks)
+        ks = b * block + jnp.arange(block)
+        if segment < block:                  # checkpoint=True: only segment ends are kept
+            carry, _ = jax.lax.scan(jax.checkpoint(run_segment), carry,
+                                    ks.reshape(block // segment, segment))
+        else:
+            carry, _ = run_segment(carry, ks)
+        q, u, status = carry
         t = jnp.asarray(t0, dtype) + (b + 1) * block * jnp.asarray(dt, dtype)
-        status = status | system.check(t, q, u)          # at the block ends: the saved states
+        # at the block ends (the saved states); the status is not differentiated, so neither is
+        # the check (reverse mode would otherwise trace through it)
+        status = status | system.check(t, jax.lax.stop_gradient(q), jax.lax.stop_gradient(u))
         return (q, u, status), (q, u)
 
     init = (q0, u0, jnp.array(0, dtype=jnp.int32))
-    final, (qs, us) = jax.lax.scan(run_block, init, jnp.arange(n_blocks))
+    # Scans nest (blocks, segments, steps, an integrator's stages), and reverse mode traces a
+    # scan's body several times per level: a level of length one is a plain call instead.
+    if n_blocks == 1:
+        final, (q, u) = run_block(init, 0)
+        qs, us = q[None], u[None]
+    else:
+        final, (qs, us) = jax.lax.scan(run_block, init, jnp.arange(n_blocks))
     qs = jnp.concatenate([q0[None], qs])[jnp.array(keep)]
     us = jnp.concatenate([u0[None], us])[jnp.array(keep)]
     return qs, us, final[2]

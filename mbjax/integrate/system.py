@@ -41,6 +41,12 @@ class AbstractSystem(eqx.Module):
         """Map coordinates back to their canonical form (unit quaternion, principal rotation vector)."""
         return q
 
+    def hold(self, t: Array, q: Array, u: Array) -> "AbstractSystem":
+        """The system as it acts over one step of `simulate` that starts at (t, q, u): sampled
+        controls (`mbjax.control.ZeroOrderHold`, `SampleAndHold`) frozen at their values there.
+        The system itself here."""
+        return self
+
     def constrain(self, t: Array, q: Array, u: Array) -> tuple[Array, Array]:
         """After each step of `simulate`: put (q, u) back on the system's constraints (a closed
         loop's projection, `mbjax.loops`). The identity here."""

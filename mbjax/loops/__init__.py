@@ -1,21 +1,29 @@
-"""Closed loops (seed 001 §VI, seed 002 §2.4): cut joints and prescribed motions as constraints
-on a tree (`CutJoint`, `Prescribed`, `Loops`), the coupled Lagrange-multiplier solution with
-Baumgarte stabilization (`coupled_acceleration`, `LoopSystem`) and seed 002's O(n + m^3)
-stabilization (`stabilized_acceleration`, `StabilizedLoopSystem`).
+"""Closed loops (seed 001 §VI, seed 002 §2.4): any tree closed by cut joints and prescribed
+motions (`CutJoint`, `Prescribed`), as a system for `simulate`:
 
-Seed 001's momentum form (`momentum_rate`, `MomentumLoopSystem`), projection onto the constraints
-(`consistent_state` for initial conditions, `projection=True` after every step) and the status
-flags of a run (`Status.CONSTRAINT_VIOLATED`, `Status.REDUNDANT`) complete the set.
+    ClosedSystem(tree, closures, method=..., projection=False)
+
+with the loop method a strategy passed in: seed 001's coupled Lagrange multipliers with Baumgarte
+stabilization (`Coupled`), its momentum form (`Momentum`), or seed 002's O(n + m^3) route from one
+triangularization with its epsilon-dynamics (`Stabilized`). Projection onto the constraints
+after every step (differentiable, by the implicit function theorem) and of initial conditions
+(`consistent_state`), and the status flags of a run (`Status.CONSTRAINT_VIOLATED`,
+`Status.REDUNDANT`) complete the set. The algorithms are also plain functions of a `Loops`
+(the tree with its closures): `coupled_acceleration`, `momentum_rate`, `eta_and_gamma`,
+`stabilized_acceleration`.
 """
 
 from mbjax.loops.closures import GROUND, CutJoint, Prescribed
 from mbjax.loops.constraints import Loops
-from mbjax.loops.coupled import coupled_acceleration, momentum_rate, multipliers, numerical_rank
-from mbjax.loops.stabilized import eta_and_gamma, stabilized_acceleration
-from mbjax.loops.projection import consistent_state, project_configuration, project_velocity
-from mbjax.loops.system import LoopSystem, MomentumLoopSystem, StabilizedLoopSystem
+from mbjax.loops.coupled import Coupled, coupled_acceleration
+from mbjax.loops.method import AbstractLoopMethod
+from mbjax.loops.momentum import Momentum, momentum_rate
+from mbjax.loops.multipliers import multipliers, numerical_rank
+from mbjax.loops.projection import consistent_state, gauss_newton, project_configuration, project_velocity
+from mbjax.loops.stabilized import Stabilized, eta_and_gamma, stabilized_acceleration
+from mbjax.loops.system import ClosedSystem
 
-__all__ = ["GROUND", "CutJoint", "LoopSystem", "Loops", "MomentumLoopSystem", "Prescribed",
-           "StabilizedLoopSystem", "consistent_state", "coupled_acceleration", "eta_and_gamma", "momentum_rate",
-           "multipliers", "numerical_rank", "project_configuration", "project_velocity",
-           "stabilized_acceleration"]
+__all__ = ["GROUND", "AbstractLoopMethod", "ClosedSystem", "Coupled", "CutJoint", "Loops",
+           "Momentum", "Prescribed", "Stabilized", "consistent_state", "coupled_acceleration",
+           "eta_and_gamma", "gauss_newton", "momentum_rate", "multipliers", "numerical_rank",
+           "project_configuration", "project_velocity", "stabilized_acceleration"]

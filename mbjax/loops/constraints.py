@@ -5,7 +5,7 @@ eqs 87-88, seed 001 eq 85), all by autodiff of the holonomic residual Phi(q, t):
 
 with A = dPhi/dq . dq/dv (the velocity constraint operator, (m, nv)), B = dPhi/dt and
 b = d/dt (A v + B) at fixed v, the "A_dot u + B_dot" of seed 002 eq 92. Derivatives follow q along
-q_dot = model.q_dot(q, v), so quaternion joints need no special case.
+q_dot = tree.q_dot(q, v), so quaternion joints need no special case.
 """
 
 import equinox as eqx
@@ -13,47 +13,39 @@ import jax
 import jax.numpy as jnp
 from jax import Array
 
-from mbjax.flex.kinematics import frame_poses
-from mbjax.flex.model import FlexibleModel
+from mbjax.integrate.tree_system import AbstractTreeSystem
 from mbjax.loops.closures import GROUND, CutJoint, Prescribed
-from mbjax.model import Model
-from mbjax.rigid.kinematics import forward_kinematics
-
-
-def frames(model: Model | FlexibleModel, q: Array) -> tuple[Array, Array]:
-    """(R, p) of every frame a cut joint can use: the bodies, and for a `FlexibleModel` its
-    markers at grid points (frame n + i), deformation included."""
-    if isinstance(model, FlexibleModel):
-        R, p, R_markers, p_markers = frame_poses(model, q)
-        return jnp.concatenate([R, R_markers]), jnp.concatenate([p, p_markers])
-    return forward_kinematics(model, q)
 
 
 class Loops(eqx.Module):
-    """A tree `model` (rigid, or a `mbjax.flex.FlexibleModel` whose markers are frames n, n + 1,
-    ...) closed by cut joints and driven by prescribed motions."""
+    """A tree (any `AbstractTreeSystem`: rigid, or flexible with markers as frames n, n + 1, ...)
+    closed by cut joints and driven by prescribed motions."""
 
-    model: Model | FlexibleModel
+    tree: AbstractTreeSystem
     closures: tuple
 
-    def __init__(self, model: Model | FlexibleModel, closures):
+    def __init__(self, tree: AbstractTreeSystem, closures):
+        if not isinstance(tree, AbstractTreeSystem):
+            raise TypeError(f"tree must be a tree system (mbjax.rigid.TreeSystem, "
+                            f"mbjax.flex.FlexibleSystem), got {type(tree).__name__}"
+                            + ("; wrap the model: TreeSystem(model)"
+                               if type(tree).__name__ == "Model" else ""))
         closures = tuple(closures)
         if not closures:
-            raise ValueError("Loops needs at least one cut joint or prescribed motion")
-        n_frames = getattr(model, "n_frames", model.n)
+            raise ValueError("a closed system needs at least one cut joint or prescribed motion")
         for c in closures:
             if isinstance(c, CutJoint):
                 for body in (c.body_a, c.body_b):
-                    if body != GROUND and not 0 <= body < n_frames:
-                        raise ValueError(f"cut joint {c.kind!r}: body {body} is not in the model "
-                                         f"(0 ... {n_frames - 1}, or -1 for the ground)")
+                    if body != GROUND and not 0 <= body < tree.n_frames:
+                        raise ValueError(f"cut joint {c.kind!r}: body {body} is not in the tree "
+                                         f"(0 ... {tree.n_frames - 1}, or -1 for the ground)")
             elif isinstance(c, Prescribed):
-                if not c.dof < model.nq or model.nq != model.nv:
-                    raise ValueError(f"prescribed motion of coordinate {c.dof}: the model has "
-                                     f"{model.nq} coordinates (and drives need nq == nv)")
+                if not c.dof < tree.nq or tree.nq != tree.nv:
+                    raise ValueError(f"prescribed motion of coordinate {c.dof}: the tree has "
+                                     f"{tree.nq} coordinates (and drives need nq == nv)")
             else:
                 raise TypeError(f"closures must be CutJoint or Prescribed, got {type(c).__name__}")
-        self.model = model
+        self.tree = tree
         self.closures = closures
 
     @property
@@ -64,7 +56,7 @@ class Loops(eqx.Module):
     def phi(self, q: Array, t=0.0) -> Array:
         """Phi(q, t), (m,)."""
         if any(isinstance(c, CutJoint) for c in self.closures):
-            R, p = frames(self.model, q)
+            R, p = self.tree.frames(q)
         else:                         # prescribed motions only: no kinematics to trace
             R = p = None
         return jnp.concatenate([c.residual(R, p, q, t) for c in self.closures])
@@ -72,14 +64,14 @@ class Loops(eqx.Module):
     def rate(self, q: Array, v: Array, t=0.0) -> Array:
         """A v + B = dPhi/dt along the motion."""
         return jax.jvp(self.phi, (q, jnp.asarray(t, q.dtype)),
-                       (self.model.q_dot(q, v), jnp.ones((), q.dtype)))[1]
+                       (self.tree.q_dot(q, v), jnp.ones((), q.dtype)))[1]
 
     def jacobian(self, q: Array, t=0.0) -> Array:
         """A (m, nv): the rate is linear in v, A v + B. Reverse mode, one pass per constraint
         row, so O(m n) rather than O(n^2) for long chains."""
-        return jax.jacrev(lambda v: self.rate(q, v, t))(jnp.zeros(self.model.nv, q.dtype))
+        return jax.jacrev(lambda v: self.rate(q, v, t))(jnp.zeros(self.tree.nv, q.dtype))
 
     def acceleration_bias(self, q: Array, v: Array, t=0.0) -> Array:
         """b = d/dt (A v + B) at fixed v, so that A v_dot + b is the second derivative of Phi."""
         return jax.jvp(lambda q_, t_: self.rate(q_, v, t_), (q, jnp.asarray(t, q.dtype)),
-                       (self.model.q_dot(q, v), jnp.ones((), q.dtype)))[1]
+                       (self.tree.q_dot(q, v), jnp.ones((), q.dtype)))[1]

@@ -6,11 +6,11 @@ gravity and no velocity gives the columns of Gamma (eqs 102-107: zeta = -Gamma f
 
     u_dot + Gamma f_c = eta                                                   (eq 108)
 
-costs one triangularization and m + 1 force passes of O(n) (`mbjax.rigid.aba.aba_responses`).
-The constraint loads f_c follow from A u_dot + b = 0:
+costs one triangularization and m + 1 force passes of O(n) (the tree's `responses`, rigid or
+flexible). The constraint loads f_c follow from A u_dot + b = 0:
 
 - epsilon = 0: (A Gamma) f_c = A eta + b, an m x m solve, O(m^3) (regularized and rank-checked
-  as in `mbjax.loops.coupled.multipliers`);
+  as in `mbjax.loops.multipliers`);
 - epsilon > 0, seed 002's epsilon-dynamics (eqs 89-93): f_c is a state with
   epsilon f_c_dot + A Gamma f_c = A eta + b, which relaxes onto the algebraic value on the time
   scale epsilon / eig(A Gamma); its integral keeps A u + B - epsilon f_c constant (zero when
@@ -27,32 +27,30 @@ Total cost O(n m + m^3) = O(n + m^3) for a fixed number of loops. Here f_c = -K_
 `mbjax.loops.coupled` (seed 002 counts the loads with the opposite sign).
 """
 
+import equinox as eqx
+import jax.numpy as jnp
 from jax import Array
 
-from mbjax.flex.aba import flexible_aba_responses
-from mbjax.flex.model import FlexibleModel
 from mbjax.loops.constraints import Loops
-from mbjax.loops.coupled import multipliers, numerical_rank
-from mbjax.rigid.aba import aba_responses
+from mbjax.loops.method import AbstractLoopMethod
+from mbjax.loops.multipliers import multipliers, numerical_rank
 
 
-def eta_and_gamma(loops: Loops, q: Array, v: Array, tau: Array, t=0.0) -> tuple[Array, Array, Array]:
+def eta_and_gamma(loops: Loops, q: Array, v: Array, t=0.0) -> tuple[Array, Array, Array]:
     """(eta, Gamma (nv, m), A): one triangularization of the O(n) recursion, then its force and
-    back-substitution passes for tau (eta, eq 101) and for the m unit loads, the rows of A
-    (Gamma, eqs 102-107)."""
+    back-substitution passes for the tree's forces (eta, eq 101) and for the m unit loads, the
+    rows of A (Gamma, eqs 102-107)."""
     A = loops.jacobian(q, t)
-    responses = (flexible_aba_responses if isinstance(loops.model, FlexibleModel)
-                 else aba_responses)                  # flexible bodies: eqs 94-100 in the recursion
-    eta, Gamma_t = responses(loops.model, q, v, tau, A)
+    eta, Gamma_t = loops.tree.responses(t, q, v, A)
     return eta, Gamma_t.T, A
 
 
-def stabilized_acceleration(loops: Loops, q: Array, v: Array, tau: Array, t=0.0,
-                            f_c=None, epsilon=0.0, kappa=0.0) -> tuple[Array, Array, Array]:
+def stabilized_acceleration(loops: Loops, q: Array, v: Array, t=0.0, f_c=None, epsilon=0.0,
+                            kappa=0.0) -> tuple[Array, Array, Array]:
     """(u_dot, f_c_dot or f_c, rank): with epsilon = 0 the algebraic loads f_c and u_dot =
     eta - Gamma f_c; with epsilon > 0 and the current loads f_c, their rate of eq 93 (plus
     kappa (A u + B) when the position feedback kappa, a Python float, is set)."""
-    eta, Gamma, A = eta_and_gamma(loops, q, v, tau, t)
+    eta, Gamma, A = eta_and_gamma(loops, q, v, t)
     AG = A @ Gamma
     rhs = A @ eta + loops.acceleration_bias(q, v, t)
     if f_c is None:
@@ -61,3 +59,59 @@ def stabilized_acceleration(loops: Loops, q: Array, v: Array, tau: Array, t=0.0,
     if kappa != 0.0:
         rhs = rhs + kappa * loops.rate(q, v, t)
     return eta - Gamma @ f_c, (rhs - AG @ f_c) / epsilon, numerical_rank(AG)
+
+
+class Stabilized(AbstractLoopMethod):
+    """Seed 002's O(n + m^3) route, for rigid and flexible trees. epsilon = 0: u = v and
+    algebraic loads; epsilon > 0: u = (v, f_c), the loads integrated by eq 93, so that
+    A v + B - epsilon f_c keeps its initial value all along: the velocity constraint holds to
+    O(epsilon |f_c|), at the price of a stiff load equation (time constant epsilon /
+    eig(A Gamma): explicit steps need dt < 2.8 epsilon / max eig(A Gamma), an A-stable implicit
+    integrator such as `ImplicitMidpoint` takes any epsilon). kappa > 0 adds position feedback
+    (module docstring)."""
+
+    epsilon: float = eqx.field(static=True, default=0.0)
+    kappa: float = eqx.field(static=True, default=0.0)
+
+    def __check_init__(self):
+        if not self.epsilon >= 0 or not self.kappa >= 0:
+            raise ValueError(f"epsilon and kappa must be >= 0, got {self.epsilon} and {self.kappa}")
+        if self.kappa and not self.epsilon:
+            raise ValueError("kappa is the position feedback of the epsilon-dynamics: "
+                             "set epsilon > 0 too")
+
+    def velocity(self, loops, q, u):
+        return u[:loops.tree.nv]
+
+    def with_velocity(self, loops, q, u, v):
+        return v if self.epsilon == 0.0 else jnp.concatenate([v, u[loops.tree.nv:]])
+
+    def initial_state(self, loops, q, v, t, consistent):
+        """v, and for epsilon > 0 the load state: with consistent=True the algebraic loads of
+        eq 93 at epsilon = 0, so that the error A v + B stays epsilon times the change of the
+        loads rather than epsilon times the loads; else eq 89, f_c = (A v + B + kappa Phi) /
+        epsilon (zero on the constraints)."""
+        if self.epsilon == 0.0:
+            return v
+        if consistent:
+            f_c = stabilized_acceleration(loops, q, v, t)[1]
+        else:
+            error = loops.rate(q, v, t)
+            if self.kappa:
+                error = error + self.kappa * loops.phi(q, t)
+            f_c = error / self.epsilon
+        return jnp.concatenate([v, f_c])
+
+    def acceleration(self, loops, t, q, u):
+        v = self.velocity(loops, q, u)
+        if self.epsilon == 0.0:
+            return stabilized_acceleration(loops, q, v, t)[0]
+        v_dot, f_c_dot, _ = stabilized_acceleration(loops, q, v, t, f_c=u[loops.tree.nv:],
+                                                    epsilon=self.epsilon, kappa=self.kappa)
+        return jnp.concatenate([v_dot, f_c_dot])
+
+    def loads(self, loops, t, q, u):
+        """f_c = -K_c: the algebraic loads (epsilon = 0) or the load state."""
+        if self.epsilon == 0.0:
+            return stabilized_acceleration(loops, q, self.velocity(loops, q, u), t)[1]
+        return u[loops.tree.nv:]

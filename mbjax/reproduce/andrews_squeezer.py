@@ -3,7 +3,7 @@
 The seven-body mechanism of Hairer & Wanner II §VII.7 (test set problem `andrews`), built from
 mbjax bodies, revolute joints, three `point_on_line` cut joints, a spring and a motor torque
 (`mbjax.scenes.andrews_squeezer`), integrated by RK4 with the coupled Lagrange multipliers
-(`LoopSystem`, seed 001 eqs 89-93) from the test set's initial values to t = 0.03 s, and compared
+(`ClosedSystem` with `Coupled()`, seed 001 eqs 89-93) from the test set's initial values to t = 0.03 s, and compared
 with the test set's reference solution (its `SOLN`, PSIDE at tolerance 1e-14).
 
 Convergence: the error against the reference for several steps dt, and the difference from the
@@ -14,7 +14,7 @@ same end state to about 1e-11, which differs from the published reference by 1.4
 Theta (1e-10 relative), the floor of the published values.
 
 Full run: dt = DT (5 us) and the study STEPS, plus the same run by projection after every step
-(`LoopSystem(projection=True)`) and by seed 002's O(n + m^3) route (`StabilizedLoopSystem`);
+(`projection=True`) and by seed 002's O(n + m^3) route (`Stabilized()`);
 quick: dt = QUICK_DT (10 us) and QUICK_STEPS, no second routes.
 
 JSON: {"t", "q" (beta, Theta, gamma, Phi, delta, Omega, epsilon at t), "reference", "max_abs_error",
@@ -31,9 +31,9 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from mbjax.bench.timing import measure
+from mbjax.timing import measure
 from mbjax.integrate import RK4, simulate
-from mbjax.loops import LoopSystem, StabilizedLoopSystem
+from mbjax.loops import Coupled, Stabilized
 from mbjax.scenes import andrews_squeezer as scene
 
 NAME = "andrews-squeezer"
@@ -91,7 +91,7 @@ def reproduce(out: Path, quick: bool = False) -> dict:
     from mbjax.plot.mechanisms import andrews_figure
 
     squeezer = scene.build()
-    system = squeezer.system(LoopSystem)
+    system = squeezer.system(Coupled())
     steps = QUICK_DT_STEPS if quick else DT_STEPS
     sol, timing = run(system, steps, repeats=1 if quick else 3)
     q = np.asarray(scene.to_testset(sol.qs[-1]))
@@ -100,14 +100,14 @@ def reproduce(out: Path, quick: bool = False) -> dict:
             "max_abs_error": float(np.abs(end_error(sol)).max()), "seconds": timing.run_s,
             "compile_seconds": timing.compile_s, "dt": scene.T1 / steps, "steps": steps,
             "status": sol.messages()[0],
-            "constraint_residual": float(jnp.linalg.norm(squeezer.loops.phi(sol.qs[-1]))),
+            "constraint_residual": float(jnp.linalg.norm(system.loops.phi(sol.qs[-1]))),
             "convergence": rows,
             "observed_order": observed_order(rows) if len(rows) >= 4 else None,
             "history": {"t": np.asarray(sol.ts).tolist(),
                         "q": np.asarray(scene.to_testset(sol.qs)).tolist()}}
     if not quick:
-        routes = {"projection": squeezer.system(LoopSystem, projection=True),
-                  "stabilized": squeezer.system(StabilizedLoopSystem)}
+        routes = {"projection": squeezer.system(Coupled(), projection=True),
+                  "stabilized": squeezer.system(Stabilized())}
         data["routes"] = {name: float(jnp.abs(run(other, steps)[0].qs[-1] - sol.qs[-1]).max())
                           for name, other in routes.items()}
     out.mkdir(parents=True, exist_ok=True)

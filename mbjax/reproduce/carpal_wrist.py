@@ -32,11 +32,11 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from mbjax.bench.timing import measure
+from mbjax.timing import measure
 from mbjax.integrate import INTEGRATORS, RK4, simulate
 from mbjax.scenes import carpal_wrist as scene
 from mbjax.trajopt.baseline import ToolPath, feedforward_torques
-from mbjax.trajopt.splines import TorqueSpline
+from mbjax.control import CubicSpline
 from mbjax.trajopt.synthesis import goal_pose, rollout, synthesize
 from mbjax.wrist import kinematics
 
@@ -123,12 +123,12 @@ def integrator_study(steps, seconds: dict | None = None) -> tuple[list[dict], di
     ref = simulate(free, RK4(), q0, u0, dt=REFERENCE_DT, t1=scene.FREE_DURATION,
                    saveat=np.array([scene.FREE_DURATION])).qs[-1]
     E0 = jax.jit(lambda q, u: free.wrist.energy(q, u))(q0, u0)
-    law = servo.torque
+    law = servo.control
 
     @jax.jit
     def servo_energy(q, u):
-        e = q - law.theta_ref
-        return 0.5 * law.stiffness * e @ e + 0.5 * u @ servo.wrist.mass_matrix(q) @ u
+        e = q - law.q_ref
+        return 0.5 * law.kp * e @ e + 0.5 * u @ servo.wrist.mass_matrix(q) @ u
 
     rows = []
     for name in METHODS:
@@ -147,7 +147,7 @@ def integrator_study(steps, seconds: dict | None = None) -> tuple[list[dict], di
             rows.append({"name": name, "dt": float(dt), "error": float(err[i]) if finite else None,
                          "energy_drift": float(drift[i]) if np.isfinite(drift[i]) else None,
                          "stable": bool(stable[i])})
-    critical = linear_critical_steps(servo, law.theta_ref, jnp.zeros(3))
+    critical = linear_critical_steps(servo, law.q_ref, jnp.zeros(3))
     return rows, critical
 
 
@@ -172,10 +172,10 @@ def trajectory_study(iterations: int) -> dict:
         q, _, _ = rollout(w, law, theta0, scene.DURATION, steps, RK4())
         return float(kinematics.pose_error(w, w.forward_kinematics(q), goal))
 
-    init = TorqueSpline.fit(ts, tau_ff, 12, scene.DURATION, scene.TORQUE_LIMIT)
+    init = CubicSpline.fit(ts, tau_ff, 12, scene.DURATION, scene.TORQUE_LIMIT)
     result = synthesize(w, theta0, scene.GOAL, duration=scene.DURATION, torque_limit=scene.TORQUE_LIMIT,
                         iterations=iterations, init=init)
-    tau_syn = np.asarray(jax.jit(jax.vmap(lambda t: result.spline(w, t, theta0, theta0)))(ts))
+    tau_syn = np.asarray(jax.jit(jax.vmap(lambda t: result.spline(t, theta0, theta0)))(ts))
     return {
         "trajectory": {"final_pose_error": miss(result.spline, 500), "effort": float(result.effort),
                        "iterations": iterations, "peak_torque": float(result.peak_torque),
@@ -184,7 +184,7 @@ def trajectory_study(iterations: int) -> dict:
         "baseline": {"effort": float(np.trapezoid(np.sum(tau_ff**2, axis=1), ts)),
                      "peak_torque": float(np.abs(tau_ff).max()),
                      "pose_error_clipped": miss(init, 500),
-                     "pose_error_unclipped": miss(TorqueSpline.fit(ts, tau_ff, 12, scene.DURATION,
+                     "pose_error_unclipped": miss(CubicSpline.fit(ts, tau_ff, 12, scene.DURATION,
                                                                    10 * scene.TORQUE_LIMIT), 500)},
         "_curves": {"t": ts, "tau_ff": tau_ff, "tau_syn": tau_syn},
     }

@@ -1,9 +1,9 @@
 """`mbjax reproduce closed-chain`: seed 002 §3.3, Fig. 8, and where unstabilized integration fails.
 
 The (n/2)-body chain with both ends fixed (`mbjax.scenes.closed_chain`), simulated (RK4, 1 ms;
-1 s for n <= 44, 0.1 s above, the time then scaled to 1 s) by seed 002's O(n + m^3) route (`StabilizedLoopSystem`: the O(n) recursion, m + 1
+1 s for n <= 44, 0.1 s above, the time then scaled to 1 s) by seed 002's O(n + m^3) route (`Stabilized()`: the O(n) recursion, m + 1
 passes) and by the coupled Lagrange multipliers with the dense mass matrix, O(n^3)
-(`LoopSystem`, seed 001 eqs 89-93); run time of each after compilation (median of 3 calls), and
+(`Coupled()`, seed 001 eqs 89-93); run time of each after compilation (median of 3 calls), and
 the largest difference between their joint angles over the run.
 
 Then the constraint drift |Phi(q(t))| over 10 s of the 12-dof chain (1 ms steps) for no
@@ -26,9 +26,9 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from mbjax.bench.timing import measure
+from mbjax.timing import measure
 from mbjax.integrate import RK4, ImplicitMidpoint, simulate
-from mbjax.loops import LoopSystem, StabilizedLoopSystem
+from mbjax.loops import ClosedSystem, Coupled, Stabilized
 from mbjax.scenes import closed_chain
 
 NAME = "closed-chain"
@@ -45,32 +45,33 @@ STIFF_EPSILONS = ((0.01, 10.0, "implicit_midpoint"),)       # full run only (abo
 
 def timing(n: int, repeats: int) -> tuple[float, float, float]:
     """(recursive_s, dense_s, max_abs_diff) per 1 s of the n-dof chain."""
-    loops, q0, v0 = closed_chain.build(n)
+    chain, q0, v0 = closed_chain.build(n)
     window = closed_chain.DURATION if n <= 44 else 0.1 * closed_chain.DURATION
     run = partial(simulate, integrator=RK4(), q0=q0, u0=v0, dt=1e-3, t1=window,
                   saveat=np.linspace(0.0, window, 11))
-    recursive, t_rec = measure(partial(run, StabilizedLoopSystem(loops)), repeats=repeats)
-    dense, t_dense = measure(partial(run, LoopSystem(loops)), repeats=repeats)
+    stabilized = ClosedSystem(chain.tree, chain.closures, Stabilized())
+    recursive, t_rec = measure(partial(run, stabilized), repeats=repeats)
+    dense, t_dense = measure(partial(run, chain), repeats=repeats)
     scale = closed_chain.DURATION / window
     return scale * t_rec.run_s, scale * t_dense.run_s, float(jnp.abs(recursive.qs - dense.qs).max())
 
 
 def drift(duration: float, stiff: bool) -> dict:
-    loops, q0, v0 = closed_chain.build(DRIFT_N)
+    chain, q0, v0 = closed_chain.build(DRIFT_N)
+    tree, closures, loops = chain.tree, chain.closures, chain.loops
     ts = np.linspace(0.0, duration, 101)
-    runs = {"none": (LoopSystem(loops), RK4()),
-            "baumgarte": (LoopSystem(loops, baumgarte=(10.0, 10.0)), RK4()),
-            "projection": (LoopSystem(loops, projection=True), RK4())}
+    runs = {"none": (chain, RK4()),
+            "baumgarte": (ClosedSystem(tree, closures, Coupled(baumgarte=(10.0, 10.0))), RK4()),
+            "projection": (ClosedSystem(tree, closures, Coupled(), projection=True), RK4())}
     for eps, kappa, integrator in EPSILONS + (STIFF_EPSILONS if stiff else ()):
         name = f"epsilon={eps:g}" + (f",kappa={kappa:g}" if kappa else "")
-        runs[name] = (StabilizedLoopSystem(loops, epsilon=eps, kappa=kappa),
+        runs[name] = (ClosedSystem(tree, closures, Stabilized(epsilon=eps, kappa=kappa)),
                       RK4() if integrator == "rk4" else ImplicitMidpoint())
     out = {}
     for name, (system, integrator) in runs.items():
         # The paper's eq 89 starts the loads from zero; with kappa the algebraic loads are used
         # so that the bound epsilon |f_c - f_c(0)| / kappa is about the load's change.
-        u0 = (jnp.concatenate([v0, system.initial_loads(q0, v0, consistent=bool(system.kappa))])
-              if isinstance(system, StabilizedLoopSystem) else v0)
+        u0 = system.initial_state(q0, v0, consistent=bool(getattr(system.method, "kappa", 0.0)))
         sol = simulate(system, integrator, q0, u0, dt=DRIFT_DT, t1=duration, saveat=ts)
         residual = jax.jit(jax.vmap(lambda q: jnp.linalg.norm(loops.phi(q))))(sol.qs)
         out[name] = [[float(t), float(r)] for t, r in zip(sol.ts, residual)]

@@ -14,7 +14,7 @@ from pathlib import Path
 import jax.numpy as jnp
 import numpy as np
 
-from mbjax.bench.timing import measure
+from mbjax.timing import measure
 from mbjax.integrate import INTEGRATORS, simulate
 from mbjax.scenes import heavy_top as top
 from mbjax.scenes import torque_free_body as tfb

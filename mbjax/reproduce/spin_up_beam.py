@@ -37,7 +37,7 @@ from pathlib import Path
 
 import numpy as np
 
-from mbjax.bench.timing import measure
+from mbjax.timing import measure
 from mbjax.flex import geometric_stiffness
 from mbjax.flex.references import spin_up_beam_reference
 from mbjax.scenes import spin_up_beam as scene

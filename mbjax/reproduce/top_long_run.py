@@ -38,7 +38,7 @@ import jax.numpy as jnp
 import numpy as np
 
 from mbjax import lie
-from mbjax.bench.timing import measure
+from mbjax.timing import measure
 from mbjax.integrate import solve_reference
 from mbjax.reproduce.vertical_top import top_transition
 from mbjax.scenes import vertical_top as vt

@@ -19,7 +19,7 @@ from pathlib import Path
 import jax
 import numpy as np
 
-from mbjax.bench.timing import measure
+from mbjax.timing import measure
 from mbjax.scenes import torque_free_body as tfb
 from mbjax.tfe import Body, Element, Mixed, PrimalUnsymmetric, initial_state, solve_tfe
 

@@ -25,7 +25,7 @@ from jax import Array
 
 from mbjax.model import Model
 from mbjax.rigid.kinematics import body_kinematics, gravity_acceleration
-from mbjax.spatial import cross_force
+from mbjax.spatial import cross_force, shift_force
 from mbjax.tree import backward_pass, forward_pass
 
 
@@ -36,15 +36,19 @@ def _solve(D: Array, b: Array) -> Array:
     return jax.scipy.linalg.cho_solve(jax.scipy.linalg.cho_factor(D), b)
 
 
-def aba(model: Model, q: Array, v: Array, tau: Array) -> Array:
-    """Joint accelerations (nv,) of the tree at (q, v) under joint forces tau and gravity."""
-    return aba_responses(model, q, v, tau, jnp.zeros((0, model.nv), q.dtype))[0]
+def aba(model: Model, q: Array, v: Array, tau: Array, f_ext: Array | None = None) -> Array:
+    """Joint accelerations (nv,) of the tree at (q, v) under joint forces tau, gravity and the
+    external wrenches f_ext (see `aba_responses`)."""
+    return aba_responses(model, q, v, tau, jnp.zeros((0, model.nv), q.dtype), f_ext)[0]
 
 
-def aba_responses(model: Model, q: Array, v: Array, tau: Array, loads: Array) -> tuple[Array, Array]:
-    """(u_dot, Gamma^T): the accelerations (nv,) under tau and gravity, and the accelerations
-    (m, nv) that each row of `loads` (m, nv) alone produces (no gravity, no velocity), the unit
-    constraint-load responses of seed 002 eqs 101-107.
+def aba_responses(model: Model, q: Array, v: Array, tau: Array, loads: Array,
+                  f_ext: Array | None = None) -> tuple[Array, Array]:
+    """(u_dot, Gamma^T): the accelerations (nv,) under tau, gravity and the external wrenches
+    f_ext (n, 6) (world frame, (torque about body k's origin; force), or None), and the
+    accelerations (m, nv) that each row of `loads` (m, nv) alone produces (no gravity, no
+    velocity), the unit constraint-load responses of seed 002 eqs 101-107. An external wrench
+    enters body k's own force F_1 of step (ii) (seed 002 eq 43's applied load).
 
     The articulated inertias (I_3, U, D) depend on q only, so one triangularization serves every
     load: the force recursion and the back-substitution run on 1 + m columns at once (seed 002's
@@ -52,6 +56,8 @@ def aba_responses(model: Model, q: Array, v: Array, tau: Array, loads: Array) ->
     kin = body_kinematics(model, q, v)
     m = loads.shape[0]
     bias = cross_force(kin.V, jnp.einsum("kij,kj->ki", kin.I, kin.V))
+    if f_ext is not None:
+        bias = bias - shift_force(f_ext, kin.p)
     pad = (~model.v_mask).astype(q.dtype)                  # 1 on padded columns
     # Columns: 0 the motion under tau, gravity and velocity; 1 ... m one load each.
     zeros = jnp.zeros((model.n, 6, m), q.dtype)

@@ -18,6 +18,8 @@ import numpy as np
 from jax import Array
 
 from mbjax import lie
+from mbjax.control import AbstractControl, as_control
+from mbjax.control.applied import about_origins, body_wrenches, check_actuation, check_points, generalized_control, hold
 from mbjax.integrate.system import AbstractSystem
 from mbjax.spatial import check_inertia
 
@@ -30,17 +32,28 @@ class RigidBody(AbstractSystem):
     fixed_point=False: a free body; `inertia` is about the centre of mass and q = (rot, x).
     fixed_point=True: the body turns about a fixed point at the origin; `inertia` is about that
     point, `com` is the centre of mass in the body frame, and q = rot.
+
+    control: a callable (t, q, u) -> generalized forces on u = (Omega, v): a body-frame torque
+    (and, for a free body, a world-frame force), or on the `actuation` coordinates only; a
+    constant array is a constant control. external: a callable (t, q, u) -> (1, 6), a world-frame
+    wrench (torque; force) at the body's origin (its centre of mass; the fixed point) or at
+    external_point (body frame, from that origin).
     """
 
     mass: Array
     inertia: Array
     com: Array
     gravity: Array
+    control: AbstractControl | None
+    external: AbstractControl | None
+    external_point: Array | None
+    actuation: tuple[int, ...] | None = eqx.field(static=True)
     fixed_point: bool = eqx.field(static=True)
     rotation: str = eqx.field(static=True)
 
     def __init__(self, mass, inertia, *, com=(0.0, 0.0, 0.0), gravity=(0.0, 0.0, -9.81),
-                 fixed_point: bool = False, rotation: str = "quaternion"):
+                 fixed_point: bool = False, rotation: str = "quaternion", control=None,
+                 external=None, external_point=None, actuation=None):
         if rotation not in ROTATIONS:
             raise ValueError(f"rotation must be one of {ROTATIONS}, got {rotation!r}")
         check_inertia(inertia, "RigidBody")
@@ -54,6 +67,15 @@ class RigidBody(AbstractSystem):
         self.gravity = jnp.asarray(gravity, dtype=float)
         self.fixed_point = fixed_point
         self.rotation = rotation
+        nv = 3 if fixed_point else 6
+        self.actuation = check_actuation(actuation, nv)
+        self.control = as_control(control)
+        value = getattr(self.control, "value", None)
+        n_act = nv if self.actuation is None else len(self.actuation)
+        if value is not None and value.shape != (n_act,):
+            raise ValueError(f"the constant control must have shape ({n_act},), got {value.shape}")
+        self.external = as_control(external)
+        self.external_point = check_points(external_point, 1)
 
     # -- coordinates ---------------------------------------------------------------------------
 
@@ -94,15 +116,23 @@ class RigidBody(AbstractSystem):
 
     def acceleration(self, t, q, u):
         """Euler's equations J Omega_dot = tau - Omega x J Omega, solved by Cholesky; the COM
-        falls freely (free body) or gravity gives tau = com x (m R^T g) (fixed point)."""
+        falls freely (free body) or gravity gives tau = com x (m R^T g) (fixed point). The
+        control and the external wrench add to tau (and to the force on the COM)."""
         Omega = u[:3]
         R = self.rotation_matrix(q)
         tau = jnp.cross(self.com, self.mass * (R.T @ self.gravity))
+        force = jnp.zeros(3, u.dtype)
+        f = body_wrenches(self.external, 1, t, q, u)
+        if f is not None:
+            f = about_origins(f, R[None], self.external_point)[0]
+            tau, force = tau + R.T @ f[:3], force + f[3:]
+        applied = generalized_control(self.control, self.actuation, u.shape[0], t, q, u)
+        tau = tau + applied[:3]
         chol = jax.scipy.linalg.cho_factor(self.inertia)
         Omega_dot = jax.scipy.linalg.cho_solve(chol, tau - jnp.cross(Omega, self.inertia @ Omega))
         if self.fixed_point:
             return Omega_dot
-        return jnp.concatenate([Omega_dot, jnp.broadcast_to(self.gravity, (3,))])
+        return jnp.concatenate([Omega_dot, self.gravity + (force + applied[3:]) / self.mass])
 
     def retract(self, q0, xi):
         """R = R0 exp(xi_rot) (body-frame increment), x = x0 + xi_x."""
@@ -118,6 +148,9 @@ class RigidBody(AbstractSystem):
         """xi_dot = Gamma(xi)^-T Omega, the body-frame dexp^-1 (seed 000 eq 2.8)."""
         xi_dot = lie.gamma_inv(xi[:3]).T @ u[:3]
         return xi_dot if self.fixed_point else jnp.concatenate([xi_dot, u[3:]])
+
+    def hold(self, t, q, u):
+        return hold(self, t, q, u)
 
     def project(self, q):
         rot = q[: self.n_rot]

@@ -20,7 +20,7 @@ import jax.numpy as jnp
 from jax import Array
 
 from mbjax.model import Model
-from mbjax.rigid.operator import OperatorTerms, generalized_mass, operator_terms
+from mbjax.rigid.operator import OperatorTerms, generalized_mass, operator_terms, with_external
 
 
 def _bias(terms: OperatorTerms, v: Array) -> Array:
@@ -30,11 +30,22 @@ def _bias(terms: OperatorTerms, v: Array) -> Array:
     return jnp.einsum("kan,ka->n", terms.alpha, force)
 
 
-def dense_forward_dynamics(model: Model, q: Array, v: Array, tau: Array) -> Array:
-    """Joint accelerations from eq 74 with mu_hat_ff factored by Cholesky."""
-    terms = operator_terms(model, q, v)
+def dense_forward_dynamics(model: Model, q: Array, v: Array, tau: Array,
+                           f_ext: Array | None = None) -> Array:
+    """Joint accelerations from eq 74 with mu_hat_ff factored by Cholesky; external wrenches
+    f_ext (n, 6) (world frame, torque about the body origins) join the applied forces K."""
+    return dense_responses(model, q, v, tau, jnp.zeros((0, model.nv), q.dtype), f_ext)[0]
+
+
+def dense_responses(model: Model, q: Array, v: Array, tau: Array, loads: Array,
+                    f_ext: Array | None = None) -> tuple[Array, Array]:
+    """As `mbjax.rigid.aba.aba_responses`, from eq 74: the accelerations under every force, and
+    mu_hat_ff^-1 of each row of `loads` (m, nv), from one Cholesky factorization."""
+    terms = with_external(operator_terms(model, q, v), f_ext)
     factor = jax.scipy.linalg.cho_factor(generalized_mass(terms))
-    return jax.scipy.linalg.cho_solve(factor, tau - _bias(terms, v))
+    rhs = jnp.concatenate([(tau - _bias(terms, v))[:, None], loads.T], -1)
+    out = jax.scipy.linalg.cho_solve(factor, rhs).T
+    return out[0], out[1:]
 
 
 def _reactions(terms: OperatorTerms, v: Array, a: Array) -> Array:

@@ -31,36 +31,44 @@ def choose_method(model: Model) -> str:
 
 
 def _check(model: Model, **arrays) -> None:
-    sizes = {"q": model.nq, "q_dot": model.nv, "tau": model.nv, "q_ddot": model.nv}
+    sizes = {"q": (model.nq,), "q_dot": (model.nv,), "tau": (model.nv,), "q_ddot": (model.nv,),
+             "f_ext": (model.n, 6)}
     for name, value in arrays.items():
+        if name == "f_ext" and value is None:
+            continue
         shape = getattr(value, "shape", None)
-        if shape is None or shape[-1:] != (sizes[name],) or len(shape) != 1:
-            raise ValueError(f"{name} must be a vector of length {sizes[name]} for this model "
-                             f"(nq = {model.nq}, nv = {model.nv}), got shape {shape}; "
-                             "use jax.vmap for batches")
+        if shape != sizes[name]:
+            raise ValueError(f"{name} must have shape {sizes[name]} for this model "
+                             f"(n = {model.n} bodies, nq = {model.nq}, nv = {model.nv}), got "
+                             f"shape {shape}; use jax.vmap for batches")
 
 
 def forward_dynamics(model: Model, q: Array, q_dot: Array, tau: Array,
-                     method: str = "auto") -> Array:
-    """Joint accelerations at configuration q and velocity q_dot under joint forces tau and gravity.
+                     method: str = "auto", f_ext: Array | None = None) -> Array:
+    """Joint accelerations at configuration q and velocity q_dot under joint forces tau, gravity
+    and external wrenches.
 
     q_dot is the generalized velocity v (length nv): the joint rates for revolute, prismatic and
     universal joints, the body angular velocity (and origin velocity) for spherical and free ones.
+    f_ext (n, 6), or None: one wrench per body, world-frame components (torque about the body's
+    origin; force), as a force acting on the body at its origin.
     """
     if method not in METHODS:
         raise ValueError(f"method must be one of {METHODS}, got {method!r}")
-    _check(model, q=q, q_dot=q_dot, tau=tau)
+    _check(model, q=q, q_dot=q_dot, tau=tau, f_ext=f_ext)
     if method == "auto":
         method = choose_method(model)
     if method == "recursive":
-        return aba(model, q, q_dot, tau)
-    return dense_forward_dynamics(model, q, q_dot, tau)
+        return aba(model, q, q_dot, tau, f_ext)
+    return dense_forward_dynamics(model, q, q_dot, tau, f_ext)
 
 
-def inverse_dynamics(model: Model, q: Array, q_dot: Array, q_ddot: Array) -> Array:
-    """Joint forces that produce accelerations q_ddot at (q, q_dot): the RNEA, O(n)."""
-    _check(model, q=q, q_dot=q_dot, q_ddot=q_ddot)
-    return _rnea(model, q, q_dot, q_ddot)
+def inverse_dynamics(model: Model, q: Array, q_dot: Array, q_ddot: Array,
+                     f_ext: Array | None = None) -> Array:
+    """Joint forces that produce accelerations q_ddot at (q, q_dot) under gravity and external
+    wrenches f_ext (as in `forward_dynamics`): the RNEA, O(n)."""
+    _check(model, q=q, q_dot=q_dot, q_ddot=q_ddot, f_ext=f_ext)
+    return _rnea(model, q, q_dot, q_ddot, f_ext)
 
 
 def mass_matrix(model: Model, q: Array) -> Array:

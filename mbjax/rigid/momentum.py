@@ -20,7 +20,7 @@ import jax.numpy as jnp
 from jax import Array
 
 from mbjax.model import Model
-from mbjax.rigid.operator import generalized_mass, operator_terms
+from mbjax.rigid.operator import generalized_mass, operator_terms, with_external
 
 
 def momentum(model: Model, q: Array, v: Array) -> Array:
@@ -34,9 +34,10 @@ def velocity_from_momentum(model: Model, q: Array, p: Array) -> Array:
     return jax.scipy.linalg.cho_solve(jax.scipy.linalg.cho_factor(M), p)
 
 
-def momentum_rate(model: Model, q: Array, v: Array, tau: Array) -> Array:
-    """G_hat_f_dot = tau + alpha_f^T K + alpha_f_dot^T mu sigma (eq 72)."""
-    terms = operator_terms(model, q, v)
+def momentum_rate(model: Model, q: Array, v: Array, tau: Array, f_ext: Array | None = None) -> Array:
+    """G_hat_f_dot = tau + alpha_f^T K + alpha_f_dot^T mu sigma (eq 72); external wrenches f_ext
+    (n, 6) (world frame, torque about the body origins) join the applied forces K."""
+    terms = with_external(operator_terms(model, q, v), f_ext)
     G = jnp.einsum("kab,kb->ka", terms.mu, terms.sigma)
     return (tau + jnp.einsum("kan,ka->n", terms.alpha, terms.K)
             + jnp.einsum("kan,ka->n", terms.alpha_dot, G))

@@ -151,6 +151,16 @@ def operator_terms(model: Model, q: Array, v: Array) -> OperatorTerms:
     return OperatorTerms(A, alpha, alpha_dot, sigma, mu, Y, K, Sw, c, h)
 
 
+def with_external(terms: OperatorTerms, f_ext: Array | None) -> OperatorTerms:
+    """The terms with external wrenches f_ext (n, 6) (world frame, (torque about body k's origin
+    h_k; force), or None) added to the applied primitive forces K, which act about the centres
+    of mass: (n + (h - c) x f; f)."""
+    if f_ext is None:
+        return terms
+    torque = f_ext[:, :3] + jnp.cross(terms.h - terms.c, f_ext[:, 3:])
+    return terms._replace(K=terms.K + jnp.concatenate([torque, f_ext[:, 3:]], -1))
+
+
 def generalized_mass(terms: OperatorTerms) -> Array:
     """mu_hat_ff = A_hat_f^T A^T mu A A_hat_f (eqs 18, 55)."""
     return jnp.einsum("kai,kab,kbj->ij", terms.alpha, terms.mu, terms.alpha)

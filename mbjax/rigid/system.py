@@ -1,66 +1,137 @@
-"""Trees as `AbstractSystem`s, so they run through `mbjax.simulate` with every integrator.
+"""Trees as systems for `mbjax.simulate`, every integrator and `mbjax.loops.ClosedSystem`.
 
 `TreeSystem` integrates (q, v) with the velocity form (seed 002's recursion or seed 001 eq 74);
-`MomentumSystem` integrates (q, p) with seed 001's momentum form (eqs 72-73).
+`MomentumSystem` integrates (q, p) with seed 001's momentum form (eqs 72-73); `BatchTreeSystem`
+B copies at once in the throughput layout.
 
-Systems are equinox modules (their model and tau are array leaves), so compile their bound
+Systems are equinox modules (their model and controls are array leaves), so compile their bound
 methods with `eqx.filter_jit(system.energy)`, or pass the system as an argument:
 `jax.jit(TreeSystem.energy)(system, q, u)`. (`jax.jit(system.energy)` fails: a bound method
 holding arrays is not hashable.)
 """
 
+from typing import ClassVar
+
 import equinox as eqx
-import jax
 import jax.numpy as jnp
 from jax import Array
 
+from mbjax.control import AbstractControl, as_control
+from mbjax.control.applied import (
+    about_origins,
+    body_wrenches,
+    check_actuation,
+    check_points,
+    generalized_control,
+    hold,
+)
 from mbjax.integrate.system import AbstractSystem
+from mbjax.integrate.tree_system import AbstractTreeSystem
 from mbjax.model import Model
+from mbjax.rigid.aba import aba_responses
 from mbjax.rigid.batched import batch_aba
-from mbjax.rigid.dynamics import METHODS, forward_dynamics
+from mbjax.rigid.dense import dense_responses
+from mbjax.rigid.dynamics import METHODS, choose_method, mass_matrix
 from mbjax.rigid.energy import energy
+from mbjax.rigid.kinematics import forward_kinematics
 from mbjax.rigid.momentum import momentum_rate, velocity_from_momentum
+from mbjax.rigid.rnea import inverse_dynamics
 
 
-class _Tree(AbstractSystem):
+def _model(model) -> Model:
+    if not isinstance(model, Model):
+        raise TypeError(f"model must be a mbjax.Model, got {type(model).__name__}"
+                        + ("; a flexible tree goes in mbjax.flex.FlexibleSystem"
+                           if type(model).__name__ == "FlexibleModel" else ""))
+    return model
+
+
+def _control(control, actuation, nv):
+    control = as_control(control)
+    n_act = nv if actuation is None else len(actuation)
+    value = getattr(control, "value", None)
+    if value is not None and value.shape != (n_act,):
+        raise ValueError(f"the constant control (tau) must have shape ({n_act},), got {value.shape}")
+    return control
+
+
+class TreeSystem(AbstractTreeSystem):
+    """A rigid tree: u = v, v_dot = forward dynamics under gravity, the control and the external
+    wrenches, by seed 002's O(n) recursion or seed 001 eq 74 (`method`, as in
+    `mbjax.forward_dynamics`).
+
+    control: a callable (t, q, v) -> forces on the actuated coordinates (a `mbjax.control`
+        module, any function, or a constant array: a constant tau); actuation: the indices of
+        the velocity coordinates it drives (all by default);
+    external: a callable (t, q, v) -> (n, 6) world-frame wrenches (torque; force) on the bodies,
+        at their origins or at external_point (n, 3), body-frame points."""
+
     model: Model
-    tau: Array
+    control: AbstractControl | None
+    external: AbstractControl | None
+    external_point: Array | None
+    actuation: tuple[int, ...] | None = eqx.field(static=True)
+    method: str = eqx.field(static=True)
+    symmetric_dynamics: ClassVar[bool] = True
+
+    def __init__(self, model: Model, control=None, *, external=None, external_point=None,
+                 actuation=None, method: str = "auto"):
+        if method not in METHODS:
+            raise ValueError(f"method must be one of {METHODS}, got {method!r}")
+        self.model = _model(model)
+        self.actuation = check_actuation(actuation, model.nv)
+        self.control = _control(control, self.actuation, model.nv)
+        self.external = as_control(external)
+        self.external_point = check_points(external_point, model.n)
+        self.method = method
+
+    @property
+    def n(self):
+        return self.model.n
+
+    @property
+    def nq(self):
+        return self.model.nq
+
+    @property
+    def nv(self):
+        return self.model.nv
+
+    def neutral(self):
+        return self.model.neutral()
+
+    def q_dot(self, q, v):
+        return self.model.q_dot(q, v)
 
     def retract(self, q0, xi):
         return self.model.retract(q0, xi)
 
-    def project(self, q):
-        return self.model.normalize(q)
-
-
-class TreeSystem(_Tree):
-    """u = v; u_dot = forward_dynamics(model, q, v, tau, method). tau is constant (nv,)."""
-
-    method: str = eqx.field(static=True)
-
-    def __init__(self, model: Model, tau=None, method: str = "auto"):
-        if method not in METHODS:
-            raise ValueError(f"method must be one of {METHODS}, got {method!r}")
-        self.model = model
-        self.tau = jnp.zeros(model.nv) if tau is None else jnp.asarray(tau, dtype=float)
-        self.method = method
-
-    def kinematics(self, q, u):
-        return self.model.q_dot(q, u)
-
-    def acceleration(self, t, q, u):
-        return forward_dynamics(self.model, q, u, self.tau, self.method)
-
     def local_rate(self, q0, xi, u):
         return self.model.local_rate(q0, xi, u)
 
-    def energy(self, q, u):
-        return energy(self.model, q, u)
+    def normalize(self, q):
+        return self.model.normalize(q)
 
-    def relative_energy_error(self, qs, us):
-        """(E(t) - E(0)) / |E(0)| along a saved trajectory."""
-        E = jax.vmap(self.energy)(qs, us)
-        return (E - E[0]) / jnp.abs(E[0])
+    def frames(self, q):
+        return forward_kinematics(self.model, q)
+
+    def energy(self, q, v):
+        return energy(self.model, q, v)
+
+    def mass_matrix(self, q):
+        return mass_matrix(self.model, q)
+
+    def responses(self, t, q, v, loads):
+        tau, f = self.applied(t, q, v), self.wrenches(t, q, v)
+        method = choose_method(self.model) if self.method == "auto" else self.method
+        route = aba_responses if method == "recursive" else dense_responses
+        return route(self.model, q, v, tau, loads, f)
+
+    def bias(self, t, q, v):
+        """The RNEA at zero acceleration (velocity terms, gravity, external wrenches) less the
+        control: M v_dot + bias = 0."""
+        return (inverse_dynamics(self.model, q, v, jnp.zeros_like(v), self.wrenches(t, q, v))
+                - self.applied(t, q, v))
 
 
 class BatchTreeSystem(AbstractSystem):
@@ -83,12 +154,23 @@ class BatchTreeSystem(AbstractSystem):
         return batch_aba(self.model, q, u, self.tau)
 
 
-class MomentumSystem(_Tree):
-    """u = p = M(q) v, the free momenta (seed 001 eq 73); u_dot from eq 72."""
+class MomentumSystem(AbstractSystem):
+    """u = p = M(q) v, the free momenta (seed 001 eq 73); u_dot from eq 72. Controls and
+    external wrenches as for `TreeSystem`."""
 
-    def __init__(self, model: Model, tau=None):
-        self.model = model
-        self.tau = jnp.zeros(model.nv) if tau is None else jnp.asarray(tau, dtype=float)
+    model: Model
+    control: AbstractControl | None
+    external: AbstractControl | None
+    external_point: Array | None
+    actuation: tuple[int, ...] | None = eqx.field(static=True)
+
+    def __init__(self, model: Model, control=None, *, external=None, external_point=None,
+                 actuation=None):
+        self.model = _model(model)
+        self.actuation = check_actuation(actuation, model.nv)
+        self.control = _control(control, self.actuation, model.nv)
+        self.external = as_control(external)
+        self.external_point = check_points(external_point, model.n)
 
     def velocity(self, q, p):
         return velocity_from_momentum(self.model, q, p)
@@ -97,10 +179,24 @@ class MomentumSystem(_Tree):
         return self.model.q_dot(q, self.velocity(q, u))
 
     def acceleration(self, t, q, u):
-        return momentum_rate(self.model, q, self.velocity(q, u), self.tau)
+        v = self.velocity(q, u)
+        f = body_wrenches(self.external, self.model.n, t, q, v)
+        if f is not None and self.external_point is not None:
+            f = about_origins(f, forward_kinematics(self.model, q)[0], self.external_point)
+        tau = generalized_control(self.control, self.actuation, self.model.nv, t, q, v)
+        return momentum_rate(self.model, q, v, tau, f)
+
+    def retract(self, q0, xi):
+        return self.model.retract(q0, xi)
 
     def local_rate(self, q0, xi, u):
         return self.model.local_rate(q0, xi, self.velocity(self.model.retract(q0, xi), u))
+
+    def project(self, q):
+        return self.model.normalize(q)
+
+    def hold(self, t, q, u):
+        return hold(self, t, q, self.velocity(q, u))
 
     def energy(self, q, u):
         return energy(self.model, q, self.velocity(q, u))

@@ -76,8 +76,10 @@ import jax.numpy as jnp
 import numpy as np
 from jax import Array
 
-from mbjax.loops import CutJoint, LoopSystem, Loops
+from mbjax.control import AbstractControl, Constant
+from mbjax.loops import ClosedSystem, CutJoint
 from mbjax.model import Model
+from mbjax.rigid import TreeSystem
 from mbjax.rigid.kinematics import forward_kinematics
 
 # masses [kg] and moments of inertia about the centres of mass [kg m^2] (test set F)
@@ -124,13 +126,14 @@ def from_testset(y) -> Array:
     return jnp.asarray(y, dtype=float)[..., jnp.array(TREE_ORDER)]
 
 
-class PointSpring(eqx.Module):
+class PointSpring(AbstractControl):
     """A linear spring from `point` (body `body`'s frame) to the fixed `anchor` (ground frame),
     stiffness `stiffness` and rest length `rest_length`: energy V = stiffness (L - rest_length)^2
     / 2 with L the length; force on the point F = -stiffness (L - rest_length) (x - anchor) / L,
     generalized force J^T F with J = dx/dv (Hairer & Wanner II §VII.7, the test set's
     fx, fy and ff(3); here for any tree, by a reverse-mode pass through the kinematics).
-    Call as force(t, q, v) -> (nv,). All parameters are leaves: differentiable and sweepable."""
+    Call as force(t, q, v) -> (nv,), a control of the tree. All parameters are leaves:
+    differentiable and sweepable."""
 
     model: Model
     body: int = eqx.field(static=True)
@@ -169,21 +172,24 @@ class PointSpring(eqx.Module):
 
 
 class Squeezer(NamedTuple):
-    """What `build` returns: the closed tree, the spring, the motor torque as tau, the initial
-    state (tree order). `system(cls, **kw)` makes `cls(loops, tau=tau, force=spring, **kw)`."""
+    """What `build` returns: the tree (driven by the motor torque `tau` plus the `spring`), its
+    cut joints, and the initial state (tree order). `system(method, **kw)` closes the tree:
+    `ClosedSystem(tree, closures, method, **kw)`."""
 
-    loops: Loops
+    tree: TreeSystem
+    closures: tuple
     spring: PointSpring
     tau: Array
     q0: Array
     v0: Array
 
-    def system(self, cls=LoopSystem, **kwargs):
-        return cls(self.loops, tau=self.tau, force=self.spring, **kwargs)
+    def system(self, method=None, **kwargs) -> ClosedSystem:
+        return ClosedSystem(self.tree, self.closures, method, **kwargs)
 
 
 def build() -> Squeezer:
-    """Andrews' squeezer as a `Squeezer` (loops, spring, tau, q0, v0); see the module docstring."""
+    """Andrews' squeezer as a `Squeezer` (tree, closures, spring, tau, q0, v0); see the module
+    docstring."""
     parents = (-1, 0, -1, -1, 3, -1, 5)
     mass = (m1, m2, m3, m5, m4, m7, m6)
     moments = np.array([i1, i2, i3, i5, i4, i7, i6])
@@ -199,8 +205,8 @@ def build() -> Squeezer:
     cuts = [CutJoint("point_on_line", 1, 2, origin_a=P, origin_b=(0.0, -ss, 0.0)),
             CutJoint("point_on_line", 1, 4, origin_a=P, origin_b=(0.0, -e, 0.0)),
             CutJoint("point_on_line", 1, 6, origin_a=P, origin_b=(zf, 0.0, 0.0))]
-    loops = Loops(model, cuts)
     spring = PointSpring(model, 2, point=(sd, -sc, 0.0), anchor=(xc, yc, 0.0), stiffness=c0,
                          rest_length=l0)
     tau = jnp.zeros(7).at[0].set(mom)
-    return Squeezer(loops, spring, tau, from_testset(Y0), jnp.zeros(7))
+    tree = TreeSystem(model, Constant(tau) + spring)
+    return Squeezer(tree, tuple(cuts), spring, tau, from_testset(Y0), jnp.zeros(7))

@@ -41,8 +41,9 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from mbjax.loops import GROUND, CutJoint, Loops
+from mbjax.loops import GROUND, ClosedSystem, CutJoint
 from mbjax.model import Model
+from mbjax.rigid import TreeSystem
 from mbjax.rigid.kinematics import forward_kinematics
 
 LENGTH = 1.0
@@ -81,10 +82,10 @@ def point_p3(model: Model, q):
 
 
 def build(phi0=0.0, phi_dot0=0.0, section=SECTION):
-    """(loops, q0, v0): the mechanism at phi0 on its motion (0: the benchmark's start) with rate
+    """(system, q0, v0): the mechanism (a `ClosedSystem`, coupled multipliers) at phi0 on its motion (0: the benchmark's start) with rate
     phi_dot0 (0: at rest, as in the benchmark); the joint at P6 is a revolute cut joint."""
     phi0 = jnp.asarray(phi0, float)
     cut = CutJoint("revolute", 4, GROUND, origin_a=CORNERS[5] - CORNERS[4], origin_b=CORNERS[5],
                    rotation_a=_ROT_Y, rotation_b=_ROT_Y)
-    loops = Loops(model(section), [cut])
-    return loops, joint_angles(phi0), jax.jacfwd(joint_angles)(phi0) * phi_dot0
+    system = ClosedSystem(TreeSystem(model(section)), [cut])
+    return system, joint_angles(phi0), jax.jacfwd(joint_angles)(phi0) * phi_dot0

@@ -14,7 +14,7 @@ physical mirror plate and the chapter's printed rotation give different dynamics
 import jax.numpy as jnp
 import numpy as np
 
-from mbjax.wrist import CarpalWrist, Servo, WristSystem, ZeroTorque
+from mbjax.wrist import CarpalWrist, WristSystem, servo as servo_law
 
 BASE_RADIUS = 0.06                           # [m]
 LINK_LENGTH = 0.10                           # [m]
@@ -51,13 +51,13 @@ def home(w: CarpalWrist | None = None) -> jnp.ndarray:
 def free_motion(rotation_model: str = "physical"):
     """(system, theta0, theta_dot0): torque-free, gravity-free motion from HOME."""
     w = wrist(rotation_model, gravity=0.0)
-    return WristSystem(w, ZeroTorque()), home(w), jnp.asarray(THETA_DOT0)
+    return WristSystem(w), home(w), jnp.asarray(THETA_DOT0)
 
 
 def servo():
     """(system, theta0, theta_dot0): the servoed wrist under gravity, offset from HOME."""
     w = wrist()
-    law = Servo(theta_ref=home(w), stiffness=jnp.asarray(SERVO_K), damping=jnp.asarray(SERVO_D))
+    law = servo_law(w, home(w), SERVO_K, SERVO_D)
     return WristSystem(w, law), home(w) + jnp.asarray(SERVO_OFFSET), jnp.zeros(3)
 
 

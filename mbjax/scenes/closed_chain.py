@@ -11,9 +11,9 @@ velocity projected onto them too.
 import jax.numpy as jnp
 import numpy as np
 
-from mbjax.loops import GROUND, CutJoint, Loops
-from mbjax.loops.projection import project_configuration, project_velocity
+from mbjax.loops import GROUND, ClosedSystem, CutJoint, consistent_state, project_velocity
 from mbjax.model import Model
+from mbjax.rigid import TreeSystem
 
 LINK = 0.3
 MASS = 1.0
@@ -22,7 +22,9 @@ DURATION = 1.0
 
 
 def build(n: int):
-    """(Loops, q0, v0) for n tree degrees of freedom (n/2 bodies, n even, n >= 4)."""
+    """(system, q0, v0) for n tree degrees of freedom (n/2 bodies, n even, n >= 4); the system
+    is a `ClosedSystem` with the coupled multipliers (rebuild it from `system.tree` and
+    `system.closures` for another method)."""
     if n < 4 or n % 2:
         raise ValueError(f"n must be an even number >= 4 (two dof per Hooke joint), got {n}")
     bodies = n // 2
@@ -33,12 +35,12 @@ def build(n: int):
                   placement_translation=np.array([[0.0, 0.0, 0.0]]
                                                  + [[0.0, 0.0, -LINK]] * (bodies - 1)))
     end = (SPAN * bodies * LINK, 0.0, 0.0)
-    loops = Loops(model, [CutJoint("universal", bodies - 1, GROUND, origin_a=(0.0, 0.0, -LINK),
-                                   origin_b=end)])
+    system = ClosedSystem(TreeSystem(model), [CutJoint("universal", bodies - 1, GROUND,
+                                                       origin_a=(0.0, 0.0, -LINK), origin_b=end)])
     alpha = float(np.arcsin(SPAN))
     guess = np.zeros((bodies, 2))
     guess[0, 1] = -alpha                               # down toward the far point ...
     guess[bodies // 2, 1] = 2 * alpha - np.pi          # ... then up to it: a V
-    q0, _, _ = project_configuration(loops, jnp.asarray(guess.ravel()))
-    v0 = project_velocity(loops, q0, 0.1 * jnp.sin(jnp.arange(n, dtype=float)))
-    return loops, q0, v0
+    q0, _ = consistent_state(system, guess.ravel(), np.zeros(n))
+    v0 = project_velocity(system.loops, q0, 0.1 * jnp.sin(jnp.arange(n, dtype=float)))
+    return system, q0, v0

@@ -11,7 +11,7 @@ a rheonomic `Prescribed` constraint); the rod a flexible body on a revolute join
 elements clamped at P (its joint grid J), all of its in-plane modes (seed 002: "all available
 modes ... associated with motion of B in the x-y plane": 3 per element, so the basis spans what a
 Craig-Bampton basis with Q as interface would); the massless slider a cut joint putting Q's grid point on the plane y = 0
-(`point_on_plane`, one equation). Seed 002's route (`StabilizedLoopSystem`) solves the loads;
+(`point_on_plane`, one equation). Seed 002's route (`ClosedSystem(..., method=Stabilized())`) solves the loads;
 (q, v) are projected back onto the constraints after every step.
 The midpoint deflection is the signed distance of the rod's material midpoint from the chord PQ,
 positive away from O at t = 0 (the rod frame's +y).
@@ -21,9 +21,9 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from mbjax.flex import Beam, FlexibleModel, beam_body, craig_bampton, shape_at
+from mbjax.flex import Beam, FlexibleModel, FlexibleSystem, beam_body, craig_bampton, shape_at
 from mbjax.integrate import RK4, simulate
-from mbjax.loops import GROUND, CutJoint, Loops, Prescribed, StabilizedLoopSystem
+from mbjax.loops import GROUND, ClosedSystem, CutJoint, Prescribed, Stabilized
 from mbjax.model import Model
 
 INCH, LBF, LBM = 0.0254, 4.4482216152605, 0.45359237
@@ -54,17 +54,18 @@ def build(n_elements: int = 2, stiffening: bool = True):
                   gravity=(0.0, 0.0, 0.0))
     model = FlexibleModel(rigid, {1: body}, markers=((1, 0),))
     slider = CutJoint("point_on_plane", model.n, GROUND, rotation_b=[[1, 0, 0], [0, 0, 1], [0, -1, 0]])
-    loops = Loops(model, [Prescribed(0, q0=np.pi / 2, rate=OMEGA), slider])
     phi0 = np.arcsin(-CRANK / ROD)                          # the rod's angle at t = 0 (-30 deg)
     q0 = model.join(jnp.array([np.pi / 2, phi0 - np.pi / 2]), jnp.zeros((model.n, model.mu)))
     v0 = model.join(jnp.array([OMEGA, -OMEGA]), jnp.zeros((model.n, model.mu)))
     midpoint, _ = shape_at(structure, basis, ROD / 2)
-    return StabilizedLoopSystem(loops, projection=True), q0, v0, midpoint
+    system = ClosedSystem(FlexibleSystem(model), [Prescribed(0, q0=np.pi / 2, rate=OMEGA), slider],
+                          method=Stabilized(), projection=True)
+    return system, q0, v0, midpoint
 
 
 def midpoint_deflection(system, midpoint, qs):
     """Signed distance [m] of the rod's midpoint from the chord PQ along a trajectory."""
-    model = system.loops.model
+    model = system.tree.model
     tip = model.bodies.node_phi[1, 0]
     _, qf = jax.vmap(model.split)(qs)
     d_mid = jnp.einsum("is,ts->ti", midpoint, qf[:, 1])

@@ -9,7 +9,7 @@ The cut joint is, by default, a planar pin: a `point_on_line` cut joint (the cou
 rocker's z line through its tip), 2 equations of full rank. `closure="revolute"` uses the spatial
 revolute cut joint instead, 5 equations of which only 2 are independent in a planar loop: the
 redundancy that `Status.REDUNDANT` reports (seed 001 §VI's multipliers then come from the
-least-squares solve of `mbjax.loops.coupled.multipliers`).
+least-squares solve of `mbjax.loops.multipliers`).
 
 `joint_angles(theta)` is the closed-form position analysis (two circles' intersection, elbow-up
 branch), the minimal-coordinate reference of the tests.
@@ -19,8 +19,9 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from mbjax.loops import CutJoint, Loops
+from mbjax.loops import ClosedSystem, CutJoint
 from mbjax.model import Model
+from mbjax.rigid import TreeSystem
 
 A_, B_, C_, D_ = 0.1, 0.35, 0.25, 0.4          # crank, coupler, rocker, ground link [m]
 LENGTHS = np.array([A_, B_, C_])
@@ -55,13 +56,14 @@ def joint_angles(theta):
 
 
 def build(closure: str = "point_on_line", theta0=THETA0, omega0=OMEGA0):
-    """(loops, q0, v0): the four-bar closed by `closure` ("point_on_line": the planar pin, 2
-    equations; "revolute": the spatial revolute joint, 5 redundant equations), started on the
-    loop at crank angle theta0 with crank rate omega0."""
+    """(system, q0, v0): the four-bar closed by `closure` ("point_on_line": the planar pin, 2
+    equations; "revolute": the spatial revolute joint, 5 redundant equations) as a
+    `ClosedSystem` (coupled multipliers; rebuild it from `system.tree` and `system.closures`
+    for another method), started on the loop at crank angle theta0 with crank rate omega0."""
     if closure not in CLOSURES:
         raise ValueError(f"closure must be one of {CLOSURES}, got {closure!r}")
     cut = CutJoint(closure, 1, 2, origin_a=(B_, 0.0, 0.0), origin_b=(C_, 0.0, 0.0))
-    loops = Loops(model(), [cut])
+    system = ClosedSystem(TreeSystem(model()), [cut])
     q0 = joint_angles(jnp.asarray(theta0, float))
     v0 = jax.jacfwd(joint_angles)(jnp.asarray(theta0, float)) * omega0
-    return loops, q0, v0
+    return system, q0, v0

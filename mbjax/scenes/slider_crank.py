@@ -12,7 +12,7 @@ slider's z line), 2 equations of full rank (planar pin; R < L, so no configurati
 With `driven=True` the crank turns at constant speed, q_0 = theta0 + rate t, a `Prescribed`
 motion (rheonomic constraint, seed 001 eq 85 with B = dPhi/dt): the mechanism has no degree of
 freedom left, and the multiplier of the prescribed row is the motor torque on the crank (about
-+z; `LoopSystem.loads(...)[-1]`, since that row of A is e_0, A^t K_c puts it on the crank
++z; `ClosedSystem.loads(...)[-1]`, since that row of A is e_0, A^t K_c puts it on the crank
 coordinate). With `driven=False` the crank is free and `rate` is its initial speed.
 
 Closed-form kinematics (`slider_position`, `joint_angles`): the rod's tip lies on the guide,
@@ -24,8 +24,9 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from mbjax.loops import CutJoint, Loops, Prescribed
+from mbjax.loops import ClosedSystem, CutJoint, Prescribed
 from mbjax.model import Model
+from mbjax.rigid import TreeSystem
 
 DENSITY = 7850.0                   # steel [kg/m^3]
 R_ = 0.1                           # crank length [m]
@@ -74,12 +75,12 @@ def joint_angles(theta):
 
 
 def build(rate=RATE, theta0=THETA0, driven: bool = True):
-    """(loops, q0, v0): the slider-crank at crank angle theta0 turning at `rate`, the crank
+    """(system, q0, v0): the slider-crank (a `ClosedSystem`, coupled multipliers) at crank angle theta0 turning at `rate`, the crank
     driven at that constant speed (`driven=True`, a `Prescribed` motion appended after the cut
     joint) or free with that initial speed."""
     theta0 = jnp.asarray(theta0, float)
     closures = [CutJoint("point_on_line", 1, 2, origin_a=(L_, 0.0, 0.0))]
     if driven:
         closures.append(Prescribed(0, q0=theta0, rate=rate))
-    loops = Loops(model(), closures)
-    return loops, joint_angles(theta0), jax.jacfwd(joint_angles)(theta0) * rate
+    system = ClosedSystem(TreeSystem(model()), closures)
+    return system, joint_angles(theta0), jax.jacfwd(joint_angles)(theta0) * rate

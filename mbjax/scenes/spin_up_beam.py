@@ -11,7 +11,7 @@ and the tip diverges; with stiffening the deflection stays small and bounded.
 mbjax's model: one flexible body (beam elements, `mbjax.flex.beam`, Craig-Bampton modes clamped at
 the hub, the lowest `n_bending` in-plane bending and `n_axial` axial modes) on a revolute joint
 about z, whose angle is the prescribed motion theta(t) (a rheonomic `Prescribed` constraint, seed
-002 eq 87) solved by seed 002's route (`StabilizedLoopSystem`, eqs 101-108). The tip deflection is
+002 eq 87) solved by seed 002's route (`ClosedSystem(..., method=Stabilized())`, eqs 101-108). The tip deflection is
 read in the rotating body frame: y (transverse, negative when the tip lags) and x (axial).
 """
 
@@ -19,9 +19,9 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from mbjax.flex import Beam, FlexibleModel, ModalBasis, beam_body, craig_bampton, spin_up_theta
+from mbjax.flex import Beam, FlexibleModel, FlexibleSystem, ModalBasis, beam_body, craig_bampton, spin_up_theta
 from mbjax.integrate import RK4, simulate
-from mbjax.loops import Loops, Prescribed, StabilizedLoopSystem
+from mbjax.loops import ClosedSystem, Prescribed, Stabilized
 from mbjax.model import Model
 
 LENGTH, AREA, INERTIA, E, G, MASS = 10.0, 4e-4, 2e-7, 7e10, 3e10, 12.0
@@ -60,7 +60,7 @@ def modes(structure: Beam, n_bending: int, n_axial: int = 1) -> ModalBasis:
 
 
 def build(n_bending: int = 4, n_axial: int = 1, n_elements: int = 10, stiffening: bool = True):
-    """(system, q0, v0): the StabilizedLoopSystem of the spun beam, at rest and undeformed.
+    """(system, q0, v0): the spun beam as a `ClosedSystem` (seed 002's route), at rest and undeformed.
     q = (hub angle, modal coordinates)."""
     structure = beam(n_elements)
     body = beam_body(structure, modes(structure, n_bending, n_axial), nodes=(n_elements,),
@@ -69,13 +69,13 @@ def build(n_bending: int = 4, n_axial: int = 1, n_elements: int = 10, stiffening
                   inertia=[np.diag([0.0, 1.0, 1.0]) * MASS * LENGTH**2 / 12 + 1e-9 * np.eye(3)],
                   axis=[[0.0, 0.0, 1.0]], gravity=(0.0, 0.0, 0.0))
     model = FlexibleModel(rigid, {0: body})
-    system = StabilizedLoopSystem(Loops(model, [Prescribed(0, motion=theta)]))
+    system = ClosedSystem(FlexibleSystem(model), [Prescribed(0, motion=theta)], method=Stabilized())
     return system, jnp.zeros(model.nq), jnp.zeros(model.nv)
 
 
 def tip(system, qs):
     """(transverse, axial) tip displacement in the rotating frame along a saved trajectory [m]."""
-    model = system.loops.model
+    model = system.tree.model
     phi = model.bodies.node_phi[0, 0]                        # (3, mu) at the tip
     _, qf = jax.vmap(model.split)(qs)
     d = jnp.einsum("is,ts->ti", phi, qf[:, 0])

@@ -10,7 +10,8 @@ from mbjax.spatial.algebra import (
     cross_motion,
     inertia_matrix,
     plucker,
+    shift_force,
     skew,
 )
 
-__all__ = ["check_inertia", "cross_force", "cross_motion", "inertia_matrix", "plucker", "skew"]
+__all__ = ["check_inertia", "cross_force", "cross_motion", "inertia_matrix", "plucker", "shift_force", "skew"]

@@ -42,6 +42,12 @@ def cross_force(V: Array, f: Array) -> Array:
     return jnp.concatenate([jnp.cross(w, fn) + jnp.cross(v, ff), jnp.cross(w, ff)], -1)
 
 
+def shift_force(f: Array, x: Array) -> Array:
+    """A force vector (torque about the point x; force) taken about the origin instead:
+    (n + x x f; f). Same components; x in them."""
+    return jnp.concatenate([f[..., :3] + jnp.cross(x, f[..., 3:]), f[..., 3:]], -1)
+
+
 def inertia_matrix(mass: Array, com: Array, inertia: Array) -> Array:
     """6x6 spatial inertia about a frame's origin, from mass, centre of mass c and the 3x3 inertia
     about c (all in that frame): [[I_c + m c~ c~^T, m c~], [m c~^T, m 1]]."""

@@ -32,12 +32,13 @@ import jax.numpy as jnp
 import numpy as np
 from jax import Array
 
+from mbjax.control import AbstractControl
 from mbjax.integrate import RK4, simulate
 from mbjax.trajopt.descent import adam_descent
 from mbjax.wrist import WristSystem, kinematics
 
 
-class NeuralController(eqx.Module):
+class NeuralController(AbstractControl):
     """tau = limit tanh((kp (theta* - theta) - kd theta_dot + C(theta*)
                          + limit MLP(theta - theta*, theta_dot / omega_scale, theta* - theta_centre)) / limit).
 
@@ -75,7 +76,7 @@ class NeuralController(eqx.Module):
             gravity_torque = wrist.eom_terms(target, jnp.zeros_like(target))[2]
         return eqx.tree_at(lambda c: (c.target, c.gravity_torque), self, (target, gravity_torque))
 
-    def __call__(self, wrist, t: Array, theta: Array, theta_dot: Array) -> Array:
+    def __call__(self, t: Array, theta: Array, theta_dot: Array) -> Array:
         tau = self.kp * (self.target - theta) - self.kd * theta_dot + self.gravity_torque
         if self.neural:
             x = jnp.concatenate([theta - self.target, theta_dot / self.omega_scale,
@@ -125,7 +126,7 @@ def episode_cost(controller, wrist, start, target, plunge, slope, gravity, *, du
     weight = (sol.ts[1:] / duration) ** end_power
     miss = ((p - plunge) / wrist.link_length) ** 2 + jnp.sum((g - slope) ** 2, axis=1)
     track = jnp.sum(weight * miss) / jnp.sum(weight)
-    tau = jax.vmap(lambda t, q, u: law(wrist, t, q, u))(sol.ts, sol.qs, sol.us)
+    tau = jax.vmap(law)(sol.ts, sol.qs, sol.us)
     work = jnp.mean(jnp.sum(tau**2, axis=1)) / law.limit**2
     cost = (track / pose_tolerance**2 + jnp.sum(sol.us[-1] ** 2) / speed_tolerance**2
             + effort_weight * work)

@@ -3,7 +3,7 @@
 problems').
 
 The unknowns are the motors' torque histories, cubic B-splines saturated at the torque limit
-(`TorqueSpline`). The objective is the effort int |tau|^2 dt plus penalties that bring the tool to
+(`mbjax.control.CubicSpline` with a limit). The objective is the effort int |tau|^2 dt plus penalties that bring the tool to
 the goal pose at rest at t = duration:
 
     J = |(p(T) - p*) / l|^2 / tol^2 + |g(T) - g*|^2 / tol^2 + |theta_dot(T)|^2 / omega_tol^2
@@ -23,7 +23,7 @@ from jax import Array
 from mbjax.integrate import RK4, simulate
 from mbjax.integrate.solution import WithStatus
 from mbjax.trajopt.descent import adam_descent
-from mbjax.trajopt.splines import TorqueSpline
+from mbjax.control import CubicSpline
 from mbjax.wrist import WristSystem, kinematics
 
 
@@ -32,7 +32,7 @@ class Synthesis(WithStatus):
     state and the figures of merit (`kinematics.pose_error` of the final pose against the goal,
     the effort int |tau|^2 dt in N^2 m^2 s, the peak |tau_i| in N m)."""
 
-    spline: TorqueSpline
+    spline: CubicSpline
     losses: Array
     theta_final: Array
     theta_dot_final: Array
@@ -52,7 +52,7 @@ def rollout(wrist, law, theta0: Array, duration: float, steps: int, integrator=R
 def effort(law, duration: float, samples: int = 400) -> tuple[Array, Array]:
     """(int |tau|^2 dt by the trapezoidal rule, peak |tau_i|) of an open-loop torque law."""
     ts = jnp.linspace(0.0, duration, samples + 1)
-    tau = jax.vmap(lambda t: law(None, t, jnp.zeros(3), jnp.zeros(3)))(ts)
+    tau = jax.vmap(lambda t: law(t, jnp.zeros(3), jnp.zeros(3)))(ts)
     sq = jnp.sum(tau**2, axis=1)
     return jnp.trapezoid(sq, ts), jnp.max(jnp.abs(tau))
 
@@ -66,12 +66,12 @@ def goal_pose(wrist, goal) -> kinematics.Pose:
 def synthesize(wrist, theta0: Array, goal, *, duration: float, torque_limit: float, n_knots: int = 12,
                steps: int = 50, iterations: int = 400, learning_rate: float = 0.02,
                pose_tolerance: float = 1e-3, speed_tolerance: float = 1e-2, effort_weight: float = 0.1,
-               integrator=RK4(), init: TorqueSpline | None = None) -> Synthesis:
+               integrator=RK4(), init: CubicSpline | None = None) -> Synthesis:
     """Torque splines that move the wrist from rest at theta0 to rest at goal = (plunge, slope)
     in `duration` with least effort, |tau_i| <= torque_limit; see the module docstring.
 
     `init` defaults to the constant torque that holds theta0 against gravity; the feed-forward
-    baseline fitted to the spline (`TorqueSpline.fit`, clipped to the limit) is a far better start
+    baseline fitted to the spline (`CubicSpline.fit`, clipped to the limit) is a far better start
     for this open-loop unstable robot. Each rollout takes `steps` steps of `integrator`;
     `iterations` Adam steps at `learning_rate` (cosine-decayed to a tenth).
     The gradient is forward mode (`jax.jacfwd` over the 3 n_knots spline values): for a few dozen
@@ -82,12 +82,12 @@ def synthesize(wrist, theta0: Array, goal, *, duration: float, torque_limit: flo
     goal_p, goal_g = (jnp.asarray(x, dtype=float) for x in goal)
     if init is None:
         hold = wrist.eom_terms(theta0, jnp.zeros_like(theta0))[2]
-        init = TorqueSpline.constant(jnp.clip(hold, -0.9 * torque_limit, 0.9 * torque_limit),
-                                     n_knots, duration, torque_limit)
+        init = CubicSpline.constant(jnp.clip(hold, -0.9 * torque_limit, 0.9 * torque_limit),
+                                    n_knots, duration, torque_limit)
     shape = init.knots.shape
 
     def spline_of(x):
-        return TorqueSpline(knots=x.reshape(shape), limit=init.limit, duration=init.duration)
+        return CubicSpline(x.reshape(shape), init.duration, init.limit)
 
     def objective(x):
         spline = spline_of(x)

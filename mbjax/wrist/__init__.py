@@ -5,7 +5,7 @@ system."""
 from mbjax.wrist.kinematics import Pose, SingularityMeasures, pose_error, rotation_angle
 from mbjax.wrist.model import CarpalWrist
 from mbjax.wrist.system import WristSystem
-from mbjax.wrist.torques import Servo, ZeroTorque
+from mbjax.wrist.torques import servo
 
-__all__ = ["CarpalWrist", "Pose", "Servo", "SingularityMeasures", "WristSystem", "ZeroTorque",
-           "pose_error", "rotation_angle"]
+__all__ = ["CarpalWrist", "Pose", "SingularityMeasures", "WristSystem", "pose_error",
+           "rotation_angle", "servo"]

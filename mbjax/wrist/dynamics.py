@@ -75,6 +75,24 @@ def eom_terms(wrist, theta: Array, theta_dot: Array) -> tuple[Array, Array, Arra
     return A, B, C
 
 
+def external_torques(wrist, theta: Array, wrench: Array, point: Array | None = None) -> Array:
+    """The motor torques (3,) equivalent to a world-frame wrench (torque; force) (6,) on the tool,
+    its force acting at the distal-plate centre (the origin of the tool's frame D) or at `point`
+    (D coordinates): J^T w, by one reverse pass through the velocity map theta_dot -> (omega,
+    v_point), which is linear."""
+    offset = -wrist.tool_com if point is None else jnp.asarray(point) - wrist.tool_com
+
+    def pose(th):
+        x_G, R = com_and_rotation(wrist, th)
+        return x_G + _dot(R, offset), R
+
+    def velocities(theta_dot):
+        (_, R), (v, R_dot) = jax.jvp(pose, (theta,), (theta_dot,))
+        return _vee(_matmul(R_dot, R.T)), v
+
+    return jax.vjp(velocities, jnp.zeros_like(theta))[1]((wrench[:3], wrench[3:]))[0]
+
+
 def mass_matrix(wrist, theta: Array) -> Array:
     """A(theta) of eq 6.16, the Hessian of T in theta_dot."""
     theta = jnp.asarray(theta)

@@ -1,23 +1,68 @@
-"""The Carpal Wrist as an `AbstractSystem` for `simulate` (seed 003 §6.4)."""
+"""The Carpal Wrist as a system for `simulate` (seed 003 §6.4)."""
 
 import equinox as eqx
+import jax
+import jax.numpy as jnp
 from jax import Array
 
+from mbjax.control import AbstractControl, as_control
+from mbjax.control.applied import body_wrenches, check_actuation, check_points, generalized_control, hold
 from mbjax.integrate.system import AbstractSystem
 from mbjax.wrist import dynamics
 from mbjax.wrist.model import CarpalWrist
 
 
 class WristSystem(AbstractSystem):
-    """q = theta, u = theta_dot; theta_ddot from eq 6.21 under the motor torques
-    `torque(wrist, t, theta, theta_dot)` (a module from `mbjax.wrist.torques`, a torque spline or
-    a controller from `mbjax.trajopt`). With `ExplicitEuler` this is the chapter's eq 6.45."""
+    """q = theta, u = theta_dot; theta_ddot from eq 6.21 under the motor torques of `control`
+    (t, theta, theta_dot) -> (3,) (a `mbjax.control` module such as a torque spline or a servo,
+    a controller from `mbjax.trajopt`, any callable or a constant; none: unpowered motors; on
+    the `actuation` motors only if given) and an `external` (t, theta, theta_dot) -> (1, 6)
+    world-frame wrench (torque; force) on the tool at the distal-plate centre, or at
+    `external_point` (tool frame D). With `ExplicitEuler` this is the chapter's eq 6.45."""
 
     wrist: CarpalWrist
-    torque: eqx.Module
+    control: AbstractControl | None
+    external: AbstractControl | None
+    external_point: Array | None
+    actuation: tuple[int, ...] | None = eqx.field(static=True)
+
+    def __init__(self, wrist: CarpalWrist, control=None, *, external=None, external_point=None,
+                 actuation=None):
+        if not isinstance(wrist, CarpalWrist):
+            raise TypeError(f"wrist must be a CarpalWrist, got {type(wrist).__name__}")
+        self.wrist = wrist
+        self.actuation = check_actuation(actuation, 3)
+        self.control = as_control(control)
+        value = getattr(self.control, "value", None)
+        n_act = 3 if self.actuation is None else len(self.actuation)
+        if value is not None and value.shape != (n_act,):
+            raise ValueError(f"the constant control must have shape ({n_act},), got {value.shape}")
+        self.external = as_control(external)
+        point = check_points(external_point, 1)
+        self.external_point = None if point is None else point[0]
+
+    def torques(self, t: Array, q: Array, u: Array) -> Array:
+        """The motor torques of the control plus the torques equivalent to the external wrench."""
+        tau = generalized_control(self.control, self.actuation, 3, t, q, u)
+        f = body_wrenches(self.external, 1, t, q, u)
+        if f is None:
+            return tau
+        return tau + dynamics.external_torques(self.wrist, q, f[0], self.external_point)
 
     def kinematics(self, q: Array, u: Array) -> Array:
         return u
 
     def acceleration(self, t: Array, q: Array, u: Array) -> Array:
-        return dynamics.forward_dynamics(self.wrist, q, u, self.torque(self.wrist, t, q, u))
+        return dynamics.forward_dynamics(self.wrist, q, u, self.torques(t, q, u))
+
+    def hold(self, t, q, u):
+        return hold(self, t, q, u)
+
+    def energy(self, q: Array, u: Array) -> Array:
+        """T + V of the tool; the work of the motors and the external wrench is not included."""
+        return dynamics.energy(self.wrist, q, u)
+
+    def relative_energy_error(self, qs: Array, us: Array) -> Array:
+        """(E(t) - E(0)) / |E(0)| along a saved trajectory."""
+        E = jax.vmap(self.energy)(qs, us)
+        return (E - E[0]) / jnp.abs(E[0])

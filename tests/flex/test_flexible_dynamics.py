@@ -14,7 +14,7 @@ from mbjax.flex import (Beam, FlexibleModel, FlexibleSystem, ModalBody, beam_bod
 from mbjax.flex.body import mass_matrix
 from mbjax.integrate import RK4, simulate
 from mbjax.lie import exp
-from mbjax.loops import LoopSystem, Loops, Prescribed, StabilizedLoopSystem
+from mbjax.loops import ClosedSystem, Coupled, Momentum, Prescribed, Stabilized
 from mbjax.model import Model
 from mbjax.spatial import skew
 
@@ -183,8 +183,10 @@ def test_bad_input_is_a_clear_error():
     with pytest.raises(ValueError, match="marker"):
         FlexibleModel(rigid, {0: body}, attach={1: 0}, markers=((1, 0),))
     model = FlexibleModel(rigid, {0: body}, attach={1: 0})
-    with pytest.raises(TypeError, match="StabilizedLoopSystem"):
-        LoopSystem(Loops(model, [Prescribed(0)]))
-    StabilizedLoopSystem(Loops(model, [Prescribed(0)]))
+    for method in (Coupled(), Momentum()):
+        with pytest.raises(TypeError, match="Stabilized"):
+            ClosedSystem(FlexibleSystem(model), [Prescribed(0)], method)
+    closed = ClosedSystem(FlexibleSystem(model), [Prescribed(0)])
+    assert isinstance(closed.method, Stabilized)
     with pytest.raises(ValueError, match="method"):
         FlexibleSystem(model, method="fast")

@@ -12,8 +12,7 @@ import pytest
 from scipy.integrate import solve_ivp
 
 from mbjax.cli import main
-from mbjax.loops import LoopSystem, StabilizedLoopSystem
-from mbjax.loops.coupled import numerical_rank
+from mbjax.loops import Coupled, Loops, Stabilized, numerical_rank
 from mbjax.reproduce import andrews_squeezer as reproduction
 from mbjax.rigid.dynamics import mass_matrix
 from mbjax.scenes import andrews_squeezer as S
@@ -122,18 +121,18 @@ def squeezer():
 
 @pytest.fixture(scope="module")
 def phi(squeezer):
-    return jax.jit(lambda q: squeezer.loops.phi(q))
+    return jax.jit(lambda q: Loops(squeezer.tree, squeezer.closures).phi(q))
 
 
 @pytest.fixture(scope="module")
 def quick_run(squeezer):
     """RK4 at dt = 10 us with the coupled multipliers: the run `--quick` times (one compilation,
     shared with the CLI test in this module)."""
-    return reproduction.run(squeezer.system(LoopSystem), reproduction.QUICK_DT_STEPS)[0]
+    return reproduction.run(squeezer.system(Coupled()), reproduction.QUICK_DT_STEPS)[0]
 
 
 def test_initial_values_satisfy_the_constraints_with_full_rank(squeezer, phi):
-    loops = squeezer.loops
+    loops = Loops(squeezer.tree, squeezer.closures)
     assert loops.m == 6
     assert float(jnp.abs(phi(squeezer.q0)).max()) < 1e-12
     A = jax.jit(lambda q: loops.jacobian(q))(squeezer.q0)
@@ -154,7 +153,7 @@ def test_cut_joints_are_the_test_sets_constraints_rotated(phi):
 
 def test_mass_matrix_is_the_test_sets(squeezer):
     rng = np.random.default_rng(1)
-    mass = jax.jit(lambda q: mass_matrix(squeezer.loops.model, q))
+    mass = jax.jit(lambda q: mass_matrix(squeezer.tree.model, q))
     for _ in range(3):
         y = rng.uniform(-np.pi, np.pi, size=7)
         ours = np.asarray(mass(S.from_testset(y)))
@@ -185,7 +184,7 @@ def test_accelerations_are_the_test_sets(squeezer, quick_run):
     """At rest at t = 0 (the test set's initial y'' = 14222.44..., -10666.83..., 0, ...) and at
     15 ms, where every velocity term acts (there the two formulations' different round-off,
     amplified by the cond(A M^-1 A^T) = 270 of the multiplier solve, leaves 2e-10)."""
-    system = squeezer.system(LoopSystem)
+    system = squeezer.system(Coupled())
     acceleration = jax.jit(lambda t, q, v: system.acceleration(t, q, v))
     a0 = np.asarray(S.to_testset(acceleration(0.0, squeezer.q0, squeezer.v0)))
     expected = np.array([14222.4439199541138705911625887, -10666.8329399655854029433719415,
@@ -223,8 +222,8 @@ def test_projection_and_order_n_routes_agree(squeezer, quick_run):
     """Seed 002's O(n + m^3) route gives the coupled multipliers' motion to round-off; projection
     after every step moves each state by its O(dt^5) constraint error, so it differs by RK4's
     truncation error (4e-9 at 10 us), and both meet the reference as closely."""
-    for system, atol in ((squeezer.system(StabilizedLoopSystem), 1e-11),
-                         (squeezer.system(LoopSystem, projection=True), TOLERANCE)):
+    for system, atol in ((squeezer.system(Stabilized()), 1e-11),
+                         (squeezer.system(Coupled(), projection=True), TOLERANCE)):
         other = reproduction.run(system, reproduction.QUICK_DT_STEPS)[0]
         assert other.messages() == ["success"]
         np.testing.assert_allclose(other.qs, quick_run.qs, rtol=0, atol=atol)

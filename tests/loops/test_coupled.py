@@ -9,15 +9,15 @@ import pytest
 from scipy.integrate import solve_ivp
 
 from mbjax.integrate import RK4, simulate
-from mbjax.loops import (CutJoint, Loops, LoopSystem, Prescribed, StabilizedLoopSystem,
-                         coupled_acceleration)
+from mbjax.loops import ClosedSystem, CutJoint, Loops, Prescribed, Stabilized, coupled_acceleration
 from mbjax.rigid import kinetic_energy, potential_energy
 from mbjax.scenes import four_bar
 from mbjax.scenes.four_bar import OMEGA0, THETA0, joint_angles
 
 # the four-bar scene closed by the spatial revolute cut joint: 5 equations of rank 2
-LOOPS, Q0, V0 = four_bar.build(closure="revolute")
-MODEL = LOOPS.model
+SYSTEM, Q0, V0 = four_bar.build(closure="revolute")
+LOOPS, TREE = SYSTEM.loops, SYSTEM.tree
+MODEL = TREE.model
 
 
 def minimal_rhs(y):
@@ -39,7 +39,7 @@ def test_four_bar_matches_minimal_coordinates():
     rhs = jax.jit(minimal_rhs)
     ref = solve_ivp(lambda t, y: np.asarray(rhs(jnp.asarray(y))), (0.0, 0.5), [THETA0, OMEGA0],
                     method="DOP853", rtol=1e-12, atol=1e-12)
-    system = LoopSystem(LOOPS)
+    system = SYSTEM
     sol = simulate(system, RK4(), Q0, V0, dt=5e-4, t1=0.5, saveat=[0.5])
     assert bool(sol.ok) and sol.messages() == ["redundant"]    # 5 equations of rank 2
     assert abs(float(sol.qs[-1, 0]) - ref.y[0, -1]) < 1e-8
@@ -53,7 +53,7 @@ def test_redundant_planar_closure_is_detected_and_finite():
 
     @jax.jit                  # one compilation (op-by-op dispatch of the passes takes far longer)
     def solved(q, v):
-        v_dot, K_c, rank = coupled_acceleration(LOOPS, q, v, jnp.zeros(3))
+        v_dot, K_c, rank = coupled_acceleration(LOOPS, q, v)
         return v_dot, K_c, rank, LOOPS.jacobian(q), LOOPS.acceleration_bias(q, v)
 
     v_dot, K_c, rank, A, b = solved(Q0, V0)
@@ -64,7 +64,7 @@ def test_redundant_planar_closure_is_detected_and_finite():
 
 def test_constraint_derivatives_by_autodiff_match_finite_differences():
     """A v + B is dPhi/dt and A a + b is d^2 Phi/dt^2 along q(t) = q0 + v t + a t^2 / 2."""
-    loops = Loops(MODEL, [*LOOPS.closures, Prescribed(0, q0=0.1, rate=0.7)])
+    loops = Loops(TREE, [*LOOPS.closures, Prescribed(0, q0=0.1, rate=0.7)])
     q, v, a, t, h = Q0 + 0.01, V0 + 0.1, jnp.array([0.3, -0.2, 0.5]), 0.2, 1e-4
 
     @jax.jit                  # one compilation (op-by-op dispatch of the passes takes far longer)
@@ -80,7 +80,7 @@ def test_constraint_derivatives_by_autodiff_match_finite_differences():
 
 @pytest.mark.slow
 def test_gradient_through_a_constrained_rollout_matches_finite_differences():
-    system = LoopSystem(LOOPS)
+    system = SYSTEM
     direction = jax.jit(jax.jacfwd(joint_angles))(THETA0)
 
     def final_crank(omega):
@@ -96,10 +96,10 @@ def test_ill_posed_closures_get_clear_errors():
         CutJoint("revolute", 1, 1)
     with pytest.raises(ValueError, match="kind must be one of"):
         CutJoint("hinge", 0, 1)
-    with pytest.raises(ValueError, match="not in the model"):
-        Loops(MODEL, [CutJoint("spherical", 0, 7)])
+    with pytest.raises(ValueError, match="not in the tree"):
+        Loops(TREE, [CutJoint("spherical", 0, 7)])
     with pytest.raises(ValueError, match="at least one"):
-        Loops(MODEL, [])
+        ClosedSystem(TREE, [])
 
 
 @pytest.mark.slow     # the closed chain's test covers the same agreement by default
@@ -107,8 +107,9 @@ def test_order_n_stabilization_agrees_with_the_coupled_solution():
     """Seed 002's eta - Gamma f_c (m + 1 passes of the O(n) recursion) against seed 001's dense
     Lagrange multipliers, the same RK4 steps: the two trajectories agree to round-off."""
     ts = np.linspace(0.0, 0.5, 6)
-    coupled = simulate(LoopSystem(LOOPS), RK4(), Q0, V0, dt=1e-3, t1=0.5, saveat=ts)
-    recursive = simulate(StabilizedLoopSystem(LOOPS), RK4(), Q0, V0, dt=1e-3, t1=0.5, saveat=ts)
+    coupled = simulate(SYSTEM, RK4(), Q0, V0, dt=1e-3, t1=0.5, saveat=ts)
+    recursive = simulate(ClosedSystem(TREE, SYSTEM.closures, Stabilized()), RK4(), Q0, V0,
+                         dt=1e-3, t1=0.5, saveat=ts)
     assert recursive.messages() == coupled.messages() == ["redundant"]
     np.testing.assert_allclose(recursive.qs, coupled.qs, atol=1e-12)
     np.testing.assert_allclose(recursive.us, coupled.us, atol=1e-10)
@@ -117,8 +118,8 @@ def test_order_n_stabilization_agrees_with_the_coupled_solution():
 @pytest.mark.slow
 def test_epsilon_dynamics_keeps_the_velocity_error_at_epsilon_times_the_loads():
     """Eqs 89-93: started from f_c = (A v + B) / epsilon, A v + B = epsilon f_c at all times."""
-    system = StabilizedLoopSystem(LOOPS, epsilon=1e-2)
-    u0 = jnp.concatenate([V0, system.initial_loads(Q0, V0)])
+    system = ClosedSystem(TREE, SYSTEM.closures, Stabilized(epsilon=1e-2))
+    u0 = system.initial_state(Q0, V0, consistent=False)
     sol = simulate(system, RK4(), Q0, u0, dt=5e-4, t1=0.2, saveat=np.linspace(0.0, 0.2, 5))
     # the velocity error epsilon f_c moves Phi past the default tolerance: the status says so
     assert sol.messages() == ["constraint violated, redundant"]

@@ -1,5 +1,5 @@
 """The mechanism scenes (planar four-bar, slider-crank, Bricard's mechanism) closed by cut joints
-and solved with seed 001's coupled Lagrange multipliers (`LoopSystem`), each against an
+and solved with seed 001's coupled Lagrange multipliers (`Coupled`), each against an
 independent minimal-coordinate reference: the scene's closed-form position analysis, the one-dof
 Lagrangian L(theta, omega) = T - V in that coordinate (differentiated by jax) and scipy's DOP853;
 for the driven slider-crank, the same Lagrangian's inverse dynamics gives the motor torque."""
@@ -15,7 +15,7 @@ from scipy.integrate import solve_ivp
 from scipy.linalg import expm
 
 from mbjax.integrate import RK4, simulate
-from mbjax.loops import LoopSystem, numerical_rank, project_configuration, project_velocity
+from mbjax.loops import ClosedSystem, Coupled, gauss_newton, numerical_rank, project_velocity
 from mbjax.rigid import kinetic_energy, potential_energy
 from mbjax.scenes import bricard, four_bar, slider_crank
 
@@ -75,13 +75,13 @@ def test_four_bar_closed_by_a_planar_pin_matches_minimal_coordinates():
     """The four-bar closed by a `point_on_line` cut (2 equations of rank 2: no redundancy to
     report) follows the one-dof DOP853 solution to 1e-8 over 0.5 s, on the closed-form loop,
     energy to 1e-8."""
-    loops, q0, v0 = four_bar.build()
+    system, q0, v0 = four_bar.build()
+    loops = system.loops
     assert loops.m == 2
     ts = np.array([0.0, 0.25, 0.5])
-    system = LoopSystem(loops)
     sol = simulate(system, RK4(), q0, v0, dt=5e-4, t1=0.5, saveat=ts)
     assert sol.messages() == ["success"]                     # 2 independent equations
-    ref = dop853(loops.model, four_bar.joint_angles, four_bar.THETA0, four_bar.OMEGA0, ts)
+    ref = dop853(system.tree.model, four_bar.joint_angles, four_bar.THETA0, four_bar.OMEGA0, ts)
     np.testing.assert_allclose(sol.qs[:, 0], ref, rtol=0, atol=1e-8)
     np.testing.assert_allclose(sol.qs, on_motion(four_bar.joint_angles, sol.qs[:, 0]),
                                rtol=0, atol=1e-8)
@@ -91,7 +91,8 @@ def test_four_bar_closed_by_a_planar_pin_matches_minimal_coordinates():
 
 
 def test_four_bar_revolute_closure_is_redundant():
-    loops, q0, _ = four_bar.build("revolute")
+    system, q0, _ = four_bar.build("revolute")
+    loops = system.loops
     rank = jax.jit(lambda q: numerical_rank(loops.jacobian(q) @ loops.jacobian(q).T))(q0)
     assert loops.m == 5 and int(rank) == 2
     with pytest.raises(ValueError, match="closure must be one of"):
@@ -115,7 +116,7 @@ def check_driven_slider_crank(loops, ts, qs, vs, torque):
     velocities = on_motion(jax.jacfwd(slider_crank.joint_angles), theta) * slider_crank.RATE
     np.testing.assert_allclose(vs, velocities, rtol=0, atol=1e-10)
     assert residual(loops, qs, ts) < 1e-12
-    terms = one_dof(loops.model, slider_crank.joint_angles)
+    terms = one_dof(loops.tree.model, slider_crank.joint_angles)
     _, h = jax.jit(jax.vmap(terms, (0, None)))(jnp.asarray(theta), slider_crank.RATE)
     scale = float(jnp.abs(h).max())
     assert scale > 1.0                                      # inertia and gravity both load it
@@ -124,16 +125,16 @@ def check_driven_slider_crank(loops, ts, qs, vs, torque):
 
 def test_driven_slider_crank_kinematics_and_motor_torque():
     """With the crank driven the mechanism has no degree of freedom: mbjax's position analysis
-    (Newton on Phi(q, t) = 0 from a perturbed guess) and velocity analysis (A v + B = 0) give the
+    (Gauss-Newton on Phi(q, t) = 0 from a perturbed guess) and velocity analysis (A v + B = 0) give the
     closed-form kinematics; the multiplier of the `Prescribed` row (`loads(...)[-1]`) is the torque
     the motor applies to the crank, about +z."""
-    loops, _, _ = slider_crank.build()
-    system = LoopSystem(loops)
+    system, _, _ = slider_crank.build()
+    loops = system.loops
 
     @jax.jit
     @jax.vmap
     def analysis(t, guess):
-        q = project_configuration(loops, guess, t)[0]
+        q = gauss_newton(loops, guess, t, iterations=10)
         v = project_velocity(loops, q, jnp.zeros(3), t)
         return q, v, system.loads(t, q, v)[-1]
 
@@ -146,8 +147,9 @@ def test_driven_slider_crank_kinematics_and_motor_torque():
 def test_driven_slider_crank_simulation():
     """The same along a simulation, projected onto Phi(q, t) = 0 and A v + B = 0 after every
     step (without projection RK4's drift leaves about 1e-9)."""
-    loops, q0, v0 = slider_crank.build()
-    system = LoopSystem(loops, projection=True)
+    closed, q0, v0 = slider_crank.build()
+    system = ClosedSystem(closed.tree, closed.closures, projection=True)
+    loops = system.loops
     sol = simulate(system, RK4(), q0, v0, dt=1e-3, t1=SLIDER_TS[-1], saveat=SLIDER_TS)
     assert sol.messages() == ["success"]
     torque = jax.jit(jax.vmap(system.loads))(sol.ts, sol.qs, sol.us)[:, -1]
@@ -156,11 +158,10 @@ def test_driven_slider_crank_simulation():
 
 @pytest.mark.slow          # the four-bar's test covers a free loop against DOP853 by default
 def test_free_slider_crank_matches_minimal_coordinates():
-    loops, q0, v0 = slider_crank.build(driven=False)
-    system = LoopSystem(loops)
+    system, q0, v0 = slider_crank.build(driven=False)
     sol = simulate(system, RK4(), q0, v0, dt=2.5e-4, t1=0.3, saveat=SLIDER_TS)
     assert sol.messages() == ["success"]
-    ref = dop853(loops.model, slider_crank.joint_angles, slider_crank.THETA0, slider_crank.RATE,
+    ref = dop853(system.tree.model, slider_crank.joint_angles, slider_crank.THETA0, slider_crank.RATE,
                  SLIDER_TS)
     np.testing.assert_allclose(sol.qs[:, 0], ref, rtol=0, atol=1e-8)
     np.testing.assert_allclose(sol.qs, on_motion(slider_crank.joint_angles, sol.qs[:, 0]),
@@ -173,14 +174,14 @@ def test_free_slider_crank_matches_minimal_coordinates():
 def test_gradient_through_a_slider_crank_rollout_matches_finite_differences():
     """d(crank angle at 0.1 s)/d(slider mass) of the free slider-crank, reverse mode through the
     constrained rollout against central differences."""
-    loops, q0, v0 = slider_crank.build(driven=False)
+    closed, q0, v0 = slider_crank.build(driven=False)
 
     def crank_angle(m_slider):
-        model = eqx.tree_at(lambda m: m.mass, loops.model, loops.model.mass.at[2].set(m_slider))
-        system = LoopSystem(eqx.tree_at(lambda lp: lp.model, loops, model))
+        system = eqx.tree_at(lambda s: s.tree.model.mass, closed,
+                             closed.tree.model.mass.at[2].set(m_slider))
         return simulate(system, RK4(), q0, v0, dt=1e-3, t1=0.1, saveat=[0.1]).qs[-1, 0]
 
-    m0, eps = float(loops.model.mass[2]), 1e-5
+    m0, eps = float(closed.tree.model.mass[2]), 1e-5
     fd = (crank_angle(m0 + eps) - crank_angle(m0 - eps)) / (2 * eps)
     grad = jax.grad(crank_angle)(m0)
     assert abs(float(fd)) > 1e-3
@@ -204,7 +205,8 @@ def test_bricard_closed_form_closes_the_loop():
     """The closed-form motion against two independent loop closures: mbjax's cut-joint residual
     and the product of exponentials of the six joint twists around the loop (Brockett's formula,
     numpy/scipy only), which must be the identity with the cut joint turned by psi as well."""
-    loops, q0, _ = bricard.build()
+    system, q0, _ = bricard.build()
+    loops = system.loops
     phis = np.linspace(-0.4, np.pi + 0.4, 9)
     qs = on_motion(bricard.joint_angles, phis)
     assert residual(loops, qs) < 1e-14
@@ -220,9 +222,9 @@ def test_bricard_closed_form_closes_the_loop():
 
 @functools.cache
 def bricard_run(projection: bool):
-    loops, q0, v0 = bricard.build()
-    system = LoopSystem(loops, projection=projection,
-                        baumgarte=(0.0, 0.0) if projection else (10.0, 10.0))
+    closed, q0, v0 = bricard.build()
+    system = ClosedSystem(closed.tree, closed.closures,
+                          Coupled(baumgarte=(0.0, 0.0) if projection else (10.0, 10.0)), projection)
     return system, simulate(system, RK4(), q0, v0, dt=1e-3, t1=bricard.DURATION,
                             saveat=BRICARD_TS)
 
@@ -244,7 +246,7 @@ def check_bricard(projection: bool, *, angle_tol, residual_tol, energy_tol):
     np.testing.assert_allclose(sol.qs[:, 0], ref, rtol=0, atol=angle_tol)
     np.testing.assert_allclose(sol.qs, on_motion(bricard.joint_angles, sol.qs[:, 0]),
                                rtol=0, atol=residual_tol)
-    model = system.loops.model
+    model = system.tree.model
     p3 = on_motion(lambda q: bricard.point_p3(model, q), sol.qs)
     p3_ref = on_motion(lambda phi: bricard.point_p3(model, bricard.joint_angles(phi)), ref)
     np.testing.assert_allclose(p3, p3_ref, rtol=0, atol=2 * angle_tol)

@@ -9,30 +9,32 @@ import numpy as np
 import pytest
 
 from mbjax.integrate import RK4, Status, simulate
-from mbjax.loops import (GROUND, CutJoint, Loops, LoopSystem, MomentumLoopSystem, Prescribed,
-                         StabilizedLoopSystem, consistent_state, coupled_acceleration,
-                         eta_and_gamma, momentum_rate)
+from mbjax.loops import (GROUND, ClosedSystem, Coupled, CutJoint, Loops, Momentum, Prescribed,
+                         Stabilized, consistent_state, coupled_acceleration, eta_and_gamma,
+                         momentum_rate)
+from mbjax.rigid import TreeSystem
 from mbjax.rigid.dynamics import forward_dynamics, mass_matrix
 from mbjax.scenes import closed_chain
 
-LOOPS, Q0, V0 = closed_chain.build(6)           # 3 links, 6 dof, 4 closure equations: 2 dof
+CHAIN, Q0, V0 = closed_chain.build(6)           # 3 links, 6 dof, 4 closure equations: 2 dof
 TAU = jnp.array([0.3, -0.2, 0.1, 0.4, -0.1, 0.2])
+MODEL = CHAIN.tree.model
+TREE = TreeSystem(MODEL, TAU)
+LOOPS = Loops(TREE, CHAIN.closures)
 
 
 def test_momentum_form_multipliers_equal_the_velocity_forms():
     """Eq 98 (momentum form) and eq 92 (velocity form) give the same multipliers (eq 99), and
     G_dot = d/dt (mu v) = mu v_dot + mu_dot v."""
-    model = LOOPS.model
-
     @jax.jit                  # one compilation (op-by-op dispatch of the passes takes far longer)
-    def both_forms(q, v, tau):
-        v_dot, K_c, _ = coupled_acceleration(LOOPS, q, v, tau)
-        mu = mass_matrix(model, q)
-        G_dot, K_c_momentum, rank = momentum_rate(LOOPS, q, mu @ v, tau)
-        mu_dot = jax.jvp(lambda q_: mass_matrix(model, q_), (q,), (model.q_dot(q, v),))[1]
+    def both_forms(q, v):
+        v_dot, K_c, _ = coupled_acceleration(LOOPS, q, v)
+        mu = mass_matrix(MODEL, q)
+        G_dot, K_c_momentum, rank = momentum_rate(LOOPS, q, mu @ v)
+        mu_dot = jax.jvp(lambda q_: mass_matrix(MODEL, q_), (q,), (MODEL.q_dot(q, v),))[1]
         return v_dot, K_c, mu, G_dot, K_c_momentum, rank, mu_dot
 
-    v_dot, K_c, mu, G_dot, K_c_momentum, rank, mu_dot = both_forms(Q0, V0, TAU)
+    v_dot, K_c, mu, G_dot, K_c_momentum, rank, mu_dot = both_forms(Q0, V0)
     np.testing.assert_allclose(K_c_momentum, K_c, rtol=1e-10, atol=1e-10 * np.abs(K_c).max())
     np.testing.assert_allclose(G_dot, mu @ v_dot + mu_dot @ V0, atol=1e-10 * np.abs(G_dot).max())
     assert int(rank) == LOOPS.m
@@ -41,10 +43,10 @@ def test_momentum_form_multipliers_equal_the_velocity_forms():
 @pytest.mark.slow     # the multipliers' identity above covers the form by default
 def test_momentum_form_follows_the_same_motion():
     """Two discretizations of one motion: RK4 on (q, G) and on (q, v) agree to O(dt^4)."""
-    system = MomentumLoopSystem(LOOPS, TAU)
+    system = ClosedSystem(TREE, CHAIN.closures, Momentum())
     ts = np.linspace(0.0, 0.2, 5)
-    momentum = simulate(system, RK4(), Q0, system.momenta(Q0, V0), dt=1e-3, t1=0.2, saveat=ts)
-    velocity = simulate(LoopSystem(LOOPS, TAU), RK4(), Q0, V0, dt=1e-3, t1=0.2, saveat=ts)
+    momentum = simulate(system, RK4(), Q0, system.initial_state(Q0, V0), dt=1e-3, t1=0.2, saveat=ts)
+    velocity = simulate(ClosedSystem(TREE, CHAIN.closures), RK4(), Q0, V0, dt=1e-3, t1=0.2, saveat=ts)
     assert momentum.messages() == velocity.messages() == ["success"]
     np.testing.assert_allclose(momentum.qs, velocity.qs, atol=1e-9)
     v_end = jax.jit(jax.vmap(system.velocity))(momentum.qs, momentum.us)
@@ -54,17 +56,15 @@ def test_momentum_form_follows_the_same_motion():
 def test_one_triangularization_gives_the_unit_load_responses():
     """eta and the columns of Gamma (seed 002 eqs 101-107) against the dense forward dynamics,
     Gamma under the rows of A with no gravity and no velocity."""
-    model = LOOPS.model
-
     @jax.jit
-    def loads_and_dense(q, v, tau):
-        eta, Gamma, A = eta_and_gamma(LOOPS, q, v, tau)
-        unloaded = eqx.tree_at(lambda m: m.gravity, model, jnp.zeros(3))
-        dense = jax.jit(jax.vmap(lambda load: forward_dynamics(unloaded, q, jnp.zeros(6), load,
-                                                               method="dense")))(A).T
-        return eta, Gamma, forward_dynamics(model, q, v, tau, method="dense"), dense
+    def loads_and_dense(q, v):
+        eta, Gamma, A = eta_and_gamma(LOOPS, q, v)
+        unloaded = eqx.tree_at(lambda m: m.gravity, MODEL, jnp.zeros(3))
+        dense = jax.vmap(lambda load: forward_dynamics(unloaded, q, jnp.zeros(6), load,
+                                                       method="dense"))(A).T
+        return eta, Gamma, forward_dynamics(MODEL, q, v, TAU, method="dense"), dense
 
-    eta, Gamma, eta_dense, dense = loads_and_dense(Q0, V0, TAU)
+    eta, Gamma, eta_dense, dense = loads_and_dense(Q0, V0)
     np.testing.assert_allclose(eta, eta_dense, rtol=1e-10, atol=1e-10)
     np.testing.assert_allclose(Gamma, dense, rtol=1e-10, atol=1e-10 * np.abs(dense).max())
 
@@ -74,47 +74,55 @@ def test_projection_after_every_step_holds_a_driven_loop_on_its_constraints():
     every step: |Phi| and |A v + B| stay at round-off, where the unprojected run drifts past the
     (deliberately tight) tolerance and says so in its status."""
     drive = Prescribed(0, q0=Q0[0], rate=2.0)
-    loops = Loops(LOOPS.model, [*LOOPS.closures, drive])
-    q0, v0 = consistent_state(loops, Q0, V0)
+    closures = [*CHAIN.closures, drive]
+    projected_system = ClosedSystem(TREE, closures, projection=True, tolerance=1e-10)
+    q0, v0 = consistent_state(projected_system, Q0, V0)
     ts = np.linspace(0.0, 0.3, 7)
-    projected = simulate(LoopSystem(loops, projection=True, tolerance=1e-10), RK4(), q0, v0,
-                         dt=2e-3, t1=0.3, saveat=ts)
+    projected = simulate(projected_system, RK4(), q0, v0, dt=2e-3, t1=0.3, saveat=ts)
     assert projected.messages() == ["success"]
+    loops = projected_system.loops
     phi = jax.jit(jax.vmap(loops.phi))(projected.qs, projected.ts)
     rate = jax.jit(jax.vmap(loops.rate))(projected.qs, projected.us, projected.ts)
     assert float(jnp.abs(phi).max()) < 1e-10 and float(jnp.abs(rate).max()) < 1e-10
-    free = simulate(LoopSystem(loops, tolerance=1e-10), RK4(), q0, v0, dt=2e-3, t1=0.3, saveat=ts)
+    free = simulate(ClosedSystem(TREE, closures, tolerance=1e-10), RK4(), q0, v0, dt=2e-3,
+                    t1=0.3, saveat=ts)
     assert free.messages() == ["constraint violated"] and not bool(free.ok)
     assert Status(int(free.status)) == Status.CONSTRAINT_VIOLATED
 
 
 def test_inconsistent_initial_conditions_are_projected_or_rejected():
     q_bad, v_bad = Q0 + 0.02, V0 + 0.3
-    q, v = consistent_state(LOOPS, q_bad, v_bad)
+    q, v = consistent_state(CHAIN, q_bad, v_bad)
     assert float(jnp.abs(LOOPS.phi(q)).max()) < 1e-10
     assert float(jnp.abs(LOOPS.rate(q, v)).max()) < 1e-10
     with pytest.raises(ValueError, match="violates the loop closures"):
-        consistent_state(LOOPS, q_bad, v_bad, project=False)
+        consistent_state(CHAIN, q_bad, v_bad, project=False)
     assert consistent_state(LOOPS, q, v, project=False)[0] is not None
-    too_far = Loops(LOOPS.model, [CutJoint("spherical", 2, GROUND, origin_a=(0.0, 0.0, -0.3),
+    too_far = ClosedSystem(TREE, [CutJoint("spherical", 2, GROUND, origin_a=(0.0, 0.0, -0.3),
                                            origin_b=(5.0, 0.0, 0.0))])   # the chain is 0.9 m
     with pytest.raises(ValueError, match="cannot be projected"):
         consistent_state(too_far, Q0, V0)
     with pytest.raises(ValueError, match="shapes"):
-        consistent_state(LOOPS, Q0[:3], V0)
+        consistent_state(CHAIN, Q0[:3], V0)
     with pytest.raises(ValueError, match="non-finite"):
-        consistent_state(LOOPS, Q0.at[0].set(jnp.nan), V0)
+        consistent_state(CHAIN, Q0.at[0].set(jnp.nan), V0)
 
 
 def test_bad_system_parameters():
-    with pytest.raises(ValueError, match="tau must have shape"):
-        LoopSystem(LOOPS, tau=jnp.zeros(3))
+    with pytest.raises(ValueError, match=r"tau\) must have shape"):
+        TreeSystem(MODEL, jnp.zeros(3))
     with pytest.raises(ValueError, match="baumgarte"):
-        LoopSystem(LOOPS, baumgarte=(-1.0, 0.0))
+        Coupled(baumgarte=(-1.0, 0.0))
     with pytest.raises(ValueError, match="set epsilon"):
-        StabilizedLoopSystem(LOOPS, kappa=1.0)
+        Stabilized(kappa=1.0)
     with pytest.raises(TypeError, match="callable"):
-        LoopSystem(LOOPS, force=3.0)
+        TreeSystem(MODEL, "three")
+    with pytest.raises(TypeError, match="an instance"):
+        ClosedSystem(TREE, CHAIN.closures, method=Coupled)
+    with pytest.raises(TypeError, match="TreeSystem"):
+        ClosedSystem(MODEL, CHAIN.closures)
+    with pytest.raises(ValueError, match="already has its control"):
+        ClosedSystem(TREE, CHAIN.closures, control=TAU)
 
 
 @pytest.mark.slow
@@ -122,8 +130,8 @@ def test_epsilon_dynamics_with_position_feedback_keeps_its_invariant():
     """epsilon f_c_dot = A u_dot + b + kappa (A u + B) integrates to
     A u + B + kappa Phi - epsilon f_c = const: the position error is bounded by the loads."""
     eps, kappa = 0.5, 5.0
-    system = StabilizedLoopSystem(LOOPS, epsilon=eps, kappa=kappa)
-    u0 = jnp.concatenate([V0, system.initial_loads(Q0, V0, consistent=True)])
+    system = ClosedSystem(TREE, CHAIN.closures, Stabilized(epsilon=eps, kappa=kappa))
+    u0 = system.initial_state(Q0, V0, consistent=True)
     sol = simulate(system, RK4(), Q0, u0, dt=1e-3, t1=0.5, saveat=np.linspace(0.0, 0.5, 6))
 
     def invariant(q, u):

@@ -10,6 +10,7 @@ import mbjax
 from mbjax import rigid
 from mbjax.model import Model, chain, random_tree
 from mbjax.model.urdf import to_urdf
+from tests.peers import pinocchio_maps, random_state
 
 I3 = 0.01 * np.eye(3)
 
@@ -237,43 +238,6 @@ def test_fixed_joints_are_merged():
 # --------------------------------------------------------------------------------------------
 
 
-def _pinocchio_maps(model, pin_model):
-    """(q -> Pinocchio q, v_index): mbjax dof i is Pinocchio dof v_index[i]. Joints are matched
-    by name. Pinocchio's free flyer has q = (xyz, quaternion xyzw) and v = (v_local; omega_local),
-    mbjax's (xyz, wxyz) and (omega; v); a continuous joint has q = (cos, sin) in Pinocchio."""
-    v_index, q_parts = [], []
-    for k, kind in enumerate(model.joint_types):
-        jid = pin_model.getJointId(model.joint_names[k])
-        assert jid < pin_model.njoints, model.joint_names[k]
-        iv, iq, nq = pin_model.idx_vs[jid], pin_model.idx_qs[jid], pin_model.nqs[jid]
-        v_index += [iv + j for j in ((3, 4, 5, 0, 1, 2) if kind == "free"
-                                      else range(mbjax.model.JOINT_TYPES[kind].nv))]
-        q_parts.append((iq, nq, kind))
-
-    q_start = np.cumsum([0] + [mbjax.model.JOINT_TYPES[k].nq for k in model.joint_types])
-
-    def to_pin(q):
-        q = np.asarray(q)
-        out = np.zeros(pin_model.nq)
-        for k, (iq, nq, kind) in enumerate(q_parts):
-            qk = q[q_start[k]:q_start[k + 1]]
-            if kind == "free":
-                qk = np.concatenate([qk[:3], qk[4:7], qk[3:4]])
-            elif nq == 2:                                    # continuous: (cos, sin)
-                qk = np.array([np.cos(qk[0]), np.sin(qk[0])])
-            out[iq:iq + nq] = qk
-        return out
-
-    return to_pin, np.asarray(v_index)
-
-
-def _random_state(model, seed):
-    rng = np.random.default_rng(seed)
-    q = np.asarray(model.neutral()) + rng.normal(size=model.nq)
-    q = np.asarray(model.normalize(jnp.asarray(q)))
-    return q, rng.normal(size=model.nv), rng.normal(size=model.nv)
-
-
 def _symmetric(M):
     return np.triu(M) + np.triu(M, 1).T          # Pinocchio's crba fills the upper triangle
 
@@ -289,9 +253,9 @@ def _dynamics(model, q, v, tau):
 def _compare_with_pinocchio(model, pin_model, seed):
     import pinocchio as pin
 
-    to_pin, vi = _pinocchio_maps(model, pin_model)
+    to_pin, vi = pinocchio_maps(model, pin_model)
     data = pin_model.createData()
-    q, v, tau = _random_state(model, seed)
+    q, v, tau = random_state(model, seed)
     qp, vp, tp = to_pin(q), np.zeros(model.nv), np.zeros(model.nv)
     vp[vi], tp[vi] = v, tau
     *accelerations, M = _dynamics(model, jnp.asarray(q), jnp.asarray(v), jnp.asarray(tau))
@@ -318,7 +282,7 @@ def test_fixed_joint_urdf_against_mujoco():
     data = mujoco.MjData(mj)
     names = [mujoco.mj_id2name(mj, mujoco.mjtObj.mjOBJ_JOINT, j) for j in range(mj.njnt)]
     assert names == list(model.joint_names)                  # MuJoCo: document order too
-    q, v, tau = _random_state(model, seed=1)
+    q, v, tau = random_state(model, seed=1)
     data.qpos[:], data.qvel[:], data.qfrc_applied[:] = q, v, tau
     mujoco.mj_forward(mj, data)
     # the same compiled call as the Pinocchio test's (same model)

@@ -464,15 +464,17 @@ def test_forward_dynamics_rejects_bad_input():
     q, v, tau = model.neutral(), jnp.zeros(model.nv), jnp.zeros(model.nv)
     with pytest.raises(ValueError, match=r"method must be one of \('auto', 'recursive', 'dense'\)"):
         rigid.forward_dynamics(model, q, v, tau, method="euler")
-    with pytest.raises(ValueError, match=rf"q must be a vector of length {model.nq}"):
+    with pytest.raises(ValueError, match=rf"q must have shape \({model.nq},\)"):
         rigid.forward_dynamics(model, v, v, tau)
-    with pytest.raises(ValueError, match=rf"q_dot must be a vector of length {model.nv}"):
+    with pytest.raises(ValueError, match=rf"q_dot must have shape \({model.nv},\)"):
         rigid.forward_dynamics(model, q, q, tau)
-    with pytest.raises(ValueError, match="tau must be a vector.*use jax.vmap for batches"):
+    with pytest.raises(ValueError, match="tau must have shape.*use jax.vmap for batches"):
         rigid.forward_dynamics(model, q, v, jnp.zeros((2, model.nv)))
-    with pytest.raises(ValueError, match="q_ddot must be a vector"):
+    with pytest.raises(ValueError, match="q_ddot must have shape"):
         rigid.inverse_dynamics(model, q, v, jnp.zeros(model.nv + 1))
-    with pytest.raises(ValueError, match="q must be a vector"):
+    with pytest.raises(ValueError, match="q must have shape"):
         rigid.mass_matrix(model, q[:-1])
+    with pytest.raises(ValueError, match=rf"f_ext must have shape \({model.n}, 6\)"):
+        rigid.forward_dynamics(model, q, v, tau, f_ext=jnp.zeros(6))
     with pytest.raises(ValueError, match="method must be one of"):
         rigid.TreeSystem(model, method="euler")

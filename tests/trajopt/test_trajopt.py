@@ -9,11 +9,11 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
+from mbjax.control import CubicSpline, bspline_basis
 from mbjax.integrate import RK4
 from mbjax.scenes import carpal_wrist as cw
 from mbjax.trajopt import sweeps
 from mbjax.trajopt.baseline import ToolPath, feedforward_torques
-from mbjax.trajopt.splines import TorqueSpline, bspline_basis
 from mbjax.trajopt.synthesis import goal_pose, rollout, synthesize
 from mbjax.wrist import kinematics
 
@@ -23,10 +23,10 @@ def test_spline_basis_is_a_partition_of_unity_and_fits_cubics_exactly():
     B = jax.vmap(lambda t: bspline_basis(t, 2.0, 9))(ts)
     np.testing.assert_allclose(B.sum(axis=1), 1.0, atol=1e-14)
     tau = np.stack([0.3 * ts**3 - ts, np.sin(0 * ts) + 0.2, 0.1 * ts**2], axis=1)
-    spline = TorqueSpline.fit(ts, tau, 9, 2.0, limit=1e6)      # a far limit: tanh is the identity
+    spline = CubicSpline.fit(ts, tau, 9, 2.0, limit=1e6)      # a far limit: tanh is the identity
     np.testing.assert_allclose(jax.vmap(spline.unsaturated)(ts), tau, atol=1e-10)   # cubics are in the space
-    big = TorqueSpline(knots=jnp.full((9, 3), 100.0), limit=jnp.asarray(2.0), duration=2.0)
-    assert float(jnp.max(jnp.abs(big(None, 1.0, None, None)))) <= 2.0
+    big = CubicSpline(jnp.full((9, 3), 100.0), 2.0, limit=2.0)
+    assert float(jnp.max(jnp.abs(big(1.0)))) <= 2.0
 
 
 def test_baseline_path_starts_and_ends_at_rest_with_the_gravity_torque():
@@ -57,7 +57,7 @@ def test_synthesis_repairs_the_clipped_baseline_inside_the_torque_limit():
     ts = np.linspace(0.0, cw.DURATION, 101)
     tau_ff = feedforward_torques(w, ToolPath(cw.START, cw.GOAL, cw.DURATION), ts)
     assert float(jnp.max(jnp.abs(tau_ff))) > cw.TORQUE_LIMIT
-    init = TorqueSpline.fit(ts, tau_ff, 12, cw.DURATION, cw.TORQUE_LIMIT)
+    init = CubicSpline.fit(ts, tau_ff, 12, cw.DURATION, cw.TORQUE_LIMIT)
     goal = goal_pose(w, cw.GOAL)
 
     def miss(law):

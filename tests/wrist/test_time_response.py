@@ -14,7 +14,7 @@ def test_explicit_euler_is_the_chapters_eq_6_45():
     system, q0, u0 = cw.servo()
     dt = 0.01
     q1, u1, _ = ExplicitEuler().step(system, 0.0, q0, u0 + 0.3, dt)
-    a = system.wrist.forward_dynamics(q0, u0 + 0.3, system.torque(system.wrist, 0.0, q0, u0 + 0.3))
+    a = system.wrist.forward_dynamics(q0, u0 + 0.3, system.torques(0.0, q0, u0 + 0.3))
     np.testing.assert_allclose(q1, q0 + (u0 + 0.3) * dt, rtol=0, atol=1e-15)
     np.testing.assert_allclose(u1, u0 + 0.3 + a * dt, rtol=0, atol=1e-13)
 
@@ -46,16 +46,16 @@ def test_stability_boundaries_match_the_linearization():
     20 and 40 ms, implicit midpoint never. The measured boundaries bracket the critical steps of each
     method's amplification matrix about the servo's equilibrium."""
     system, q0, u0 = cw.servo()
-    law = system.torque
-    critical = linear_critical_steps(system, law.theta_ref, jnp.zeros(3))
+    law = system.control
+    critical = linear_critical_steps(system, law.q_ref, jnp.zeros(3))
     assert 0.005 < critical["explicit_euler"] < 0.01
     assert 0.01 < critical["semi_implicit_euler"] < 0.02
     assert 0.02 < critical["rk4"] < 0.04
     assert critical["implicit_midpoint"] is None
 
     def servo_energy(q, u):
-        e = q - law.theta_ref
-        return 0.5 * law.stiffness * e @ e + 0.5 * u @ system.wrist.mass_matrix(q) @ u
+        e = q - law.q_ref
+        return 0.5 * law.kp * e @ e + 0.5 * u @ system.wrist.mass_matrix(q) @ u
 
     energies = jax.jit(jax.vmap(servo_energy))
     E0 = float(jax.jit(servo_energy)(q0, u0))

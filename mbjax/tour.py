@@ -11,7 +11,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from mbjax.bench.timing import measure
+from mbjax.timing import measure
 from mbjax.integrate import INTEGRATORS, simulate, solve_reference
 from mbjax.scenes import heavy_top as top
 from mbjax.scenes import rigid_chain as rc
@@ -139,20 +139,23 @@ def closed_loops_tour(out: Path, quick: bool) -> dict:
     error being the largest joint-angle error after 1 s against an adaptive Dopri8 reference
     (rtol 1e-12), with the constraint residual |Phi| reached."""
     from mbjax.integrate import RK4
-    from mbjax.loops import LoopSystem, StabilizedLoopSystem
+    from mbjax.loops import ClosedSystem, Coupled, Stabilized
     from mbjax.plot.loops import closed_loops_tour_figure
     from mbjax.scenes import closed_chain as cc
 
-    loops, q0, v0 = cc.build(12)
+    chain, q0, v0 = cc.build(12)
     duration = cc.DURATION
     saveat = np.linspace(0.0, duration, 51)
-    ref = solve_reference(LoopSystem(loops), q0, v0, jnp.asarray(saveat), rtol=1e-12, atol=1e-12)
-    systems = {"coupled, none": LoopSystem(loops),
-               "coupled, baumgarte": LoopSystem(loops, baumgarte=(10.0, 10.0)),
-               "coupled, projection": LoopSystem(loops, projection=True),
-               "O(n + m^3), none": StabilizedLoopSystem(loops)}
+    ref = solve_reference(chain, q0, v0, jnp.asarray(saveat), rtol=1e-12, atol=1e-12)
+    methods = {"coupled, none": (Coupled(), False),
+               "coupled, baumgarte": (Coupled(baumgarte=(10.0, 10.0)), False),
+               "coupled, projection": (Coupled(), True),
+               "O(n + m^3), none": (Stabilized(), False)}
     if quick:
-        systems = {name: systems[name] for name in QUICK_LOOP_SYSTEMS}
+        methods = {name: methods[name] for name in QUICK_LOOP_SYSTEMS}
+    systems = {name: ClosedSystem(chain.tree, chain.closures, method, projection)
+               for name, (method, projection) in methods.items()}
+    loops = chain.loops
     residual = jax.jit(jax.vmap(lambda q: jnp.linalg.norm(loops.phi(q))))
     runs, rows, drift = {}, {}, {}
     for name, system in systems.items():

@@ -1,0 +1,113 @@
+"""What every control is: a callable (t, q, v) -> generalized forces, and how controls combine.
+
+A control is an equinox module, so its array leaves (gains, knots, weights) can be differentiated,
+vmapped and swept like a model's parameters. `hold(t, q, v)` says what the control is over one
+step of `mbjax.simulate` that starts at (t, q, v): itself for a law of continuous time, the value
+at the step's start for a sampled one (`ZeroOrderHold`, `SampleAndHold`: MuJoCo's `ctrl`, held
+over the step's stages).
+"""
+
+import abc
+from collections.abc import Callable
+
+import equinox as eqx
+import jax.numpy as jnp
+import numpy as np
+from jax import Array
+
+
+class AbstractControl(eqx.Module):
+    """A control law tau = control(t, q, v) on a system's actuated velocity coordinates."""
+
+    @abc.abstractmethod
+    def __call__(self, t: Array, q: Array, v: Array) -> Array:
+        """The generalized forces at time t and state (q, v)."""
+
+    def hold(self, t: Array, q: Array, v: Array) -> "AbstractControl":
+        """The control over one step that starts at (t, q, v); the law itself unless sampled."""
+        return self
+
+    def __add__(self, other) -> "Sum":
+        return Sum((self, as_control(other)))
+
+    def __radd__(self, other) -> "Sum":
+        return Sum((as_control(other), self))
+
+
+class Constant(AbstractControl):
+    """tau = value, whatever the time and state (the shorthand a constant `tau` stands for)."""
+
+    value: Array
+
+    def __init__(self, value):
+        self.value = jnp.asarray(value, dtype=float)
+
+    def __call__(self, t, q, v):
+        return self.value
+
+
+class Sum(AbstractControl):
+    """The sum of several controls (feed-forward plus feedback, a spring plus a motor, ...)."""
+
+    terms: tuple
+
+    def __init__(self, terms):
+        flat = []
+        for term in terms:
+            flat.extend(term.terms if isinstance(term, Sum) else (as_control(term),))
+        self.terms = tuple(flat)
+
+    def __call__(self, t, q, v):
+        return sum(term(t, q, v) for term in self.terms)   # a few terms, fixed at trace time
+
+    def hold(self, t, q, v):
+        return Sum(tuple(term.hold(t, q, v) for term in self.terms))
+
+
+class Function(AbstractControl):
+    """Any callable fn(t, q, v) as a control. Its parameters are differentiable when fn is an
+    equinox module (a plain Python function has none)."""
+
+    fn: Callable
+
+    def __call__(self, t, q, v):
+        return self.fn(t, q, v)
+
+
+class Saturated(AbstractControl):
+    """limit tanh(control / limit): smooth, and inside +-limit by construction."""
+
+    control: AbstractControl
+    limit: Array
+
+    def __init__(self, control, limit):
+        self.control = as_control(control)
+        self.limit = jnp.asarray(limit, dtype=float)
+
+    def __call__(self, t, q, v):
+        return saturate(self.control(t, q, v), self.limit)
+
+    def hold(self, t, q, v):
+        return Saturated(self.control.hold(t, q, v), self.limit)
+
+
+def saturate(x: Array, limit: Array | None) -> Array:
+    """limit tanh(x / limit), or x when limit is None: the one saturation every control uses."""
+    return x if limit is None else limit * jnp.tanh(x / limit)
+
+
+def as_control(control) -> AbstractControl | None:
+    """None, an `AbstractControl`, any callable (t, q, v) -> tau, or a constant array."""
+    if control is None or isinstance(control, AbstractControl):
+        return control
+    if isinstance(control, type):
+        raise TypeError(f"control must be an instance, got the class {control.__name__}; "
+                        f"call it first, e.g. {control.__name__}(...)")
+    if callable(control):
+        return Function(control)
+    dtype = getattr(control, "dtype", None)
+    dtype = np.asarray(control).dtype if dtype is None else dtype
+    if not (np.issubdtype(dtype, np.integer) or np.issubdtype(dtype, np.floating)):
+        raise TypeError(f"control must be a callable (t, q, v) -> tau or a real constant array, "
+                        f"got {type(control).__name__} of dtype {dtype}")
+    return Constant(control)

@@ -1,0 +1,132 @@
+"""What `simulate` and the closed loops of `mbjax.loops` need from an open tree, rigid or flexible.
+
+An `AbstractTreeSystem` integrates (q, v): configuration coordinates q (nq) and velocity
+coordinates v (nv), with q_dot = q_dot(q, v) and a chart (`retract`, `local_rate`) about any q
+for quaternion joints. It gives the poses of its frames (bodies, then markers), its energy, its
+mass matrix M(q) = d^2 T / dv^2, and the O(n) response of the recursion to m unit generalized
+loads at once (seed 002 eqs 101-107: one triangularization, m + 1 force passes): what the
+O(n + m^3) loop route needs. Trees whose equations of motion are M(q) v_dot + bias(t, q, v) = 0
+with that symmetric M (`symmetric_dynamics`; rigid trees, not flexible ones, whose geometric
+stiffening adds acceleration-dependent loads) also serve the dense loop routes.
+
+Applied forces live on the tree: `control` (t, q, v) -> generalized forces on the `actuation`
+coordinates, `external` (t, q, v) -> one world-frame wrench (torque; force) per body at its
+origin or at `external_point`. A closed loop wrapped around the tree inherits them.
+
+Final implementations: `mbjax.rigid.TreeSystem`, `mbjax.flex.FlexibleSystem`.
+"""
+
+import abc
+
+import equinox as eqx
+import jax
+import jax.numpy as jnp
+from jax import Array
+
+from mbjax.control import AbstractControl
+from mbjax.control.applied import about_origins, body_wrenches, generalized_control, hold
+from mbjax.integrate.system import AbstractSystem
+
+
+class AbstractTreeSystem(AbstractSystem):
+    """An open tree of bodies as a system for `simulate` and `mbjax.loops.ClosedSystem`."""
+
+    control: eqx.AbstractVar[AbstractControl | None]
+    external: eqx.AbstractVar[AbstractControl | None]
+    external_point: eqx.AbstractVar[Array | None]
+    actuation: eqx.AbstractVar[tuple[int, ...] | None]
+    symmetric_dynamics: eqx.AbstractClassVar[bool]
+
+    # -- coordinates ----------------------------------------------------------------------------
+
+    @property
+    @abc.abstractmethod
+    def n(self) -> int:
+        """Number of bodies."""
+
+    @property
+    @abc.abstractmethod
+    def nq(self) -> int:
+        """Number of configuration coordinates."""
+
+    @property
+    @abc.abstractmethod
+    def nv(self) -> int:
+        """Number of velocity coordinates."""
+
+    @property
+    def n_frames(self) -> int:
+        """Frames `frames` returns: the bodies, then any markers."""
+        return self.n
+
+    @abc.abstractmethod
+    def neutral(self) -> Array:
+        """The reference configuration (zero angles, identity quaternions, undeformed)."""
+
+    @abc.abstractmethod
+    def q_dot(self, q: Array, v: Array) -> Array:
+        """dq/dt for velocity v."""
+
+    @abc.abstractmethod
+    def normalize(self, q: Array) -> Array:
+        """q with every quaternion scaled to unit length."""
+
+    # -- kinematics, energy, dynamics -------------------------------------------------------------
+
+    @abc.abstractmethod
+    def frames(self, q: Array) -> tuple[Array, Array]:
+        """World rotation (n_frames, 3, 3) and origin (n_frames, 3) of every frame."""
+
+    @abc.abstractmethod
+    def energy(self, q: Array, v: Array) -> Array:
+        """Kinetic plus gravitational (plus strain) energy; the work of the applied forces is
+        not included."""
+
+    @abc.abstractmethod
+    def mass_matrix(self, q: Array) -> Array:
+        """M(q) = d^2 T / dv^2, symmetric positive-definite (nv, nv)."""
+
+    @abc.abstractmethod
+    def responses(self, t: Array, q: Array, v: Array, loads: Array) -> tuple[Array, Array]:
+        """(v_dot (nv,), responses (m, nv)): the accelerations under every force (gravity,
+        velocity terms, elasticity, control, external wrenches), and those each row of `loads`
+        (m, nv) alone produces (no gravity, velocity or applied force): the unit constraint-load
+        responses of seed 002 eqs 101-107, from one triangularization."""
+
+    def bias(self, t: Array, q: Array, v: Array) -> Array:
+        """The equations of motion as M(q) v_dot + bias(t, q, v) = 0 (`symmetric_dynamics`
+        trees only): velocity terms and gravity less the applied forces."""
+        raise TypeError(f"{type(self).__name__} has no equations of the form M(q) v_dot + bias = 0 "
+                        "with a symmetric M (symmetric_dynamics is False)")
+
+    # -- applied forces -------------------------------------------------------------------------
+
+    def applied(self, t: Array, q: Array, v: Array) -> Array:
+        """The control's generalized forces on all nv coordinates."""
+        return generalized_control(self.control, self.actuation, self.nv, t, q, v)
+
+    def wrenches(self, t: Array, q: Array, v: Array) -> Array | None:
+        """The external wrenches (n, 6), world frame, torque about each body's origin; or None."""
+        f = body_wrenches(self.external, self.n, t, q, v)
+        if f is None or self.external_point is None:
+            return f
+        return about_origins(f, self.frames(q)[0][:self.n], self.external_point)
+
+    # -- AbstractSystem ---------------------------------------------------------------------------
+
+    def kinematics(self, q, u):
+        return self.q_dot(q, u)
+
+    def acceleration(self, t, q, u):
+        return self.responses(t, q, u, jnp.zeros((0, self.nv), u.dtype))[0]
+
+    def project(self, q):
+        return self.normalize(q)
+
+    def hold(self, t, q, u):
+        return hold(self, t, q, u)
+
+    def relative_energy_error(self, qs: Array, us: Array) -> Array:
+        """(E(t) - E(0)) / |E(0)| along a saved trajectory."""
+        E = jax.vmap(self.energy)(qs, us)
+        return (E - E[0]) / jnp.abs(E[0])

@@ -1,0 +1,46 @@
+"""How a closed system solves for its motion: the strategy `ClosedSystem` takes as `method=`.
+
+Each method chooses the velocity state u that `simulate` integrates (the joint velocities v, the
+momenta M v, or v with the constraint loads appended) and the equations that give u_dot; the
+constraints themselves, the projection and the status checks are the closed system's.
+"""
+
+import abc
+
+import equinox as eqx
+from jax import Array
+
+
+class AbstractLoopMethod(eqx.Module):
+    """A loop-closure method (`Coupled`, `Momentum`, `Stabilized`)."""
+
+    def validate(self, tree) -> None:
+        """Raise if this method cannot close loops on `tree`."""
+
+    def velocity(self, loops, q: Array, u: Array) -> Array:
+        """The joint velocities v in the state u."""
+        return u
+
+    def with_velocity(self, loops, q: Array, u: Array, v: Array) -> Array:
+        """u with its velocity part replaced by v."""
+        return v
+
+    def initial_state(self, loops, q: Array, v: Array, t, consistent: bool) -> Array:
+        """The state u for joint velocities v."""
+        return v
+
+    @abc.abstractmethod
+    def acceleration(self, loops, t: Array, q: Array, u: Array) -> Array:
+        """u_dot."""
+
+    @abc.abstractmethod
+    def loads(self, loops, t: Array, q: Array, u: Array) -> Array:
+        """The constraint loads on the rows of A at (t, q, u)."""
+
+
+def require_symmetric(method: str, tree) -> None:
+    """The dense routes need M(q) v_dot + bias = 0 with a symmetric M."""
+    if not tree.symmetric_dynamics:
+        raise TypeError(f"{method} solves seed 001's multipliers with the symmetric mass matrix of "
+                        f"M v_dot + bias = 0; {type(tree).__name__} has none (geometric stiffening "
+                        "adds acceleration-dependent loads): close its loops with Stabilized()")
