@@ -5,12 +5,12 @@ compose over all of them. mbjax does not change global JAX settings: enable floa
 accuracy work (``jax.config.update("jax_enable_x64", True)``).
 """
 
-from mbjax import control, integrate, lie, model, rigid, scenes, spatial, tree
+from mbjax import control, data, integrate, lie, model, rigid, scenes, spatial, tree
 from mbjax.integrate import simulate
 from mbjax.model import Model
 from mbjax.model.urdf import load_urdf
 from mbjax.rigid import forward_dynamics, inverse_dynamics, mass_matrix
 
 __version__ = "0.1.0"
-__all__ = ["Model", "control", "forward_dynamics", "integrate", "inverse_dynamics", "lie", "load_urdf",
+__all__ = ["Model", "control", "data", "forward_dynamics", "integrate", "inverse_dynamics", "lie", "load_urdf",
            "mass_matrix", "model", "rigid", "scenes", "simulate", "spatial", "tree"]

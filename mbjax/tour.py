@@ -252,6 +252,86 @@ def carpal_wrist_tour(out: Path, quick: bool) -> dict:
             "seconds_per_step": seconds}
 
 
+def controls_tour(out: Path, quick: bool) -> dict:
+    """A 7-dof arm from a URDF (`mbjax.scenes.arm`): held by a PD servo with gravity feed-forward,
+    pushed at its flange for 0.1 s; driven by a torque history sampled per step as MuJoCo applies
+    it, against `mujoco.rollout` (when installed); and `jax.grad` of a reach loss with respect to
+    a torque spline's knots and a link mass against central differences."""
+
+    from mbjax.control import ZeroOrderHold
+    from mbjax.plot.scenes import controls_figure
+    from mbjax.rigid import TreeSystem
+    from mbjax.scenes import arm as scene
+
+    arm = scene.model()
+    duration = 0.5 if quick else 1.0
+    ts = np.linspace(0.0, duration, 101)
+    q0, v0 = jnp.asarray(scene.Q_REF), jnp.zeros(arm.nv)
+    run = partial(simulate, integrator=INTEGRATORS["rk4"](), q0=q0, u0=v0, dt=scene.DT, t1=duration,
+                  saveat=ts)
+    held = run(TreeSystem(arm, scene.servo(arm)))
+    pushed, timing = measure(partial(run, scene.pushed(arm)), repeats=3)
+    track = jax.jit(jax.vmap(lambda q: scene.flange(arm, q)))
+    displacement = np.asarray(track(pushed.qs) - track(held.qs))
+
+    steps = 200
+    history = np.random.default_rng(0).normal(0.0, 5.0, (steps, 3))
+    sampled = simulate(TreeSystem(arm, ZeroOrderHold(history, scene.DT), actuation=[1, 3, 5]),
+                       INTEGRATORS["rk4"](), q0, v0, dt=scene.DT, t1=steps * scene.DT,
+                       saveat=[steps * scene.DT])
+    mujoco_diff = _mujoco_sampled(arm, scene.Q_REF, history, [1, 3, 5], scene.DT, steps)
+    if mujoco_diff is not None:
+        mujoco_diff = float(np.abs(mujoco_diff - np.asarray(sampled.qs[-1])).max())
+
+    horizon = 100 if quick else 250
+    knots, mass = 0.5 * jnp.ones((6, 7)), arm.mass[3]
+    loss = jax.jit(lambda k, m: scene.reach_loss(arm, k, m, horizon))
+    grads, grad_timing = measure(jax.jit(jax.grad(loss, argnums=(0, 1))), knots, mass, repeats=3)
+    h = 1e-6
+    fd_knot = float(loss(knots.at[2, 1].add(h), mass) - loss(knots.at[2, 1].add(-h), mass)) / (2 * h)
+    fd_mass = float(loss(knots, mass + h) - loss(knots, mass - h)) / (2 * h)
+    checks = {"d loss / d knot[2, 1]": (float(grads[0][2, 1]), fd_knot),
+              "d loss / d mass of link 4": (float(grads[1]), fd_mass)}
+    rows = {name: {"jax_grad": g, "central_difference": fd,
+                   "relative_difference": abs(g - fd) / abs(fd)} for name, (g, fd) in checks.items()}
+    fig = controls_figure(np.asarray(ts), np.asarray(pushed.qs - q0), displacement, checks,
+                          f"7-dof arm (mbjax.data.ARM7), PD servo + gravity feed-forward, RK4 "
+                          f"{scene.DT * 1e3:g} ms" + (f"; sampled control vs mujoco.rollout: "
+                                                       f"{mujoco_diff:.1e} rad" if mujoco_diff is not None else ""))
+    fig.savefig(out / "controls.png", dpi=110)
+    return {"figure": "controls.png", "duration": duration,
+            "runs": {"pushed": {"peak_flange_displacement_m": float(np.abs(displacement).max()),
+                                "seconds": timing.run_s, "status": pushed.messages()[0]},
+                     "sampled": {"max_abs_diff_mujoco_rad": mujoco_diff,
+                                 "status": sampled.messages()[0]}},
+            "gradients": rows, "grad_seconds": grad_timing.run_s,
+            "grad_compile_seconds": grad_timing.compile_s}
+
+
+def _mujoco_sampled(arm, q0, history, actuated, dt, steps):
+    """The final qpos of `mujoco.rollout` with `history` as qfrc_applied on `actuated` and RK4;
+    None without MuJoCo."""
+    try:
+        import mujoco
+        from mujoco import rollout
+    except ImportError:
+        return None
+    from mbjax.model.urdf import to_urdf
+
+    mj = mujoco.MjModel.from_xml_string(to_urdf(arm))
+    mj.opt.timestep, mj.opt.integrator = dt, mujoco.mjtIntegrator.mjINT_RK4
+    data = mujoco.MjData(mj)
+    data.qpos[:] = q0
+    spec = mujoco.mjtState.mjSTATE_FULLPHYSICS
+    state = np.empty(mujoco.mj_stateSize(mj, spec))
+    mujoco.mj_getState(mj, data, state, spec)
+    qfrc = np.zeros((steps, mj.nv))
+    qfrc[:, actuated] = history
+    out, _ = rollout.rollout(mj, data, state[None], qfrc[None],
+                             control_spec=mujoco.mjtState.mjSTATE_QFRC_APPLIED)
+    return out[0, -1, 1:1 + mj.nq]
+
+
 TOUR = {
     "torque-free-body": torque_free_body_tour,
     "heavy-top": heavy_top_tour,
@@ -260,4 +340,5 @@ TOUR = {
     "closed-loops": closed_loops_tour,
     "flexible-bodies": flexible_bodies_tour,
     "carpal-wrist": carpal_wrist_tour,
+    "controls": controls_tour,
 }

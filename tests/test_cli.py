@@ -70,7 +70,7 @@ def test_reproduce_tree_scaling(tmp_path):
 # The tour's scenes in three groups of similar cost, so the two xdist workers share them.
 TOUR_GROUPS = {
     "rigid": ("torque-free-body", "heavy-top", "rigid-chain", "closed-loops"),
-    "time-elements": ("time-elements", "flexible-bodies"),
+    "time-elements": ("time-elements", "flexible-bodies", "controls"),
     "carpal-wrist": ("carpal-wrist",),
 }
 
@@ -80,7 +80,7 @@ def test_tour_groups_cover_every_scene():
 
     assert sorted(s for group in TOUR_GROUPS.values() for s in group) == sorted(TOUR)
     assert set(TOUR) == {"torque-free-body", "heavy-top", "rigid-chain", "time-elements",
-                         "closed-loops", "flexible-bodies", "carpal-wrist"}
+                         "closed-loops", "flexible-bodies", "carpal-wrist", "controls"}
 
 
 def test_tour_rejects_an_unknown_scene(capsys):
@@ -131,6 +131,15 @@ def _check_time_elements(scenes):
     assert flex["2 modes, stiffened"]["peak_relative_error"] < 5e-3
     assert flex["2 modes, stiffened"]["max_error_m"] < 0.02
     assert (flex["2 modes, no stiffening"]["max_error_m"] or math.inf) > 1.0
+    # controls: the push moves the flange by millimetres and the servo catches it; a sampled
+    # torque history gives MuJoCo's trajectory; jax.grad of the reach loss is the central difference
+    controls = scenes["controls"]
+    assert controls["runs"]["pushed"]["status"] == "success"
+    assert 1e-3 < controls["runs"]["pushed"]["peak_flange_displacement_m"] < 0.1
+    if peers.available("mujoco"):
+        assert controls["runs"]["sampled"]["max_abs_diff_mujoco_rad"] < 1e-9
+    for row in controls["gradients"].values():
+        assert row["relative_difference"] < 1e-6
 
 
 def _check_carpal_wrist(scenes):

@@ -26,7 +26,7 @@ from jax import Array
 
 from mbjax.flex.model import FlexibleModel
 from mbjax.lie import exp, gamma
-from mbjax.rigid.kinematics import _compose, to_ground
+from mbjax.rigid.kinematics import compose, to_ground
 from mbjax.spatial import cross_motion, skew
 from mbjax.tree import forward_pass
 
@@ -86,7 +86,7 @@ def _poses(model: FlexibleModel, q: Array, v: Array):
     parent, has_parent = _parents(model)
     q_parent = jnp.where(has_parent[:, None], qf[parent], 0.0)
     E, o, rho, psi, phi = attachment(model, q_parent)
-    R, p = _compose(model.model, E @ R_local, o + jnp.einsum("kij,kj->ki", E, p_local - rho))
+    R, p = compose(model.model, E @ R_local, o + jnp.einsum("kij,kj->ki", E, p_local - rho))
     return R, p, (S_local, S_dot_local, q_parent, psi, phi, rho, parent, has_parent)
 
 

@@ -36,3 +36,30 @@ def heavy_top_figure(runs: dict, title: str) -> Figure:
         ax.legend(fontsize=8)
     fig.suptitle(title)
     return fig
+
+
+def controls_figure(ts, dq, displacement, checks: dict, title: str) -> Figure:
+    """(a) joint angles of the pushed arm about its pose; (b) the flange's displacement from the
+    unpushed run; (c) jax.grad against central differences."""
+    fig = Figure(figsize=(14, 4.2), layout="constrained")
+    ax_q, ax_f, ax_g = fig.subplots(1, 3, width_ratios=(1, 1, 0.8))
+    ax_q.plot(ts, dq, lw=1)
+    ax_q.set(xlabel="t [s]", ylabel="q - q_ref [rad]", title="pushed at the flange for 0.1 s")
+    for i, axis in enumerate("xyz"):
+        ax_f.plot(ts, displacement[:, i] * 1e3, label=axis)
+    ax_f.axvspan(0.0, 0.1, color="0.9")
+    ax_f.set(xlabel="t [s]", ylabel="flange displacement [mm]", title="caught by the servo")
+    ax_f.legend(fontsize=8)
+    names = list(checks)
+    y = np.arange(len(names))
+    grads = [abs(checks[n][0]) for n in names]
+    fds = [abs(checks[n][1]) for n in names]
+    ax_g.barh(y - 0.18, grads, height=0.35, label="jax.grad")
+    ax_g.barh(y + 0.18, fds, height=0.35, label="central differences")
+    ax_g.set(yticks=y, yticklabels=names, xscale="log", xlabel="|derivative|",
+             title="gradient of the reach loss")
+    ax_g.legend(fontsize=8)
+    for ax in (ax_q, ax_f, ax_g):
+        ax.grid(alpha=0.3)
+    fig.suptitle(title, fontsize=10)
+    return fig

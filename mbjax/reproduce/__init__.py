@@ -3,8 +3,9 @@
 Each entry is reproduce(out: Path, quick: bool) -> dict (the JSON written).
 """
 
-from mbjax.reproduce import (andrews_squeezer, carpal_wrist, closed_chain, flexible_slider_crank, integrators, spin_up_beam,
-                             top_long_run, torque_free_tfe, tree_scaling, vertical_top)
+from mbjax.reproduce import (andrews_squeezer, carpal_wrist, closed_chain, flexible_slider_crank, gradient_matrix,
+                             integrators, spin_up_beam, top_long_run, torque_free_tfe, tree_scaling,
+                             vertical_top)
 
 REPRODUCTIONS = {
     integrators.NAME: integrators.reproduce,
@@ -17,6 +18,7 @@ REPRODUCTIONS = {
     spin_up_beam.NAME: spin_up_beam.reproduce,
     flexible_slider_crank.NAME: flexible_slider_crank.reproduce,
     carpal_wrist.NAME: carpal_wrist.reproduce,
+    gradient_matrix.NAME: gradient_matrix.reproduce,
 }
 
 __all__ = ["REPRODUCTIONS"]

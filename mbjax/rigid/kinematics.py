@@ -34,15 +34,17 @@ class Kinematics(NamedTuple):
 def forward_kinematics(model: Model, q: Array) -> tuple[Array, Array]:
     """World orientation (n, 3, 3) and origin (n, 3) of every body frame."""
     R, p, _, _ = model.joints(q, jnp.zeros(model.nv, q.dtype))
-    return _compose(model, R, p)
+    return compose(model, R, p)
 
 
-def _compose(model: Model, R: Array, p: Array) -> tuple[Array, Array]:
-    def compose(parent, local):
+def compose(model: Model, R: Array, p: Array) -> tuple[Array, Array]:
+    """World poses (R, p) of every body from each body's pose (R, p) in its parent's frame: the
+    outward product along the tree (one tree pass)."""
+    def step(parent, local):
         (R_parent, p_parent), (R_local, p_local) = parent, local
         return R_parent @ R_local, p_parent + R_parent @ p_local
 
-    return forward_pass(model.topology, compose, (jnp.eye(3, dtype=R.dtype), jnp.zeros(3, R.dtype)),
+    return forward_pass(model.topology, step, (jnp.eye(3, dtype=R.dtype), jnp.zeros(3, R.dtype)),
                         (R, p))
 
 
@@ -56,7 +58,7 @@ def to_ground(R: Array, p: Array, m: Array) -> Array:
 def body_kinematics(model: Model, q: Array, v: Array) -> Kinematics:
     """Poses, motion subspaces, velocities, remainder accelerations and inertias of every body."""
     R_local, p_local, S_local, S_dot_local = model.joints(q, v)
-    R, p = _compose(model, R_local, p_local)
+    R, p = compose(model, R_local, p_local)
     S = to_ground(R, p, S_local)
     vb = model.body_v(v)
     joint_velocity = jnp.einsum("kij,kj->ki", S, vb)

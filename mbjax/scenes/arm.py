@@ -1,0 +1,80 @@
+"""A 7-dof arm from a URDF (`mbjax.data.ARM7`) under controls and forces: held in a pose by a PD
+servo with the gravity torque there as feed-forward, driven by a torque spline, pushed at its
+flange, and sampled the way MuJoCo applies a control (a zero-order hold per step).
+
+`build()` gives the servoed arm; `reach_loss` is the rollout loss whose gradient with respect to
+the spline's knots and a link mass the tour, the tests and notebook 09 take.
+"""
+
+import equinox as eqx
+import jax.numpy as jnp
+import numpy as np
+from jax import Array
+
+from mbjax.control import PD, AbstractControl, CubicSpline
+from mbjax.data import ARM7
+from mbjax.integrate import RK4, simulate
+from mbjax.model import Model
+from mbjax.model.urdf import load_urdf
+from mbjax.rigid import TreeSystem, forward_kinematics, inverse_dynamics
+
+Q_REF = np.array([0.0, -0.4, 0.0, -2.0, 0.0, 1.6, 0.8])        # [rad], inside every joint's limits
+KP = np.array([60.0, 60.0, 60.0, 60.0, 20.0, 20.0, 10.0])        # [N m / rad]
+KD = 4.0                                                         # [N m s / rad]
+FLANGE = np.array([0.0, 0.0, 0.107])                             # on the last link's z axis [m]
+DT = 2e-3                                                        # [s]
+TARGET_OFFSET = np.array([0.05, -0.05, 0.03])                    # the reach: from the pose [m]
+
+
+def model() -> Model:
+    return load_urdf(ARM7)
+
+
+def servo(arm: Model) -> PD:
+    """PD about Q_REF with the gravity torque at Q_REF (the inverse dynamics at rest) as
+    feed-forward."""
+    q_ref = jnp.asarray(Q_REF)
+    gravity = inverse_dynamics(arm, q_ref, jnp.zeros(arm.nv), jnp.zeros(arm.nv))
+    return PD(jnp.asarray(KP), KD, q_ref, feedforward=gravity)
+
+
+def flange(arm: Model, q: Array) -> Array:
+    """The flange's position in the world."""
+    R, p = forward_kinematics(arm, q)
+    return p[-1] + R[-1] @ jnp.asarray(FLANGE)
+
+
+class Push(AbstractControl):
+    """A world force on the last body (at `external_point`) from t = 0 to `duration`."""
+
+    force: Array
+    n_bodies: int = eqx.field(static=True)
+    duration: float = eqx.field(static=True)
+
+    def __call__(self, t, q, v):
+        on = (t < self.duration).astype(self.force.dtype)
+        return jnp.zeros((self.n_bodies, 6), self.force.dtype).at[-1, 3:].set(on * self.force)
+
+
+def pushed(arm: Model, force=(30.0, 0.0, 0.0), duration: float = 0.1) -> TreeSystem:
+    """The servoed arm pushed at its flange."""
+    points = jnp.zeros((arm.n, 3)).at[-1].set(jnp.asarray(FLANGE))
+    return TreeSystem(arm, servo(arm), external=Push(jnp.asarray(force, float), arm.n, duration),
+                      external_point=points)
+
+
+def build():
+    """(system, q0, v0): the arm held at Q_REF by its servo, at rest."""
+    arm = model()
+    return TreeSystem(arm, servo(arm)), jnp.asarray(Q_REF), jnp.zeros(arm.nv)
+
+
+def reach_loss(arm: Model, knots: Array, link_mass: Array, steps: int, link: int = 3) -> Array:
+    """1e4 |flange(T) - target|^2 + 1e-3 |knots|^2 for the servoed arm driven by a spline with
+    `knots` (n_knots, 7) over T = steps DT, link `link`'s mass set to `link_mass`."""
+    arm = eqx.tree_at(lambda m: m.mass, arm, arm.mass.at[link].set(link_mass))
+    system = TreeSystem(arm, servo(arm) + CubicSpline(knots, duration=steps * DT))
+    T = steps * DT
+    sol = simulate(system, RK4(), jnp.asarray(Q_REF), jnp.zeros(arm.nv), dt=DT, t1=T, saveat=[T])
+    miss = flange(arm, sol.qs[-1]) - flange(arm, jnp.asarray(Q_REF)) - jnp.asarray(TARGET_OFFSET)
+    return 1e4 * miss @ miss + 1e-3 * jnp.sum(knots**2)
