@@ -16,11 +16,11 @@ from mbjax.data import ARM7
 from mbjax.integrate import RK4, simulate
 from mbjax.model import Model
 from mbjax.model.urdf import load_urdf
-from mbjax.rigid import TreeSystem, forward_kinematics, inverse_dynamics
+from mbjax.rigid import TreeSystem, forward_kinematics, inverse_dynamics, mass_matrix
 
 Q_REF = np.array([0.0, -0.4, 0.0, -2.0, 0.0, 1.6, 0.8])        # [rad], inside every joint's limits
-KP = np.array([60.0, 60.0, 60.0, 60.0, 20.0, 20.0, 10.0])        # [N m / rad]
-KD = 4.0                                                         # [N m s / rad]
+BANDWIDTH = 15.0                                                 # [rad/s] of each joint's servo
+DAMPING_RATIO = 0.7
 FLANGE = np.array([0.0, 0.0, 0.107])                             # on the last link's z axis [m]
 DT = 2e-3                                                        # [s]
 TARGET_OFFSET = np.array([0.05, -0.05, 0.03])                    # the reach: from the pose [m]
@@ -32,10 +32,14 @@ def model() -> Model:
 
 def servo(arm: Model) -> PD:
     """PD about Q_REF with the gravity torque at Q_REF (the inverse dynamics at rest) as
-    feed-forward."""
+    feed-forward; each joint's gains from its diagonal mass-matrix entry M_ii, kp = M_ii w^2 and
+    kd = 2 zeta w M_ii, so every joint has the bandwidth w (the wrist joints' inertia is a
+    hundredth of the shoulder's: equal gains would make them stiff for an explicit step)."""
     q_ref = jnp.asarray(Q_REF)
+    inertia = jnp.diag(mass_matrix(arm, q_ref))
     gravity = inverse_dynamics(arm, q_ref, jnp.zeros(arm.nv), jnp.zeros(arm.nv))
-    return PD(jnp.asarray(KP), KD, q_ref, feedforward=gravity)
+    return PD(inertia * BANDWIDTH**2, 2 * DAMPING_RATIO * BANDWIDTH * inertia, q_ref,
+              feedforward=gravity)
 
 
 def flange(arm: Model, q: Array) -> Array:

@@ -79,7 +79,7 @@ def test_modal_mass_matrix_is_the_sum_over_mass_points():
     np.testing.assert_allclose(mass_matrix(body, q), direct, rtol=0, atol=1e-13)
 
 
-@pytest.mark.parametrize("stiffening", [True, False])
+@pytest.mark.parametrize("stiffening", [True, pytest.param(False, marks=pytest.mark.slow)])
 def test_recursion_matches_the_lagrangian_route(stiffening):
     """Seed 002's O(n) recursion with modal blocks, attachments and Table 1 stiffening against
     Lagrange's equations from the energies (no shared partial velocities), at a random state."""

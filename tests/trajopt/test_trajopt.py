@@ -8,6 +8,7 @@ import textwrap
 import jax
 import jax.numpy as jnp
 import numpy as np
+import pytest
 
 from mbjax.control import CubicSpline, bspline_basis
 from mbjax.integrate import RK4
@@ -47,6 +48,7 @@ def test_baseline_path_starts_and_ends_at_rest_with_the_gravity_torque():
     np.testing.assert_allclose(path.joint_motion(w, jnp.asarray(0.2))[1], (qb - qa) / (2 * h), atol=1e-7)
 
 
+@pytest.mark.slow     # notebook 07 runs and asserts the same descent by default
 def test_synthesis_repairs_the_clipped_baseline_inside_the_torque_limit():
     """The feed-forward baseline needs 1.96 N m > the 1.8 N m limit; clipped, the tool misses the
     goal. A short descent through the RK4 simulator brings the tool much closer, torques inside
