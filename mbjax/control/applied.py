@@ -11,11 +11,12 @@ import jax.numpy as jnp
 import numpy as np
 from jax import Array
 
-from mbjax.control.base import AbstractControl
+from mbjax.control.base import AbstractControl, as_control
 
 
 def check_actuation(actuation, nv: int) -> tuple[int, ...] | None:
-    """The actuated velocity coordinates as a sorted tuple of distinct indices, or None (all)."""
+    """The actuated velocity coordinates as a tuple of distinct indices (in the order of the
+    control's outputs), or None (all of them)."""
     if actuation is None:
         return None
     index = np.atleast_1d(np.asarray(actuation))
@@ -29,6 +30,17 @@ def check_actuation(actuation, nv: int) -> tuple[int, ...] | None:
     if len(set(index.tolist())) != len(index) or np.any(index < 0) or np.any(index >= nv):
         raise ValueError(f"actuation must be distinct indices in 0 ... {nv - 1}, got {index.tolist()}")
     return tuple(int(i) for i in index)
+
+
+def check_control(control, actuation: tuple | None, nv: int) -> AbstractControl | None:
+    """The control as an `AbstractControl` (see `as_control`); a constant must have one entry per
+    actuated coordinate."""
+    control = as_control(control)
+    n_act = nv if actuation is None else len(actuation)
+    value = getattr(control, "value", None)
+    if value is not None and value.shape != (n_act,):
+        raise ValueError(f"the constant control (tau) must have shape ({n_act},), got {value.shape}")
+    return control
 
 
 def generalized_control(control: AbstractControl | None, actuation: tuple | None, nv: int,

@@ -14,7 +14,7 @@ import jax.numpy as jnp
 from jax import Array
 
 from mbjax.control import AbstractControl, as_control
-from mbjax.control.applied import check_actuation, check_points
+from mbjax.control.applied import check_actuation, check_control, check_points
 from mbjax.flex.aba import flexible_aba_responses
 from mbjax.flex.body import kinetic_energy as body_kinetic_energy
 from mbjax.flex.kinematics import body_velocities, frame_poses
@@ -50,45 +50,10 @@ class FlexibleSystem(AbstractTreeSystem):
             raise ValueError(f"method must be one of {METHODS}, got {method!r}")
         self.model = model
         self.actuation = check_actuation(actuation, model.nv)
-        self.control = as_control(control)
-        n_act = model.nv if self.actuation is None else len(self.actuation)
-        value = getattr(self.control, "value", None)
-        if value is not None and value.shape != (n_act,):
-            raise ValueError(f"the constant control (tau) must have shape ({n_act},), got {value.shape}")
+        self.control = check_control(control, self.actuation, model.nv)
         self.external = as_control(external)
         self.external_point = check_points(external_point, model.n)
         self.method = method
-
-    @property
-    def n(self):
-        return self.model.n
-
-    @property
-    def nq(self):
-        return self.model.nq
-
-    @property
-    def nv(self):
-        return self.model.nv
-
-    @property
-    def n_frames(self):
-        return self.model.n_frames
-
-    def neutral(self):
-        return self.model.neutral()
-
-    def q_dot(self, q, v):
-        return self.model.q_dot(q, v)
-
-    def retract(self, q0, xi):
-        return self.model.retract(q0, xi)
-
-    def local_rate(self, q0, xi, u):
-        return self.model.local_rate(q0, xi, u)
-
-    def normalize(self, q):
-        return self.model.normalize(q)
 
     def frames(self, q):
         """Body frames (joint grids), then the markers at grid points, deformation included."""

@@ -14,6 +14,7 @@ defaults (retract(q0, xi) = q0 + xi).
 import abc
 
 import equinox as eqx
+import jax
 import jax.numpy as jnp
 from jax import Array
 
@@ -56,3 +57,8 @@ class AbstractSystem(eqx.Module):
         """`Status` flags for a state `simulate` saves (a violated or redundant constraint,
         `mbjax.loops`); 0 here."""
         return jnp.array(0, jnp.int32)
+
+    def relative_energy_error(self, qs: Array, us: Array) -> Array:
+        """(E(t) - E(0)) / |E(0)| along a saved trajectory, for systems with an `energy(q, u)`."""
+        E = jax.vmap(self.energy)(qs, us)
+        return (E - E[0]) / jnp.abs(E[0])

@@ -19,7 +19,6 @@ Final implementations: `mbjax.rigid.TreeSystem`, `mbjax.flex.FlexibleSystem`.
 import abc
 
 import equinox as eqx
-import jax
 import jax.numpy as jnp
 from jax import Array
 
@@ -29,8 +28,10 @@ from mbjax.integrate.system import AbstractSystem
 
 
 class AbstractTreeSystem(AbstractSystem):
-    """An open tree of bodies as a system for `simulate` and `mbjax.loops.ClosedSystem`."""
+    """An open tree of bodies as a system for `simulate` and `mbjax.loops.ClosedSystem`. Its
+    `model` (a `mbjax.Model` or a `mbjax.flex.FlexibleModel`) gives the coordinates."""
 
+    model: eqx.AbstractVar[object]
     control: eqx.AbstractVar[AbstractControl | None]
     external: eqx.AbstractVar[AbstractControl | None]
     external_point: eqx.AbstractVar[Array | None]
@@ -40,36 +41,42 @@ class AbstractTreeSystem(AbstractSystem):
     # -- coordinates ----------------------------------------------------------------------------
 
     @property
-    @abc.abstractmethod
     def n(self) -> int:
         """Number of bodies."""
+        return self.model.n
 
     @property
-    @abc.abstractmethod
     def nq(self) -> int:
         """Number of configuration coordinates."""
+        return self.model.nq
 
     @property
-    @abc.abstractmethod
     def nv(self) -> int:
         """Number of velocity coordinates."""
+        return self.model.nv
 
     @property
     def n_frames(self) -> int:
         """Frames `frames` returns: the bodies, then any markers."""
-        return self.n
+        return self.model.n_frames
 
-    @abc.abstractmethod
     def neutral(self) -> Array:
         """The reference configuration (zero angles, identity quaternions, undeformed)."""
+        return self.model.neutral()
 
-    @abc.abstractmethod
     def q_dot(self, q: Array, v: Array) -> Array:
         """dq/dt for velocity v."""
+        return self.model.q_dot(q, v)
 
-    @abc.abstractmethod
+    def retract(self, q0: Array, xi: Array) -> Array:
+        return self.model.retract(q0, xi)
+
+    def local_rate(self, q0: Array, xi: Array, u: Array) -> Array:
+        return self.model.local_rate(q0, xi, u)
+
     def normalize(self, q: Array) -> Array:
         """q with every quaternion scaled to unit length."""
+        return self.model.normalize(q)
 
     # -- kinematics, energy, dynamics -------------------------------------------------------------
 
@@ -126,7 +133,3 @@ class AbstractTreeSystem(AbstractSystem):
     def hold(self, t, q, u):
         return hold(self, t, q, u)
 
-    def relative_energy_error(self, qs: Array, us: Array) -> Array:
-        """(E(t) - E(0)) / |E(0)| along a saved trajectory."""
-        E = jax.vmap(self.energy)(qs, us)
-        return (E - E[0]) / jnp.abs(E[0])

@@ -14,7 +14,6 @@ least-squares loads of `mbjax.loops.multipliers` keep the run finite).
 """
 
 import equinox as eqx
-import jax
 import jax.numpy as jnp
 from jax import Array
 
@@ -153,7 +152,3 @@ class ClosedSystem(AbstractSystem):
         of the applied forces and prescribed motions is not included."""
         return self.tree.energy(q, self.velocity(q, u))
 
-    def relative_energy_error(self, qs: Array, us: Array) -> Array:
-        """(E(t) - E(0)) / |E(0)| along a saved trajectory."""
-        E = jax.vmap(self.energy)(qs, us)
-        return (E - E[0]) / jnp.abs(E[0])

@@ -141,6 +141,11 @@ class Model(eqx.Module):
         return self.topology.n
 
     @property
+    def n_frames(self) -> int:
+        """Frames of the tree: its bodies (a flexible model adds markers)."""
+        return self.topology.n
+
+    @property
     def nq(self) -> int:
         return _layout(self.joint_types)["nq"]
 

@@ -19,7 +19,8 @@ from jax import Array
 
 from mbjax import lie
 from mbjax.control import AbstractControl, as_control
-from mbjax.control.applied import about_origins, body_wrenches, check_actuation, check_points, generalized_control, hold
+from mbjax.control.applied import (about_origins, body_wrenches, check_actuation, check_control,
+                                   check_points, generalized_control, hold)
 from mbjax.integrate.system import AbstractSystem
 from mbjax.spatial import check_inertia
 
@@ -69,11 +70,7 @@ class RigidBody(AbstractSystem):
         self.rotation = rotation
         nv = 3 if fixed_point else 6
         self.actuation = check_actuation(actuation, nv)
-        self.control = as_control(control)
-        value = getattr(self.control, "value", None)
-        n_act = nv if self.actuation is None else len(self.actuation)
-        if value is not None and value.shape != (n_act,):
-            raise ValueError(f"the constant control must have shape ({n_act},), got {value.shape}")
+        self.control = check_control(control, self.actuation, nv)
         self.external = as_control(external)
         self.external_point = check_points(external_point, 1)
 
@@ -169,11 +166,6 @@ class RigidBody(AbstractSystem):
 
     def energy(self, q, u):
         return self.kinetic_energy(q, u) + self.potential_energy(q)
-
-    def relative_energy_error(self, qs, us):
-        """E(q_i, u_i) / E(q_0, u_0) - 1 along saved states (non-finite where a run diverged)."""
-        E = jax.vmap(self.energy)(qs, us)
-        return E / E[0] - 1.0
 
     def angular_momentum(self, q, u):
         """Spatial angular momentum about the origin (the fixed point, if any)."""

@@ -21,6 +21,7 @@ from mbjax.control.applied import (
     about_origins,
     body_wrenches,
     check_actuation,
+    check_control,
     check_points,
     generalized_control,
     hold,
@@ -44,15 +45,6 @@ def _model(model) -> Model:
                         + ("; a flexible tree goes in mbjax.flex.FlexibleSystem"
                            if type(model).__name__ == "FlexibleModel" else ""))
     return model
-
-
-def _control(control, actuation, nv):
-    control = as_control(control)
-    n_act = nv if actuation is None else len(actuation)
-    value = getattr(control, "value", None)
-    if value is not None and value.shape != (n_act,):
-        raise ValueError(f"the constant control (tau) must have shape ({n_act},), got {value.shape}")
-    return control
 
 
 class TreeSystem(AbstractTreeSystem):
@@ -80,37 +72,10 @@ class TreeSystem(AbstractTreeSystem):
             raise ValueError(f"method must be one of {METHODS}, got {method!r}")
         self.model = _model(model)
         self.actuation = check_actuation(actuation, model.nv)
-        self.control = _control(control, self.actuation, model.nv)
+        self.control = check_control(control, self.actuation, model.nv)
         self.external = as_control(external)
         self.external_point = check_points(external_point, model.n)
         self.method = method
-
-    @property
-    def n(self):
-        return self.model.n
-
-    @property
-    def nq(self):
-        return self.model.nq
-
-    @property
-    def nv(self):
-        return self.model.nv
-
-    def neutral(self):
-        return self.model.neutral()
-
-    def q_dot(self, q, v):
-        return self.model.q_dot(q, v)
-
-    def retract(self, q0, xi):
-        return self.model.retract(q0, xi)
-
-    def local_rate(self, q0, xi, u):
-        return self.model.local_rate(q0, xi, u)
-
-    def normalize(self, q):
-        return self.model.normalize(q)
 
     def frames(self, q):
         return forward_kinematics(self.model, q)
@@ -168,7 +133,7 @@ class MomentumSystem(AbstractSystem):
                  actuation=None):
         self.model = _model(model)
         self.actuation = check_actuation(actuation, model.nv)
-        self.control = _control(control, self.actuation, model.nv)
+        self.control = check_control(control, self.actuation, model.nv)
         self.external = as_control(external)
         self.external_point = check_points(external_point, model.n)
 

@@ -1,12 +1,11 @@
 """The Carpal Wrist as a system for `simulate` (seed 003 §6.4)."""
 
 import equinox as eqx
-import jax
-import jax.numpy as jnp
 from jax import Array
 
 from mbjax.control import AbstractControl, as_control
-from mbjax.control.applied import body_wrenches, check_actuation, check_points, generalized_control, hold
+from mbjax.control.applied import (body_wrenches, check_actuation, check_control, check_points,
+                                   generalized_control, hold)
 from mbjax.integrate.system import AbstractSystem
 from mbjax.wrist import dynamics
 from mbjax.wrist.model import CarpalWrist
@@ -32,11 +31,7 @@ class WristSystem(AbstractSystem):
             raise TypeError(f"wrist must be a CarpalWrist, got {type(wrist).__name__}")
         self.wrist = wrist
         self.actuation = check_actuation(actuation, 3)
-        self.control = as_control(control)
-        value = getattr(self.control, "value", None)
-        n_act = 3 if self.actuation is None else len(self.actuation)
-        if value is not None and value.shape != (n_act,):
-            raise ValueError(f"the constant control must have shape ({n_act},), got {value.shape}")
+        self.control = check_control(control, self.actuation, 3)
         self.external = as_control(external)
         point = check_points(external_point, 1)
         self.external_point = None if point is None else point[0]
@@ -62,7 +57,3 @@ class WristSystem(AbstractSystem):
         """T + V of the tool; the work of the motors and the external wrench is not included."""
         return dynamics.energy(self.wrist, q, u)
 
-    def relative_energy_error(self, qs: Array, us: Array) -> Array:
-        """(E(t) - E(0)) / |E(0)| along a saved trajectory."""
-        E = jax.vmap(self.energy)(qs, us)
-        return (E - E[0]) / jnp.abs(E[0])
