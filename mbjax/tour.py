@@ -265,7 +265,7 @@ def controls_tour(out: Path, quick: bool) -> dict:
 
     arm = scene.model()
     duration = 0.5 if quick else 1.0
-    ts = np.linspace(0.0, duration, 101)
+    ts = np.linspace(0.0, duration, 51)                     # every 5 steps
     q0, v0 = jnp.asarray(scene.Q_REF), jnp.zeros(arm.nv)
     run = partial(simulate, integrator=INTEGRATORS["rk4"](), q0=q0, u0=v0, dt=scene.DT, t1=duration,
                   saveat=ts)

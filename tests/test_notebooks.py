@@ -1,4 +1,8 @@
-"""Every notebook in notebooks/ runs top to bottom."""
+"""Every notebook in notebooks/ runs top to bottom.
+
+By default in a smoke mode: MBJAX_QUICK=1 (the notebooks shorten their studies) and without the
+cells tagged "slow" (long studies whose results the unit tests check anyway: the scaling runs,
+the long marches, the stability sweeps). `-m slow` runs every cell."""
 
 from pathlib import Path
 
@@ -13,13 +17,24 @@ def test_there_are_notebooks():
     assert NOTEBOOKS
 
 
-@pytest.mark.parametrize("path", NOTEBOOKS, ids=lambda p: p.name)
-def test_notebook_runs(path, tmp_path, monkeypatch):
-    # MBJAX_QUICK=1: the notebooks shorten their longest studies (scaling sweeps, training) here
+def _run(path, tmp_path, monkeypatch, smoke: bool):
     monkeypatch.setenv("MBJAX_QUICK", "1")
     nb = nbformat.read(path, as_version=4)
+    if smoke:
+        nb.cells = [c for c in nb.cells if "slow" not in c.metadata.get("tags", [])]
     NotebookClient(nb, timeout=600, kernel_name="python3",
                    resources={"metadata": {"path": str(tmp_path)}}).execute()
     errors = [o for cell in nb.cells if cell.cell_type == "code"
               for o in cell.get("outputs", []) if o.get("output_type") == "error"]
     assert not errors
+
+
+@pytest.mark.parametrize("path", NOTEBOOKS, ids=lambda p: p.name)
+def test_notebook_smoke(path, tmp_path, monkeypatch):
+    _run(path, tmp_path, monkeypatch, smoke=True)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("path", NOTEBOOKS, ids=lambda p: p.name)
+def test_notebook_runs(path, tmp_path, monkeypatch):
+    _run(path, tmp_path, monkeypatch, smoke=False)

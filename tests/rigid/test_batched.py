@@ -93,7 +93,6 @@ def test_batch_rollout_equals_vmapped_rollouts():
     assert int(batch.status) == 0
 
 
-@pytest.mark.slow     # notebook 08 asserts the same gradient and memory slopes by default
 def test_checkpointed_gradient_is_the_same_in_sqrt_t_memory():
     model = chain(4, seed=7)
     q, v, _ = _states(model, 16, seed=3)
