@@ -144,9 +144,10 @@ def _check_time_elements(scenes):
 
 def _check_carpal_wrist(scenes):
     # the Carpal Wrist: the chapter's explicit Euler fails first, where the others hold
+    # (quick: against RK4; test_time_response checks all four boundaries)
     wrist = scenes["carpal-wrist"]["integrators"]
-    assert not wrist["explicit_euler dt=10 ms"]["stable"] and wrist["semi_implicit_euler dt=10 ms"]["stable"]
-    assert wrist["rk4 dt=10 ms"]["stable"] and wrist["implicit_midpoint dt=40 ms"]["stable"]
+    assert not wrist["explicit_euler dt=10 ms"]["stable"] and wrist["rk4 dt=10 ms"]["stable"]
+    assert not wrist["rk4 dt=40 ms"]["stable"]
 
 
 TOUR_CHECKS = {"rigid": _check_rigid, "time-elements": _check_time_elements,
@@ -183,6 +184,7 @@ def test_bench_rigid_quick(tmp_path):
     assert (tmp_path / "rigid.png").stat().st_size > 10_000
 
 
+@pytest.mark.slow     # tests/tfe/test_stability checks the tables; notebook 03 prints them
 def test_reproduce_vertical_top(tmp_path):
     """Seed 000 Tables 1-2 (the quick run's rows) to the issue's tolerances, and eq 7.10."""
     assert main(["reproduce", "vertical-top", "--quick", "--out", str(tmp_path)]) == 0

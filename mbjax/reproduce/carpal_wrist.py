@@ -115,9 +115,10 @@ def linear_critical_steps(system, q_eq, u_eq) -> dict:
     return out
 
 
-def integrator_study(steps, seconds: dict | None = None) -> tuple[list[dict], dict]:
-    """The rows of the JSON's "integrators" and the predicted critical steps; with a `seconds`
-    dict, each method's run time per step of the vmapped free-motion runs is stored in it."""
+def integrator_study(steps, seconds: dict | None = None, methods=METHODS) -> tuple[list[dict], dict]:
+    """The rows of the JSON's "integrators" for `methods` and the predicted critical steps; with a
+    `seconds` dict, each method's run time per step of the vmapped free-motion runs is stored in
+    it."""
     free, q0, u0 = scene.free_motion()
     servo, s0, v0 = scene.servo()
     ref = simulate(free, RK4(), q0, u0, dt=REFERENCE_DT, t1=scene.FREE_DURATION,
@@ -131,7 +132,7 @@ def integrator_study(steps, seconds: dict | None = None) -> tuple[list[dict], di
         return 0.5 * law.kp * e @ e + 0.5 * u @ servo.wrist.mass_matrix(q) @ u
 
     rows = []
-    for name in METHODS:
+    for name in methods:
         integrator = INTEGRATORS[name]()
         timings = {} if seconds is not None else None
         q, _, drift = masked_rollout(free, integrator, q0, u0, steps, scene.FREE_DURATION,

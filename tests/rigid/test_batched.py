@@ -59,6 +59,7 @@ def test_float32_runs_in_float32_and_stays_close():
     assert _relative(single, exact) < 1e-4
 
 
+@pytest.mark.slow     # the checkpointed-gradient test differentiates batch_aba rollouts by default
 def test_gradients_match_finite_differences_at_zero_rotation():
     model = chain(4, seed=2)
     q = jnp.zeros((4, 3))

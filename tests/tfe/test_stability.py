@@ -58,7 +58,8 @@ def test_two_node_exponents_are_eqs_7_8_and_7_9(quadrature, a, b):
 
 
 @pytest.mark.parametrize("name", [pytest.param(n, marks=pytest.mark.slow)
-                                  if n in ("primal_symmetric", "mixed_unsymmetric", "three_field") else n
+                                  if n in ("primal_symmetric", "mixed", "mixed_unsymmetric", "three_field")
+                                  else n
                                   for n in sorted(FORMS)])
 def test_paper_transition_matrix_equals_the_implicit_function_jacobian(name):
     """Eq 6.8 (condensed primal) or eq 6.12 (mixed, three-field) equals d z_2 / d z_1 of the

@@ -112,6 +112,7 @@ SHARDED = textwrap.dedent("""
 """)
 
 
+@pytest.mark.slow     # notebook 07 asserts the sharded sweep against the vmapped one by default
 def test_the_same_sweep_sharded_over_two_devices():
     env = {**os.environ, "XLA_FLAGS": "--xla_force_host_platform_device_count=2", "JAX_PLATFORMS": "cpu"}
     out = subprocess.run([sys.executable, "-c", SHARDED], env=env, capture_output=True, text=True, timeout=600)
