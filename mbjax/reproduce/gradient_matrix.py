@@ -18,6 +18,7 @@ the errors are max |d - fd| / max |fd|; "seconds" is compilation plus one run of
 the six perturbed rollouts together.
 """
 
+import functools
 import json
 import time
 from collections.abc import Callable
@@ -86,6 +87,17 @@ def quaternion_tree(p, integrator):
     return _run(system, integrator, q0, jnp.array([0.5, 0.0, -0.3, 0.2]), 0.01, 10)
 
 
+def _built_once(build):
+    """A scene built once, eagerly even when first asked for inside a traced loss (a beam's modal
+    reduction traced into every gradient program would be compiled with it)."""
+    @functools.cache
+    def cached():
+        with jax.ensure_compile_time_eval():
+            return build()
+    return cached
+
+
+@_built_once
 def _beam_on_a_hinge() -> FlexibleModel:
     beam = Beam.round(1.0, 0.02, E=7e10, rho=2700.0, nu=0.33, n_elements=2)
     body = beam_body(beam, craig_bampton(beam, n_modes=2, planar="xz"))
@@ -104,9 +116,14 @@ def flexible(p, integrator):
     return _run(system, integrator, q0, jnp.zeros(model.nv), 2e-4, 10)
 
 
+_servo = _built_once(cw.servo)
+_four_bar = _built_once(four_bar.build)
+_slider_crank = _built_once(lambda: fsc.build(n_elements=1))
+
+
 def wrist(p, integrator):
     """The Carpal Wrist under its servo plus a torque spline."""
-    servoed, theta0, _ = cw.servo()
+    servoed, theta0, _ = _servo()
     w = eqx.tree_at(lambda w: w.tool_mass, servoed.wrist, servoed.wrist.tool_mass * (1.0 + p[2]))
     feedforward = CubicSpline(jnp.array([[0.1, -0.1, 0.0], [0.3, 0.0, -0.2], [0.0, 0.2, 0.1],
                                          [-0.1, 0.1, 0.0]]) * (1.0 + p[1]), 0.1)
@@ -117,7 +134,7 @@ def wrist(p, integrator):
 def closed(method, projection: bool):
     """The four-bar driven by a constant crank torque, closed by `method`."""
     def loss(p, integrator):
-        system0, q0, v0 = four_bar.build()
+        system0, q0, v0 = _four_bar()
         model = system0.tree.model
         model = eqx.tree_at(lambda m: m.mass, model, model.mass.at[1].multiply(1.0 + p[2]))
         tree_ = TreeSystem(model, Constant(jnp.array([0.2 * (1.0 + p[1])])), actuation=[0])
@@ -131,7 +148,7 @@ def closed_flexible(projection: bool):
     """The flexible slider-crank (driven crank, the slider at a marker of the rod, one element)
     closed by seed 002's route, a torque on the rod's joint."""
     def loss(p, integrator):
-        system0, q0, v0, _ = fsc.build(n_elements=1)
+        system0, q0, v0, _ = _slider_crank()
         model = system0.tree.model
         model = eqx.tree_at(lambda m: m.bodies.stiffness, model, model.bodies.stiffness * (1.0 + p[2]))
         tree_ = FlexibleSystem(model, Constant(jnp.array([0.05 * (1.0 + p[1])])), actuation=[1])

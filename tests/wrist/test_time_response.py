@@ -4,6 +4,7 @@ convergence order, and stability exactly where each method's linearization says 
 import jax
 import jax.numpy as jnp
 import numpy as np
+import pytest
 
 from mbjax.integrate import INTEGRATORS, RK4, ExplicitEuler, simulate
 from mbjax.reproduce.carpal_wrist import QUICK_STEPS, linear_critical_steps, masked_rollout
@@ -40,6 +41,7 @@ def test_energy_is_conserved_and_rk4_converges_at_order_four():
     assert float(m.inverse.min()) > 0.5 and float(m.direct.min()) > 0.9
 
 
+@pytest.mark.slow     # the quick tour checks explicit Euler against RK4 by default
 def test_stability_boundaries_match_the_linearization():
     """Explicit Euler (eq 6.45) fails first: between 5 and 10 ms, where semi-implicit Euler, RK4
     and implicit midpoint are stable; semi-implicit Euler fails between 10 and 20 ms, RK4 between
