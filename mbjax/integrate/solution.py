@@ -17,10 +17,12 @@ class Status(enum.IntFlag):
     CONSTRAINT_VIOLATED = 8  # a closed loop's residual |Phi| grew past the system's tolerance
     REDUNDANT = 16         # a note, not a failure: the constraint Jacobian lost rank (redundant
                            # closures or a singular configuration); least-squares loads were used
+    LIMIT_EXCEEDED = 32    # a note: a saved state or control is beyond the model's joint limits
+                           # (position, velocity or effort; `mbjax.model.limits`)
 
     @classmethod
     def failures(cls) -> int:
-        """The flags that make a run fail (`REDUNDANT` only informs)."""
+        """The flags that make a run fail (`REDUNDANT` and `LIMIT_EXCEEDED` only inform)."""
         return cls.NONFINITE | cls.NOT_CONVERGED | cls.SOLVER_FAILED | cls.CONSTRAINT_VIOLATED
 
 
@@ -30,7 +32,7 @@ class WithStatus(eqx.Module):
 
     @property
     def ok(self) -> Array:
-        """True where the run succeeded (no failure flag; `Status.REDUNDANT` only informs)."""
+        """True where the run succeeded (no failure flag; the notes only inform)."""
         return (self.status & Status.failures()) == 0
 
     def messages(self) -> list[str]:

@@ -1,5 +1,5 @@
 """Closed loops (seed 001 §VI, seed 002 §2.4): any tree closed by cut joints and prescribed
-motions (`CutJoint`, `Prescribed`), as a system for `simulate`:
+motions (`CutJoint`, `Coupling`, `Prescribed`), as a system for `simulate`:
 
     ClosedSystem(tree, closures, method=..., projection=False)
 
@@ -13,7 +13,7 @@ after every step (differentiable, by the implicit function theorem) and of initi
 `stabilized_acceleration`.
 """
 
-from mbjax.loops.closures import GROUND, CutJoint, Prescribed
+from mbjax.loops.closures import GROUND, Coupling, CutJoint, Prescribed
 from mbjax.loops.constraints import Loops
 from mbjax.loops.coupled import Coupled, coupled_acceleration
 from mbjax.loops.method import AbstractLoopMethod
@@ -23,7 +23,7 @@ from mbjax.loops.projection import consistent_state, gauss_newton, project_confi
 from mbjax.loops.stabilized import Stabilized, eta_and_gamma, stabilized_acceleration
 from mbjax.loops.system import ClosedSystem
 
-__all__ = ["GROUND", "AbstractLoopMethod", "ClosedSystem", "Coupled", "CutJoint", "Loops",
+__all__ = ["GROUND", "AbstractLoopMethod", "ClosedSystem", "Coupled", "Coupling", "CutJoint", "Loops",
            "Momentum", "Prescribed", "Stabilized", "consistent_state", "coupled_acceleration",
            "eta_and_gamma", "gauss_newton", "momentum_rate", "multipliers", "numerical_rank",
            "project_configuration", "project_velocity", "stabilized_acceleration"]

@@ -14,7 +14,8 @@ axis is the frame's z axis. Its residual, from the poses of the two frames (grou
     point_on_line  (p_A - p_B) . x_B, (p_A - p_B) . y_B  (p_A on the line z_B)   2
     point_on_plane (p_A - p_B) . z_B                     (p_A on the plane z_B)  1
 
-A `Prescribed` motion drives one velocity coordinate, q_j = q0 + rate t (a rheonomic constraint,
+A `Coupling` ties one configuration coordinate to another, q_a = multiplier q_b + offset (URDF's
+mimic joints, MJCF's joint equality). A `Prescribed` motion drives one velocity coordinate, q_j = q0 + rate t (a rheonomic constraint,
 e.g. a crank turning at constant speed), or q_j = motion(t) for any differentiable motion (a
 spin-up profile): its velocity and acceleration terms come from autodiff in t.
 
@@ -127,3 +128,30 @@ class Prescribed(eqx.Module):
         if self.motion is not None:
             return (q[self.dof] - self.motion(t))[None]
         return (q[self.dof] - self.q0 - self.rate * t)[None]
+
+
+class Coupling(eqx.Module):
+    """Configuration coordinate `coordinate` tied to `reference`: q_a = multiplier q_b + offset
+    (a URDF mimic joint or an MJCF joint equality; indices into q)."""
+
+    coordinate: int = eqx.field(static=True)
+    reference: int = eqx.field(static=True)
+    multiplier: Array
+    offset: Array
+
+    def __init__(self, coordinate: int, reference: int, multiplier=1.0, offset=0.0):
+        for what, value in (("coordinate", coordinate), ("reference", reference)):
+            if not isinstance(value, int | np.integer) or value < 0:
+                raise ValueError(f"{what} must be a non-negative int, got {value!r}")
+        if coordinate == reference:
+            raise ValueError(f"coordinate {coordinate} cannot be coupled to itself")
+        self.coordinate, self.reference = int(coordinate), int(reference)
+        self.multiplier = jnp.asarray(multiplier, float)
+        self.offset = jnp.asarray(offset, float)
+
+    @property
+    def size(self) -> int:
+        return 1
+
+    def residual(self, R: Array, p: Array, q: Array, t) -> Array:
+        return (q[self.coordinate] - self.multiplier * q[self.reference] - self.offset)[None]

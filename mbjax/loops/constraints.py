@@ -14,7 +14,7 @@ import jax.numpy as jnp
 from jax import Array
 
 from mbjax.integrate.tree_system import AbstractTreeSystem
-from mbjax.loops.closures import GROUND, CutJoint, Prescribed
+from mbjax.loops.closures import GROUND, Coupling, CutJoint, Prescribed
 
 
 class Loops(eqx.Module):
@@ -43,8 +43,13 @@ class Loops(eqx.Module):
                 if not c.dof < tree.nq or tree.nq != tree.nv:
                     raise ValueError(f"prescribed motion of coordinate {c.dof}: the tree has "
                                      f"{tree.nq} coordinates (and drives need nq == nv)")
+            elif isinstance(c, Coupling):
+                if not max(c.coordinate, c.reference) < tree.nq:
+                    raise ValueError(f"coupling of coordinates {c.coordinate} and {c.reference}: "
+                                     f"the tree has {tree.nq} coordinates")
             else:
-                raise TypeError(f"closures must be CutJoint or Prescribed, got {type(c).__name__}")
+                raise TypeError(f"closures must be CutJoint, Coupling or Prescribed, got "
+                                f"{type(c).__name__}")
         self.tree = tree
         self.closures = closures
 

@@ -143,7 +143,8 @@ class ClosedSystem(AbstractSystem):
         A = self.loops.jacobian(q, t)
         redundant = numerical_rank(A @ A.T) < self.loops.m
         return (jnp.where(violated, int(Status.CONSTRAINT_VIOLATED), 0)
-                | jnp.where(redundant, int(Status.REDUNDANT), 0)).astype(jnp.int32)
+                | jnp.where(redundant, int(Status.REDUNDANT), 0)
+                | self.tree.check(t, q, self.velocity(q, u))).astype(jnp.int32)
 
     # -- invariants -------------------------------------------------------------------------------
 

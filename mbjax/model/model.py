@@ -25,7 +25,8 @@ from mbjax.model.joints import (
     joint_rate,
     joint_retract,
 )
-from mbjax.spatial import check_inertia, inertia_matrix
+from mbjax.model.checks import check_body
+from mbjax.spatial import inertia_matrix
 from mbjax.tree import Topology
 
 
@@ -57,6 +58,26 @@ class Model(eqx.Module):
         axis, axis2 (n, 3): joint axes in the joint frame (axis2 only for universal joints);
         mass (n,), com (n, 3) in body k's frame, inertia (n, 3, 3) about the centre of mass;
         gravity (3,): the ground-frame acceleration of gravity.
+
+    Per coordinate (joint data, as URDF and MJCF give it):
+        lower, upper (nq,): position limits (-inf, inf where there are none; a revolute joint
+            without limits is a URDF "continuous" joint);
+        velocity_limit, effort_limit (nv,): |v| and |tau| bounds (inf: none). Limits are data
+            (bounds for trajectory optimisation, `mbjax.model.limits.violations`, checked by
+            `TreeSystem.check` in `simulate`'s status), not contact forces;
+        damping (nv,): viscous joint damping, a force -damping * v in the dynamics;
+        armature (nv,): rotor inertia reflected to the joint, added to the mass matrix diagonal
+            (Featherstone's ABA adds it to D; MuJoCo's and Pinocchio's armature);
+        friction (nv,): dry friction, kept as data (not used by the dynamics).
+
+    Named frames (URDF links merged through fixed joints, fixed joints, MJCF sites):
+        frame_names, frame_parents: static names and the body each frame is fixed to (-1: the
+            ground); frame_rotation (m, 3, 3), frame_translation (m, 3): its pose in that body.
+        See `mbjax.model.frames.frame_pose`.
+
+    Bodies with implausible but computable mass data (a triangle-inequality violation, round-off
+    negative moments, a massless leaf) load with a `ModelWarning` (`mbjax.model.checks`);
+    `strict=True` makes it an error.
     """
 
     topology: Topology = eqx.field(static=True)
@@ -71,10 +92,24 @@ class Model(eqx.Module):
     com: Array
     inertia: Array
     gravity: Array
+    lower: Array
+    upper: Array
+    velocity_limit: Array
+    effort_limit: Array
+    damping: Array
+    armature: Array
+    friction: Array
+    frame_names: tuple[str, ...] = eqx.field(static=True)
+    frame_parents: tuple[int, ...] = eqx.field(static=True)
+    frame_rotation: Array
+    frame_translation: Array
 
     def __init__(self, parents, joint_types, *, mass, inertia, com=None, axis=None, axis2=None,
                  placement_rotation=None, placement_translation=None,
-                 gravity=(0.0, 0.0, -9.81), names=None, joint_names=None):
+                 gravity=(0.0, 0.0, -9.81), names=None, joint_names=None, lower=None,
+                 upper=None, velocity_limit=None, effort_limit=None, damping=None,
+                 armature=None, friction=None, frame_names=(), frame_parents=(),
+                 frame_rotation=None, frame_translation=None, strict: bool = False):
         self.topology = parents if isinstance(parents, Topology) else Topology(parents)
         n = self.topology.n
         joint_types = (joint_types,) * n if isinstance(joint_types, str) else tuple(joint_types)
@@ -113,6 +148,26 @@ class Model(eqx.Module):
         self.placement_translation = field(placement_translation, np.zeros((n, 3)), (n, 3),
                                            "placement_translation")
         self.gravity = field(gravity, None, (3,), "gravity")
+        nq, nv = _layout(joint_types)["nq"], _layout(joint_types)["nv"]
+        inf = np.inf
+        self.lower = field(lower, np.full(nq, -inf), (nq,), "lower")
+        self.upper = field(upper, np.full(nq, inf), (nq,), "upper")
+        self.velocity_limit = field(velocity_limit, np.full(nv, inf), (nv,), "velocity_limit")
+        self.effort_limit = field(effort_limit, np.full(nv, inf), (nv,), "effort_limit")
+        self.damping = field(damping, np.zeros(nv), (nv,), "damping")
+        self.armature = field(armature, np.zeros(nv), (nv,), "armature")
+        self.friction = field(friction, np.zeros(nv), (nv,), "friction")
+        self.frame_names, self.frame_parents = tuple(frame_names), tuple(int(k) for k in frame_parents)
+        m = len(self.frame_names)
+        if len(self.frame_parents) != m:
+            raise ValueError(f"{m} frame names and {len(self.frame_parents)} frame parents")
+        for name, k in zip(self.frame_names, self.frame_parents):
+            if not -1 <= k < n:
+                raise ValueError(f"frame {name!r}: parent body {k} is not in 0 ... {n - 1} or -1")
+        self.frame_rotation = field(frame_rotation, np.tile(np.eye(3), (m, 1, 1)), (m, 3, 3),
+                                    "frame_rotation")
+        self.frame_translation = field(frame_translation, np.zeros((m, 3)), (m, 3),
+                                       "frame_translation")
         for what, raw, uses in (("axis", axis, ("revolute", "prismatic", "universal")),
                                 ("axis2", axis2, ("universal",))):
             if raw is not None and not isinstance(raw, jax.core.Tracer):
@@ -124,15 +179,21 @@ class Model(eqx.Module):
         if not isinstance(self.mass, jax.core.Tracer):
             mass, inertia = np.asarray(self.mass), np.asarray(self.inertia)
             for k in range(n):
-                name = f"body {self.names[k]!r}"
-                if mass[k] == 0 and not inertia[k].any():
-                    if not self.topology.distal(k):   # a massless link must carry something
-                        raise ValueError(f"{name} is massless and carries no other body: its "
-                                         "joint would have no inertia to act on")
-                    continue
-                if not mass[k] > 0:
-                    raise ValueError(f"{name}: mass must be positive, got {mass[k]}")
-                check_inertia(inertia[k], name)
+                check_body(float(mass[k]), inertia[k], f"body {self.names[k]!r}",
+                           carries=bool(self.topology.distal(k)), strict=strict)
+        if not isinstance(self.lower, jax.core.Tracer):
+            self._check_joint_data()
+
+    def _check_joint_data(self) -> None:
+        lower, upper = np.asarray(self.lower), np.asarray(self.upper)
+        bad = np.flatnonzero(~(lower <= upper))
+        if bad.size:
+            raise ValueError(f"lower must not exceed upper; coordinate {bad[0]}: lower "
+                             f"{lower[bad[0]]}, upper {upper[bad[0]]}")
+        for what in ("velocity_limit", "effort_limit", "damping", "armature", "friction"):
+            value = np.asarray(getattr(self, what))
+            if np.isnan(value).any() or (value < 0).any():
+                raise ValueError(f"{what} must be non-negative, got {value}")
 
     # -- sizes and layout -----------------------------------------------------------------------
 

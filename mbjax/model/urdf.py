@@ -3,12 +3,24 @@
 Links with <inertial> become bodies; revolute and continuous joints become revolute joints,
 prismatic joints prismatic ones and floating joints free joints; a fixed joint merges its child
 link (mass, centre of mass and inertia, and the placements of the joints beyond it) into the
-parent body. The root link is welded to the ground unless `floating_base=True` adds a free joint.
-Bodies are numbered depth-first from the root, as Pinocchio numbers its joints, so q and v line
-up with Pinocchio's. Pinocchio (through urdfdom, which keeps joints in a name-sorted map) visits
-the children of a link in order of joint name; that is the default here. `sibling_order=
-"document"` visits them in document order instead (the two agree when sibling joint names sort
-in document order, as `to_urdf`'s zero-padded defaults do).
+parent body, and keeps the link and the joint as named frames (`mbjax.frame_pose`). The root link
+is welded to the ground unless `floating_base=True` adds a free joint. Bodies are numbered
+depth-first from the root, as Pinocchio numbers its joints, so q and v line up with Pinocchio's.
+Pinocchio (through urdfdom, which keeps joints in a name-sorted map) visits the children of a link
+in order of joint name; that is the default here. `sibling_order="document"` visits them in
+document order instead, as MuJoCo's URDF import does.
+
+Masses and inertias are checked on the bodies after the merge, as MuJoCo checks them, so a dummy
+root, sensor and contact frames welded by fixed joints load whatever their data. Implausible but
+computable data (CAD inertias that break the triangle inequality, round-off negatives, a massless
+leaf on a moving joint) loads with a `ModelWarning` naming the link and the fix (`strict=True`:
+an error; `mbjax.model.checks`); non-finite or unparsable numbers are errors.
+
+Joint data: <limit> gives position (revolute, prismatic), effort and velocity limits, <dynamics>
+damping (used by the dynamics) and friction (kept as data); `armature=` adds rotor inertia to
+every joint (URDF has no field for it). <mimic> joints load as independent joints, as Pinocchio
+and MuJoCo load them, with a warning; `closures=True` also returns their couplings as
+`mbjax.loops.Coupling` closures for `mbjax.loops.ClosedSystem`.
 """
 
 import os
@@ -17,8 +29,9 @@ from pathlib import Path
 
 import numpy as np
 
+from mbjax.model.checks import warn
+from mbjax.model.joints import JOINT_TYPES
 from mbjax.model.model import Model
-from mbjax.spatial import check_inertia
 
 _KINDS = {"revolute": "revolute", "continuous": "revolute", "prismatic": "prismatic",
           "floating": "free", "fixed": None}
@@ -27,13 +40,30 @@ _KINDS = {"revolute": "revolute", "continuous": "revolute", "prismatic": "prisma
 def _floats(text: str | None, count: int, what: str, default) -> np.ndarray:
     if text is None:
         return np.asarray(default, dtype=float)
+    expected = "a number" if count == 1 else f"{count} numbers"
     try:
         values = np.array([float(x) for x in text.split()])
     except ValueError:
-        raise ValueError(f"URDF: {what} must be {count} numbers, got {text!r}") from None
+        raise ValueError(f"URDF: {what} must be {expected}, got {text!r}") from None
     if values.shape != (count,):
-        raise ValueError(f"URDF: {what} must be {count} numbers, got {text!r}")
+        raise ValueError(f"URDF: {what} must be {expected}, got {text!r}")
+    if not np.all(np.isfinite(values)):
+        raise ValueError(f"URDF: {what} must be finite, got {text!r}")
     return values
+
+
+def _attribute(element, key: str, what: str, default: float) -> float:
+    """A numeric attribute (infinite values allowed: they mean "no limit")."""
+    text = element.get(key) if element is not None else None
+    if text is None:
+        return default
+    try:
+        value = float(text)
+    except ValueError:
+        raise ValueError(f"URDF: {what} {key} must be a number, got {text!r}") from None
+    if np.isnan(value):
+        raise ValueError(f"URDF: {what} {key} is NaN")
+    return value
 
 
 def rpy_matrix(rpy) -> np.ndarray:
@@ -56,7 +86,7 @@ def _origin(element, what: str) -> tuple[np.ndarray, np.ndarray]:
 
 def _inertial(link) -> tuple[float, np.ndarray, np.ndarray]:
     """(mass, centre of mass, inertia about it) in the link frame; a link without <inertial> is
-    massless."""
+    massless. Plausibility is checked later, on the merged bodies."""
     name = link.get("name")
     inertial = link.find("inertial")
     if inertial is None:
@@ -67,28 +97,21 @@ def _inertial(link) -> tuple[float, np.ndarray, np.ndarray]:
     mass = _floats(mass_el.get("value"), 1, f"link {name!r} mass", None)[0]
     if inertia_el is None:
         raise ValueError(f"URDF: link {name!r} has <inertial> without <inertia>")
-    try:
-        i = {k: float(inertia_el.get(k, "0")) for k in ("ixx", "ixy", "ixz", "iyy", "iyz", "izz")}
-    except ValueError:
-        raise ValueError(f"URDF: link {name!r} has a non-numeric inertia entry") from None
+    i = {k: _floats(inertia_el.get(k, "0"), 1, f"link {name!r} inertia {k}", None)[0]
+         for k in ("ixx", "ixy", "ixz", "iyy", "iyz", "izz")}
     J = np.array([[i["ixx"], i["ixy"], i["ixz"]],
                   [i["ixy"], i["iyy"], i["iyz"]],
                   [i["ixz"], i["iyz"], i["izz"]]])
     R, xyz = _origin(inertial, f"link {name!r} inertial")
-    if mass < 0 or (mass == 0 and J.any()):
-        raise ValueError(f"URDF: link {name!r} has mass {mass}: it must be positive")
-    if mass > 0:
-        check_inertia(J, f"URDF link {name!r}")
     return float(mass), xyz, R @ J @ R.T
 
 
 def _merge(a, b):
-    """Two (mass, com, inertia about com) in one frame combined (parallel-axis theorem)."""
+    """Two (mass, com, inertia about com) in one frame combined (parallel-axis theorem); massless
+    parts (a pure rotational inertia) add their inertia as it is."""
     (ma, ca, Ja), (mb, cb, Jb) = a, b
     m = ma + mb
-    if m == 0:
-        return a
-    c = (ma * ca + mb * cb) / m
+    c = (ma * ca + mb * cb) / m if m > 0 else ca
 
     def shifted(mass, com, J):
         d = com - c
@@ -96,11 +119,37 @@ def _merge(a, b):
     return m, c, shifted(ma, ca, Ja) + shifted(mb, cb, Jb)
 
 
+def _bounded(inertial, min_mass: float, min_inertia: float):
+    """MuJoCo's boundmass and boundinertia: mass and principal moments raised to the bounds."""
+    m, c, J = inertial
+    if min_inertia > 0:
+        moments, axes = np.linalg.eigh(J)
+        J = axes @ np.diag(np.maximum(moments, min_inertia)) @ axes.T
+    return (max(m, min_mass) if min_mass > 0 else m), c, J
+
+
+def _read(text: str):
+    try:
+        robot = ET.fromstring(text)
+    except ET.ParseError as err:
+        raise ValueError(f"URDF: malformed XML ({err})") from None
+    if robot.tag != "robot":
+        raise ValueError(f"URDF: the root element must be <robot>, got <{robot.tag}>")
+    return robot
+
+
 def load_urdf(source: str | os.PathLike, *, floating_base: bool = False,
-              gravity=(0.0, 0.0, -9.81), sibling_order: str = "name") -> Model:
+              gravity=(0.0, 0.0, -9.81), sibling_order: str = "name", armature=0.0,
+              min_mass: float = 0.0, min_inertia: float = 0.0, strict: bool = False,
+              closures: bool = False):
     """A Model from a URDF path or XML string (a string starting with '<' is read as XML).
 
-    sibling_order: "name" (Pinocchio's numbering) or "document" (see the module docstring).
+    sibling_order: "name" (Pinocchio's numbering) or "document" (MuJoCo's; see the module).
+    armature: rotor inertia on every joint coordinate (a number or an (nv,) array).
+    min_mass, min_inertia: lower bounds on the mass and the principal moments of every body (like
+        MuJoCo's boundmass and boundinertia), a remedy for massless leaves on moving joints.
+    strict: turn the warnings on implausible data into errors.
+    closures: also return the mimic joints' couplings, `(model, [mbjax.loops.Coupling, ...])`.
     """
     if sibling_order not in ("name", "document"):
         raise ValueError(f"sibling_order must be 'name' or 'document', got {sibling_order!r}")
@@ -110,12 +159,7 @@ def load_urdf(source: str | os.PathLike, *, floating_base: bool = False,
         if not path.is_file():
             raise FileNotFoundError(f"URDF file not found: {path}")
         text = path.read_text()
-    try:
-        robot = ET.fromstring(text)
-    except ET.ParseError as err:
-        raise ValueError(f"URDF: malformed XML ({err})") from None
-    if robot.tag != "robot":
-        raise ValueError(f"URDF: the root element must be <robot>, got <{robot.tag}>")
+    robot = _read(text)
 
     links = {}
     for link in robot.findall("link"):
@@ -153,51 +197,118 @@ def load_urdf(source: str | os.PathLike, *, floating_base: bool = False,
     if sibling_order == "name":
         children = {link: sorted(joints, key=lambda j: j.get("name"))
                     for link, joints in children.items()}
+    if not links:
+        raise ValueError("URDF: the robot has no links")
     roots = [name for name in links if name not in has_parent]
     if len(roots) != 1:
         raise ValueError(f"URDF: expected exactly one root link, found {roots or 'none (a cycle)'}")
 
-    bodies = []    # dicts: parent index, kind, joint/link names, placement, axis, inertial
+    bodies = []    # dicts: parent index, kind, joint/link names, placement, axis, inertial, data
+    frames = []    # (name, body, R, p): links merged through fixed joints, and those joints
 
     def visit(link: str, body: int, R_acc: np.ndarray, p_acc: np.ndarray) -> None:
         """Walk the joints below `link`, which sits at (R_acc, p_acc) in body `body`'s frame."""
         for joint in children[link]:
-            R, p = _origin(joint, f"joint {joint.get('name')!r}")
+            name = joint.get("name")
+            R, p = _origin(joint, f"joint {name!r}")
             R_place, p_place = R_acc @ R, p_acc + R_acc @ p
             child = joint.find("child").get("link")
             kind = _KINDS[joint.get("type")]
             if kind is None:                             # fixed: merge into `body`
                 m, c, J = links[child]
-                if body >= 0 and m > 0:
+                if body >= 0 and (m > 0 or J.any()):
                     target = bodies[body]
                     target["inertial"] = _merge(target["inertial"],
                                                 (m, R_place @ c + p_place, R_place @ J @ R_place.T))
+                frames.extend([(child, body, R_place, p_place), (name, body, R_place, p_place)])
                 visit(child, body, R_place, p_place)
                 continue
+            what = f"joint {name!r}"
             axis = _floats(joint.find("axis").get("xyz") if joint.find("axis") is not None
-                           else None, 3, f"joint {joint.get('name')!r} axis", [1.0, 0.0, 0.0])
+                           else None, 3, f"{what} axis", [1.0, 0.0, 0.0])
             if kind != "free" and not np.linalg.norm(axis) > 0:
-                raise ValueError(f"URDF: joint {joint.get('name')!r} has a zero axis")
-            bodies.append(dict(parent=body, kind=kind, joint=joint.get("name"), link=child,
-                               R=R_place, p=p_place, axis=axis, inertial=links[child]))
+                raise ValueError(f"URDF: joint {name!r} has a zero axis")
+            limit, dynamics = joint.find("limit"), joint.find("dynamics")
+            bounded = joint.get("type") in ("revolute", "prismatic")
+            bodies.append(dict(
+                parent=body, kind=kind, joint=name, link=child, R=R_place, p=p_place, axis=axis,
+                inertial=links[child], mimic=joint.find("mimic"),
+                lower=_attribute(limit, "lower", what, 0.0) if bounded else -np.inf,
+                upper=_attribute(limit, "upper", what, 0.0) if bounded else np.inf,
+                effort=abs(_attribute(limit, "effort", what, np.inf)) or np.inf,
+                velocity=abs(_attribute(limit, "velocity", what, np.inf)) or np.inf,
+                damping=_attribute(dynamics, "damping", what, 0.0),
+                friction=_attribute(dynamics, "friction", what, 0.0)))
             visit(child, len(bodies) - 1, np.eye(3), np.zeros(3))
 
     root = roots[0]
     if floating_base:
         bodies.append(dict(parent=-1, kind="free", joint="root_joint", link=root, R=np.eye(3),
-                           p=np.zeros(3), axis=np.array([1.0, 0.0, 0.0]), inertial=links[root]))
+                           p=np.zeros(3), axis=np.array([1.0, 0.0, 0.0]), inertial=links[root],
+                           mimic=None, lower=-np.inf, upper=np.inf, effort=np.inf,
+                           velocity=np.inf, damping=0.0, friction=0.0))
         visit(root, 0, np.eye(3), np.zeros(3))
     else:
+        frames.append((root, -1, np.eye(3), np.zeros(3)))
         visit(root, -1, np.eye(3), np.zeros(3))
     if not bodies:
-        raise ValueError("URDF: no movable joint; the model would have no degrees of freedom")
-    return Model(
+        raise ValueError("URDF: no movable joint; the model would have no degrees of freedom "
+                         "(load a single free-flying body with floating_base=True)")
+
+    def per_coordinate(key: str, size: str) -> np.ndarray:
+        return np.concatenate([np.full(getattr(JOINT_TYPES[b["kind"]], size), b[key])
+                               for b in bodies])
+
+    inertials = [_bounded(b["inertial"], min_mass, min_inertia) for b in bodies]
+    model = Model(
         [b["parent"] for b in bodies], [b["kind"] for b in bodies],
-        mass=[b["inertial"][0] for b in bodies], com=[b["inertial"][1] for b in bodies],
-        inertia=[b["inertial"][2] for b in bodies], axis=[b["axis"] for b in bodies],
+        mass=[m for m, _, _ in inertials], com=[c for _, c, _ in inertials],
+        inertia=[J for _, _, J in inertials], axis=[b["axis"] for b in bodies],
         placement_rotation=[b["R"] for b in bodies],
         placement_translation=[b["p"] for b in bodies], gravity=gravity,
-        names=[b["link"] for b in bodies], joint_names=[b["joint"] for b in bodies])
+        names=[b["link"] for b in bodies], joint_names=[b["joint"] for b in bodies],
+        lower=per_coordinate("lower", "nq"), upper=per_coordinate("upper", "nq"),
+        effort_limit=per_coordinate("effort", "nv"),
+        velocity_limit=per_coordinate("velocity", "nv"),
+        damping=per_coordinate("damping", "nv"), friction=per_coordinate("friction", "nv"),
+        armature=np.broadcast_to(np.asarray(armature, float), (sum(
+            JOINT_TYPES[b["kind"]].nv for b in bodies),)),
+        frame_names=[f[0] for f in frames], frame_parents=[f[1] for f in frames],
+        frame_rotation=np.reshape([f[2] for f in frames], (-1, 3, 3)),
+        frame_translation=np.reshape([f[3] for f in frames], (-1, 3)), strict=strict)
+    couplings = _mimics(model, bodies, strict, quiet=closures)
+    return (model, couplings) if closures else model
+
+
+def _mimics(model: Model, bodies: list, strict: bool, quiet: bool) -> list:
+    """The mimic joints' couplings q = multiplier q_reference + offset."""
+    from mbjax.loops.closures import Coupling
+
+    q_start = dict(zip(model.joint_names, _q_starts(model), strict=True))
+    out, names = [], []
+    for b in bodies:
+        mimic = b["mimic"]
+        if mimic is None:
+            continue
+        reference = mimic.get("joint")
+        if reference not in q_start:
+            names.append(f"{b['joint']} mimics {reference!r}, which is not a moving joint of "
+                         "the model: no coupling")
+            continue
+        what = f"joint {b['joint']!r} mimic"
+        out.append(Coupling(q_start[b["joint"]], q_start[reference],
+                            _attribute(mimic, "multiplier", what, 1.0),
+                            _attribute(mimic, "offset", what, 0.0)))
+        names.append(f"{b['joint']} = {out[-1].multiplier} {reference} + {out[-1].offset}")
+    if names and not (quiet and len(names) == len(out)):
+        warn(f"URDF: mimic joints load as independent joints, as Pinocchio and MuJoCo load them "
+             f"({'; '.join(names)}); load_urdf(..., closures=True) also returns the couplings "
+             "as mbjax.loops.Coupling closures for mbjax.loops.ClosedSystem", strict)
+    return out
+
+
+def _q_starts(model: Model) -> list[int]:
+    return list(np.cumsum([0] + [JOINT_TYPES[k].nq for k in model.joint_types])[:-1])
 
 
 def matrix_rpy(R: np.ndarray) -> np.ndarray:

@@ -58,18 +58,19 @@ def aba_responses(model: Model, q: Array, v: Array, tau: Array, loads: Array,
     bias = cross_force(kin.V, jnp.einsum("kij,kj->ki", kin.I, kin.V))
     if f_ext is not None:
         bias = bias - shift_force(f_ext, kin.p)
-    pad = (~model.v_mask).astype(q.dtype)                  # 1 on padded columns
+    # padded columns get 1 (identity, u = 0); real ones the joint's armature, added to D
+    pad = (~model.v_mask).astype(q.dtype) + model.body_v(model.armature)
     # Columns: 0 the motion under tau, gravity and velocity; 1 ... m one load each.
     zeros = jnp.zeros((model.n, 6, m), q.dtype)
     F1 = jnp.concatenate([bias[..., None], zeros], -1)
     c = jnp.concatenate([kin.c[..., None], zeros], -1)
-    t = jnp.concatenate([model.body_v(tau)[..., None],
+    t = jnp.concatenate([model.body_v(tau - model.damping * v)[..., None],
                          jax.vmap(model.body_v, out_axes=-1)(loads)], -1)
 
     def triangularize(received, inp):
         (IA, pA), (S, c, t, padding) = received, inp
         U = IA @ S
-        D = S.T @ U + jnp.diag(padding)                 # padded columns: identity, u = 0
+        D = S.T @ U + jnp.diag(padding)
         u = t - S.T @ pA
         Ia = IA - U @ _solve(D, U.T)
         pa = pA + Ia @ c + U @ _solve(D, u)

@@ -207,6 +207,7 @@ def batch_aba(model: Model, q: Array, v: Array, tau: Array) -> Array:
                          model)
     v = jnp.broadcast_to(jnp.asarray(v, dtype), q.shape)
     tau = jnp.broadcast_to(jnp.reshape(jnp.asarray(tau, dtype), (n, -1)), q.shape)
+    tau = tau - model.damping[:, None] * v                  # joint damping, a force -d v
     R, p, s = _joint_transforms(model, revolute, q)
     sv = (_scale(s[0], v), _scale(s[1], v))
     inertia = model.spatial_inertia()
@@ -225,9 +226,9 @@ def batch_aba(model: Model, q: Array, v: Array, tau: Array) -> Array:
 
     # (ii) articulated inertias and forces, inward
     def triangularize(received, x):
-        (IA, pA), (R, p, s, c, t) = received, x
+        (IA, pA), (R, p, s, c, t, armature) = received, x
         U = _inertia_times(IA, s)
-        D = _sdot(s, U)
+        D = _sdot(s, U) + armature
         u = t - _sdot(s, pA)
         inv_D = 1.0 / D
         Ia = tuple(_madd(block, _outer(Ui, Uj, -inv_D))
@@ -239,7 +240,8 @@ def batch_aba(model: Model, q: Array, v: Array, tau: Array) -> Array:
         return (U, D, u), (_inertia_to_parent(R, p, Ia), _force_to_parent(R, p, pa))
 
     full = jax.tree.map(lambda x: jnp.broadcast_to(x, (n, batch)), blocks)
-    (U, D, u), _ = backward_pass(model.topology, triangularize, (full, F1), (R, p, s, c, tau))
+    (U, D, u), _ = backward_pass(model.topology, triangularize, (full, F1),
+                                 (R, p, s, c, tau, model.armature))
 
     # (iii) accelerations, outward
     def substitute(parent, x):

@@ -13,9 +13,9 @@ from mbjax.rigid.kinematics import body_kinematics, forward_kinematics
 
 
 def kinetic_energy(model: Model, q: Array, v: Array) -> Array:
-    """1/2 sum_k V_k^T I_k V_k (eq 10)."""
+    """1/2 sum_k V_k^T I_k V_k (eq 10), plus the rotors' 1/2 armature v^2."""
     kin = body_kinematics(model, q, v)
-    return 0.5 * jnp.einsum("ki,kij,kj->", kin.V, kin.I, kin.V)
+    return 0.5 * (jnp.einsum("ki,kij,kj->", kin.V, kin.I, kin.V) + model.armature @ (v * v))
 
 
 def potential_energy(model: Model, q: Array) -> Array:

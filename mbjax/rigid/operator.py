@@ -45,6 +45,8 @@ class OperatorTerms(NamedTuple):
     A_hat: Array       # (n, 6, width) free axes (Gamma_f; Delta_f) at the hinges, world frame
     c: Array           # (n, 3) centres of mass c_k, world frame
     h: Array           # (n, 3) hinge points h_k (body-frame origins), world frame
+    armature: Array    # (nv,) rotor inertias on the joint coordinates (model.armature)
+    damping: Array     # (nv,) joint forces -damping * v (model.damping times v, negated)
 
 
 def _shift(r: Array) -> Array:
@@ -148,7 +150,8 @@ def operator_terms(model: Model, q: Array, v: Array) -> OperatorTerms:
     Y = jnp.concatenate([jnp.cross(omega, jnp.einsum("kij,kj->ki", I_c, omega)),
                          jnp.zeros_like(omega)], -1)
     K = jnp.concatenate([jnp.zeros_like(c), model.mass[:, None] * model.gravity], -1)
-    return OperatorTerms(A, alpha, alpha_dot, sigma, mu, Y, K, Sw, c, h)
+    return OperatorTerms(A, alpha, alpha_dot, sigma, mu, Y, K, Sw, c, h, model.armature,
+                         -model.damping * v)
 
 
 def with_external(terms: OperatorTerms, f_ext: Array | None) -> OperatorTerms:
@@ -162,8 +165,9 @@ def with_external(terms: OperatorTerms, f_ext: Array | None) -> OperatorTerms:
 
 
 def generalized_mass(terms: OperatorTerms) -> Array:
-    """mu_hat_ff = A_hat_f^T A^T mu A A_hat_f (eqs 18, 55)."""
-    return jnp.einsum("kai,kab,kbj->ij", terms.alpha, terms.mu, terms.alpha)
+    """mu_hat_ff = A_hat_f^T A^T mu A A_hat_f (eqs 18, 55), plus the joints' armature."""
+    return (jnp.einsum("kai,kab,kbj->ij", terms.alpha, terms.mu, terms.alpha)
+            + jnp.diag(terms.armature))
 
 
 def mass_matrix(model: Model, q: Array) -> Array:

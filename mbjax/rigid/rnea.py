@@ -43,6 +43,8 @@ def joint_wrenches(model: Model, q: Array, v: Array, a: Array, f_ext: Array | No
 
 def inverse_dynamics(model: Model, q: Array, v: Array, a: Array, f_ext: Array | None = None) -> Array:
     """Joint forces tau (nv,) that give accelerations a at state (q, v) under gravity and the
-    external wrenches f_ext (n, 6) (world frame, (torque about body k's origin; force))."""
+    external wrenches f_ext (n, 6) (world frame, (torque about body k's origin; force)), with
+    the joints' armature and damping."""
     f_bar, kin = _rnea(model, q, v, a, f_ext)
-    return model.flat_v(jnp.einsum("kij,ki->kj", kin.S, f_bar))
+    return (model.flat_v(jnp.einsum("kij,ki->kj", kin.S, f_bar))
+            + model.armature * a + model.damping * v)

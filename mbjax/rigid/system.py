@@ -13,7 +13,9 @@ holding arrays is not hashable.)
 from typing import ClassVar
 
 import equinox as eqx
+import jax
 import jax.numpy as jnp
+import numpy as np
 from jax import Array
 
 from mbjax.control import AbstractControl, as_control
@@ -28,7 +30,9 @@ from mbjax.control.applied import (
 )
 from mbjax.integrate.system import AbstractSystem
 from mbjax.integrate.tree_system import AbstractTreeSystem
+from mbjax.integrate.solution import Status
 from mbjax.model import Model
+from mbjax.model.limits import exceeded
 from mbjax.rigid.aba import aba_responses
 from mbjax.rigid.batched import batch_aba
 from mbjax.rigid.dense import dense_responses
@@ -64,6 +68,7 @@ class TreeSystem(AbstractTreeSystem):
     external_point: Array | None
     actuation: tuple[int, ...] | None = eqx.field(static=True)
     method: str = eqx.field(static=True)
+    limited: bool = eqx.field(static=True)
     symmetric_dynamics: ClassVar[bool] = True
 
     def __init__(self, model: Model, control=None, *, external=None, external_point=None,
@@ -76,9 +81,20 @@ class TreeSystem(AbstractTreeSystem):
         self.external = as_control(external)
         self.external_point = check_points(external_point, model.n)
         self.method = method
+        self.limited = any(isinstance(x, jax.core.Tracer) or np.isfinite(np.asarray(x)).any()
+                           for x in (model.lower, model.upper, model.velocity_limit,
+                                     model.effort_limit))
 
     def frames(self, q):
         return forward_kinematics(self.model, q)
+
+    def check(self, t, q, u):
+        """`Status.LIMIT_EXCEEDED` where the state or the control is beyond the model's joint
+        limits (`mbjax.model.limits`); limits are data here, not contact forces."""
+        if not self.limited:
+            return jnp.array(0, jnp.int32)
+        over = exceeded(self.model, q, u, self.applied(t, q, u))
+        return jnp.where(over, int(Status.LIMIT_EXCEEDED), 0).astype(jnp.int32)
 
     def energy(self, q, v):
         return energy(self.model, q, v)

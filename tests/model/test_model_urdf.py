@@ -9,6 +9,7 @@ import pytest
 import mbjax
 from mbjax import rigid
 from mbjax.model import Model, chain, random_tree
+from mbjax.model.checks import ModelWarning
 from mbjax.model.urdf import to_urdf
 from tests.peers import pinocchio_maps, random_state
 
@@ -35,16 +36,10 @@ def _with_body1_inertia(J):
     ({"joint_types": ("revolute",)}, "1 joint types for 2 bodies"),
     ({"parents": [-1, 1]}, "cannot be its own parent"),
     ({"mass": [1.0, -2.0]}, r"body 'body1': mass must be positive, got -2.0"),
-    ({"mass": [1.0, 0.0]}, "mass must be positive, got 0.0"),
-    ({"mass": [1.0, 0.0], "inertia": _with_body1_inertia(np.zeros((3, 3)))},
-     "massless and carries no other body"),
-    ({"inertia": _with_body1_inertia(np.diag([1.0, -1.0, 1.0]))}, "must be positive-definite"),
-    ({"inertia": _with_body1_inertia(np.diag([1.0, 1.0, 0.0]))}, "must be positive-definite"),
-    ({"inertia": _with_body1_inertia(np.diag([1.0, 1.0, 2.5]))},
-     r"violate the triangle inequality J1 \+ J2 >= J3"),
+    ({"mass": [1.0, np.inf]}, r"body 'body1': mass and inertia must be finite, got mass inf"),
     ({"inertia": _with_body1_inertia([[1.0, 0.5, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]])},
      "must be symmetric"),
-    ({"inertia": _with_body1_inertia(np.diag([1.0, np.nan, 1.0]))}, "non-finite"),
+    ({"inertia": _with_body1_inertia(np.diag([1.0, np.nan, 1.0]))}, "must be finite"),
     ({"mass": [1.0, 2.0, 3.0]}, r"mass must have shape \(2,\), got \(3,\)"),
     ({"inertia": np.ones((2, 3, 4))}, r"inertia must have shape \(2, 3, 3\)"),
     ({"com": np.zeros((2, 2))}, r"com must have shape \(2, 3\)"),
@@ -56,6 +51,24 @@ def _with_body1_inertia(J):
 def test_model_rejects_bad_input(overrides, match):
     with pytest.raises(ValueError, match=match):
         _model(**overrides)
+
+
+@pytest.mark.parametrize("overrides, match", [
+    ({"mass": [1.0, 0.0]}, "has rotational inertia but no mass"),
+    ({"mass": [1.0, 0.0], "inertia": _with_body1_inertia(np.zeros((3, 3)))},
+     "massless and carries no other body.*armature"),
+    ({"inertia": _with_body1_inertia(np.diag([1.0, -1.0, 1.0]))}, "not positive semi-definite"),
+    ({"inertia": _with_body1_inertia(np.diag([1.0, 1.0, -1e-9]))}, "negative by round-off"),
+    ({"inertia": _with_body1_inertia(np.diag([1.0, 1.0, 2.5]))},
+     r"violate the triangle inequality J1 \+ J2 >= J3"),
+], ids=["rotor_without_mass", "massless_leaf", "indefinite", "round_off", "triangle"])
+def test_model_warns_on_implausible_but_computable_data(overrides, match):
+    """Implausible data loads with a ModelWarning naming the body (Pinocchio computes with it);
+    strict=True makes it an error."""
+    with pytest.warns(ModelWarning, match="body 'body1'.*" + match):
+        _model(**overrides)
+    with pytest.raises(ValueError, match=match + ".*strict=True"):
+        _model(strict=True, **overrides)
 
 
 def test_model_rejects_zero_axis():
@@ -154,9 +167,11 @@ GOOD = _robot(_link("base"), _link("a"), _joint("j", "revolute", "base", "a"))
     (_robot(_link("base"), '<link name="a"><inertial><mass value="1"/></inertial></link>',
             _joint("j", "revolute", "base", "a")), "link 'a' has <inertial> without <inertia>"),
     (_robot(_link("base"), _link("a", _inertial(mass="-1")), _joint("j", "revolute", "base", "a")),
-     "link 'a' has mass -1.0: it must be positive"),
-    (_robot(_link("base"), _link("a", _inertial(inertia='ixx="1" iyy="1" izz="3"')),
-            _joint("j", "revolute", "base", "a")), "URDF link 'a'.*triangle inequality"),
+     "body 'a': mass must be positive, got -1.0"),
+    (_robot(_link("base"), _link("a", _inertial(mass="nan")), _joint("j", "revolute", "base", "a")),
+     "link 'a' mass must be finite"),
+    (_robot(_link("base"), _link("a", _inertial(inertia='ixx="1" iyy="x" izz="3"')),
+            _joint("j", "revolute", "base", "a")), "link 'a' inertia iyy must be a number"),
     (_robot(_link("base"), _link("a"), _joint("j", "revolute", "base", "a", axis="0 0 0")),
      "joint 'j' has a zero axis"),
     (_robot(_link("base"), _link("a"), _joint("j", "revolute", "base", "a", xyz="1 2")),
@@ -166,7 +181,7 @@ GOOD = _robot(_link("base"), _link("a"), _joint("j", "revolute", "base", "a"))
     (_robot(_link("base")), "no movable joint"),
 ], ids=["malformed", "not_robot", "planar", "bogus", "undefined_link", "two_roots", "two_parents",
         "cycle", "duplicate_link", "missing_mass", "missing_inertia", "negative_mass",
-        "triangle_inequality", "zero_axis", "bad_origin", "only_fixed", "no_joints"])
+        "nan_mass", "unparsable_inertia", "zero_axis", "bad_origin", "only_fixed", "no_joints"])
 def test_urdf_errors(xml, match):
     with pytest.raises(ValueError, match=match):
         mbjax.load_urdf(xml)

@@ -1,0 +1,66 @@
+"""Plausibility of a body's mass and inertia: what is an error, what only a warning.
+
+Errors are kept for data that makes the computation meaningless: non-finite numbers, a negative
+mass (a sign error, never round-off), an asymmetric inertia. Data that is implausible but
+computable loads, as Pinocchio loads it, with a `ModelWarning` that names the body and the fix:
+CAD inertias that break the triangle inequality J1 + J2 >= J3, negative principal moments
+(round-off, or wrong data that may make the mass matrix indefinite), a massless body at the end
+of a moving joint (its mass matrix is singular). `strict=True` turns those warnings into errors.
+"""
+
+import warnings
+
+import numpy as np
+
+# A principal moment below zero by at most this fraction of the largest one (or by 1e-7 kg m^2)
+# is round-off in the source data, not a wrong sign.
+ROUND_OFF = 1e-4
+ROUND_OFF_ABS = 1e-7
+
+MASSLESS_REMEDY = ("give its joint armature (Model(..., armature=...)) or bound the mass and "
+                   "inertia from below (load_urdf(..., min_mass=..., min_inertia=...), like "
+                   "MuJoCo's compiler options boundmass and boundinertia)")
+
+
+class ModelWarning(UserWarning):
+    """Model data that is implausible but computable; `strict=True` makes it an error."""
+
+
+def warn(message: str, strict: bool) -> None:
+    if strict:
+        raise ValueError(message + " (strict=True)")
+    warnings.warn(message, ModelWarning, stacklevel=4)
+
+
+def check_body(mass: float, inertia: np.ndarray, name: str, *, carries: bool,
+               strict: bool = False) -> None:
+    """Validate one body's mass and 3x3 inertia about its centre of mass (see the module)."""
+    J = np.asarray(inertia, dtype=float)
+    if not (np.isfinite(mass) and np.all(np.isfinite(J))):
+        raise ValueError(f"{name}: mass and inertia must be finite, got mass {mass} and inertia "
+                         f"{J.tolist()}")
+    if mass < 0:
+        raise ValueError(f"{name}: mass must be positive, got {mass}")
+    if not np.allclose(J, J.T, rtol=1e-9, atol=1e-12 * max(np.abs(J).max(), 1.0)):
+        raise ValueError(f"{name}: inertia must be symmetric, got\n{J}")
+    moments = np.linalg.eigvalsh(J)
+    tol = max(ROUND_OFF * abs(moments[-1]), ROUND_OFF_ABS)
+    if mass == 0 and not J.any():
+        if not carries:
+            warn(f"{name} is massless and carries no other body: its joint has no inertia to act "
+                 f"on and the mass matrix is singular; {MASSLESS_REMEDY}", strict)
+        return
+    if mass == 0:
+        warn(f"{name} has rotational inertia but no mass; give it the mass of its parts", strict)
+    elif moments[0] < -tol:
+        warn(f"{name}: inertia is not positive semi-definite (principal moments {moments}): the "
+             "mass matrix may be indefinite; the dynamics use it as given, fix the source data",
+             strict)
+        return
+    elif moments[0] < 0:
+        warn(f"{name}: principal moments {moments} are negative by round-off; the dynamics use "
+             "them as given (fix the source data, or clip them at zero)", strict)
+    if moments[0] + moments[1] < moments[2] * (1 - 1e-9) - tol:
+        warn(f"{name}: principal moments {moments} violate the triangle inequality J1 + J2 >= J3 "
+             "that every mass distribution satisfies (typical of CAD exports); the dynamics use "
+             "them as given, fix the inertia to make it physical", strict)

@@ -1,0 +1,25 @@
+"""Joint limits as data: how far a state and a control lie outside a model's bounds.
+
+URDF's <limit> and MJCF's range, actuatorfrcrange and velocity bounds are kept on the `Model`
+(lower, upper, velocity_limit, effort_limit). mbjax does not enforce them as contact forces;
+`simulate` flags a saved state beyond them (`Status.LIMIT_EXCEEDED`, a note), and `excess` gives a
+smooth-almost-everywhere penalty for trajectory optimisation.
+"""
+
+import jax.numpy as jnp
+from jax import Array
+
+
+def excess(model, q: Array, v: Array, tau: Array | None = None) -> Array:
+    """How far (q, v, tau) lie beyond the model's limits, per coordinate, concatenated
+    (nq position, nv velocity, nv effort entries; zero inside the bounds)."""
+    tau = jnp.zeros_like(v) if tau is None else tau
+    parts = [jnp.maximum(model.lower - q, 0.0) + jnp.maximum(q - model.upper, 0.0),
+             jnp.maximum(jnp.abs(v) - model.velocity_limit, 0.0),
+             jnp.maximum(jnp.abs(tau) - model.effort_limit, 0.0)]
+    return jnp.concatenate(parts)
+
+
+def exceeded(model, q: Array, v: Array, tau: Array | None = None) -> Array:
+    """True if any coordinate of (q, v, tau) is beyond the model's limits."""
+    return jnp.any(excess(model, q, v, tau) > 0)

@@ -1,0 +1,195 @@
+"""The MJCF corpus: every MuJoCo model shipped by the installed packages (dm_control's suite,
+gymnasium's and gymnasium_robotics' MuJoCo assets, the mujoco package's own), loaded with
+`mbjax.from_mujoco` and checked against MuJoCo's forward dynamics and kinematics.
+
+A file is a model when MuJoCo compiles it on its own and it has joints; the others (include
+fragments, files that need a parent's assets, jointless scenes) are listed as skipped with
+MuJoCo's reason. For each model, at one random state (qpos0 plus noise, quaternions normalized,
+random qvel and qfrc_applied) `compare` sets both engines side by side:
+
+    qacc            mbjax's `forward_dynamics`, mapped to MuJoCo's qvel coordinates by `jax.jvp`
+                    of `state_to_mujoco`, against `mj_forward`'s qacc: max |difference| /
+                    max(1, max |qacc|);
+    poses           every body's and site's world pose (`frame_pose`'s lookup) against
+                    xpos/xmat and site_xpos/site_xmat: max abs difference.
+
+MuJoCo computes what mbjax models and nothing else: `comparable` disables contacts, constraints
+(limits, dry friction, equality), actuator forces and springs by flag (mjDSBL_CONTACT,
+mjDSBL_CONSTRAINT, mjDSBL_ACTUATION, mjDSBL_SPRING) and zeroes in a copy of the model the passive
+forces mbjax does not model but whose flag would also switch off joint damping: tendon damping and
+armature, polynomial damping, gravity compensation and fluid forces (opt.density, viscosity);
+sleeping is disabled. Joint damping, armature (actuators' included), gravity and the rigid-body
+dynamics stay on. The row's note names what the model's warning listed as ignored.
+
+JSON (`reproduce`): {"rows": [{"model", "nv", "loads", "max_relative_difference",
+"max_pose_difference", "note", "seconds"}], "skipped": [{"model", "reason"}], "tolerance"}.
+"""
+
+import copy
+import importlib.util
+import json
+import time
+import warnings
+from pathlib import Path
+
+import jax
+import jax.numpy as jnp
+import numpy as np
+
+from mbjax.model import Model
+from mbjax.model.checks import ModelWarning
+from mbjax.model.mjcf import from_mujoco, object_name, site_frame_name
+from mbjax.model.states import state_from_mujoco, state_to_mujoco
+from mbjax.rigid import forward_dynamics
+from mbjax.rigid.kinematics import forward_kinematics
+
+NAME = "mjcf-corpus"
+TOLERANCE = 1e-8
+# (package, folder in it, glob): where the MJCF files are
+SOURCES = (("dm_control", "suite", "*.xml"), ("gymnasium", "envs/mujoco/assets", "*.xml"),
+           ("gymnasium_robotics", "envs", "**/*.xml"), ("mujoco", ".", "**/*.xml"))
+# A small representative subset for the default test suite: planar hinge/slide chains, free
+# floating bases, ball joints, several joints per body, tendons, equality constraints, ref offsets.
+QUICK = ("dm_control/cartpole", "dm_control/cheetah", "dm_control/humanoid",
+         "dm_control/manipulator", "gymnasium/ant", "mujoco/testdata/model")
+
+
+def _sources():
+    for package, folder, pattern in SOURCES:
+        spec = importlib.util.find_spec(package)
+        if spec is not None and spec.submodule_search_locations:
+            yield package, Path(spec.submodule_search_locations[0]) / folder, pattern
+
+
+def short_name(path: Path) -> str:
+    """"dm_control/cheetah" for .../dm_control/suite/cheetah.xml."""
+    path = Path(path)
+    for package, root, _ in _sources():
+        if path.is_relative_to(root):
+            return f"{package}/{path.relative_to(root).with_suffix('').as_posix()}"
+    return path.stem
+
+
+def corpus_paths() -> list[Path]:
+    """Every .xml file under the corpus folders of the installed packages (sorted)."""
+    return [path for _, root, pattern in _sources() for path in sorted(root.glob(pattern))]
+
+
+def comparable(mjmodel):
+    """A copy of mjmodel computing only what mbjax models (see the module docstring)."""
+    import mujoco
+
+    m = copy.deepcopy(mjmodel)
+    bits = mujoco.mjtDisableBit
+    m.opt.disableflags |= int(bits.mjDSBL_CONTACT | bits.mjDSBL_CONSTRAINT
+                              | bits.mjDSBL_ACTUATION | bits.mjDSBL_SPRING)
+    m.opt.enableflags &= ~int(mujoco.mjtEnableBit.mjENBL_SLEEP)
+    m.opt.density = m.opt.viscosity = 0.0
+    for field in ("tendon_damping", "tendon_armature", "tendon_dampingpoly", "dof_dampingpoly",
+                  "actuator_dampingpoly", "body_gravcomp"):
+        if getattr(m, field, None) is not None:
+            getattr(m, field)[:] = 0.0
+    return m
+
+
+def _locate(model: Model, name: str):
+    """(body, R, p) of a frame or body name (as `mbjax.frame_pose` looks it up)."""
+    if name in model.frame_names:
+        i = model.frame_names.index(name)
+        return model.frame_parents[i], model.frame_rotation[i], model.frame_translation[i]
+    return model.names.index(name), jnp.eye(3), jnp.zeros(3)
+
+
+def compare(mjmodel, model: Model, seed: int = 0) -> dict:
+    """{"qacc": relative qacc difference, "poses": max body and site pose difference} at one
+    random state of `comparable(mjmodel)`."""
+    import mujoco
+
+    m = comparable(mjmodel)
+    d = mujoco.MjData(m)
+    rng = np.random.default_rng(seed)
+    d.qpos[:] = m.qpos0 + 0.5 * rng.normal(size=m.nq)
+    mujoco.mj_normalizeQuat(m, d.qpos)
+    d.qvel[:] = rng.normal(size=m.nv)
+    d.qfrc_applied[:] = rng.normal(size=m.nv)
+    mujoco.mj_forward(m, d)
+
+    q, v = state_from_mujoco(model, jnp.asarray(d.qpos), jnp.asarray(d.qvel))
+    to_qvel = lambda q_, v_: state_to_mujoco(model, q_, v_)[1]  # noqa: E731
+    tau = jax.vjp(lambda v_: to_qvel(q, v_), v)[1](jnp.asarray(d.qfrc_applied))[0]
+    a = forward_dynamics(model, q, v, tau)
+    qacc = jax.jvp(to_qvel, (q, v), (model.q_dot(q, v), a))[1]
+    qacc_error = float(np.max(np.abs(np.asarray(qacc) - d.qacc)) / max(1.0, np.abs(d.qacc).max()))
+
+    R, p = (np.asarray(x) for x in forward_kinematics(model, q))
+    pose_error = 0.0
+    targets = [(object_name(m, "body", b), d.xmat[b], d.xpos[b]) for b in range(1, m.nbody)]
+    targets += [(site_frame_name(model, object_name(m, "site", s)), d.site_xmat[s],
+                 d.site_xpos[s]) for s in range(m.nsite)]
+    for name, xmat, xpos in targets:
+        k, R_f, p_f = (np.asarray(x) for x in _locate(model, name))
+        R_w, p_w = (R_f, p_f) if k < 0 else (R[k] @ R_f, p[k] + R[k] @ p_f)
+        pose_error = max(pose_error, np.abs(R_w.reshape(9) - xmat).max(),
+                         np.abs(p_w - xpos).max())
+    return {"qacc": qacc_error, "poses": float(pose_error)}
+
+
+def survey(paths=None) -> tuple[list[dict], list[dict]]:
+    """(rows, skipped): a row per model (see `rows`), and {"model", "reason"} per file that is
+    not a model on its own."""
+    import mujoco
+
+    rows, skipped = [], []
+    for path in corpus_paths() if paths is None else [Path(p) for p in paths]:
+        name = short_name(path)
+        try:
+            mjmodel = mujoco.MjModel.from_xml_path(str(path))
+        except ValueError as err:
+            skipped.append({"model": name, "reason": str(err).splitlines()[0]})
+            continue
+        if mjmodel.nv == 0:
+            skipped.append({"model": name, "reason": "compiles, but has no joints"})
+            continue
+        start = time.perf_counter()
+        row = {"model": name, "nv": int(mjmodel.nv), "loads": False,
+               "max_relative_difference": float("nan"), "max_pose_difference": float("nan"),
+               "note": ""}
+        try:
+            with warnings.catch_warnings(record=True) as caught:
+                warnings.simplefilter("always", ModelWarning)
+                model = from_mujoco(mjmodel)
+            row["loads"] = True
+            row["note"] = "; ".join(str(w.message).removeprefix(
+                "from_mujoco: mbjax does not model, and ignored: ") for w in caught)
+            errors = compare(mjmodel, model)
+            row["max_relative_difference"], row["max_pose_difference"] = (errors["qacc"],
+                                                                         errors["poses"])
+        except Exception as err:                      # a failure is a row, not a crash
+            row["note"] = f"{type(err).__name__}: {err}"
+        row["seconds"] = time.perf_counter() - start
+        rows.append(row)
+    return rows, skipped
+
+
+def rows(paths=None) -> list[dict]:
+    """One dict per model that MuJoCo compiles (all of `corpus_paths()` by default): {"model",
+    "nv", "loads", "max_relative_difference", "max_pose_difference", "note", "seconds"}."""
+    return survey(paths)[0]
+
+
+def quick_paths() -> list[Path]:
+    """The `QUICK` subset's files (those installed)."""
+    return [path for path in corpus_paths() if short_name(path) in QUICK]
+
+
+def reproduce(out: Path, quick: bool = False) -> dict:
+    """Survey the corpus (`QUICK` with quick), write out/mjcf-corpus.json, return the JSON."""
+    found, skipped = survey(quick_paths() if quick else None)
+    data = {"rows": found, "skipped": skipped, "tolerance": TOLERANCE}
+    for row in found:
+        print(f"{row['model']:60s} nv {row['nv']:3d}  loads {row['loads']!s:5s}  "
+              f"qacc {row['max_relative_difference']:.1e}  poses {row['max_pose_difference']:.1e}")
+    out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    (out / f"{NAME}.json").write_text(json.dumps(data, indent=1))
+    return data
