@@ -34,7 +34,8 @@ def warn(message: str, strict: bool) -> None:
 
 def check_body(mass: float, inertia: np.ndarray, name: str, *, carries: bool,
                strict: bool = False) -> None:
-    """Validate one body's mass and 3x3 inertia about its centre of mass (see the module)."""
+    """Validate one body's mass and 3x3 inertia about its centre of mass (see the module);
+    `carries`: the body carries others, or its joint has armature (so a massless body is fine)."""
     J = np.asarray(inertia, dtype=float)
     if not (np.isfinite(mass) and np.all(np.isfinite(J))):
         raise ValueError(f"{name}: mass and inertia must be finite, got mass {mass} and inertia "
@@ -48,7 +49,8 @@ def check_body(mass: float, inertia: np.ndarray, name: str, *, carries: bool,
     if mass == 0 and not J.any():
         if not carries:
             warn(f"{name} is massless and carries no other body: its joint has no inertia to act "
-                 f"on and the mass matrix is singular; {MASSLESS_REMEDY}", strict)
+                 f"on (no armature either) and the mass matrix is singular; {MASSLESS_REMEDY}",
+                 strict)
         return
     if mass == 0:
         warn(f"{name} has rotational inertia but no mass; give it the mass of its parts", strict)

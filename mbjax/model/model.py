@@ -178,9 +178,12 @@ class Model(eqx.Module):
                                          f"zero (or not finite); give a nonzero direction")
         if not isinstance(self.mass, jax.core.Tracer):
             mass, inertia = np.asarray(self.mass), np.asarray(self.inertia)
+            rotor = np.asarray(self.armature) > 0
+            dof_body = self.dof_body()
             for k in range(n):
                 check_body(float(mass[k]), inertia[k], f"body {self.names[k]!r}",
-                           carries=bool(self.topology.distal(k)), strict=strict)
+                           carries=bool(self.topology.distal(k)) or bool(rotor[dof_body == k].all()),
+                           strict=strict)
         if not isinstance(self.lower, jax.core.Tracer):
             self._check_joint_data()
 
