@@ -16,8 +16,7 @@ from mbjax.model.states import (
     state_to_pinocchio,
 )
 from mbjax.model.urdf import load_urdf
-from mbjax.rigid import forward_dynamics, inverse_dynamics, mass_matrix
-from mbjax.rigid.frames import frame_jacobian, frame_pose
+from mbjax.rigid import forward_dynamics, frame_jacobian, frame_pose, inverse_dynamics, mass_matrix
 
 __version__ = "0.1.0"
 __all__ = ["Model", "control", "data", "forward_dynamics", "frame_jacobian", "frame_pose",

@@ -334,6 +334,73 @@ def _mujoco_sampled(arm, q0, history, actuated, dt, steps):
     return out[0, -1, 1:1 + mj.nq]
 
 
+def models_tour(out: Path, quick: bool) -> dict:
+    """A URDF arm as a user brings it (`mbjax.data.ARM7`): its links and fixed joints as named
+    frames, the flange's pose and Jacobian by name, its joint limits as data that `simulate`'s
+    status checks (the unpowered arm falls through them), and the same arm through MuJoCo's
+    compiler (`mbjax.from_mujoco`) and Pinocchio, when installed, against their dynamics."""
+    from mbjax.model.limits import excess
+    from mbjax.plot.scenes import models_figure
+    from mbjax.rigid import TreeSystem, frame_jacobian, frame_pose
+    from mbjax.scenes import arm as scene
+
+    arm = scene.model()
+    duration = 0.6 if quick else 1.5
+    ts = np.linspace(0.0, duration, 61)
+    q0 = jnp.asarray(scene.Q_REF)
+    fall = simulate(TreeSystem(arm), INTEGRATORS["rk4"](), q0, jnp.zeros(arm.nv), dt=scene.DT,
+                    t1=duration, saveat=ts)
+    flange = jax.jit(jax.vmap(lambda q: frame_pose(arm, q, "flange")[1]))(fall.qs)
+    beyond = jax.vmap(lambda q, v: excess(arm, q, v))(fall.qs, fall.us)
+    first = int(np.argmax(np.asarray(beyond).max(axis=1) > 0))
+    J = frame_jacobian(arm, q0, "flange")
+    manipulability = float(jnp.sqrt(jnp.linalg.det(J[3:] @ J[3:].T)))
+    peers = _model_peers(arm, q0)
+    fig = models_figure(np.asarray(ts), np.asarray(fall.qs), np.asarray(arm.lower),
+                        np.asarray(arm.upper), np.asarray(flange), peers,
+                        f"{len(arm.frame_names)} named frames; status: {fall.messages()[0]}")
+    fig.savefig(out / "models.png", dpi=110)
+    return {"figure": "models.png", "frames": list(arm.frame_names),
+            "flange_at_start_m": np.asarray(flange[0]).tolist(),
+            "flange_manipulability": manipulability, "status": fall.messages()[0],
+            "first_limit_exceeded_s": float(ts[first]) if np.asarray(beyond).any() else None,
+            "peers_max_relative_difference": peers}
+
+
+def _model_peers(arm, q) -> dict:
+    """The arm's forward dynamics against Pinocchio (from the same URDF) and against MuJoCo
+    (through MuJoCo's compiler and `from_mujoco`), each where installed."""
+    from mbjax.data import ARM7
+    from mbjax.model.states import state_to_pinocchio
+    from mbjax.rigid import forward_dynamics
+
+    rng = np.random.default_rng(0)
+    v, tau = jnp.asarray(rng.normal(size=arm.nv)), jnp.asarray(rng.normal(size=arm.nv))
+    out = {}
+    try:
+        import pinocchio as pin
+        pm = pin.buildModelFromUrdf(str(ARM7))
+        a_pin = pin.aba(pm, pm.createData(), *(np.asarray(x) for x in state_to_pinocchio(arm, q, v)),
+                        np.asarray(tau - arm.damping * v))
+        a = np.asarray(forward_dynamics(arm, q, v, tau))
+        out["pinocchio"] = float(np.abs(a - a_pin).max() / max(1.0, np.abs(a_pin).max()))
+    except ImportError:
+        pass
+    try:
+        import mujoco
+        from mbjax.model.mjcf import from_mujoco
+        mj = mujoco.MjModel.from_xml_path(str(ARM7))
+        mj.opt.disableflags |= mujoco.mjtDisableBit.mjDSBL_CONSTRAINT
+        data = mujoco.MjData(mj)
+        data.qpos[:], data.qvel[:], data.qfrc_applied[:] = q, v, tau
+        mujoco.mj_forward(mj, data)
+        a = np.asarray(forward_dynamics(from_mujoco(mj), q, v, tau))
+        out["mujoco"] = float(np.abs(a - data.qacc).max() / max(1.0, np.abs(data.qacc).max()))
+    except ImportError:
+        pass
+    return out
+
+
 TOUR = {
     "torque-free-body": torque_free_body_tour,
     "heavy-top": heavy_top_tour,
@@ -343,4 +410,5 @@ TOUR = {
     "flexible-bodies": flexible_bodies_tour,
     "carpal-wrist": carpal_wrist_tour,
     "controls": controls_tour,
+    "models": models_tour,
 }

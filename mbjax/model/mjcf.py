@@ -112,15 +112,20 @@ def _nonzero(m, field: str) -> int:
     return int(np.any(np.reshape(value, (np.shape(value)[0], -1)) != 0, axis=1).sum())
 
 
-def _contact_pairs(m) -> int:
-    """Geom pairs on different rigid bodies whose contype/conaffinity let them collide, plus
-    explicit <pair>s."""
+def _contact_pairs(m, filter_parent: bool) -> int:
+    """Geom pairs that MuJoCo's broadphase may pass on (contype/conaffinity match, different
+    rigid bodies, not both static, not parent and child), plus explicit <pair>s."""
     if m.ngeom < 2:
         return int(m.npair)
     ct, ca = m.geom_contype, m.geom_conaffinity
     weld = m.body_weldid[m.geom_bodyid]
-    can = (((ct[:, None] & ca[None, :]) | (ca[:, None] & ct[None, :])) != 0)
-    can &= weld[:, None] != weld[None, :]
+    parent = m.body_weldid[m.body_parentid[weld]]
+    moving = m.body_dofnum[weld] > 0
+    can = ((ct[:, None] & ca[None, :]) | (ca[:, None] & ct[None, :])) != 0
+    can &= (weld[:, None] != weld[None, :]) & (moving[:, None] | moving[None, :])
+    if filter_parent:
+        related = (weld[:, None] == parent[None, :]) | (parent[:, None] == weld[None, :])
+        can &= ~(related & (weld[:, None] != 0) & (weld[None, :] != 0))
     return int(np.triu(can, 1).sum()) + int(m.npair)
 
 
@@ -130,7 +135,8 @@ def _ignored(m, mujoco, connect_weld: int, closures: bool) -> list[str]:
     off = lambda flag: bool(disabled & int(flag))  # noqa: E731
     bits = mujoco.mjtDisableBit
     out = []
-    if not off(bits.mjDSBL_CONTACT) and (pairs := _contact_pairs(m)):
+    pairs = 0 if off(bits.mjDSBL_CONTACT) else _contact_pairs(m, not off(bits.mjDSBL_FILTERPARENT))
+    if pairs:
         out.append(f"contacts ({pairs} geom pairs can collide)")
     if m.nu:
         out.append(f"actuator forces ({m.nu} actuators; apply them as tau)")

@@ -63,3 +63,31 @@ def controls_figure(ts, dq, displacement, checks: dict, title: str) -> Figure:
         ax.grid(alpha=0.3)
     fig.suptitle(title, fontsize=10)
     return fig
+
+
+def models_figure(ts, qs, lower, upper, flange, peers: dict, title: str) -> Figure:
+    """(a) the falling arm's joint angles against their limits; (b) the flange's path, by name;
+    (c) forward dynamics against the peers."""
+    fig = Figure(figsize=(14, 4.2), layout="constrained")
+    ax_q, ax_f, ax_p = fig.subplots(1, 3, width_ratios=(1.2, 1, 0.6))
+    for j in range(qs.shape[1]):
+        line, = ax_q.plot(ts, qs[:, j], lw=1, label=f"joint {j + 1}")
+        for bound in (lower[j], upper[j]):
+            ax_q.axhline(bound, color=line.get_color(), lw=0.6, ls=":")
+    ax_q.set(xlabel="t [s]", ylabel="q [rad]", title="(a) unpowered fall, limits dotted")
+    ax_q.legend(fontsize=7, ncol=2)
+    ax_f.plot(flange[:, 0], flange[:, 2], "-", lw=1.5)
+    ax_f.plot(flange[0, 0], flange[0, 2], "o", label="start")
+    ax_f.set(xlabel="x [m]", ylabel="z [m]", title='(b) frame_pose(model, q, "flange")',
+             aspect="equal")
+    ax_f.legend(fontsize=7)
+    names = list(peers) or ["(no peer installed)"]
+    values = [max(peers.get(n, 0.0), 1e-17) for n in names]
+    ax_p.bar(names, values, color="C0")
+    ax_p.set_yscale("log")
+    ax_p.set(ylim=(1e-17, 1e-6), ylabel="max relative difference",
+             title="(c) forward dynamics vs peers")
+    for ax in (ax_q, ax_f, ax_p):
+        ax.grid(alpha=0.3)
+    fig.suptitle(f"ARM7 from URDF: {title}")
+    return fig

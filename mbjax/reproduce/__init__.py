@@ -4,7 +4,7 @@ Each entry is reproduce(out: Path, quick: bool) -> dict (the JSON written).
 """
 
 from mbjax.reproduce import (andrews_squeezer, carpal_wrist, closed_chain, flexible_slider_crank, gradient_matrix,
-                             integrators, spin_up_beam, top_long_run, torque_free_tfe, tree_scaling,
+                             integrators, model_corpus, spin_up_beam, top_long_run, torque_free_tfe, tree_scaling,
                              vertical_top)
 
 REPRODUCTIONS = {
@@ -19,6 +19,7 @@ REPRODUCTIONS = {
     flexible_slider_crank.NAME: flexible_slider_crank.reproduce,
     carpal_wrist.NAME: carpal_wrist.reproduce,
     gradient_matrix.NAME: gradient_matrix.reproduce,
+    model_corpus.NAME: model_corpus.reproduce,
 }
 
 __all__ = ["REPRODUCTIONS"]

@@ -1,0 +1,78 @@
+"""`mbjax reproduce model-corpus`: every real robot model we can find, loaded by mbjax and compared
+with the engine that owns its format.
+
+URDF: every robot of `example-robot-data`, fixed and floating base, against Pinocchio
+(`mbjax.reproduce.urdf_corpus`). MJCF: every model shipped by dm_control, gymnasium and
+gymnasium-robotics that MuJoCo compiles, against MuJoCo's `mj_forward` with contacts and
+constraints disabled (`mbjax.reproduce.mjcf_corpus`). `--quick`: a few of each.
+
+JSON: {"urdf": [rows], "mjcf": [rows], "versions": {...}}; a row has "loads", "nv" and
+"max_relative_difference" (see the two modules for the quantities compared).
+"""
+
+import json
+from pathlib import Path
+
+NAME = "model-corpus"
+QUICK_URDF = ("panda/panda", "romeo/romeo_small", "go1/go1")
+QUICK_MJCF = 6
+
+
+def _versions() -> dict:
+    from importlib.metadata import PackageNotFoundError, version
+    out = {}
+    for package in ("pin", "mujoco", "example-robot-data", "dm_control", "gymnasium",
+                    "gymnasium-robotics"):
+        try:
+            out[package] = version(package)
+        except PackageNotFoundError:
+            out[package] = None
+    return out
+
+
+def reproduce(out: Path, quick: bool = False) -> dict:
+    """Both corpora (quick: a few models of each); writes NAME.json and NAME.png."""
+    from mbjax.plot.corpus import corpus_figure
+    from mbjax.progress import progress
+    from mbjax.reproduce import mjcf_corpus, urdf_corpus
+
+    urdf_paths = urdf_corpus.corpus_paths()
+    if quick:
+        urdf_paths = [p for p in urdf_paths if urdf_corpus.name(p) in QUICK_URDF]
+    mjcf_paths = mjcf_corpus.corpus_paths()[:QUICK_MJCF] if quick else mjcf_corpus.corpus_paths()
+    urdf = [row for path in progress(urdf_paths, len(urdf_paths), "urdf")
+            for row in urdf_corpus.rows([path])]
+    mjcf = [row for path in progress(mjcf_paths, len(mjcf_paths), "mjcf")
+            for row in mjcf_corpus.rows([path])]
+    data = {"urdf": urdf, "mjcf": mjcf, "versions": _versions()}
+    out.mkdir(parents=True, exist_ok=True)
+    (out / f"{NAME}.json").write_text(json.dumps(data, indent=1))
+    corpus_figure(data).savefig(out / f"{NAME}.png", dpi=110)
+    return data
+
+
+def markdown_tables(data: dict) -> str:
+    """The two tables of benchmarks/README.md."""
+    lines = ["| robot | nv (fixed / floating) | loads | max relative difference (fixed / floating) |",
+             "| --- | --- | --- | --- |"]
+    by_robot: dict = {}
+    for row in data["urdf"]:
+        by_robot.setdefault(row["robot"], {})[row["floating"]] = row
+    for robot, pair in by_robot.items():
+        def cell(row, key):
+            if not row["loads"]:
+                return "n/a"
+            return f"{row[key]:.1e}" if key == "max_relative_difference" else str(row[key])
+        rows = [pair.get(False), pair.get(True)]
+        if not any(r and r["loads"] for r in rows):
+            loads = "not a robot" if "no links" in (rows[0] or {}).get("note", "") else "no"
+        else:
+            loads = "yes" + (" (floating only: no joints)" if not rows[0]["loads"] else "")
+        lines.append(f"| {robot} | {' / '.join(cell(r, 'nv') for r in rows)} | {loads} | "
+                     f"{' / '.join(cell(r, 'max_relative_difference') for r in rows)} |")
+    lines += ["", "| model | nv | loads | max relative difference |", "| --- | --- | --- | --- |"]
+    for row in data["mjcf"]:
+        diff = row["max_relative_difference"]
+        lines.append(f"| {row['model']} | {row['nv']} | {'yes' if row['loads'] else 'no'} | "
+                     f"{'n/a' if diff is None else f'{diff:.1e}'} |")
+    return "\n".join(lines)
