@@ -24,14 +24,18 @@ The mapping (MuJoCo body frames, joints and names to mbjax):
       armature of actuators on the joint (gear^2-scaled, MuJoCo >= 4) as armature, dof_damping
       plus such actuators' damping as damping (zero where the model disables dampers),
       dof_frictionloss as friction, jnt_actfrcrange of force-limited joints as effort_limit;
-      opt.gravity (zero where disabled). Limits and friction are data, not forces.
+      opt.gravity (zero where disabled). Limits and friction are data, not forces. A free
+      joint's translational armature is left out: MuJoCo adds it to the world-frame linear
+      velocity, whose rate in mbjax's body-frame velocity has a term omega x v that a diagonal
+      armature cannot give (its damping and rotational armature map exactly).
     - Active connect and weld equality constraints (body or site semantics) become
       `mbjax.loops.CutJoint`s ("spherical", "weld") with the same zero set as MuJoCo's residual,
       returned with `closures=True`.
 
 What mbjax does not model (contacts, actuator forces, tendons, springs, polynomial damping,
-gravity compensation, fluid forces, flexes, plugins, other equality constraints, connect and
-weld constraints unless closures=True) is named in one `ModelWarning`; `strict=True` makes it an
+gravity compensation, fluid forces, flexes, plugins, ball joint limits, other equality
+constraints, connect and weld constraints unless closures=True, free joints' translational
+armature) is named in one `ModelWarning`; `strict=True` makes it an
 error, as it does for implausible inertias.
 """
 
@@ -241,7 +245,7 @@ def from_mujoco(mjmodel, *, strict: bool = False, closures: bool = False):
     per_dof = {key: np.zeros(m.nv) for key in ("damping", "armature", "friction")}
     effort = np.full(m.nv, np.inf)
     damper = not (int(m.opt.disableflags) & int(mujoco.mjtDisableBit.mjDSBL_DAMPER))
-    iq = iv = 0
+    iq = iv = free_armature = 0
     for body in bodies:
         j, kind = body["joint"], body["kind"]
         if m.jnt_qposadr[j] != iq or m.jnt_dofadr[j] != iv:
@@ -252,6 +256,9 @@ def from_mujoco(mjmodel, *, strict: bool = False, closures: bool = False):
         dofs = iv + np.asarray(_FREE_DOFS if kind == "free" else range(nv_j))
         per_dof["damping"][iv:iv + nv_j] = (m.dof_damping[dofs] + act_damping[j]) * damper
         per_dof["armature"][iv:iv + nv_j] = m.dof_armature[dofs] + act_armature[j]
+        if kind == "free" and per_dof["armature"][iv + 3:iv + 6].any():
+            per_dof["armature"][iv + 3:iv + 6] = 0.0       # see the module docstring
+            free_armature += 1
         per_dof["friction"][iv:iv + nv_j] = m.dof_frictionloss[dofs]
         if m.jnt_actfrclimited[j]:
             effort[iv:iv + nv_j] = np.abs(m.jnt_actfrcrange[j]).max()
@@ -263,6 +270,8 @@ def from_mujoco(mjmodel, *, strict: bool = False, closures: bool = False):
         gravity = np.zeros(3)
     cuts, connect_weld = _cut_joints(m, mujoco, where)
     ignored = _ignored(m, mujoco, connect_weld, closures)
+    if free_armature:
+        ignored.append(f"armature on free joints' translation ({free_armature})")
     if ignored:
         message = "from_mujoco: mbjax does not model, and ignored: " + "; ".join(ignored)
         if strict:

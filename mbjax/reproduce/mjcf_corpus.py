@@ -17,8 +17,8 @@ MuJoCo computes what mbjax models and nothing else: `comparable` disables contac
 (limits, dry friction, equality), actuator forces and springs by flag (mjDSBL_CONTACT,
 mjDSBL_CONSTRAINT, mjDSBL_ACTUATION, mjDSBL_SPRING) and zeroes in a copy of the model the passive
 forces mbjax does not model but whose flag would also switch off joint damping: tendon damping and
-armature, polynomial damping, gravity compensation and fluid forces (opt.density, viscosity);
-sleeping is disabled. Joint damping, armature (actuators' included), gravity and the rigid-body
+armature, polynomial damping, gravity compensation and fluid forces (opt.density, viscosity),
+and free joints' translational armature; sleeping is disabled. Joint damping, armature (actuators' included), gravity and the rigid-body
 dynamics stay on. The row's note names what the model's warning listed as ignored.
 
 JSON (`reproduce`): {"rows": [{"model", "nv", "loads", "max_relative_difference",
@@ -85,6 +85,8 @@ def comparable(mjmodel):
                               | bits.mjDSBL_ACTUATION | bits.mjDSBL_SPRING)
     m.opt.enableflags &= ~int(mujoco.mjtEnableBit.mjENBL_SLEEP)
     m.opt.density = m.opt.viscosity = 0.0
+    for j in np.flatnonzero(m.jnt_type == mujoco.mjtJoint.mjJNT_FREE):
+        m.dof_armature[m.jnt_dofadr[j]:m.jnt_dofadr[j] + 3] = 0.0    # translational armature
     for field in ("tendon_damping", "tendon_armature", "tendon_dampingpoly", "dof_dampingpoly",
                   "actuator_dampingpoly", "body_gravcomp"):
         if getattr(m, field, None) is not None:

@@ -15,7 +15,6 @@ from pathlib import Path
 
 NAME = "model-corpus"
 QUICK_URDF = ("panda/panda", "romeo/romeo_small", "go1/go1")
-QUICK_MJCF = 6
 
 
 def _versions() -> dict:
@@ -39,7 +38,7 @@ def reproduce(out: Path, quick: bool = False) -> dict:
     urdf_paths = urdf_corpus.corpus_paths()
     if quick:
         urdf_paths = [p for p in urdf_paths if urdf_corpus.name(p) in QUICK_URDF]
-    mjcf_paths = mjcf_corpus.corpus_paths()[:QUICK_MJCF] if quick else mjcf_corpus.corpus_paths()
+    mjcf_paths = mjcf_corpus.quick_paths() if quick else mjcf_corpus.corpus_paths()
     urdf = [row for path in progress(urdf_paths, len(urdf_paths), "urdf")
             for row in urdf_corpus.rows([path])]
     mjcf = [row for path in progress(mjcf_paths, len(mjcf_paths), "mjcf")
