@@ -66,3 +66,18 @@ def check_body(mass: float, inertia: np.ndarray, name: str, *, carries: bool,
         warn(f"{name}: principal moments {moments} violate the triangle inequality J1 + J2 >= J3 "
              "that every mass distribution satisfies (typical of CAD exports); the dynamics use "
              "them as given, fix the inertia to make it physical", strict)
+
+
+def combine(parts) -> tuple[float, np.ndarray, np.ndarray]:
+    """(mass, centre of mass, inertia about it) of rigidly joined parts, each (mass, centre of
+    mass, inertia about it) in one frame (parallel axes); massless parts (a pure rotational
+    inertia) add their inertia as it is."""
+    mass = sum(p[0] for p in parts)
+    if mass == 0:
+        return 0.0, np.zeros(3), sum((p[2] for p in parts), np.zeros((3, 3)))
+    com = sum(p[0] * p[1] for p in parts) / mass
+    inertia = np.zeros((3, 3))
+    for m_i, c_i, J_i in parts:
+        d = c_i - com
+        inertia += J_i + m_i * (d @ d * np.eye(3) - np.outer(d, d))
+    return float(mass), com, inertia

@@ -35,8 +35,8 @@ The mapping (MuJoCo body frames, joints and names to mbjax):
 What mbjax does not model (contacts, actuator forces, tendons, springs, polynomial damping,
 gravity compensation, fluid forces, flexes, plugins, ball joint limits, other equality
 constraints, connect and weld constraints unless closures=True, free joints' translational
-armature) is named in one `ModelWarning`; `strict=True` makes it an
-error, as it does for implausible inertias.
+armature) is named in one `ModelWarning`; `strict=True` makes it an error, as it does for
+implausible inertias.
 """
 
 import os
@@ -44,7 +44,7 @@ import warnings
 
 import numpy as np
 
-from mbjax.model.checks import ModelWarning
+from mbjax.model.checks import ModelWarning, combine
 from mbjax.model.joints import JOINT_TYPES
 from mbjax.model.model import Model
 
@@ -98,10 +98,10 @@ def _actuator_joint_terms(m) -> tuple[np.ndarray, np.ndarray]:
     if not hasattr(m, "actuator_armature"):
         return armature, damping
     mujoco = _mujoco()
-    joint_trn = (mujoco.mjtTrn.mjTRN_JOINT, mujoco.mjtTrn.mjTRN_JOINTINPARENT)
+    joint_trn = (int(mujoco.mjtTrn.mjTRN_JOINT), int(mujoco.mjtTrn.mjTRN_JOINTINPARENT))
     gear = np.ravel(m.actuator_gear)
     for k in range(m.nu):
-        if m.actuator_trntype[k] in joint_trn:
+        if int(m.actuator_trntype[k]) in joint_trn:
             g = gear[6 * (m.actuator_outadr[k] if hasattr(m, "actuator_outadr") else k)]
             armature[m.actuator_trnid[k, 0]] += m.actuator_armature[k] * g**2
             damping[m.actuator_trnid[k, 0]] += m.actuator_damping[k] * g**2
@@ -139,7 +139,9 @@ def _ignored(m, mujoco, connect_weld: int, closures: bool) -> list[str]:
     off = lambda flag: bool(disabled & int(flag))  # noqa: E731
     bits = mujoco.mjtDisableBit
     out = []
-    pairs = 0 if off(bits.mjDSBL_CONTACT) else _contact_pairs(m, not off(bits.mjDSBL_FILTERPARENT))
+    constraints = not off(bits.mjDSBL_CONSTRAINT)
+    pairs = (_contact_pairs(m, not off(bits.mjDSBL_FILTERPARENT))
+             if constraints and not off(bits.mjDSBL_CONTACT) else 0)
     if pairs:
         out.append(f"contacts ({pairs} geom pairs can collide)")
     if m.nu:
@@ -160,12 +162,14 @@ def _ignored(m, mujoco, connect_weld: int, closures: bool) -> list[str]:
         out.append(f"flexes ({m.nflex})")
     if m.nplugin:
         out.append(f"plugins ({m.nplugin})")
-    ball_limits = int(np.sum(m.jnt_limited.astype(bool) & (m.jnt_type == 1)))
+    ball_limits = int(np.sum(m.jnt_limited.astype(bool)
+                             & (m.jnt_type == int(mujoco.mjtJoint.mjJNT_BALL))))
     if ball_limits:
         out.append(f"ball joint limits ({ball_limits})")
     other = int(np.sum(m.eq_active0.astype(bool)
-                       & ~np.isin(m.eq_type, (mujoco.mjtEq.mjEQ_CONNECT, mujoco.mjtEq.mjEQ_WELD))))
-    if other and not off(bits.mjDSBL_EQUALITY):
+                       & ~np.isin(m.eq_type, (int(mujoco.mjtEq.mjEQ_CONNECT),
+                                              int(mujoco.mjtEq.mjEQ_WELD)))))
+    if other and _equality_on(m, mujoco):
         out.append(f"joint, tendon, flex and distance equality constraints ({other})")
     if connect_weld and not closures:
         out.append(f"connect and weld equality constraints ({connect_weld}; load with "
@@ -173,26 +177,13 @@ def _ignored(m, mujoco, connect_weld: int, closures: bool) -> list[str]:
     return out
 
 
-def _merge(parts) -> tuple[float, np.ndarray, np.ndarray]:
-    """(mass, centre of mass, inertia about it) of rigidly joined parts, each given as (mass,
-    centre of mass, inertia about it) in one frame (parallel axes)."""
-    mass = sum(p[0] for p in parts)
-    if mass == 0:
-        return 0.0, np.zeros(3), sum((p[2] for p in parts), np.zeros((3, 3)))
-    com = sum(p[0] * p[1] for p in parts) / mass
-    inertia = np.zeros((3, 3))
-    for m_i, c_i, J_i in parts:
-        d = c_i - com
-        inertia += J_i + m_i * (d @ d * np.eye(3) - np.outer(d, d))
-    return float(mass), com, inertia
-
-
 def from_mujoco(mjmodel, *, strict: bool = False, closures: bool = False):
     """A `Model` from a compiled `mujoco.MjModel` (see the module docstring for the mapping).
 
     closures=True returns (model, cut_joints): the active connect and weld equality constraints
     as `mbjax.loops.CutJoint`s, for `mbjax.loops.ClosedSystem(TreeSystem(model), cut_joints)`.
-    What mbjax does not model is named in one `ModelWarning` (an error with strict=True)."""
+    What mbjax does not model is named in one `ModelWarning`; strict=True makes implausible
+    inertias errors (`mbjax.model.checks`), not the features mbjax leaves out."""
     mujoco = _mujoco()
     m = mjmodel
     if m.nv == 0:
@@ -240,7 +231,7 @@ def from_mujoco(mjmodel, *, strict: bool = False, closures: bool = False):
         frames.append((f"site/{name}" if name in taken else name, k, R @ site_quat[s],
                        p + R @ m.site_pos[s]))
 
-    n, nq = len(bodies), m.nq
+    nq = m.nq
     lower, upper = np.full(nq, -np.inf), np.full(nq, np.inf)
     per_dof = {key: np.zeros(m.nv) for key in ("damping", "armature", "friction")}
     effort = np.full(m.nv, np.inf)
@@ -248,8 +239,7 @@ def from_mujoco(mjmodel, *, strict: bool = False, closures: bool = False):
     iq = iv = free_armature = 0
     for body in bodies:
         j, kind = body["joint"], body["kind"]
-        if m.jnt_qposadr[j] != iq or m.jnt_dofadr[j] != iv:
-            raise AssertionError(f"joint {body['joint_name']!r}: coordinates out of MuJoCo order")
+        assert (m.jnt_qposadr[j], m.jnt_dofadr[j]) == (iq, iv), "bodies out of MuJoCo's order"
         nq_j, nv_j = JOINT_TYPES[kind]
         if kind in ("revolute", "prismatic") and m.jnt_limited[j]:
             lower[iq], upper[iq] = m.jnt_range[j]
@@ -264,7 +254,7 @@ def from_mujoco(mjmodel, *, strict: bool = False, closures: bool = False):
             effort[iv:iv + nv_j] = np.abs(m.jnt_actfrcrange[j]).max()
         iq, iv = iq + nq_j, iv + nv_j
 
-    inertial = [_merge(p) for p in parts]
+    inertial = [combine(p) for p in parts]
     gravity = np.array(m.opt.gravity, dtype=float)
     if int(m.opt.disableflags) & int(mujoco.mjtDisableBit.mjDSBL_GRAVITY):
         gravity = np.zeros(3)
@@ -273,10 +263,8 @@ def from_mujoco(mjmodel, *, strict: bool = False, closures: bool = False):
     if free_armature:
         ignored.append(f"armature on free joints' translation ({free_armature})")
     if ignored:
-        message = "from_mujoco: mbjax does not model, and ignored: " + "; ".join(ignored)
-        if strict:
-            raise ValueError(message + " (strict=True)")
-        warnings.warn(message, ModelWarning, stacklevel=2)
+        warnings.warn("from_mujoco: mbjax does not model, and ignored: " + "; ".join(ignored),
+                      ModelWarning, stacklevel=2)
     model = Model(
         [body["parent"] for body in bodies], [body["kind"] for body in bodies],
         mass=[x[0] for x in inertial], com=np.stack([x[1] for x in inertial]),
@@ -291,8 +279,13 @@ def from_mujoco(mjmodel, *, strict: bool = False, closures: bool = False):
         frame_parents=[f[1] for f in frames],
         frame_rotation=np.reshape([f[2] for f in frames], (-1, 3, 3)),
         frame_translation=np.reshape([f[3] for f in frames], (-1, 3)), strict=strict)
-    assert n == model.n
     return (model, cuts) if closures else model
+
+
+def _equality_on(m, mujoco) -> bool:
+    """Whether the model's options leave its equality constraints acting."""
+    bits = mujoco.mjtDisableBit
+    return not int(m.opt.disableflags) & int(bits.mjDSBL_CONSTRAINT | bits.mjDSBL_EQUALITY)
 
 
 def _cut_joints(m, mujoco, where) -> tuple[list, int]:
@@ -301,6 +294,8 @@ def _cut_joints(m, mujoco, where) -> tuple[list, int]:
     from mbjax.loops.closures import CutJoint
 
     cuts, count = [], 0
+    if not _equality_on(m, mujoco):
+        return cuts, count
     site_quat = quat_matrix(m.site_quat) if m.nsite else None
     for i in range(m.neq):
         kind = {int(mujoco.mjtEq.mjEQ_CONNECT): "spherical",
@@ -309,11 +304,12 @@ def _cut_joints(m, mujoco, where) -> tuple[list, int]:
             continue
         count += 1
         data, ids = np.asarray(m.eq_data[i], dtype=float), (m.eq_obj1id[i], m.eq_obj2id[i])
-        if m.eq_objtype[i] == mujoco.mjtObj.mjOBJ_SITE:      # the two sites' frames
+        if int(m.eq_objtype[i]) == int(mujoco.mjtObj.mjOBJ_SITE):      # the two sites' frames
             ends = [(int(m.site_bodyid[s]), site_quat[s], m.site_pos[s]) for s in ids]
-        elif kind == "spherical":                            # anchors data[0:3], data[3:6]
+        elif kind == "spherical":          # body 1's point data[0:3] on body 2's data[3:6]
             ends = [(int(ids[0]), np.eye(3), data[0:3]), (int(ids[1]), np.eye(3), data[3:6])]
-        else:              # body 1: anchor data[3:6], rotated by relpose; body 2: anchor data[0:3]
+        else:    # body 1's frame at data[3:6] turned by the relpose quaternion data[6:10] on body
+            #      2's frame at its anchor data[0:3] (MuJoCo's weld residual)
             ends = [(int(ids[0]), quat_matrix(data[6:10]), data[3:6]),
                     (int(ids[1]), np.eye(3), data[0:3])]
             if data[10] == 0:                                # torquescale 0: position only

@@ -29,7 +29,7 @@ from pathlib import Path
 
 import numpy as np
 
-from mbjax.model.checks import warn
+from mbjax.model.checks import combine, warn
 from mbjax.model.joints import JOINT_TYPES
 from mbjax.model.model import Model
 
@@ -104,19 +104,6 @@ def _inertial(link) -> tuple[float, np.ndarray, np.ndarray]:
                   [i["ixz"], i["iyz"], i["izz"]]])
     R, xyz = _origin(inertial, f"link {name!r} inertial")
     return float(mass), xyz, R @ J @ R.T
-
-
-def _merge(a, b):
-    """Two (mass, com, inertia about com) in one frame combined (parallel-axis theorem); massless
-    parts (a pure rotational inertia) add their inertia as it is."""
-    (ma, ca, Ja), (mb, cb, Jb) = a, b
-    m = ma + mb
-    c = (ma * ca + mb * cb) / m if m > 0 else ca
-
-    def shifted(mass, com, J):
-        d = com - c
-        return J + mass * (d @ d * np.eye(3) - np.outer(d, d))
-    return m, c, shifted(ma, ca, Ja) + shifted(mb, cb, Jb)
 
 
 def _bounded(inertial, min_mass: float, min_inertia: float):
@@ -218,8 +205,8 @@ def load_urdf(source: str | os.PathLike, *, floating_base: bool = False,
                 m, c, J = links[child]
                 if body >= 0 and (m > 0 or J.any()):
                     target = bodies[body]
-                    target["inertial"] = _merge(target["inertial"],
-                                                (m, R_place @ c + p_place, R_place @ J @ R_place.T))
+                    target["inertial"] = combine([target["inertial"],
+                                                  (m, R_place @ c + p_place, R_place @ J @ R_place.T)])
                 frames.extend([(child, body, R_place, p_place), (name, body, R_place, p_place)])
                 visit(child, body, R_place, p_place)
                 continue

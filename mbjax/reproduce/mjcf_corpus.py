@@ -15,19 +15,19 @@ random qvel and qfrc_applied) `compare` sets both engines side by side:
 
 MuJoCo computes what mbjax models and nothing else: `comparable` disables contacts, constraints
 (limits, dry friction, equality), actuator forces and springs by flag (mjDSBL_CONTACT,
-mjDSBL_CONSTRAINT, mjDSBL_ACTUATION, mjDSBL_SPRING) and zeroes in a copy of the model the passive
-forces mbjax does not model but whose flag would also switch off joint damping: tendon damping and
-armature, polynomial damping, gravity compensation and fluid forces (opt.density, viscosity),
-and free joints' translational armature; sleeping is disabled. Joint damping, armature (actuators' included), gravity and the rigid-body
-dynamics stay on. The row's note names what the model's warning listed as ignored.
+mjDSBL_CONSTRAINT, mjDSBL_ACTUATION, mjDSBL_SPRING) and zeroes, in a copy of the model, what
+mbjax does not model but mjDSBL_DAMPER would not remove alone or would remove with the joint
+damping mbjax does model: tendon damping and armature, polynomial damping, gravity compensation,
+fluid forces (opt.density, viscosity) and free joints' translational armature; sleeping is
+disabled. Joint damping, armature (actuators' included), gravity and the rigid-body dynamics
+stay on. A row's note is what the model's `from_mujoco` warning listed as ignored.
 
-JSON (`reproduce`): {"rows": [{"model", "nv", "loads", "max_relative_difference",
-"max_pose_difference", "note", "seconds"}], "skipped": [{"model", "reason"}], "tolerance"}.
+`mbjax reproduce model-corpus` (`mbjax.reproduce.model_corpus`) writes the rows with the URDF
+corpus's.
 """
 
 import copy
 import importlib.util
-import json
 import time
 import warnings
 from pathlib import Path
@@ -40,10 +40,9 @@ from mbjax.model import Model
 from mbjax.model.checks import ModelWarning
 from mbjax.model.mjcf import from_mujoco, object_name, site_frame_name
 from mbjax.model.states import state_from_mujoco, state_to_mujoco
-from mbjax.rigid import forward_dynamics
+from mbjax.rigid import forward_dynamics, frame_placement
 from mbjax.rigid.kinematics import forward_kinematics
 
-NAME = "mjcf-corpus"
 TOLERANCE = 1e-8
 # (package, folder in it, glob): where the MJCF files are
 SOURCES = (("dm_control", "suite", "*.xml"), ("gymnasium", "envs/mujoco/assets", "*.xml"),
@@ -85,21 +84,13 @@ def comparable(mjmodel):
                               | bits.mjDSBL_ACTUATION | bits.mjDSBL_SPRING)
     m.opt.enableflags &= ~int(mujoco.mjtEnableBit.mjENBL_SLEEP)
     m.opt.density = m.opt.viscosity = 0.0
-    for j in np.flatnonzero(m.jnt_type == mujoco.mjtJoint.mjJNT_FREE):
+    for j in np.flatnonzero(m.jnt_type == int(mujoco.mjtJoint.mjJNT_FREE)):
         m.dof_armature[m.jnt_dofadr[j]:m.jnt_dofadr[j] + 3] = 0.0    # translational armature
     for field in ("tendon_damping", "tendon_armature", "tendon_dampingpoly", "dof_dampingpoly",
                   "actuator_dampingpoly", "body_gravcomp"):
         if getattr(m, field, None) is not None:
             getattr(m, field)[:] = 0.0
     return m
-
-
-def _locate(model: Model, name: str):
-    """(body, R, p) of a frame or body name (as `mbjax.frame_pose` looks it up)."""
-    if name in model.frame_names:
-        i = model.frame_names.index(name)
-        return model.frame_parents[i], model.frame_rotation[i], model.frame_translation[i]
-    return model.names.index(name), jnp.eye(3), jnp.zeros(3)
 
 
 @jax.jit
@@ -137,7 +128,7 @@ def compare(mjmodel, model: Model, seed: int = 0) -> dict:
     targets += [(site_frame_name(model, object_name(m, "site", s)), d.site_xmat[s],
                  d.site_xpos[s]) for s in range(m.nsite)]
     for name, xmat, xpos in targets:
-        k, R_f, p_f = (np.asarray(x) for x in _locate(model, name))
+        k, R_f, p_f = (np.asarray(x) for x in frame_placement(model, name))
         R_w, p_w = (R_f, p_f) if k < 0 else (R[k] @ R_f, p[k] + R[k] @ p_f)
         pose_error = max(pose_error, np.abs(R_w.reshape(9) - xmat).max(),
                          np.abs(p_w - xpos).max())
@@ -149,7 +140,7 @@ def survey(paths=None) -> tuple[list[dict], list[dict]]:
     not a model on its own."""
     import mujoco
 
-    rows, skipped = [], []
+    found, skipped = [], []
     for path in corpus_paths() if paths is None else [Path(p) for p in paths]:
         name = short_name(path)
         try:
@@ -162,8 +153,7 @@ def survey(paths=None) -> tuple[list[dict], list[dict]]:
             continue
         start = time.perf_counter()
         row = {"model": name, "nv": int(mjmodel.nv), "loads": False,
-               "max_relative_difference": float("nan"), "max_pose_difference": float("nan"),
-               "note": ""}
+               "max_relative_difference": None, "max_pose_difference": None, "note": ""}
         try:
             with warnings.catch_warnings(record=True) as caught:
                 warnings.simplefilter("always", ModelWarning)
@@ -177,29 +167,17 @@ def survey(paths=None) -> tuple[list[dict], list[dict]]:
         except Exception as err:                      # a failure is a row, not a crash
             row["note"] = f"{type(err).__name__}: {err}"
         row["seconds"] = time.perf_counter() - start
-        rows.append(row)
-    return rows, skipped
+        found.append(row)
+    return found, skipped
 
 
 def rows(paths=None) -> list[dict]:
     """One dict per model that MuJoCo compiles (all of `corpus_paths()` by default): {"model",
-    "nv", "loads", "max_relative_difference", "max_pose_difference", "note", "seconds"}."""
+    "nv", "loads", "max_relative_difference", "max_pose_difference" (None where not compared),
+    "note" (what was ignored, or the error), "seconds"}."""
     return survey(paths)[0]
 
 
 def quick_paths() -> list[Path]:
     """The `QUICK` subset's files (those installed)."""
     return [path for path in corpus_paths() if short_name(path) in QUICK]
-
-
-def reproduce(out: Path, quick: bool = False) -> dict:
-    """Survey the corpus (`QUICK` with quick), write out/mjcf-corpus.json, return the JSON."""
-    found, skipped = survey(quick_paths() if quick else None)
-    data = {"rows": found, "skipped": skipped, "tolerance": TOLERANCE}
-    for row in found:
-        print(f"{row['model']:60s} nv {row['nv']:3d}  loads {row['loads']!s:5s}  "
-              f"qacc {row['max_relative_difference']:.1e}  poses {row['max_pose_difference']:.1e}")
-    out = Path(out)
-    out.mkdir(parents=True, exist_ok=True)
-    (out / f"{NAME}.json").write_text(json.dumps(data, indent=1))
-    return data

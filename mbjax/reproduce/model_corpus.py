@@ -6,8 +6,10 @@ URDF: every robot of `example-robot-data`, fixed and floating base, against Pino
 gymnasium-robotics that MuJoCo compiles, against MuJoCo's `mj_forward` with contacts and
 constraints disabled (`mbjax.reproduce.mjcf_corpus`). `--quick`: a few of each.
 
-JSON: {"urdf": [rows], "mjcf": [rows], "versions": {...}}; a row has "loads", "nv" and
-"max_relative_difference" (see the two modules for the quantities compared).
+JSON: {"urdf": [rows], "mjcf": [rows], "mjcf_skipped": [{"model", "reason"}], "tolerance",
+"versions"}; a row has "loads", "nv" and "max_relative_difference" (see the two modules for the
+quantities compared). Files that are not models on their own (MJCF include fragments, jointless
+scenes, an empty URDF) are listed, not counted.
 """
 
 import json
@@ -41,9 +43,10 @@ def reproduce(out: Path, quick: bool = False) -> dict:
     mjcf_paths = mjcf_corpus.quick_paths() if quick else mjcf_corpus.corpus_paths()
     urdf = [row for path in progress(urdf_paths, len(urdf_paths), "urdf")
             for row in urdf_corpus.rows([path])]
-    mjcf = [row for path in progress(mjcf_paths, len(mjcf_paths), "mjcf")
-            for row in mjcf_corpus.rows([path])]
-    data = {"urdf": urdf, "mjcf": mjcf, "versions": _versions()}
+    surveyed = [mjcf_corpus.survey([path]) for path in progress(mjcf_paths, len(mjcf_paths), "mjcf")]
+    data = {"urdf": urdf, "mjcf": [row for rows, _ in surveyed for row in rows],
+            "mjcf_skipped": [row for _, skipped in surveyed for row in skipped],
+            "tolerance": mjcf_corpus.TOLERANCE, "versions": _versions()}
     out.mkdir(parents=True, exist_ok=True)
     (out / f"{NAME}.json").write_text(json.dumps(data, indent=1))
     corpus_figure(data).savefig(out / f"{NAME}.png", dpi=110)

@@ -12,7 +12,7 @@ from mbjax.rigid.dynamics import (
     inverse_dynamics,
     mass_matrix,
 )
-from mbjax.rigid.frames import frame_jacobian, frame_names, frame_pose, frame_poses
+from mbjax.rigid.frames import frame_jacobian, frame_names, frame_placement, frame_pose, frame_poses
 from mbjax.rigid.energy import energy, kinetic_energy, potential_energy, spatial_momentum
 from mbjax.rigid.kinematics import body_kinematics, forward_kinematics
 from mbjax.rigid.momentum import (
@@ -37,7 +37,7 @@ __all__ = [
     "batched_forward_dynamics", "body_kinematics",
     "choose_method", "constraint_forces", "constraint_forces_momentum", "dense_forward_dynamics",
     "energy", "forward_dynamics", "forward_kinematics", "frame_jacobian", "frame_names",
-    "frame_pose", "frame_poses", "inverse_dynamics", "inverse_operator",
+    "frame_placement", "frame_pose", "frame_poses", "inverse_dynamics", "inverse_operator",
     "joint_reactions",
     "joint_wrenches", "kinetic_energy", "mass_matrix", "momentum", "momentum_rate",
     "operator_terms", "potential_energy", "primitive_inverse_mass", "spatial_momentum", "system_momenta",

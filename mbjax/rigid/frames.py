@@ -18,8 +18,9 @@ def frame_names(model: Model) -> tuple[str, ...]:
     return tuple(dict.fromkeys((*model.frame_names, *model.names, *model.joint_names)))
 
 
-def _locate(model: Model, name: str) -> tuple[int, Array, Array]:
-    """(body, R, p): the frame's body (-1: the ground) and its pose in that body's frame."""
+def frame_placement(model: Model, name: str) -> tuple[int, Array, Array]:
+    """(body, R, p): the frame's body (-1: the ground) and its pose in that body's frame; a
+    KeyError that lists the model's names when there is no such frame, body or joint."""
     if name in model.frame_names:
         i = model.frame_names.index(name)
         return model.frame_parents[i], model.frame_rotation[i], model.frame_translation[i]
@@ -34,7 +35,7 @@ def _locate(model: Model, name: str) -> tuple[int, Array, Array]:
 
 def frame_pose(model: Model, q: Array, name: str) -> tuple[Array, Array]:
     """World orientation (3, 3) and origin (3,) of the frame, body or joint called `name`."""
-    body, R_f, p_f = _locate(model, name)
+    body, R_f, p_f = frame_placement(model, name)
     if body < 0:
         return R_f, p_f
     R, p = forward_kinematics(model, q)
@@ -44,7 +45,7 @@ def frame_pose(model: Model, q: Array, name: str) -> tuple[Array, Array]:
 def frame_jacobian(model: Model, q: Array, name: str) -> Array:
     """J (6, nv) with (omega; v) = J v: the frame's angular velocity and the velocity of its
     origin, world components (Pinocchio's LOCAL_WORLD_ALIGNED, in (angular; linear) order)."""
-    body, R_f, p_f = _locate(model, name)
+    body, R_f, p_f = frame_placement(model, name)
     if body < 0:
         return jnp.zeros((6, model.nv), q.dtype)
     kin = body_kinematics(model, q, jnp.zeros(model.nv, q.dtype))
