@@ -5,7 +5,11 @@ Per robot and base: forward dynamics (ABA), inverse dynamics (RNEA) and the mass
 a random state, and the world pose and Jacobian of every frame Pinocchio names (links, joints,
 fixed joints). Pinocchio reads URDF damping but its ABA does not apply it; mbjax does, so the
 comparison gives Pinocchio the joint forces tau - damping * v. The difference is
-max |mbjax - Pinocchio| / max(1, max |Pinocchio|) over every quantity.
+max |mbjax - Pinocchio| / max(1, max |Pinocchio|) over every quantity. Where the mass matrix is
+ill-conditioned (a near-massless body, cond(M) > 1e5) the accelerations of both engines carry
+cond(M) times round-off; there mbjax's accelerations are put into Pinocchio's equations of motion
+instead (their residual relative to the size of its terms, max(|tau|, |M| |a|): the backward
+error).
 
 A file that is not a robot (an empty <robot>, as `ur3.urdf` of the package) is listed but not
 counted, and a robot whose only joint is its free base (a quadrotor) has no fixed-base row.
@@ -23,6 +27,11 @@ from mbjax.model.states import state_to_pinocchio
 from mbjax.model.urdf import load_urdf
 from mbjax.rigid import aba, forward_kinematics, inverse_dynamics, mass_matrix
 from mbjax.rigid.frames import frame_jacobian, frame_poses
+
+
+# Above this condition number of the mass matrix, forward dynamics are compared by their backward
+# error: cond(M) eps exceeds 1e-10 there, so neither engine's accelerations are accurate to it.
+ILL_CONDITIONED = 1e5
 
 
 def corpus_paths() -> list[Path]:
@@ -79,29 +88,39 @@ def compare(path: Path, floating: bool, seed: int = 0) -> dict:
     P = np.asarray(jax.jacfwd(lambda v_: state_to_pinocchio(model, q, v_)[1])(v))  # v_pin = P v
     a, tau_back, M, (R, p), (R_body, p_body) = _mbjax(model, q, v, tau)
     a_pin = pin.aba(pm, pd, q_pin, v_pin, P @ np.asarray(tau - model.damping * v))
-    diffs = [_rel(P @ np.asarray(M) @ P.T, _symmetric(pin.crba(pm, pd, q_pin)))]
-    if np.all(np.isfinite(a_pin)):
-        diffs += [_rel(P @ np.asarray(a), a_pin),
-                  _rel(P @ np.asarray(tau_back - model.damping * v),
-                       pin.rnea(pm, pd, q_pin, v_pin, P @ np.asarray(a)))]
-    else:      # a massless leaf: M is singular, and Pinocchio's ABA returns NaN
+    M_pin = _symmetric(pin.crba(pm, pd, q_pin))
+    diffs = [_rel(P @ np.asarray(M) @ P.T, M_pin)]
+    condition = float(np.linalg.cond(M_pin))
+    row["mass_matrix_condition"] = condition
+    tau_pin = P @ np.asarray(tau - model.damping * v)
+    if not np.all(np.isfinite(a_pin)):      # a massless leaf: M is singular, Pinocchio's ABA NaN
         row["note"] = "singular mass matrix: forward dynamics not compared (Pinocchio's is NaN)"
         a_any = jnp.asarray(rng.normal(size=model.nv))
         tau_id = inverse_dynamics(model, q, v, a_any)
         diffs.append(_rel(P @ np.asarray(tau_id - model.damping * v),
                           pin.rnea(pm, pd, q_pin, v_pin, P @ np.asarray(a_any))))
+    elif condition > ILL_CONDITIONED:
+        # a near-massless body: both engines' accelerations carry cond(M) times round-off, so
+        # mbjax's go into Pinocchio's equations of motion (the backward error: the residual
+        # against the size of its terms)
+        row["note"] = (f"ill-conditioned mass matrix (cond {condition:.0e}): forward dynamics "
+                       "compared by the residual of Pinocchio's equations of motion")
+        residual = pin.rnea(pm, pd, q_pin, v_pin, P @ np.asarray(a)) - tau_pin
+        scale = max(1.0, np.abs(tau_pin).max(), np.abs(M_pin).max() * np.abs(np.asarray(a)).max())
+        diffs.append(float(np.abs(residual).max() / scale))
+    else:
+        diffs += [_rel(P @ np.asarray(a), a_pin),
+                  _rel(P @ np.asarray(tau_back - model.damping * v),
+                       pin.rnea(pm, pd, q_pin, v_pin, P @ np.asarray(a)))]
     pin.framesForwardKinematics(pm, pd, q_pin)
-    names = {n: i for i, n in enumerate(model.frame_names)}
     compared = 0
     for fid, frame in enumerate(pm.frames):
-        if frame.name not in names and frame.name not in model.names:
+        pose = _mbjax_frame(model, frame, R, p, R_body, p_body)
+        if pose is None:
             continue
-        pose = pd.oMf[fid]
-        if frame.name in names:
-            Rf, pf = R[names[frame.name]], p[names[frame.name]]
-        else:
-            Rf, pf = R_body[model.names.index(frame.name)], p_body[model.names.index(frame.name)]
-        diffs += [_rel(np.asarray(Rf), pose.rotation), _rel(np.asarray(pf), pose.translation)]
+        expected = pd.oMf[fid]
+        diffs += [_rel(np.asarray(pose[0]), expected.rotation),
+                  _rel(np.asarray(pose[1]), expected.translation)]
         compared += 1
     last = model.names[-1]
     J = pin.computeFrameJacobian(pm, pd, q_pin, pm.getFrameId(last),
@@ -111,6 +130,25 @@ def compare(path: Path, floating: bool, seed: int = 0) -> dict:
     row["max_relative_difference"] = float(max(diffs))
     row["frames_compared"] = compared
     return row
+
+
+def _mbjax_frame(model, frame, R, p, R_body, p_body):
+    """mbjax's pose of a Pinocchio frame, matched by name and type (a URDF may name a link like a
+    joint): a JOINT frame is its body's frame, a BODY frame a link (a body, or a named frame if
+    merged), a FIXED_JOINT frame a named frame; None for the others (the universe, operational
+    frames)."""
+    import pinocchio as pin
+    kind = frame.type
+    if kind == pin.FrameType.JOINT and frame.name in model.joint_names:
+        k = model.joint_names.index(frame.name)
+        return R_body[k], p_body[k]
+    if kind == pin.FrameType.BODY and frame.name in model.names:
+        k = model.names.index(frame.name)
+        return R_body[k], p_body[k]
+    if kind in (pin.FrameType.BODY, pin.FrameType.FIXED_JOINT) and frame.name in model.frame_names:
+        i = model.frame_names.index(frame.name)
+        return R[i], p[i]
+    return None
 
 
 def _symmetric(M):
