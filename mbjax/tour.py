@@ -322,6 +322,7 @@ def _mujoco_sampled(arm, q0, history, actuated, dt, steps):
 
     mj = mujoco.MjModel.from_xml_string(to_urdf(arm))
     mj.opt.timestep, mj.opt.integrator = dt, mujoco.mjtIntegrator.mjINT_RK4
+    mj.opt.disableflags |= mujoco.mjtDisableBit.mjDSBL_CONSTRAINT     # limits: data in mbjax
     data = mujoco.MjData(mj)
     data.qpos[:] = q0
     spec = mujoco.mjtState.mjSTATE_FULLPHYSICS

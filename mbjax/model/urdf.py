@@ -306,7 +306,10 @@ def matrix_rpy(R: np.ndarray) -> np.ndarray:
 
 def to_urdf(model: Model, name: str = "mbjax") -> str:
     """The URDF of a revolute/prismatic/free tree (for loading the same model into Pinocchio or
-    MuJoCo). Link k is `model.names[k]`; the ground link is `base`."""
+    MuJoCo). Link k is `model.names[k]`; the ground link is `base`. Limits, damping and friction
+    are written; a joint without limits gets wide ones (+-1e3), so that the peers keep one angle
+    per revolute joint (a URDF continuous joint is (cos, sin) in Pinocchio). Armature and named
+    frames have no URDF field and are not written."""
     kinds = {"revolute": "revolute", "prismatic": "prismatic", "free": "floating"}
     for kind in model.joint_types:
         if kind not in kinds:
@@ -315,6 +318,12 @@ def to_urdf(model: Model, name: str = "mbjax") -> str:
     def fmt(values) -> str:
         return " ".join(repr(float(x)) for x in values)
 
+    lower, upper, effort, velocity, damping, friction = (np.asarray(x) for x in (
+        model.lower, model.upper, model.effort_limit, model.velocity_limit, model.damping,
+        model.friction))
+    starts = list(zip(_q_starts(model), np.cumsum([0] + [JOINT_TYPES[t].nv
+                                                         for t in model.joint_types])[:-1],
+                      strict=True))
     lines = [f'<robot name="{name}">', '  <link name="base"/>']
     for k in range(model.n):
         J = np.asarray(model.inertia[k]).astype(float).tolist()
@@ -332,7 +341,15 @@ def to_urdf(model: Model, name: str = "mbjax") -> str:
                   f'rpy="{fmt(matrix_rpy(R))}"/>',
                   f'    <axis xyz="{fmt(model.axis[k])}"/>']
         if model.joint_types[k] in ("revolute", "prismatic"):
-            lines.append('    <limit lower="-1e3" upper="1e3" effort="1e6" velocity="1e6"/>')
+            iq, iv = starts[k]
+            bound = lambda x, wide: repr(float(x)) if np.isfinite(x) else wide  # noqa: E731
+            lines.append(f'    <limit lower="{bound(lower[iq], "-1e3")}" '
+                         f'upper="{bound(upper[iq], "1e3")}" '
+                         f'effort="{bound(effort[iv], "1e6")}" '
+                         f'velocity="{bound(velocity[iv], "1e6")}"/>')
+            if damping[iv] or friction[iv]:
+                lines.append(f'    <dynamics damping="{float(damping[iv])!r}" '
+                             f'friction="{float(friction[iv])!r}"/>')
         lines.append("  </joint>")
     lines.append("</robot>")
     return "\n".join(lines) + "\n"
