@@ -135,7 +135,7 @@ def load_urdf(source: str | os.PathLike, *, floating_base: bool = False,
     armature: rotor inertia on every joint coordinate (a number or an (nv,) array).
     min_mass, min_inertia: lower bounds on the mass and the principal moments of every body (like
         MuJoCo's boundmass and boundinertia), a remedy for massless leaves on moving joints.
-    strict: turn the warnings on implausible data into errors.
+    strict: turn the warnings on implausible data into errors (not the note on mimic joints).
     closures: also return the mimic joints' couplings, `(model, [mbjax.loops.Coupling, ...])`.
     """
     if sibling_order not in ("name", "document"):
@@ -263,11 +263,11 @@ def load_urdf(source: str | os.PathLike, *, floating_base: bool = False,
         frame_names=[f[0] for f in frames], frame_parents=[f[1] for f in frames],
         frame_rotation=np.reshape([f[2] for f in frames], (-1, 3, 3)),
         frame_translation=np.reshape([f[3] for f in frames], (-1, 3)), strict=strict)
-    couplings = _mimics(model, bodies, strict, quiet=closures)
+    couplings = _mimics(model, bodies, quiet=closures)
     return (model, couplings) if closures else model
 
 
-def _mimics(model: Model, bodies: list, strict: bool, quiet: bool) -> list:
+def _mimics(model: Model, bodies: list, quiet: bool) -> list:
     """The mimic joints' couplings q = multiplier q_reference + offset."""
     from mbjax.loops.closures import Coupling
 
@@ -290,7 +290,7 @@ def _mimics(model: Model, bodies: list, strict: bool, quiet: bool) -> list:
     if names and not (quiet and len(names) == len(out)):
         warn(f"URDF: mimic joints load as independent joints, as Pinocchio and MuJoCo load them "
              f"({'; '.join(names)}); load_urdf(..., closures=True) also returns the couplings "
-             "as mbjax.loops.Coupling closures for mbjax.loops.ClosedSystem", strict)
+             "as mbjax.loops.Coupling closures for mbjax.loops.ClosedSystem", strict=False)
     return out
 
 
