@@ -168,6 +168,7 @@ def survey(paths=None) -> tuple[list[dict], list[dict]]:
             row["note"] = f"{type(err).__name__}: {err}"
         row["seconds"] = time.perf_counter() - start
         found.append(row)
+        jax.clear_caches()   # a compiled program per model: hundreds of them exhaust mmap
     return found, skipped
 
 

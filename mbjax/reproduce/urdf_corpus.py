@@ -169,4 +169,5 @@ def rows(paths=None) -> list[dict]:
             row = compare(path, floating)
             row["seconds"] = time.perf_counter() - start
             out.append(row)
+        jax.clear_caches()   # a compiled program per robot: hundreds of them exhaust mmap
     return out

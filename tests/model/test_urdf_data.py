@@ -253,7 +253,7 @@ def test_floating_base_against_mujoco_free_joint_layout():
 
 # -- the corpus -----------------------------------------------------------------------------------
 
-QUICK_ROBOTS = ("panda/panda", "romeo/romeo_small")
+QUICK_ROBOTS = ("romeo/romeo_small",)
 
 
 def _corpus():
@@ -265,8 +265,8 @@ def _corpus():
 
 
 def test_urdf_corpus_quick():
-    """Two robots of example-robot-data with mimic joints, limits and CAD inertias that break the
-    triangle inequality, floating base: they load and agree with Pinocchio."""
+    """A humanoid of example-robot-data whose CAD inertias break the triangle inequality, on a
+    floating base: it loads (with warnings) and agrees with Pinocchio (the slow test: all)."""
     corpus, paths = _corpus()
     chosen = [p for p in paths if corpus.name(p) in QUICK_ROBOTS]
     assert len(chosen) == len(QUICK_ROBOTS)
