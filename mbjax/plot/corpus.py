@@ -22,12 +22,15 @@ def corpus_figure(data: dict) -> Figure:
         ax.barh(y, np.where(np.isfinite(diff), np.maximum(diff, floor), 0.0), left=floor,
                 color=np.where(loaded, "C0", "C3"))
         for i in np.flatnonzero(~np.isfinite(diff)):
-            ax.text(floor * 3, i, "not compared" if loaded[i] else "did not load", va="center",
-                    fontsize=6, color="C3")
+            note = rows[i].get("note", "")
+            why = ("not compared" if loaded[i] else "empty file, not a robot" if "no links" in note
+                   else "no joint: floating base only" if "no movable joint" in note
+                   else "did not load")
+            ax.text(floor * 3, i, why, va="center", fontsize=6, color="C3")
         ax.set_xscale("log")
         ax.set_xlim(floor, 1e-6)
         ax.set_yticks(y, [label(r) for r in rows], fontsize=6)
-        ax.invert_yaxis()
+        ax.set_ylim(len(rows) - 0.5, -0.5)
         ax.set_title(f"{title}: {int(loaded.sum())} of {len(rows)} load", fontsize=9)
         ax.grid(alpha=0.3, axis="x", which="both")
     axes[-1].set_xlabel("max |mbjax - peer| / max(1, |peer|)")

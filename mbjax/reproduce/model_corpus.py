@@ -13,6 +13,7 @@ scenes, an empty URDF) are listed, not counted.
 """
 
 import json
+import re
 from pathlib import Path
 
 NAME = "model-corpus"
@@ -53,28 +54,49 @@ def reproduce(out: Path, quick: bool = False) -> dict:
     return data
 
 
+_TAGS = (("triangle inequality", "triangle inequality"), ("round-off", "round-off moments"),
+         ("not positive semi-definite", "indefinite inertia"), ("massless", "massless leaf"),
+         ("rotational inertia but no mass", "inertia without mass"), ("mimic", "mimic joints"))
+
+
+def _warned(rows) -> str:
+    """The kinds of ModelWarning a robot loads with, with how many bodies each names."""
+    counts: dict = {}
+    for row in rows:
+        for message in (row or {}).get("warnings", []):
+            for key, tag in _TAGS:
+                if key in message:
+                    counts[tag] = max(counts.get(tag, 0), sum(key in m for m in row["warnings"]))
+    return ", ".join(f"{tag} ({n})" if tag != "mimic joints" else tag for tag, n in counts.items())
+
+
 def markdown_tables(data: dict) -> str:
     """The two tables of benchmarks/README.md."""
-    lines = ["| robot | nv (fixed / floating) | loads | max relative difference (fixed / floating) |",
-             "| --- | --- | --- | --- |"]
+    lines = ["| robot | nv (fixed / floating) | loads | max relative difference (fixed / floating) "
+             "| loads with warnings |", "| --- | --- | --- | --- | --- |"]
     by_robot: dict = {}
     for row in data["urdf"]:
         by_robot.setdefault(row["robot"], {})[row["floating"]] = row
+
+    def cell(row, key):
+        if not row or not row["loads"]:
+            return "n/a"
+        return f"{row[key]:.1e}" if key == "max_relative_difference" else str(row[key])
+
     for robot, pair in by_robot.items():
-        def cell(row, key):
-            if not row["loads"]:
-                return "n/a"
-            return f"{row[key]:.1e}" if key == "max_relative_difference" else str(row[key])
         rows = [pair.get(False), pair.get(True)]
         if not any(r and r["loads"] for r in rows):
-            loads = "not a robot" if "no links" in (rows[0] or {}).get("note", "") else "no"
+            loads = "not a robot (empty file)" if "no links" in rows[0]["note"] else "no"
         else:
-            loads = "yes" + (" (floating only: no joints)" if not rows[0]["loads"] else "")
+            loads = "yes" + (" (floating only: no joint)" if not rows[0]["loads"] else "")
         lines.append(f"| {robot} | {' / '.join(cell(r, 'nv') for r in rows)} | {loads} | "
-                     f"{' / '.join(cell(r, 'max_relative_difference') for r in rows)} |")
-    lines += ["", "| model | nv | loads | max relative difference |", "| --- | --- | --- | --- |"]
+                     f"{' / '.join(cell(r, 'max_relative_difference') for r in rows)} | "
+                     f"{_warned(rows)} |")
+    lines += ["", "| model | nv | loads | max relative difference | not modelled (off in MuJoCo) |",
+              "| --- | --- | --- | --- | --- |"]
     for row in data["mjcf"]:
         diff = row["max_relative_difference"]
+        ignored = ", ".join(p for p in re.sub(r"\s*\([^)]*\)", "", row["note"]).split("; ") if p)
         lines.append(f"| {row['model']} | {row['nv']} | {'yes' if row['loads'] else 'no'} | "
-                     f"{'n/a' if diff is None else f'{diff:.1e}'} |")
+                     f"{'n/a' if diff is None else f'{diff:.1e}'} | {ignored} |")
     return "\n".join(lines)
