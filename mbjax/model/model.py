@@ -63,7 +63,7 @@ class Model(eqx.Module):
         lower, upper (nq,): position limits (-inf, inf where there are none; a revolute joint
             without limits is a URDF "continuous" joint);
         velocity_limit, effort_limit (nv,): |v| and |tau| bounds (inf: none). Limits are data
-            (bounds for trajectory optimisation, `mbjax.model.limits.violations`, checked by
+            (bounds for trajectory optimisation, `mbjax.model.limits.excess`, checked by
             `TreeSystem.check` in `simulate`'s status), not contact forces;
         damping (nv,): viscous joint damping, a force -damping * v in the dynamics;
         armature (nv,): rotor inertia reflected to the joint, added to the mass matrix diagonal
@@ -73,10 +73,10 @@ class Model(eqx.Module):
     Named frames (URDF links merged through fixed joints, fixed joints, MJCF sites):
         frame_names, frame_parents: static names and the body each frame is fixed to (-1: the
             ground); frame_rotation (m, 3, 3), frame_translation (m, 3): its pose in that body.
-        See `mbjax.model.frames.frame_pose`.
+        See `mbjax.frame_pose` and `mbjax.frame_jacobian` (`mbjax.rigid.frames`).
 
-    Bodies with implausible but computable mass data (a triangle-inequality violation, round-off
-    negative moments, a massless leaf) load with a `ModelWarning` (`mbjax.model.checks`);
+    Bodies with implausible but computable mass data (a triangle-inequality violation, negative
+    moments, a massless leaf without armature) load with a `ModelWarning` (`mbjax.model.checks`);
     `strict=True` makes it an error.
     """
 

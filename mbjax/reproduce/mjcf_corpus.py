@@ -105,9 +105,9 @@ def _mbjax_side(model: Model, qpos, qvel, qfrc_applied):
     return qacc, forward_kinematics(model, q)
 
 
-def compare(mjmodel, model: Model, seed: int = 0) -> dict:
-    """{"qacc": relative qacc difference, "poses": max body and site pose difference} at one
-    random state of `comparable(mjmodel)`."""
+def random_state(mjmodel, seed: int):
+    """(m, d): `comparable(mjmodel)` and its data after `mj_forward` at qpos0 plus noise
+    (quaternions normalized), random qvel and qfrc_applied."""
     import mujoco
 
     m = comparable(mjmodel)
@@ -118,6 +118,13 @@ def compare(mjmodel, model: Model, seed: int = 0) -> dict:
     d.qvel[:] = rng.normal(size=m.nv)
     d.qfrc_applied[:] = rng.normal(size=m.nv)
     mujoco.mj_forward(m, d)
+    return m, d
+
+
+def compare(mjmodel, model: Model, seed: int = 0) -> dict:
+    """{"qacc": relative qacc difference, "poses": max body and site pose difference} at one
+    random state of `comparable(mjmodel)`."""
+    m, d = random_state(mjmodel, seed)
 
     qacc, (R, p) = _mbjax_side(model, *(jnp.asarray(x) for x in (d.qpos, d.qvel,
                                                                   d.qfrc_applied)))

@@ -13,9 +13,7 @@ holding arrays is not hashable.)
 from typing import ClassVar
 
 import equinox as eqx
-import jax
 import jax.numpy as jnp
-import numpy as np
 from jax import Array
 
 from mbjax.control import AbstractControl, as_control
@@ -68,7 +66,6 @@ class TreeSystem(AbstractTreeSystem):
     external_point: Array | None
     actuation: tuple[int, ...] | None = eqx.field(static=True)
     method: str = eqx.field(static=True)
-    limited: bool = eqx.field(static=True)
     symmetric_dynamics: ClassVar[bool] = True
 
     def __init__(self, model: Model, control=None, *, external=None, external_point=None,
@@ -81,9 +78,6 @@ class TreeSystem(AbstractTreeSystem):
         self.external = as_control(external)
         self.external_point = check_points(external_point, model.n)
         self.method = method
-        self.limited = any(isinstance(x, jax.core.Tracer) or np.isfinite(np.asarray(x)).any()
-                           for x in (model.lower, model.upper, model.velocity_limit,
-                                     model.effort_limit))
 
     def frames(self, q):
         return forward_kinematics(self.model, q)
@@ -91,8 +85,6 @@ class TreeSystem(AbstractTreeSystem):
     def check(self, t, q, u):
         """`Status.LIMIT_EXCEEDED` where the state or the control is beyond the model's joint
         limits (`mbjax.model.limits`); limits are data here, not contact forces."""
-        if not self.limited:
-            return jnp.array(0, jnp.int32)
         over = exceeded(self.model, q, u, self.applied(t, q, u))
         return jnp.where(over, int(Status.LIMIT_EXCEEDED), 0).astype(jnp.int32)
 

@@ -24,9 +24,9 @@ from mbjax.model.checks import ModelWarning
 from mbjax.model.mjcf import object_name, site_frame_name
 from mbjax.reproduce.mjcf_corpus import (
     TOLERANCE,
-    comparable,
     compare,
     quick_paths,
+    random_state,
     rows,
     survey,
 )
@@ -45,25 +45,13 @@ def _load(xml: str, **kwargs):
         return mjmodel, mbjax.from_mujoco(mjmodel, **kwargs)
 
 
-def _random_state(mjmodel, seed):
-    """MuJoCo data of `comparable(mjmodel)` at a random state, after mj_forward."""
-    m = comparable(mjmodel)
-    d = mujoco.MjData(m)
-    rng = np.random.default_rng(seed)
-    d.qpos[:] = m.qpos0 + 0.5 * rng.normal(size=m.nq)
-    mujoco.mj_normalizeQuat(m, d.qpos)
-    d.qvel[:] = rng.normal(size=m.nv)
-    mujoco.mj_forward(m, d)
-    return m, d
-
-
 def _check(mjmodel, model, seeds=(0, 1)):
     """Accelerations and every body and site pose agree with MuJoCo's."""
     for seed in seeds:
         errors = compare(mjmodel, model, seed)
         assert errors["qacc"] < TOLERANCE, errors
         assert errors["poses"] < 1e-12, errors
-    m, d = _random_state(mjmodel, seeds[0])
+    m, d = random_state(mjmodel, seeds[0])
     q, _ = mbjax.state_from_mujoco(model, jnp.asarray(d.qpos), jnp.asarray(d.qvel))
     named = [(object_name(m, "body", b), d.xmat[b], d.xpos[b]) for b in range(1, m.nbody)]
     named += [(site_frame_name(model, object_name(m, "site", s)), d.site_xmat[s], d.site_xpos[s])
@@ -207,7 +195,7 @@ def test_several_joints_per_body_and_anchors():
     assert model.mass[0] == 0 and model.mass[1] > 0
     assert {"link", "child", "tip"} <= set(model.frame_names)
     _check(mjmodel, model)
-    m, d = _random_state(mjmodel, 3)
+    m, d = random_state(mjmodel, 3)
     q, _ = mbjax.state_from_mujoco(model, jnp.asarray(d.qpos), jnp.asarray(d.qvel))
     for j, name in enumerate(model.joint_names):
         np.testing.assert_allclose(mbjax.frame_pose(model, q, name)[1], d.xanchor[j], atol=1e-12)
@@ -372,7 +360,7 @@ def _check_closure(xml, kind, assembled=True):
 
     # the residual's zero set is MuJoCo's: the same position error and, for a weld, the rotation
     # error vee(R - R^T) / 2 = 2 w * (x, y, z) of MuJoCo's quaternion error (w, x, y, z)
-    m, d = _random_state(mjmodel, 0)
+    m, d = random_state(mjmodel, 0)
     m.opt.disableflags &= ~int(mujoco.mjtDisableBit.mjDSBL_CONSTRAINT)
     mujoco.mj_forward(m, d)
     efc = d.efc_pos[d.efc_type == mujoco.mjtConstraint.mjCNSTR_EQUALITY]
