@@ -286,3 +286,19 @@ def test_urdf_corpus_every_robot():
                     or ("no movable joint" in row["note"] and not row["floating"])), row
             continue
         assert row["max_relative_difference"] < 1e-10, row
+
+
+def test_converters_match_the_name_matched_map():
+    """The public converter (joint order) against the tests' own map, which matches joints by
+    name: the same Pinocchio state for a floating base with a continuous joint."""
+    from tests.model.test_model_urdf import FIXED_URDF
+    from tests.peers import pinocchio_maps, random_state
+
+    model = mbjax.load_urdf(FIXED_URDF, floating_base=True)
+    to_pin, vi = pinocchio_maps(model, pin.buildModelFromXML(FIXED_URDF, pin.JointModelFreeFlyer()))
+    q, v, _ = random_state(model, 7)
+    q_pin, v_pin = mbjax.state_to_pinocchio(model, jnp.asarray(q), jnp.asarray(v))
+    expected_v = np.zeros(model.nv)
+    expected_v[vi] = v
+    np.testing.assert_allclose(q_pin, to_pin(q), atol=1e-15)
+    np.testing.assert_allclose(v_pin, expected_v, atol=1e-15)
