@@ -1,5 +1,6 @@
 """The MJCF corpus: every MuJoCo model shipped by the installed packages (dm_control's suite,
-gymnasium's and gymnasium_robotics' MuJoCo assets, the mujoco package's own), loaded with
+locomotion walkers, third-party arms and test models, gymnasium's and gymnasium_robotics' MuJoCo
+assets, the mujoco package's own), loaded with
 `mbjax.from_mujoco` and checked against MuJoCo's forward dynamics and kinematics.
 
 A file is a model when MuJoCo compiles it on its own and it has joints; the others (include
@@ -45,8 +46,14 @@ from mbjax.rigid.kinematics import forward_kinematics
 
 TOLERANCE = 1e-8
 # (package, folder in it, glob): where the MJCF files are
-SOURCES = (("dm_control", "suite", "*.xml"), ("gymnasium", "envs/mujoco/assets", "*.xml"),
-           ("gymnasium_robotics", "envs", "**/*.xml"), ("mujoco", ".", "**/*.xml"))
+SOURCES = (("dm_control", "suite", "*.xml", "dm_control"),
+           ("dm_control", "locomotion", "**/*.xml", "dm_control/locomotion"),
+           ("dm_control", "third_party", "**/*.xml", "dm_control/third_party"),
+           ("dm_control", "mujoco/testing", "**/*.xml", "dm_control/testing"),
+           ("dm_control", "mjcf/test_assets", "**/*.xml", "dm_control/mjcf"),
+           ("gymnasium", "envs/mujoco/assets", "*.xml", "gymnasium"),
+           ("gymnasium_robotics", "envs", "**/*.xml", "gymnasium_robotics"),
+           ("mujoco", ".", "**/*.xml", "mujoco"))
 # A small representative subset for the default test suite: planar hinge/slide chains, free
 # floating bases, ball joints, several joints per body, tendons, equality constraints, ref offsets.
 QUICK = ("dm_control/cartpole", "dm_control/cheetah", "dm_control/humanoid",
@@ -54,18 +61,18 @@ QUICK = ("dm_control/cartpole", "dm_control/cheetah", "dm_control/humanoid",
 
 
 def _sources():
-    for package, folder, pattern in SOURCES:
+    for package, folder, pattern, label in SOURCES:
         spec = importlib.util.find_spec(package)
         if spec is not None and spec.submodule_search_locations:
-            yield package, Path(spec.submodule_search_locations[0]) / folder, pattern
+            yield label, Path(spec.submodule_search_locations[0]) / folder, pattern
 
 
 def short_name(path: Path) -> str:
     """"dm_control/cheetah" for .../dm_control/suite/cheetah.xml."""
     path = Path(path)
-    for package, root, _ in _sources():
+    for label, root, _ in _sources():
         if path.is_relative_to(root):
-            return f"{package}/{path.relative_to(root).with_suffix('').as_posix()}"
+            return f"{label}/{path.relative_to(root).with_suffix('').as_posix()}"
     return path.stem
 
 
