@@ -6,6 +6,7 @@ accuracy work (``jax.config.update("jax_enable_x64", True)``).
 """
 
 from mbjax import control, data, integrate, lie, model, rigid, scenes, spatial, tree
+from mbjax.cache import use_compilation_cache
 from mbjax.integrate import simulate
 from mbjax.model import Model
 from mbjax.model.mjcf import from_mujoco, load_mjcf
@@ -22,4 +23,5 @@ __version__ = "0.1.0"
 __all__ = ["Model", "control", "data", "forward_dynamics", "frame_jacobian", "frame_pose",
            "from_mujoco", "integrate", "inverse_dynamics", "lie", "load_mjcf", "load_urdf",
            "mass_matrix", "model", "rigid", "scenes", "simulate", "spatial", "state_from_mujoco",
-           "state_from_pinocchio", "state_to_mujoco", "state_to_pinocchio", "tree"]
+           "state_from_pinocchio", "state_to_mujoco", "state_to_pinocchio", "tree",
+           "use_compilation_cache"]

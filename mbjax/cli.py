@@ -4,7 +4,8 @@
     mbjax reproduce NAME [--out DIR] [--quick]    |    mbjax reproduce --list
     mbjax bench SUITE [--out DIR] [--quick]
 
-Unknown names and bad options exit with status 2 and list the valid choices.
+Compiled programs are kept on disk between runs (`mbjax.cache`; `mbjax --no-cache ...` or
+MBJAX_NO_CACHE=1 turns that off). Unknown names and bad options exit with status 2 and list the valid choices.
 """
 
 import argparse
@@ -16,6 +17,8 @@ from pathlib import Path
 
 def _parser(reproductions, suites, scenes) -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(prog="mbjax", description=__doc__.split("\n\n")[0])
+    parser.add_argument("--no-cache", action="store_true",
+                        help="do not keep compiled programs on disk (mbjax.cache)")
     commands = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
 
     tour = commands.add_parser("tour", help="run every scene briefly; figures + summary")
@@ -92,12 +95,15 @@ def main(argv=None) -> int:
 
     jax.config.update("jax_enable_x64", True)
     from mbjax.bench import SUITES
+    from mbjax.cache import use_compilation_cache
     from mbjax.reproduce import REPRODUCTIONS
 
     from mbjax.tour import TOUR
 
     parser = _parser(REPRODUCTIONS, SUITES, TOUR)
     args = parser.parse_args(argv)
+    if not args.no_cache:
+        use_compilation_cache()
     if args.command == "bench" and args.suite == "throughput":
         _one_device_per_core()
     if args.command == "tour":

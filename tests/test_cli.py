@@ -430,3 +430,24 @@ def test_bench_throughput_quick(tmp_path):
             "gpu_forward_evals_per_s"} <= set(targets)
     assert all(t["met"] in (True, False, None) for t in targets.values())
     assert (tmp_path / "throughput.png").stat().st_size > 10_000
+
+
+def test_compilation_cache_folder_and_switch(tmp_path, monkeypatch):
+    """The CLI and notebooks keep compiled programs in a user folder (JAX's config, recorded here
+    rather than changed for the test process); MBJAX_NO_CACHE turns it off."""
+    import jax
+
+    from mbjax.cache import cache_folder, use_compilation_cache
+
+    updates = {}
+    monkeypatch.setattr(jax.config, "update", lambda key, value: updates.__setitem__(key, value))
+    monkeypatch.delenv("JAX_COMPILATION_CACHE_DIR", raising=False)
+    monkeypatch.delenv("JAX_PERSISTENT_CACHE_MIN_COMPILE_TIME_SECS", raising=False)
+    monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path))
+    assert cache_folder() == tmp_path / "mbjax" / "jax"
+    assert use_compilation_cache() == tmp_path / "mbjax" / "jax" and (tmp_path / "mbjax" / "jax").is_dir()
+    assert updates == {"jax_compilation_cache_dir": str(tmp_path / "mbjax" / "jax"),
+                       "jax_persistent_cache_min_compile_time_secs": 0.1}
+    monkeypatch.setenv("MBJAX_NO_CACHE", "1")
+    updates.clear()
+    assert use_compilation_cache() is None and not updates
