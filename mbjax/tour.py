@@ -356,7 +356,7 @@ def models_tour(out: Path, quick: bool) -> dict:
     first = int(np.argmax(np.asarray(beyond).max(axis=1) > 0))
     J = frame_jacobian(arm, q0, "flange")
     manipulability = float(jnp.sqrt(jnp.linalg.det(J[3:] @ J[3:].T)))
-    peers = _model_peers(arm, q0)
+    peers = _model_peers()
     fig = models_figure(np.asarray(ts), np.asarray(fall.qs), np.asarray(arm.lower),
                         np.asarray(arm.upper), np.asarray(flange), peers,
                         f"{len(arm.frame_names)} named frames; status: {fall.messages()[0]}")
@@ -368,37 +368,24 @@ def models_tour(out: Path, quick: bool) -> dict:
             "peers_max_relative_difference": peers}
 
 
-def _model_peers(arm, q) -> dict:
-    """The arm's forward dynamics against Pinocchio (from the same URDF) and against MuJoCo
-    (through MuJoCo's compiler and `from_mujoco`), each where installed."""
+def _model_peers() -> dict:
+    """The arm against Pinocchio from the same URDF (`mbjax.reproduce.urdf_corpus`: forward and
+    inverse dynamics, mass matrix, frames) and against MuJoCo through MuJoCo's compiler and
+    `from_mujoco` (`mbjax.reproduce.mjcf_corpus`: accelerations), each where installed."""
+    from mbjax.bench import peers
     from mbjax.data import ARM7
-    from mbjax.model.states import state_to_pinocchio
-    from mbjax.rigid import forward_dynamics
 
-    rng = np.random.default_rng(0)
-    v, tau = jnp.asarray(rng.normal(size=arm.nv)), jnp.asarray(rng.normal(size=arm.nv))
     out = {}
-    try:
-        import pinocchio as pin
-        pm = pin.buildModelFromUrdf(str(ARM7))
-        a_pin = pin.aba(pm, pm.createData(), *(np.asarray(x) for x in state_to_pinocchio(arm, q, v)),
-                        np.asarray(tau - arm.damping * v))
-        a = np.asarray(forward_dynamics(arm, q, v, tau))
-        out["pinocchio"] = float(np.abs(a - a_pin).max() / max(1.0, np.abs(a_pin).max()))
-    except ImportError:
-        pass
-    try:
+    if peers.available("pinocchio"):
+        from mbjax.reproduce import urdf_corpus
+        out["pinocchio"] = urdf_corpus.compare(ARM7, floating=False)["max_relative_difference"]
+    if peers.available("mujoco"):
         import mujoco
+
         from mbjax.model.mjcf import from_mujoco
+        from mbjax.reproduce import mjcf_corpus
         mj = mujoco.MjModel.from_xml_path(str(ARM7))
-        mj.opt.disableflags |= mujoco.mjtDisableBit.mjDSBL_CONSTRAINT
-        data = mujoco.MjData(mj)
-        data.qpos[:], data.qvel[:], data.qfrc_applied[:] = q, v, tau
-        mujoco.mj_forward(mj, data)
-        a = np.asarray(forward_dynamics(from_mujoco(mj), q, v, tau))
-        out["mujoco"] = float(np.abs(a - data.qacc).max() / max(1.0, np.abs(data.qacc).max()))
-    except ImportError:
-        pass
+        out["mujoco"] = mjcf_corpus.compare(mj, from_mujoco(mj))["qacc"]
     return out
 
 

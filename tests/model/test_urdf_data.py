@@ -13,6 +13,7 @@ from mbjax.loops import ClosedSystem, Coupled, Coupling
 from mbjax.model.checks import ModelWarning
 from mbjax.rigid import TreeSystem
 from tests.model.test_model_urdf import LIMIT, _inertial, _joint, _link, _robot
+from tests.peers import random_state
 
 pin = pytest.importorskip("pinocchio")
 
@@ -22,9 +23,7 @@ def _pin_state(model, q, v):
 
 
 def _random_state(model, seed):
-    rng = np.random.default_rng(seed)
-    q = model.normalize(model.neutral() + jnp.asarray(rng.uniform(-1, 1, model.nq)))
-    return q, jnp.asarray(rng.normal(size=model.nv)), jnp.asarray(rng.normal(size=model.nv))
+    return tuple(jnp.asarray(x) for x in random_state(model, seed))
 
 
 # A robot with what real URDFs carry: a dummy root with a rank-1 inertia welded to the world, a
@@ -292,7 +291,7 @@ def test_converters_match_the_name_matched_map():
     """The public converter (joint order) against the tests' own map, which matches joints by
     name: the same Pinocchio state for a floating base with a continuous joint."""
     from tests.model.test_model_urdf import FIXED_URDF
-    from tests.peers import pinocchio_maps, random_state
+    from tests.peers import pinocchio_maps
 
     model = mbjax.load_urdf(FIXED_URDF, floating_base=True)
     to_pin, vi = pinocchio_maps(model, pin.buildModelFromXML(FIXED_URDF, pin.JointModelFreeFlyer()))
