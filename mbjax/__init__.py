@@ -1,10 +1,13 @@
 """mbjax: differentiable multibody dynamics in JAX.
 
 Kernels are pure functions of equinox modules and arrays, so `jax.jit`, `jax.vmap` and `jax.grad`
-compose over all of them. mbjax does not change global JAX settings: enable float64 yourself for
-accuracy work (``jax.config.update("jax_enable_x64", True)``).
+compose over all of them. mbjax changes no JAX setting: enable float64 yourself for accuracy work
+(``jax.config.update("jax_enable_x64", True)``). Imported before JAX starts its backend, it sets
+one XLA CPU runtime option that makes its small kernels run up to 2x faster (`mbjax.runtime`;
+MBJAX_XLA_DEFAULTS=0 turns that off).
 """
 
+from mbjax import runtime  # first: it sets XLA_FLAGS before anything can start JAX's backend
 from mbjax import control, data, integrate, lie, model, rigid, scenes, spatial, tree
 from mbjax.cache import use_compilation_cache
 from mbjax.integrate import simulate
@@ -22,6 +25,6 @@ from mbjax.rigid import forward_dynamics, frame_jacobian, frame_pose, inverse_dy
 __version__ = "0.1.0"
 __all__ = ["Model", "control", "data", "forward_dynamics", "frame_jacobian", "frame_pose",
            "from_mujoco", "integrate", "inverse_dynamics", "lie", "load_mjcf", "load_urdf",
-           "mass_matrix", "model", "rigid", "scenes", "simulate", "spatial", "state_from_mujoco",
+           "mass_matrix", "model", "rigid", "runtime", "scenes", "simulate", "spatial", "state_from_mujoco",
            "state_from_pinocchio", "state_to_mujoco", "state_to_pinocchio", "tree",
            "use_compilation_cache"]

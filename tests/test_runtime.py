@@ -1,0 +1,74 @@
+"""`mbjax.runtime`: the XLA CPU option mbjax sets at import, and `mbjax bench speed`'s HLO reader."""
+
+import json
+import os
+import subprocess
+import sys
+
+import jax
+import jax.numpy as jnp
+import pytest
+
+from mbjax import runtime
+from mbjax.bench.speed import kernel_counts
+
+# A float64 rollout of the 7-link chain, printed bit for bit, with what the process's XLA_FLAGS
+# became on `import mbjax`.
+SCRIPT = """
+import json, os, jax
+jax.config.update("jax_enable_x64", True)
+import mbjax
+from mbjax.model import chain
+m = chain(7)
+def step(s, _):
+    q, v = s
+    v = v + 1e-3 * mbjax.forward_dynamics(m, q, v, 0 * v)
+    return (q + 1e-3 * v, v), None
+q = jax.jit(lambda q: jax.lax.scan(step, (q, 0 * q), None, length=200)[0][0])(0.3 + 0 * m.neutral())
+print(json.dumps({"flags": os.environ.get("XLA_FLAGS"), "applied": mbjax.runtime.applied(),
+                  "q": [float(x).hex() for x in q]}))
+"""
+
+
+def _run(**env) -> dict:
+    environment = {k: v for k, v in os.environ.items() if k not in ("XLA_FLAGS", "MBJAX_XLA_DEFAULTS")}
+    out = subprocess.run([sys.executable, "-c", SCRIPT], env={**environment, **env},
+                         capture_output=True, text=True, check=True)
+    return json.loads(out.stdout.strip().splitlines()[-1])
+
+
+@pytest.mark.skipif(runtime._jaxlib_version() not in runtime.TESTED,
+                    reason="the flag is set only on jaxlib releases known to have it")
+def test_import_sets_the_flag_and_changes_no_result():
+    """`import mbjax` adds the flag to XLA_FLAGS; the user's own setting and MBJAX_XLA_DEFAULTS=0
+    win; the same rollout is bit-for-bit the same either way (a scheduling choice only)."""
+    default = _run()
+    assert default["applied"] and default["flags"] == runtime.FLAG
+    off = _run(MBJAX_XLA_DEFAULTS="0")
+    assert not off["applied"] and off["flags"] is None
+    own = _run(XLA_FLAGS="--xla_cpu_enable_concurrency_optimized_scheduler=true")
+    assert not own["applied"]
+    assert own["flags"] == "--xla_cpu_enable_concurrency_optimized_scheduler=true"
+    assert default["q"] == off["q"] == own["q"]
+
+
+def test_no_flag_once_the_backend_runs(monkeypatch):
+    """XLA reads XLA_FLAGS once: after the backend has started, configure_xla leaves it alone."""
+    jnp.zeros(1).block_until_ready()
+    monkeypatch.delenv("XLA_FLAGS", raising=False)
+    monkeypatch.delenv("MBJAX_XLA_DEFAULTS", raising=False)
+    assert not runtime.configure_xla()
+    assert "XLA_FLAGS" not in os.environ
+
+
+def test_kernel_counts_reads_loop_bodies():
+    """A scan whose body is one matrix product and one elementwise op: the body has kernels of
+    its own, counted apart from the entry computation's."""
+    def f(A, x):
+        return jax.lax.scan(lambda x, _: (jnp.tanh(A @ x), None), x, None, length=5)[0]
+
+    A, x = jnp.eye(3), jnp.ones(3)
+    counts = kernel_counts(jax.jit(f).lower(A, x).compile().as_text())
+    assert len(counts["per_step"]) == 1
+    assert 1 <= counts["per_step"][0] <= 8
+    assert counts["entry"] >= 1
