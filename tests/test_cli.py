@@ -451,3 +451,20 @@ def test_compilation_cache_folder_and_switch(tmp_path, monkeypatch):
     monkeypatch.setenv("MBJAX_NO_CACHE", "1")
     updates.clear()
     assert use_compilation_cache() is None and not updates
+
+
+@pytest.mark.slow
+def test_bench_speed_quick(tmp_path):
+    """The 7-link chain through every library of `mbjax bench speed`: every peer that imports
+    agrees with mbjax, gradients are finite, the targets are recorded."""
+    assert main(["bench", "speed", "--quick", "--out", str(tmp_path)]) == 0
+    records = [json.loads(line) for line in (tmp_path / "speed.jsonl").read_text().splitlines()]
+    rows = {r["library"]: r for r in records if "library" in r and "skipped" not in r}
+    assert "mbjax" in rows and rows["mbjax"]["grad_finite"]
+    assert rows["mbjax"]["kernels"]["per_step"]
+    for peer in ("pinocchio", "jaxsim", "adam"):
+        if peer in rows:
+            assert rows[peer]["rel_diff_mbjax"] < 1e-12
+    targets = records[-1]["targets"]
+    assert any(t["target"] == "chain7: one jitted call" for t in targets)
+    assert (tmp_path / "speed.png").stat().st_size > 10_000

@@ -4,13 +4,14 @@ Each suite is run(out: Path, quick: bool) -> list of records, written as out/SUI
 out/SUITE.png. Peers (MuJoCo, Pinocchio, exudyn) are measured in the same process when installed.
 """
 
-from mbjax.bench import flexible, integrators, loops, rigid, tfe, throughput, wrist
+from mbjax.bench import flexible, integrators, loops, rigid, speed, tfe, throughput, wrist
 
 SUITES = {
     flexible.NAME: flexible.run,
     integrators.NAME: integrators.run,
     loops.NAME: loops.run,
     rigid.NAME: rigid.run,
+    speed.NAME: speed.run,
     tfe.NAME: tfe.run,
     throughput.NAME: throughput.run,
     wrist.NAME: wrist.run,

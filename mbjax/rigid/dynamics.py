@@ -11,6 +11,7 @@ from jax import Array
 
 from mbjax.model import Model
 from mbjax.rigid.aba import aba
+from mbjax.rigid.batching import aba_batchable, batchable
 from mbjax.rigid.dense import dense_forward_dynamics
 from mbjax.rigid.operator import mass_matrix as _mass_matrix
 from mbjax.rigid.rnea import inverse_dynamics as _rnea
@@ -59,6 +60,8 @@ def forward_dynamics(model: Model, q: Array, q_dot: Array, tau: Array,
     if method == "auto":
         method = choose_method(model)
     if method == "recursive":
+        if f_ext is None and batchable(model):     # jax.vmap's fast route (mbjax.rigid.batching)
+            return aba_batchable(model, q, q_dot, tau)
         return aba(model, q, q_dot, tau, f_ext)
     return dense_forward_dynamics(model, q, q_dot, tau, f_ext)
 

@@ -1,0 +1,71 @@
+"""How `jax.vmap` batches the recursive forward dynamics: onto `batch_aba`'s layout.
+
+A user batches with `jax.vmap(mbjax.forward_dynamics)`. Left to itself, vmap puts the batch axis
+in front of every 6x6 block of `aba` (mbjax.rigid.aba), many small batched matrix products per
+body; `batch_aba` (mbjax.rigid.batched) runs the same recursion of seed 002 §2.3 with the batch
+last, as straight-line elementwise code, about 2x faster per state from B = 256 on
+(`mbjax bench speed`, benchmarks/README.md). `aba_batchable` is `aba` whose vmap rule
+(`jax.custom_batching.custom_vmap`) takes that route when it can:
+
+- the model itself is not batched (a sweep over model parameters keeps the plain vmap), its
+  joints are all revolute or prismatic, and the batch has at least BATCH_CROSSOVER states (below
+  that the two are within noise of each other and the plain vmap compiles faster);
+- anything else falls back to the plain vmap of `aba`, so the answer never depends on the route
+  (the two agree to rounding: tests/rigid/test_batching.py).
+
+custom_vmap functions cannot be differentiated in reverse mode, so a `jax.custom_jvp` wraps it
+whose rule is `aba`'s own JVP: a derivative of any order, batched or not, is exactly `aba`'s (and
+compiles as before); the batched route serves the values a vmapped program does not differentiate.
+"""
+
+import jax
+import jax.numpy as jnp
+from jax import Array
+from jax.custom_batching import custom_vmap
+
+from mbjax.model import Model
+from mbjax.rigid.aba import aba
+from mbjax.rigid.batched import JOINTS, batch_aba
+
+# Batch size from which jax.vmap runs batch_aba (`mbjax bench speed`'s vmap series at n = 7:
+# 3.2 against 3.6 us per state at B = 64, 2.4 against 2.9 at 256, 3.0 against 7.2 at 4096).
+BATCH_CROSSOVER = 64
+
+
+def batchable(model: Model) -> bool:
+    """Whether `batch_aba` can run this model (revolute and prismatic joints only)."""
+    return all(kind in JOINTS for kind in model.joint_types)
+
+
+@custom_vmap
+def _aba_vmappable(model: Model, q: Array, v: Array, tau: Array) -> Array:
+    return aba(model, q, v, tau)
+
+
+@_aba_vmappable.def_vmap
+def _vmap_rule(axis_size, in_batched, model, q, v, tau):
+    model_batched, *batched = in_batched
+    if not any(jax.tree.leaves(in_batched)):     # e.g. jacrev's vmap over cotangents only
+        return aba(model, q, v, tau), False
+    if any(jax.tree.leaves(model_batched)) or axis_size < BATCH_CROSSOVER:
+        axes = (jax.tree.map(lambda b: 0 if b else None, model_batched),
+                *(0 if b else None for b in batched))
+        return jax.vmap(aba, in_axes=axes)(model, q, v, tau), True
+
+    def columns(x, b):            # (B, nv) -> (nv, B); an unbatched (nv,) is broadcast
+        return x.T if b else jnp.broadcast_to(x[:, None], (x.shape[0], axis_size))
+
+    q, v, tau = (columns(x, b) for x, b in zip((q, v, tau), batched, strict=True))
+    return batch_aba(model, q, v, tau).T, True
+
+
+@jax.custom_jvp
+def aba_batchable(model: Model, q: Array, v: Array, tau: Array) -> Array:
+    """`aba(model, q, v, tau)` (no external wrenches), batched by `jax.vmap` onto `batch_aba`
+    where that is faster (see the module). The model must be `batchable`."""
+    return _aba_vmappable(model, q, v, tau)
+
+
+@aba_batchable.defjvp
+def _jvp(primals, tangents):
+    return jax.jvp(aba, primals, tangents)
