@@ -27,6 +27,7 @@ import time
 from functools import partial
 from pathlib import Path
 
+import equinox as eqx
 import jax
 import jax.numpy as jnp
 import numpy as np
@@ -174,6 +175,9 @@ def run(out: Path, quick: bool = False) -> list[dict]:
     records = []
     for name, urdf, floating in robots(quick):
         model = load_urdf(urdf, floating_base=floating, min_mass=1e-4 if floating else 0.0)
+        # the peers' forward dynamics ignore the URDF's joint damping (the Panda's 0.003-0.3 N m s),
+        # mbjax's applies it: all run without it, so that every library computes the same motion
+        model = eqx.tree_at(lambda m: m.damping, model, jnp.zeros_like(model.damping))
         rng = np.random.default_rng(0)
         Q = jnp.asarray(rng.uniform(-1, 1, (batch, model.nq)))
         if floating:              # unit quaternions on the free joints
@@ -283,11 +287,31 @@ def plot(records: list[dict], path: Path) -> None:
 
 
 def report(records: list[dict]) -> str:
-    """The targets as a Markdown table."""
-    summary = records[-1]
+    """The measurements and the targets as Markdown tables."""
+    lines = ["| robot | nv | library | call [us] | eval in a rollout [us] | vmap per state [us] "
+             "| grad / rollout | compile [s] | agrees with mbjax |",
+             "| --- | --- | --- | --- | --- | --- | --- | --- | --- |"]
+    for r in records[:-1]:
+        if "skipped" in r:
+            continue
+
+        def us(key, r=r):
+            return f"{r[key] * 1e6:.2f}" if key in r else ""
+        lines.append(f"| {r['robot']} | {r['nv']} | {r['library']} | {us('call_s')} | "
+                     f"{us('eval_s')} | {us('vmap_s')} | "
+                     f"{r['grad_ratio']:.2f} | " if "grad_ratio" in r else
+                     f"| {r['robot']} | {r['nv']} | {r['library']} | {us('call_s')} | | "
+                     f"{us('vmap_s')} | | ")
+        lines[-1] += (f"{r['compile_s']:.2f} | " if "compile_s" in r else "| ") + (
+            f"{r['rel_diff_mbjax']:.1e} |" if "rel_diff_mbjax" in r else "|")
+    lines += ["", *_targets(records[-1])]
+    return "\n".join(lines)
+
+
+def _targets(summary: dict) -> list[str]:
     lines = ["| target | measured | limit | met |", "| --- | --- | --- | --- |"]
     for t in summary["targets"]:
         value = f"{t['value'] * 1e6:.1f} us" if t["unit"] == "s" else f"{t['value']:.2f}"
         limit = f"{t['limit'] * 1e6:.0f} us" if t["unit"] == "s" else f"{t['limit']:g}"
         lines.append(f"| {t['target']} | {value} | {limit} | {'yes' if t['met'] else 'no'} |")
-    return "\n".join(lines)
+    return lines
