@@ -12,7 +12,8 @@ mbjax and Pinocchio only). Every library reads the same URDF; float64, CPU. Per 
   semi-implicit Euler steps (the same loop for every JAX library; mbjax also through
   `simulate(TreeSystem(model), RK4())`, per evaluation = run / (4 STEPS));
 - vmap: per state of `jit(vmap(forward_dynamics))` at B = BATCH;
-- grad: `jax.grad` of sum q(T)^2 over the rollout with respect to q0, divided by the rollout;
+- grad: `jax.grad` of sum q(T)^2 over the rollout with respect to q0, divided by the rollout, and
+  the temporary memory XLA allocates for it (grad_temp_bytes: what the reverse pass keeps);
 - compile: lowering and compiling the rollout.
 
 Pinocchio: `aba` per call (the C++ estimate: Python loop time minus an empty loop's) and
@@ -117,6 +118,7 @@ def _measure_jax(fd, q, v, tau, Q, V, TAU, steps: int, repeats: int, budget: flo
         _rollout(lambda q, v: fd(q, v, tau), steps, retract)(q0, v) ** 2)))
     g, tg = timed(grad, q, repeats=repeats, budget_s=budget)
     record["grad_ratio"] = tg.run_s / t.run_s
+    record["grad_temp_bytes"] = int(grad.lower(q).compile().memory_analysis().temp_size_in_bytes)
     record["grad_finite"] = bool(np.all(np.isfinite(g)))
     return record
 
@@ -284,21 +286,19 @@ def plot(records: list[dict], path: Path) -> None:
 def report(records: list[dict]) -> str:
     """The measurements and the targets as Markdown tables."""
     lines = ["| robot | nv | library | call [us] | eval in a rollout [us] | vmap per state [us] "
-             "| grad / rollout | compile [s] | agrees with mbjax |",
-             "| --- | --- | --- | --- | --- | --- | --- | --- | --- |"]
+             "| grad / rollout | grad memory [MB] | compile [s] | agrees with mbjax |",
+             "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |"]
     for r in records[:-1]:
         if "skipped" in r:
             continue
 
-        def us(key, r=r):
-            return f"{r[key] * 1e6:.2f}" if key in r else ""
-        lines.append(f"| {r['robot']} | {r['nv']} | {r['library']} | {us('call_s')} | "
-                     f"{us('eval_s')} | {us('vmap_s')} | "
-                     f"{r['grad_ratio']:.2f} | " if "grad_ratio" in r else
-                     f"| {r['robot']} | {r['nv']} | {r['library']} | {us('call_s')} | | "
-                     f"{us('vmap_s')} | | ")
-        lines[-1] += (f"{r['compile_s']:.2f} | " if "compile_s" in r else "| ") + (
-            f"{r['rel_diff_mbjax']:.1e} |" if "rel_diff_mbjax" in r else "|")
+        def cell(key, scale, digits, r=r):
+            return f"{r[key] * scale:.{digits}f}" if key in r else ""
+        cells = [r["robot"], str(r["nv"]), r["library"], cell("call_s", 1e6, 2),
+                 cell("eval_s", 1e6, 2), cell("vmap_s", 1e6, 2), cell("grad_ratio", 1, 2),
+                 cell("grad_temp_bytes", 1e-6, 1), cell("compile_s", 1, 2),
+                 f"{r['rel_diff_mbjax']:.1e}" if "rel_diff_mbjax" in r else ""]
+        lines.append("| " + " | ".join(cells) + " |")
     lines += ["", *_targets(records[-1])]
     return "\n".join(lines)
 

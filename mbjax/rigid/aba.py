@@ -19,6 +19,8 @@ block solved by Cholesky. Flexible bodies (issue "flexible bodies") will enter s
 modal mass (eqs 51-60).
 """
 
+from typing import NamedTuple
+
 import jax
 import jax.numpy as jnp
 from jax import Array
@@ -36,10 +38,54 @@ def _solve(D: Array, b: Array) -> Array:
     return jax.scipy.linalg.cho_solve(jax.scipy.linalg.cho_factor(D), b)
 
 
+class Factor(NamedTuple):
+    """The articulated-body factorization of the mass matrix at q: per body the motion subspace
+    S (n, 6, width), U = I_2 S (n, 6, width) and D = S^T U (n, width, width), step (ii)'s
+    elimination. It is a sparse L D L^T factorization of M(q) (the triangularization of seed 002
+    eqs 48-50), so `solve` applies M(q)^-1 in two vector passes."""
+
+    S: Array
+    U: Array
+    D: Array
+
+
 def aba(model: Model, q: Array, v: Array, tau: Array, f_ext: Array | None = None) -> Array:
     """Joint accelerations (nv,) of the tree at (q, v) under joint forces tau, gravity and the
     external wrenches f_ext (see `aba_responses`)."""
     return aba_responses(model, q, v, tau, jnp.zeros((0, model.nv), q.dtype), f_ext)[0]
+
+
+def aba_factored(model: Model, q: Array, v: Array, tau: Array,
+                 f_ext: Array | None = None) -> tuple[Array, Factor]:
+    """(`aba(model, q, v, tau, f_ext)`, the `Factor` of M(q) it eliminated with)."""
+    (u_dot, _), factor = _recursion(model, q, v, tau, jnp.zeros((0, model.nv), q.dtype), f_ext)
+    return u_dot, factor
+
+
+def solve(model: Model, factor: Factor, b: Array) -> Array:
+    """M(q)^-1 b from the `Factor` at q: the accelerations joint forces b produce with no
+    velocity and no gravity, steps (ii) and (iii) with the inertias already eliminated
+    (c = 0, a_ground = 0): u = b - S^T F_2, F_3 = F_2 + U D^-1 u; u_dot = D^-1 (u - U^T a_p),
+    a = a_p + S u_dot."""
+
+    def forces(F2, inp):
+        S, U, D, t = inp
+        u = t - S.T @ F2
+        return u, F2 + U @ _solve(D, u)
+
+    t = model.body_v(b)
+    u, _ = backward_pass(model.topology, forces, jnp.zeros((model.n, 6), b.dtype),
+                         (factor.S, factor.U, factor.D, t))
+
+    def substitute(parent, inp):
+        (a_parent, _), (S, U, D, u) = parent, inp
+        u_dot = _solve(D, u - U.T @ a_parent)
+        return a_parent + S @ u_dot, u_dot
+
+    _, u_dot = forward_pass(model.topology, substitute,
+                            (jnp.zeros(6, b.dtype), jnp.zeros(model.width, b.dtype)),
+                            (factor.S, factor.U, factor.D, u))
+    return model.flat_v(u_dot)
 
 
 def aba_responses(model: Model, q: Array, v: Array, tau: Array, loads: Array,
@@ -53,6 +99,11 @@ def aba_responses(model: Model, q: Array, v: Array, tau: Array, loads: Array,
     The articulated inertias (I_3, U, D) depend on q only, so one triangularization serves every
     load: the force recursion and the back-substitution run on 1 + m columns at once (seed 002's
     O(n + m n) for the loads)."""
+    return _recursion(model, q, v, tau, loads, f_ext)[0]
+
+
+def _recursion(model: Model, q: Array, v: Array, tau: Array, loads: Array,
+               f_ext: Array | None) -> tuple[tuple[Array, Array], Factor]:
     kin = body_kinematics(model, q, v)
     m = loads.shape[0]
     bias = cross_force(kin.V, jnp.einsum("kij,kj->ki", kin.I, kin.V))
@@ -88,4 +139,4 @@ def aba_responses(model: Model, q: Array, v: Array, tau: Array, loads: Array,
     _, qdd = forward_pass(model.topology, substitute,
                           (ground, jnp.zeros((model.width, 1 + m), q.dtype)), (kin.S, c, U, D, u))
     flat = jax.vmap(model.flat_v, in_axes=-1)(qdd)          # (1 + m, nv)
-    return flat[0], flat[1:]
+    return (flat[0], flat[1:]), Factor(kin.S, U, D)

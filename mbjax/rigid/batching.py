@@ -13,9 +13,10 @@ B = 4096 (`mbjax bench speed`, benchmarks/README.md). `aba_batchable` is `aba` w
 - anything else falls back to the plain vmap of `aba`, so the answer never depends on the route
   (the two agree to rounding: tests/rigid/test_batching.py).
 
-custom_vmap functions cannot be differentiated in reverse mode, so a `jax.custom_jvp` wraps it
-whose rule is `aba`'s own JVP: a derivative of any order, batched or not, is exactly `aba`'s (and
-compiles as before); the batched route serves the values a vmapped program does not differentiate.
+custom_vmap functions cannot be differentiated, so `forward_dynamics` wraps `aba_vmappable` in
+the derivative rule of `mbjax.rigid.adjoint` (a `jax.custom_jvp`): a derivative of any order,
+batched or not, comes from that rule; the batched route serves the values a vmapped program does
+not differentiate.
 """
 
 import jax
@@ -39,11 +40,13 @@ def batchable(model: Model) -> bool:
 
 
 @custom_vmap
-def _aba_vmappable(model: Model, q: Array, v: Array, tau: Array) -> Array:
+def aba_vmappable(model: Model, q: Array, v: Array, tau: Array) -> Array:
+    """`aba(model, q, v, tau)` (no external wrenches), batched by `jax.vmap` onto `batch_aba`
+    where that is faster (see the module). The model must be `batchable`."""
     return aba(model, q, v, tau)
 
 
-@_aba_vmappable.def_vmap
+@aba_vmappable.def_vmap
 def _vmap_rule(axis_size, in_batched, model, q, v, tau):
     model_batched, *batched = in_batched
     if not any(jax.tree.leaves(in_batched)):     # e.g. jacrev's vmap over cotangents only
@@ -59,14 +62,3 @@ def _vmap_rule(axis_size, in_batched, model, q, v, tau):
     q, v, tau = (columns(x, b) for x, b in zip((q, v, tau), batched, strict=True))
     return batch_aba(model, q, v, tau).T, True
 
-
-@jax.custom_jvp
-def aba_batchable(model: Model, q: Array, v: Array, tau: Array) -> Array:
-    """`aba(model, q, v, tau)` (no external wrenches), batched by `jax.vmap` onto `batch_aba`
-    where that is faster (see the module). The model must be `batchable`."""
-    return _aba_vmappable(model, q, v, tau)
-
-
-@aba_batchable.defjvp
-def _jvp(primals, tangents):
-    return jax.jvp(aba, primals, tangents)

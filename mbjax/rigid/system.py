@@ -34,7 +34,7 @@ from mbjax.model.limits import exceeded
 from mbjax.rigid.aba import aba_responses
 from mbjax.rigid.batched import batch_aba
 from mbjax.rigid.dense import dense_responses
-from mbjax.rigid.dynamics import METHODS, choose_method, mass_matrix
+from mbjax.rigid.dynamics import METHODS, choose_method, forward_dynamics, mass_matrix
 from mbjax.rigid.energy import energy
 from mbjax.rigid.kinematics import forward_kinematics
 from mbjax.rigid.momentum import momentum_rate, velocity_from_momentum
@@ -99,6 +99,12 @@ class TreeSystem(AbstractTreeSystem):
         method = choose_method(self.model) if self.method == "auto" else self.method
         route = aba_responses if method == "recursive" else dense_responses
         return route(self.model, q, v, tau, loads, f)
+
+    def acceleration(self, t, q, u):
+        """`forward_dynamics` under the control and the external wrenches (its derivatives by the
+        adjoint rule of `mbjax.rigid.adjoint`)."""
+        return forward_dynamics(self.model, q, u, self.applied(t, q, u), self.method,
+                                self.wrenches(t, q, u))
 
     def bias(self, t, q, v):
         """The RNEA at zero acceleration (velocity terms, gravity, external wrenches) less the
