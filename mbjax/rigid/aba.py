@@ -15,8 +15,13 @@ origin (see `kinematics`), so no quantity changes frame on its way along the tre
       a = a' + P u_dot. The ground's acceleration is -g, which puts gravity in every body.
 
 P may have several columns for multi-DOF joints; D is then a small symmetric positive-definite
-block solved by Cholesky. Flexible bodies (issue "flexible bodies") will enter step (ii) with their
-modal mass (eqs 51-60).
+block solved by Cholesky. The passes run at one width for every body, so a floating base (a free
+joint under revolute ones) is eliminated on its own, outside the passes, with 6 x 6 blocks, and
+the revolute bodies keep their division (`_wide_root`; the Unitree G1's evaluation 138 -> 32 us).
+
+Step (ii) eliminates M(q) itself: (S, U, D) per body (`Factor`, from `aba_factored`) is a sparse
+L D L^T factorization of the mass matrix, with which `solve` applies M^-1 in two vector passes
+(the derivatives of `mbjax.rigid.adjoint` use it).
 """
 
 from typing import NamedTuple
@@ -26,6 +31,7 @@ import jax.numpy as jnp
 from jax import Array
 
 from mbjax.model import Model
+from mbjax.model.joints import JOINT_TYPES
 from mbjax.rigid.kinematics import body_kinematics, gravity_acceleration
 from mbjax.spatial import cross_force, shift_force
 from mbjax.tree import backward_pass, forward_pass
@@ -39,14 +45,29 @@ def _solve(D: Array, b: Array) -> Array:
 
 
 class Factor(NamedTuple):
-    """The articulated-body factorization of the mass matrix at q: per body the motion subspace
-    S (n, 6, width), U = I_2 S (n, 6, width) and D = S^T U (n, width, width), step (ii)'s
-    elimination. It is a sparse L D L^T factorization of M(q) (the triangularization of seed 002
-    eqs 48-50), so `solve` applies M(q)^-1 in two vector passes."""
+    """The articulated-body factorization of the mass matrix at q, step (ii)'s elimination: per
+    body the motion subspace S (n, 6, w), U = I_2 S (n, 6, w) and D = S^T U (n, w, w), and for a
+    floating base eliminated on its own (see `_wide_root`) its S, U, D (6 x 6, else None). It is
+    a sparse L D L^T factorization of M(q) (the triangularization of seed 002 eqs 48-50), so
+    `solve` applies M(q)^-1 in two vector passes."""
 
     S: Array
     U: Array
     D: Array
+    root: tuple[Array, Array, Array] | None
+
+
+def _wide_root(model: Model) -> tuple[int | None, int]:
+    """(root, w): a floating base, the tree's only base body when its joint is wider than every
+    other body's, is eliminated on its own with 6 x 6 blocks, and the tree passes run at the
+    width w of the other joints (1 for a humanoid of revolute joints: a division per body, not a
+    6 x 6 Cholesky factorization). (None, model.width) for any other tree."""
+    widths = [JOINT_TYPES[kind].nv for kind in model.joint_types]
+    roots = [k for k, parent in enumerate(model.topology.parents) if parent < 0]
+    rest = max((w for k, w in enumerate(widths) if k != roots[0]), default=0)
+    if len(roots) == 1 and widths[roots[0]] > rest > 0:
+        return roots[0], rest
+    return None, model.width
 
 
 def aba(model: Model, q: Array, v: Array, tau: Array, f_ext: Array | None = None) -> Array:
@@ -67,25 +88,40 @@ def solve(model: Model, factor: Factor, b: Array) -> Array:
     velocity and no gravity, steps (ii) and (iii) with the inertias already eliminated
     (c = 0, a_ground = 0): u = b - S^T F_2, F_3 = F_2 + U D^-1 u; u_dot = D^-1 (u - U^T a_p),
     a = a_p + S u_dot."""
+    root, w = _wide_root(model)
+    t = model.body_v(b)
+    t_scan = t[:, :w] if root is None else t[:, :w].at[root].set(0)
 
     def forces(F2, inp):
         S, U, D, t = inp
         u = t - S.T @ F2
         return u, F2 + U @ _solve(D, u)
 
-    t = model.body_v(b)
-    u, _ = backward_pass(model.topology, forces, jnp.zeros((model.n, 6), b.dtype),
-                         (factor.S, factor.U, factor.D, t))
+    u, F_root = backward_pass(model.topology, forces, jnp.zeros((model.n, 6), b.dtype),
+                              (factor.S, factor.U, factor.D, t_scan))
+    ground = jnp.zeros(6, b.dtype)
+    if root is not None:              # the floating base: F_root is what it received
+        S_r, U_r, D_r = factor.root
+        u_dot_root = _solve(D_r, t[root] - S_r.T @ F_root)
+        ground = S_r @ u_dot_root
 
     def substitute(parent, inp):
         (a_parent, _), (S, U, D, u) = parent, inp
         u_dot = _solve(D, u - U.T @ a_parent)
         return a_parent + S @ u_dot, u_dot
 
-    _, u_dot = forward_pass(model.topology, substitute,
-                            (jnp.zeros(6, b.dtype), jnp.zeros(model.width, b.dtype)),
+    _, u_dot = forward_pass(model.topology, substitute, (ground, jnp.zeros(w, b.dtype)),
                             (factor.S, factor.U, factor.D, u))
+    if root is not None:
+        u_dot = _widen(u_dot, model.width).at[root].set(u_dot_root)
     return model.flat_v(u_dot)
+
+
+def _widen(x: Array, width: int) -> Array:
+    """(n, w, ...) -> (n, width, ...), zero columns appended."""
+    pad = [(0, 0)] * x.ndim
+    pad[1] = (0, width - x.shape[1])
+    return jnp.pad(x, pad)
 
 
 def aba_responses(model: Model, q: Array, v: Array, tau: Array, loads: Array,
@@ -118,6 +154,14 @@ def _recursion(model: Model, q: Array, v: Array, tau: Array, loads: Array,
     t = jnp.concatenate([model.body_v(tau - model.damping * v)[..., None],
                          jax.vmap(model.body_v, out_axes=-1)(loads)], -1)
 
+    # A floating base is eliminated on its own (`_wide_root`): in the tree passes its joint has
+    # no columns (S = 0, D = 1, u = 0), so it hands its articulated inertia and force on
+    # unchanged, and the ground it sits on moves with its joint acceleration S_r u_dot_r.
+    root, w = _wide_root(model)
+    S, t_scan, pad_scan = kin.S[..., :w], t[:, :w], pad[:, :w]
+    if root is not None:
+        S, t_scan, pad_scan = S.at[root].set(0), t_scan.at[root].set(0), pad_scan.at[root].set(1)
+
     def triangularize(received, inp):
         (IA, pA), (S, c, t, padding) = received, inp
         U = IA @ S
@@ -127,7 +171,18 @@ def _recursion(model: Model, q: Array, v: Array, tau: Array, loads: Array,
         pa = pA + Ia @ c + U @ _solve(D, u)
         return (U, D, u), (Ia, pa)
 
-    (U, D, u), _ = backward_pass(model.topology, triangularize, (kin.I, F1), (kin.S, c, t, pad))
+    (U, D, u), (I_root, F_root) = backward_pass(model.topology, triangularize, (kin.I, F1),
+                                                (S, c, t_scan, pad_scan))
+    ground = jnp.zeros((6, 1 + m), q.dtype).at[:, 0].set(gravity_acceleration(model))
+    root_factor = None
+    if root is not None:              # its own elimination, 6 x 6 (received: I_root, F_2)
+        S_r = kin.S[root]
+        U_r = I_root @ S_r
+        D_r = S_r.T @ U_r + jnp.diag(pad[root])
+        u_r = t[root] - S_r.T @ (F_root - I_root @ c[root])
+        u_dot_root = _solve(D_r, u_r - U_r.T @ (ground + c[root]))
+        ground = ground + S_r @ u_dot_root
+        root_factor = (S_r, U_r, D_r)
 
     def substitute(parent, inp):
         (a_parent, _), (S, c, U, D, u) = parent, inp
@@ -135,8 +190,9 @@ def _recursion(model: Model, q: Array, v: Array, tau: Array, loads: Array,
         qdd = _solve(D, u - U.T @ a_prime)
         return a_prime + S @ qdd, qdd
 
-    ground = jnp.zeros((6, 1 + m), q.dtype).at[:, 0].set(gravity_acceleration(model))
     _, qdd = forward_pass(model.topology, substitute,
-                          (ground, jnp.zeros((model.width, 1 + m), q.dtype)), (kin.S, c, U, D, u))
+                          (ground, jnp.zeros((w, 1 + m), q.dtype)), (S, c, U, D, u))
+    if root is not None:
+        qdd = _widen(qdd, model.width).at[root].set(u_dot_root)
     flat = jax.vmap(model.flat_v, in_axes=-1)(qdd)          # (1 + m, nv)
-    return (flat[0], flat[1:]), Factor(kin.S, U, D)
+    return (flat[0], flat[1:]), Factor(S, U, D, root_factor)

@@ -19,6 +19,7 @@ from mbjax import rigid
 from mbjax.integrate import RK4, RKMK4, simulate
 from mbjax.model import Model, chain, random_tree
 from mbjax.model.urdf import to_urdf
+from mbjax.rigid.aba import _wide_root
 
 RTOL = 1e-10          # float64 identities
 
@@ -150,6 +151,18 @@ def case(request):
     model = MODELS[request.param]()
     state = random_state(model, seed=len(request.param))
     return request.param, model, state, _dynamics(model, *state)
+
+
+def test_a_floating_base_is_eliminated_on_its_own():
+    """A free base under narrower joints is eliminated with its own 6 x 6 blocks and the tree
+    passes run at the other joints' width (mbjax.rigid.aba._wide_root): the identities below
+    check that route on "multi_dof" and "mixed", the URDF tests on real floating robots. Two
+    free bodies, or a tree without a free base, keep one width."""
+    assert _wide_root(_multi_dof()) == _wide_root(_mixed()) == (0, 3)     # spherical joints
+    assert _wide_root(mbjax.load_urdf(TREE_URDF)) == (None, 1)
+    assert _wide_root(random_tree(3, joint_types="free")) == (None, 6)
+    floating = mbjax.load_urdf(TREE_URDF, floating_base=True)
+    assert _wide_root(floating) == (0, 1)
 
 
 # --------------------------------------------------------------------------------------------
