@@ -26,12 +26,14 @@ def step(s, _):
     return (q + 1e-3 * v, v), None
 q = jax.jit(lambda q: jax.lax.scan(step, (q, 0 * q), None, length=200)[0][0])(0.3 + 0 * m.neutral())
 print(json.dumps({"flags": os.environ.get("XLA_FLAGS"), "applied": mbjax.runtime.applied(),
+                  "synchronous": mbjax.runtime.synchronous(),
                   "q": [float(x).hex() for x in q]}))
 """
 
 
 def _run(**env) -> dict:
-    environment = {k: v for k, v in os.environ.items() if k not in ("XLA_FLAGS", "MBJAX_XLA_DEFAULTS")}
+    environment = {k: v for k, v in os.environ.items()
+                   if k not in ("XLA_FLAGS", "MBJAX_XLA_DEFAULTS", "JAX_CPU_ENABLE_ASYNC_DISPATCH")}
     out = subprocess.run([sys.executable, "-c", SCRIPT], env={**environment, **env},
                          capture_output=True, text=True, check=True)
     return json.loads(out.stdout.strip().splitlines()[-1])
@@ -40,16 +42,19 @@ def _run(**env) -> dict:
 @pytest.mark.skipif(runtime._jaxlib_version() not in runtime.TESTED,
                     reason="the flag is set only on jaxlib releases known to have it")
 def test_import_sets_the_flag_and_changes_no_result():
-    """`import mbjax` adds the flag to XLA_FLAGS; the user's own setting and MBJAX_XLA_DEFAULTS=0
-    win; the same rollout is bit-for-bit the same either way (a scheduling choice only)."""
+    """`import mbjax` adds the flag to XLA_FLAGS and makes CPU dispatch synchronous; the user's
+    own settings and MBJAX_XLA_DEFAULTS=0 win; the same rollout is bit-for-bit the same either
+    way (scheduling choices only)."""
     default = _run()
-    assert default["applied"] and default["flags"] == runtime.FLAG
+    assert default["applied"] and default["flags"] == runtime.FLAG and default["synchronous"]
     off = _run(MBJAX_XLA_DEFAULTS="0")
-    assert not off["applied"] and off["flags"] is None
+    assert not off["applied"] and off["flags"] is None and not off["synchronous"]
+    asynchronous = _run(JAX_CPU_ENABLE_ASYNC_DISPATCH="1")
+    assert asynchronous["applied"] and not asynchronous["synchronous"]
     own = _run(XLA_FLAGS="--xla_cpu_enable_concurrency_optimized_scheduler=true")
     assert not own["applied"]
     assert own["flags"] == "--xla_cpu_enable_concurrency_optimized_scheduler=true"
-    assert default["q"] == off["q"] == own["q"]
+    assert default["q"] == off["q"] == own["q"] == asynchronous["q"]
 
 
 def test_no_flag_once_the_backend_runs(monkeypatch):
