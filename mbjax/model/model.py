@@ -275,16 +275,28 @@ class Model(eqx.Module):
 
     def q_dot(self, q: Array, v: Array) -> Array:
         """dq/dt for velocity v (equal to v for revolute, prismatic and universal joints)."""
+        if self.euclidean:
+            return v
         return self._flat_q(self._per_type(
             lambda kind, qk, vk, a, a2: self._pad_q(kind, joint_rate(kind, qk, vk)), q, v))
 
+    @property
+    def euclidean(self) -> bool:
+        """Whether every joint's coordinates are Euclidean (revolute, prismatic, universal): then
+        q_dot = v and retract(q0, xi) = q0 + xi, with no per-joint-type gathers and scatters."""
+        return all(JOINT_TYPES[kind].nq == JOINT_TYPES[kind].nv for kind in self.joint_types)
+
     def retract(self, q0: Array, xi: Array) -> Array:
         """The configuration at chart point xi (length nv) about q0 (see joints.joint_retract)."""
+        if self.euclidean:
+            return q0 + xi
         return self._flat_q(self._per_type(
             lambda kind, qk, xk, a, a2: self._pad_q(kind, joint_retract(kind, qk, xk)), q0, xi))
 
     def local_rate(self, q0: Array, xi: Array, v: Array) -> Array:
         """xi_dot (length nv) at chart point xi about q0 for velocity v."""
+        if self.euclidean:
+            return v
         width = self.width
         rates = self._per_type(
             lambda kind, qk, xk, vk, a, a2: jnp.pad(joint_local_rate(kind, qk, xk, vk),
