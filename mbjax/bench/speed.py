@@ -16,7 +16,9 @@ mbjax and Pinocchio only). Every library reads the same URDF; float64, CPU. Per 
   `simulate(TreeSystem(model), RK4())`, per evaluation = run / (4 STEPS));
 - vmap: per state of `jit(vmap(forward_dynamics))` at B = BATCH;
 - grad: `jax.grad` of sum q(T)^2 over the rollout with respect to q0, divided by the rollout, and
-  the temporary memory XLA allocates for it (grad_temp_bytes: what the reverse pass keeps);
+  the temporary memory XLA allocates for it (grad_temp_bytes: what the reverse pass keeps); for
+  the 7-link chain also that memory through `simulate`, plain and checkpointed, against the
+  horizon (`grad_memory`);
 - compile: lowering and compiling the rollout.
 
 Pinocchio: `aba` per call (the C++ estimate: Python loop time minus an empty loop's) and
@@ -47,6 +49,7 @@ from mbjax.timing import write_jsonl
 NAME = "speed"
 STEPS, QUICK_STEPS = 1000, 100
 BATCH, QUICK_BATCH = 4096, 256
+MEMORY_STEPS = (256, 1024, 4096)            # horizons of `grad_memory` (powers of 2: sqrt exact)
 DT = 1e-3
 # issue 21's targets
 TARGET_EVAL_RATIO, TARGET_CALL_S, TARGET_GRAD_RATIO = 2.0, 10e-6, 3.0
@@ -126,6 +129,27 @@ def _measure_jax(fd, q, v, tau, Q, V, TAU, steps: int, repeats: int, budget: flo
     return record
 
 
+def grad_memory(system, q, horizons=MEMORY_STEPS) -> dict:
+    """XLA's temporary bytes for `jax.grad` of sum q(T)^2 through `simulate(system, RK4())`
+    from rest, plain and with checkpoint=True, at each horizon T (compiled, not run), and the
+    slope of log(bytes) against log(T): 1 for memory O(T), 0.5 for O(sqrt T)."""
+    from mbjax.bench.throughput import temp_bytes
+
+    out = {}
+    for checkpoint in (False, True):
+        memory = []
+        for steps in horizons:
+            def loss(q0, steps=steps, checkpoint=checkpoint):
+                return jnp.sum(simulate(system, RK4(), q0, jnp.zeros_like(q0), dt=DT,
+                                        t1=steps * DT, saveat=None,
+                                        checkpoint=checkpoint).qs[-1] ** 2)
+            memory.append(temp_bytes(jax.grad(loss), q))
+        slope = float(np.polyfit(np.log(horizons), np.log(memory), 1)[0])
+        out["checkpoint" if checkpoint else "plain"] = {"steps": list(horizons), "bytes": memory,
+                                                        "slope": slope}
+    return out
+
+
 def _pinocchio(urdf: str, floating: bool, Q, V, TAU, repeats: int, budget: float) -> dict:
     import pinocchio as pin
     record = {}
@@ -198,6 +222,8 @@ def run(out: Path, quick: bool = False) -> list[dict]:
                                             saveat=None).qs[-1])
         _, t = timed(sim, q, jnp.zeros_like(v), repeats=repeats, budget_s=budget)
         mb["eval_simulate_rk4_s"] = t.run_s / (4 * steps)
+        if name == "chain7":
+            mb["grad_memory"] = grad_memory(system, q)
         hlo = jax.jit(forward_dynamics).lower(model, q, v, tau).compile().as_text()
         mb["kernels"] = kernel_counts(hlo)
         acc = mb.pop("acc")
@@ -250,6 +276,9 @@ def summarize(records: list[dict], common: dict) -> dict:
             target("chain7: one jitted call's fixed cost, model closed over",
                    mb["call_closed_s"] - mb["eval_s"], TARGET_CALL_S, "s")
             target("chain7: grad / rollout", mb["grad_ratio"], TARGET_GRAD_RATIO)
+            if "grad_memory" in mb:      # O(sqrt T): log-log slope 0.5
+                target("chain7: grad memory ~ T^slope, simulate(checkpoint=True)",
+                       mb["grad_memory"]["checkpoint"]["slope"], 0.6)
             if pin and "vmap_s" in pin:
                 target("chain7: vmap per state / abaInParallel", mb["vmap_s"] / pin["vmap_s"], 1.0)
         for peer in ("jaxsim", "adam"):
