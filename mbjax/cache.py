@@ -1,4 +1,5 @@
-"""JAX's persistent compilation cache, on by default in the `mbjax` command and the notebooks.
+"""JAX's persistent compilation cache, on by default in the `mbjax` command and the notebooks
+(not in `mbjax bench`, whose compile times must be compiles).
 
 Compiling dominates a first run (a scene compiles for seconds and runs for milliseconds); with the
 cache, a second run loads the compiled programs from disk. The folder is the argument, else

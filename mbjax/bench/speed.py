@@ -141,7 +141,7 @@ def grad_memory(system, q, horizons=MEMORY_STEPS) -> dict:
         for steps in horizons:
             def loss(q0, steps=steps, checkpoint=checkpoint):
                 return jnp.sum(simulate(system, RK4(), q0, jnp.zeros_like(q0), dt=DT,
-                                        t1=steps * DT, saveat=None,
+                                        t1=steps * DT, saveat=np.array([steps * DT]),
                                         checkpoint=checkpoint).qs[-1] ** 2)
             memory.append(temp_bytes(jax.grad(loss), q))
         slope = float(np.polyfit(np.log(horizons), np.log(memory), 1)[0])
