@@ -447,7 +447,7 @@ def test_compilation_cache_folder_and_switch(tmp_path, monkeypatch):
     assert cache_folder() == tmp_path / "mbjax" / "jax"
     assert use_compilation_cache() == tmp_path / "mbjax" / "jax" and (tmp_path / "mbjax" / "jax").is_dir()
     assert updates == {"jax_compilation_cache_dir": str(tmp_path / "mbjax" / "jax"),
-                       "jax_persistent_cache_min_compile_time_secs": 0.1}
+                       "jax_persistent_cache_min_compile_time_secs": 0.0}
     monkeypatch.setenv("MBJAX_NO_CACHE", "1")
     updates.clear()
     assert use_compilation_cache() is None and not updates
