@@ -456,7 +456,8 @@ def test_compilation_cache_folder_and_switch(tmp_path, monkeypatch):
 @pytest.mark.slow
 def test_bench_speed_quick(tmp_path):
     """The 7-link chain through every library of `mbjax bench speed`: every peer that imports
-    agrees with mbjax, gradients are finite, the targets are recorded."""
+    agrees with mbjax, gradients are finite, the checkpointed gradient's memory grows like
+    sqrt(T), the targets are recorded."""
     assert main(["bench", "speed", "--quick", "--out", str(tmp_path)]) == 0
     records = [json.loads(line) for line in (tmp_path / "speed.jsonl").read_text().splitlines()]
     rows = {r["library"]: r for r in records if "library" in r and "skipped" not in r}
@@ -465,6 +466,8 @@ def test_bench_speed_quick(tmp_path):
     for peer in ("pinocchio", "jaxsim", "adam"):
         if peer in rows:
             assert rows[peer]["rel_diff_mbjax"] < 1e-12
+    memory = rows["mbjax"]["grad_memory"]          # XLA's compiled sizes, not timings
+    assert memory["plain"]["slope"] > 0.9 and memory["checkpoint"]["slope"] < 0.6
     targets = records[-1]["targets"]
-    assert any(t["target"] == "chain7: one jitted call" for t in targets)
+    assert any(t["target"].startswith("chain7: one jitted call's fixed cost") for t in targets)
     assert (tmp_path / "speed.png").stat().st_size > 10_000

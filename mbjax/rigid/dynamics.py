@@ -65,7 +65,7 @@ def forward_dynamics(model: Model, q: Array, q_dot: Array, tau: Array,
     return dense_forward_dynamics(model, q, q_dot, tau, f_ext)
 
 
-def _recursion(model: Model, q: Array, v: Array, tau: Array, f_ext: Array | None) -> Array:
+def _primal(model: Model, q: Array, v: Array, tau: Array, f_ext: Array | None) -> Array:
     if f_ext is None and batchable(model):     # jax.vmap's fast route (mbjax.rigid.batching)
         return aba_vmappable(model, q, v, tau)
     return aba(model, q, v, tau, f_ext)
@@ -73,7 +73,7 @@ def _recursion(model: Model, q: Array, v: Array, tau: Array, f_ext: Array | None
 
 # seed 002's recursion, differentiated through the equations of motion (mbjax.rigid.adjoint):
 # jax.grad of a 1000-step rollout of the 7-link chain costs 3x the rollout instead of 6x
-recursive_forward_dynamics = with_adjoint(_recursion)
+recursive_forward_dynamics = with_adjoint(_primal)
 
 
 def inverse_dynamics(model: Model, q: Array, q_dot: Array, q_ddot: Array,

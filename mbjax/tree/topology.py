@@ -106,9 +106,9 @@ class Topology:
 
         Level by level when that is compact and saves steps (all bodies of one depth at once,
         vectorized; at most 3/4 as many steps as bodies), else one body per step in index order
-        (valid because parents come first). A chain is one body
-        per step either way; a bushy tree is a few wide steps. Short levels are padded with a
-        repeat of their first body (mask False), so padding computes on real data and is dropped.
+        (valid because parents come first). A chain is one body per step either way; a bushy
+        tree is a few wide steps. Short levels are padded with a repeat of their first body (mask
+        False), so padding computes on real data and is dropped.
         """
         width = max(len(level) for level in self.levels)
         # A level step (gathers, vmapped body, scatters) costs more than a one-body step, so the
