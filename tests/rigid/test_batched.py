@@ -94,6 +94,8 @@ def test_batch_rollout_equals_vmapped_rollouts():
     assert int(batch.status) == 0
 
 
+# slow (25-35 s): the default suite checks the same gradient and memory slope in notebook 08 §4
+@pytest.mark.slow
 def test_checkpointed_gradient_is_the_same_in_sqrt_t_memory():
     model = chain(4, seed=7)
     q, v, _ = _states(model, 16, seed=3)
