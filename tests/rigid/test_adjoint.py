@@ -7,7 +7,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from mbjax.model import chain, random_tree
+from mbjax.model import random_tree
 from mbjax.rigid import forward_dynamics, mass_matrix
 from mbjax.rigid.aba import aba, aba_factored, solve
 from mbjax.rigid.dynamics import recursive_forward_dynamics
@@ -120,26 +120,3 @@ def test_second_derivatives_against_central_differences():
                          for e in jnp.eye(model.nv)])
     assert _relative(H, central) < 1e-7
     assert _relative(H, H.T) < 1e-12
-
-
-def test_a_rollouts_gradient_keeps_little():
-    """jax.grad of a 1000-step rollout keeps per step only the state, the accelerations and the
-    factor (the RNEA's linearization is recomputed): XLA's temporary memory for the 7-link chain
-    is under a tenth of the plain recursion's (0.9 against 17 MB), with the same gradient."""
-    model = chain(7)
-
-    def loss(fd):
-        def run(q0):
-            def step(state, _):
-                q, v = state
-                v = v + 1e-3 * fd(model, q, v, jnp.zeros_like(v))
-                return (q + 1e-3 * v, v), None
-            q, _ = jax.lax.scan(step, (q0, jnp.zeros_like(q0)), None, length=1000)[0]
-            return jnp.sum(q ** 2)
-        return jax.jit(jax.grad(run))
-
-    q0 = jnp.linspace(-0.3, 0.3, model.nv)
-    ours, plain = loss(forward_dynamics), loss(aba)
-    assert _relative(ours(q0), plain(q0)) < 1e-10
-    memory = [f.lower(q0).compile().memory_analysis().temp_size_in_bytes for f in (ours, plain)]
-    assert memory[0] < memory[1] / 10
