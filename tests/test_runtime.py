@@ -1,4 +1,4 @@
-"""`mbjax.runtime`: the XLA CPU option mbjax sets at import, and `mbjax bench speed`'s HLO reader."""
+"""`mbjax.runtime`: the XLA CPU options mbjax sets at import, and `mbjax bench speed`'s HLO reader."""
 
 import json
 import os
@@ -42,19 +42,24 @@ def _run(**env) -> dict:
 @pytest.mark.skipif(runtime._jaxlib_version() not in runtime.TESTED,
                     reason="the flag is set only on jaxlib releases known to have it")
 def test_import_sets_the_flag_and_changes_no_result():
-    """`import mbjax` adds the flag to XLA_FLAGS and makes CPU dispatch synchronous; the user's
-    own settings and MBJAX_XLA_DEFAULTS=0 win; the same rollout is bit-for-bit the same either
-    way (scheduling choices only)."""
+    """`import mbjax` adds its flags to XLA_FLAGS and makes CPU dispatch synchronous; the user's
+    own settings (flag by flag) and MBJAX_XLA_DEFAULTS=0 win; the same rollout is bit-for-bit the
+    same either way."""
     default = _run()
     assert default["applied"] and default["flags"] == runtime.FLAG and default["synchronous"]
     off = _run(MBJAX_XLA_DEFAULTS="0")
     assert not off["applied"] and off["flags"] is None and not off["synchronous"]
     asynchronous = _run(JAX_CPU_ENABLE_ASYNC_DISPATCH="1")
     assert asynchronous["applied"] and not asynchronous["synchronous"]
-    own = _run(XLA_FLAGS="--xla_cpu_enable_concurrency_optimized_scheduler=true")
+    mine = "--xla_cpu_enable_concurrency_optimized_scheduler=true"
+    own = _run(XLA_FLAGS=mine)
     assert not own["applied"]
-    assert own["flags"] == "--xla_cpu_enable_concurrency_optimized_scheduler=true"
-    assert default["q"] == off["q"] == own["q"] == asynchronous["q"]
+    assert own["flags"] == f"{mine} {runtime.FLAGS[0]}"         # the other flag is still added
+    mine = "--xla_backend_extra_options=xla_cpu_small_while_loop_byte_threshold=2000"
+    own_options = _run(XLA_FLAGS=mine)
+    assert own_options["flags"] == f"{mine} {runtime.FLAGS[1]}"
+    # loops compiled as one kernel or as many, kernels scheduled either way: the same numbers
+    assert default["q"] == off["q"] == own["q"] == own_options["q"] == asynchronous["q"]
 
 
 def test_no_flag_once_the_backend_runs(monkeypatch):

@@ -26,6 +26,7 @@ from mbjax.model.joints import (
     joint_retract,
 )
 from mbjax.model.checks import check_body
+from mbjax.model.take import take
 from mbjax.spatial import inertia_matrix
 from mbjax.tree import Topology
 
@@ -43,9 +44,18 @@ def _layout(joint_types: tuple[str, ...]):
     q_mask = np.array([[j < nqs[k] for j in range(wq)] for k in range(len(nqs))])
     groups = {kind: np.array([k for k, t in enumerate(joint_types) if t == kind])
               for kind in dict.fromkeys(joint_types)}
+    # each joint type's own coordinates (bodies of the type, its nq or nv columns), and where the
+    # bodies and coordinates of all types, concatenated type by type, go back to in body order
+    q_own = {kind: q0[idx][:, None] + np.arange(JOINT_TYPES[kind].nq) for kind, idx in groups.items()}
+    v_own = {kind: v0[idx][:, None] + np.arange(JOINT_TYPES[kind].nv) for kind, idx in groups.items()}
+
+    def order(maps):
+        return np.argsort(np.concatenate([m.ravel() for m in maps]), kind="stable")
     return dict(nq=int(q0[-1]), nv=int(v0[-1]), q_start=tuple(int(x) for x in q0[:-1]),
                 v_start=tuple(int(x) for x in v0[:-1]), q_index=q_index, v_index=v_index,
-                v_mask=v_mask, q_mask=q_mask, width=wv, groups=groups)
+                v_mask=v_mask, q_mask=q_mask, width=wv, groups=groups, q_own=q_own, v_own=v_own,
+                body_order=order(groups.values()), q_order=order(q_own.values()),
+                v_order=order(v_own.values()))
 
 
 class Model(eqx.Module):
@@ -232,14 +242,16 @@ class Model(eqx.Module):
         return _layout(self.joint_types)["v_mask"]
 
     def body_v(self, v: Array) -> Array:
-        """Per-body velocities (n, width), zero-padded."""
-        layout = _layout(self.joint_types)
-        return jnp.where(layout["v_mask"], v[layout["v_index"]], 0.0)
+        """Per-body velocities (n, width, ...), zero-padded, of v (nv, ...)."""
+        layout, width = _layout(self.joint_types), self.width
+        return _by_body(layout, [
+            jnp.pad(take(v, own), [(0, 0), (0, width - own.shape[1])] + [(0, 0)] * (v.ndim - 1))
+            for own in layout["v_own"].values()])
 
     def flat_v(self, per_body: Array) -> Array:
-        """Inverse of body_v: (n, width) -> (nv,)."""
+        """Inverse of body_v: (n, width, ...) -> (nv, ...)."""
         layout = _layout(self.joint_types)
-        return per_body[layout["v_mask"]]
+        return _flat(layout, "v", per_body)
 
     def dof_body(self) -> np.ndarray:
         """The body each velocity coordinate belongs to."""
@@ -251,17 +263,11 @@ class Model(eqx.Module):
         """Apply fn(kind, q_k, *v_k, axis_k, axis2_k) to every body, grouped by joint type so each
         type is one vmapped call (no Python loop over bodies). Each v in vs has length nv."""
         layout = _layout(self.joint_types)
-        qb, vbs = q[layout["q_index"]], [self.body_v(v) for v in vs]
-        results = None
-        for kind, idx in layout["groups"].items():
-            out = jax.vmap(lambda qk, a, a2, *vk, kind=kind: fn(kind, qk, *vk, a, a2))(
-                qb[idx], self.axis[idx], self.axis2[idx], *[vb[idx] for vb in vbs])
-            if len(layout["groups"]) == 1:
-                return out
-            if results is None:
-                results = jax.tree.map(lambda o: jnp.zeros((self.n, *o.shape[1:]), o.dtype), out)
-            results = jax.tree.map(lambda r, o, idx=idx: r.at[idx].set(o), results, out)
-        return results
+        outs = [jax.vmap(lambda qk, a, a2, *vk, kind=kind: fn(kind, qk, *vk, a, a2))(
+                    take(q, layout["q_own"][kind]), take(self.axis, idx), take(self.axis2, idx),
+                    *[take(v, layout["v_own"][kind]) for v in vs])
+                for kind, idx in layout["groups"].items()]
+        return jax.tree.map(lambda *pieces: _by_body(layout, pieces), *outs)
 
     def joints(self, q: Array, v: Array):
         """Per-body (R, p, S, S_dot): body k's orientation and origin in its proximal body's frame,
@@ -307,7 +313,7 @@ class Model(eqx.Module):
         return jnp.pad(qk, (0, _layout(self.joint_types)["q_index"].shape[1] - qk.shape[0]))
 
     def _flat_q(self, per_body: Array) -> Array:
-        return per_body[_layout(self.joint_types)["q_mask"]]
+        return _flat(_layout(self.joint_types), "q", per_body)
 
     def normalize(self, q: Array) -> Array:
         """q with every quaternion scaled to unit length."""
@@ -323,6 +329,21 @@ class Model(eqx.Module):
     def spatial_inertia(self) -> Array:
         """(n, 6, 6) spatial inertias about each body's origin, body coordinates."""
         return inertia_matrix(self.mass, self.com, self.inertia)
+
+
+def _by_body(layout: dict, pieces) -> Array:
+    """Per-type arrays (one per joint type, leading axis that type's bodies) in body order."""
+    if len(pieces) == 1:
+        return pieces[0]
+    return take(jnp.concatenate(pieces), layout["body_order"])
+
+
+def _flat(layout: dict, which: str, per_body: Array) -> Array:
+    """Per-body padded rows (n, width, ...) -> the flat coordinates (nq or nv, ...) they hold."""
+    blocks = [take(per_body, idx)[:, :own.shape[1]].reshape(-1, *per_body.shape[2:])
+              for idx, own in zip(layout["groups"].values(), layout[f"{which}_own"].values(),
+                                  strict=True)]
+    return take(jnp.concatenate(blocks), layout[f"{which}_order"])
 
 
 def _unit_rows(a: Array) -> Array:

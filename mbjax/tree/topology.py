@@ -11,6 +11,8 @@ from functools import cached_property
 
 import numpy as np
 
+from mbjax import runtime
+
 
 class Topology:
     """Static, hashable description of a tree: `Topology(parents)` with parents[k] < k or -1."""
@@ -104,20 +106,29 @@ class Topology:
     def schedule(self) -> tuple[np.ndarray, np.ndarray]:
         """The order a tree pass visits the bodies in: (steps, width) body indices and a mask.
 
-        Level by level when that is compact and saves steps (all bodies of one depth at once,
-        vectorized; at most 3/4 as many steps as bodies), else one body per step in index order
-        (valid because parents come first). A chain is one body per step either way; a bushy
-        tree is a few wide steps. Short levels are padded with a repeat of their first body (mask
-        False), so padding computes on real data and is dropped.
+        One body per step in index order (valid because parents come first), or level by level
+        (all bodies of one depth at once, vectorized: gathers, a vmapped body, scatters) where
+        `levels_pay` and the levels are compact and save steps (at most 3/4 as many steps as
+        bodies). Short levels are padded with a repeat of their first body (mask False), so
+        padding computes on real data and is dropped.
         """
         width = max(len(level) for level in self.levels)
-        # A level step (gathers, vmapped body, scatters) costs more than a one-body step, so the
-        # levels must also save steps: `mbjax bench speed`'s forward dynamics in a rollout, the
-        # Panda (9 bodies, 8 levels) 16.4 us by levels against 13.7 one by one; the G1 humanoid
-        # (30 bodies, 11 levels) 31 against 47.
-        if len(self.levels) * width <= 2 * self.n and 4 * len(self.levels) <= 3 * self.n:
+        if (levels_pay() and len(self.levels) * width <= 2 * self.n
+                and 4 * len(self.levels) <= 3 * self.n):
             rows = [list(level) + [level[0]] * (width - len(level)) for level in self.levels]
             mask = [[True] * len(level) + [False] * (width - len(level)) for level in self.levels]
             return np.asarray(rows, dtype=np.int64), np.asarray(mask)
         return (np.arange(self.n, dtype=np.int64).reshape(self.n, 1),
                 np.ones((self.n, 1), dtype=bool))
+
+
+def levels_pay() -> bool:
+    """Whether level steps beat one body per step: only where XLA runs each operation of a loop
+    body as a kernel of its own. Where it compiles a loop as one kernel (`mbjax.runtime`'s
+    default), a level step's scatters keep its loop out of that, and one body per step wins on
+    every tree measured (forward dynamics in a jitted rollout, us per evaluation, levels against
+    one by one: the G1 humanoid, 30 bodies in 11 levels, 30.8 against 10.6; stars of 10, 40, 100
+    and 300 bodies 7.6, 18.9, 39.0, 106 against 2.6, 10.1, 24.8, 74; a binary tree of 31 bodies
+    7.9 against 7.7). With kernels one by one (MBJAX_XLA_DEFAULTS=0), levels win on bushy trees:
+    the G1 31 against 47 us."""
+    return not runtime.hoisting()

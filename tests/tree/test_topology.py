@@ -11,7 +11,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from mbjax.tree import Topology, backward_pass, forward_pass
+from mbjax.tree import Topology, backward_pass, forward_pass, topology
 
 # --------------------------------------------------------------------------------------------
 # Validation
@@ -48,7 +48,8 @@ def test_topology_is_static_and_hashable():
 #               |     +- 3
 #               +- 4 --- 5
 #
-FIVE = Topology([-1, 0, 1, 1, 0, 4])
+FIVE_PARENTS = [-1, 0, 1, 1, 0, 4]
+FIVE = Topology(FIVE_PARENTS)
 
 
 def test_sets_of_branched_tree():
@@ -79,7 +80,16 @@ def test_path_and_reference_matrices_of_branched_tree():
     np.testing.assert_array_equal(pi @ rho, np.eye(6))
 
 
-def test_depth_levels_and_schedule_of_branched_tree():
+@pytest.fixture(params=["levels", "one body per step"])
+def schedule(request, monkeypatch):
+    """Both kinds of tree pass: level steps (where `levels_pay`) and one body per step."""
+    monkeypatch.setattr(topology, "levels_pay", lambda: request.param == "levels")
+    return request.param
+
+
+def test_depth_levels_and_schedule_of_branched_tree(monkeypatch):
+    monkeypatch.setattr(topology, "levels_pay", lambda: True)
+    FIVE = Topology(FIVE_PARENTS)
     assert FIVE.depth == (0, 1, 2, 2, 1, 2)
     assert FIVE.levels == ((0,), (1, 4), (2, 3, 5))
     order, mask = FIVE.schedule
@@ -195,9 +205,10 @@ TREES = {
 }
 
 
-def test_sequential_and_level_schedules_are_both_exercised():
+def test_sequential_and_level_schedules_are_both_exercised(schedule):
     assert Topology(TREES["sequential"]).schedule[0].shape == (24, 1)     # one body per step
-    assert Topology(TREES["star"]).schedule[0].shape == (2, 9)            # two wide steps
+    star = (2, 9) if schedule == "levels" else (10, 1)                    # two wide steps
+    assert Topology(TREES["star"]).schedule[0].shape == star
     assert Topology(TREES["chain"]).schedule[0].shape == (10, 1)
 
 
@@ -223,7 +234,7 @@ def _python_subtree(parents, weights, matrices):
 
 
 @pytest.mark.parametrize("name", list(TREES))
-def test_forward_pass_depth_and_path_products(name):
+def test_forward_pass_depth_and_path_products(name, schedule):
     parents = TREES[name]
     top, n = Topology(parents), len(parents)
     depth = forward_pass(top, lambda d, _: d + 1, jnp.array(-1))
@@ -241,7 +252,7 @@ def test_forward_pass_depth_and_path_products(name):
 
 
 @pytest.mark.parametrize("name", list(TREES))
-def test_backward_pass_subtree_sizes_and_transported_sums(name):
+def test_backward_pass_subtree_sizes_and_transported_sums(name, schedule):
     parents = TREES[name]
     top, n = Topology(parents), len(parents)
     size, ground = backward_pass(top, lambda r, _: (r, r), jnp.ones(n, dtype=int))
@@ -262,7 +273,7 @@ def test_backward_pass_subtree_sizes_and_transported_sums(name):
 
 
 @pytest.mark.parametrize("name", ["chain", "random", "sequential"])
-def test_passes_are_differentiable(name):
+def test_passes_are_differentiable(name, schedule):
     """Reverse mode through both passes matches the plain-Python recursion's derivative."""
     parents = TREES[name]
     top, n = Topology(parents), len(parents)
