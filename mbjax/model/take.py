@@ -4,9 +4,10 @@ A model's coordinate maps (which entries of q are body k's, which bodies have re
 are static integer arrays. Indexing with them is a gather, and its reverse-mode transpose a
 scatter-add, which XLA's CPU compiler cannot put inside a loop compiled as one kernel (see
 `mbjax.runtime`): a loop with a scatter in it runs as dozens of kernels per step instead of one.
-The maps of real robots are a few runs of consecutive indices (all the revolute joints of an arm;
-a floating base's six velocities, then one per revolute joint), so `take` writes them as static
-slices and one concatenation, whose transposes are pads and slices. Only a map of more than
+The maps of real robots are a few runs of consecutive indices, ascending or descending (all the
+revolute joints of an arm; a floating base's six velocities, then one per revolute joint; a tree
+pass's bodies, tips first), so `take` writes them as static slices, reversals and one
+concatenation, whose transposes are pads, slices and reversals. Only a map of more than
 `MAX_RUNS` runs (joint types interleaved along a chain) is left a gather.
 """
 
@@ -17,14 +18,27 @@ from jax import Array
 MAX_RUNS = 8
 
 
-def runs(index: np.ndarray) -> list[tuple[int, int]]:
-    """(first, length) of each maximal run of consecutive values in index (flattened)."""
-    flat = np.asarray(index, dtype=int).ravel()
-    if flat.size == 0:
-        return []
-    cuts = np.flatnonzero(np.diff(flat) != 1) + 1
-    starts, ends = np.concatenate([[0], cuts]), np.concatenate([cuts, [flat.size]])
-    return [(int(flat[a]), int(b - a)) for a, b in zip(starts, ends, strict=True)]
+def runs(index: np.ndarray) -> list[tuple[int, int, int]]:
+    """(first, length, step) of each maximal run of consecutive values in index (flattened),
+    ascending (step 1) or descending (step -1, as a reversed tree order visits bodies)."""
+    out = []
+    for value in np.asarray(index, dtype=int).ravel():
+        if out:
+            first, length, step = out[-1]
+            if length == 1 and abs(value - first) == 1:
+                out[-1] = (first, 2, int(value - first))
+                continue
+            if value == first + step * length:
+                out[-1] = (first, length + 1, step)
+                continue
+        out.append((int(value), 1, 1))
+    return out
+
+
+def _piece(x: Array, first: int, length: int, step: int) -> Array:
+    if step == 1:
+        return x[first:first + length]
+    return jnp.flip(x[first - length + 1:first + 1], 0)
 
 
 def take(x: Array, index: np.ndarray) -> Array:
@@ -37,8 +51,8 @@ def take(x: Array, index: np.ndarray) -> Array:
         return jnp.zeros(index.shape + x.shape[1:], x.dtype)
     if len(pieces) > MAX_RUNS:
         return x[index]
-    if len(pieces) == 1 and pieces[0] == (0, x.shape[0]):
+    if len(pieces) == 1 and pieces[0] == (0, x.shape[0], 1):
         out = x
     else:
-        out = jnp.concatenate([x[first:first + length] for first, length in pieces])
+        out = jnp.concatenate([_piece(x, *piece) for piece in pieces])
     return out.reshape(index.shape + x.shape[1:])

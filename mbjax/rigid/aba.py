@@ -106,7 +106,7 @@ def solve(model: Model, factor: Factor, b: Array) -> Array:
     a = a_p + S u_dot."""
     root, w = _wide_root(model)
     t = model.body_v(b)
-    t_scan = t[:, :w] if root is None else t[:, :w].at[root].set(0)
+    t_scan = t[:, :w] if root is None else _set_row(t[:, :w], root, 0.0)
 
     def forces(F2, inp):
         S, U, D, t = inp
@@ -129,8 +129,15 @@ def solve(model: Model, factor: Factor, b: Array) -> Array:
     _, u_dot = forward_pass(model.topology, substitute, (ground, jnp.zeros(w, b.dtype)),
                             (factor.S, factor.U, factor.D, u))
     if root is not None:
-        u_dot = _widen(u_dot, model.width).at[root].set(u_dot_root)
+        u_dot = _set_row(_widen(u_dot, model.width), root, u_dot_root)
     return model.flat_v(u_dot)
+
+
+def _set_row(x: Array, k: int, value) -> Array:
+    """x with row k (static) set to value: an update of a slice, whose derivatives are slices
+    too (an `.at[k].set` is a scatter, and its transpose a scatter-add)."""
+    row = jnp.broadcast_to(jnp.asarray(value, x.dtype), x.shape[1:])
+    return jax.lax.dynamic_update_index_in_dim(x, row, k, 0)
 
 
 def _widen(x: Array, width: int) -> Array:
@@ -176,7 +183,8 @@ def _recursion(model: Model, q: Array, v: Array, tau: Array, loads: Array,
     root, w = _wide_root(model)
     S, t_scan, pad_scan = kin.S[..., :w], t[:, :w], pad[:, :w]
     if root is not None:
-        S, t_scan, pad_scan = S.at[root].set(0), t_scan.at[root].set(0), pad_scan.at[root].set(1)
+        S, t_scan = _set_row(S, root, 0.0), _set_row(t_scan, root, 0.0)
+        pad_scan = _set_row(pad_scan, root, 1.0)
 
     def triangularize(received, inp):
         (IA, pA), (S, c, t, padding) = received, inp
@@ -189,7 +197,7 @@ def _recursion(model: Model, q: Array, v: Array, tau: Array, loads: Array,
 
     (U, D, u), (I_root, F_root) = backward_pass(model.topology, triangularize, (kin.I, F1),
                                                 (S, c, t_scan, pad_scan))
-    ground = jnp.zeros((6, 1 + m), q.dtype).at[:, 0].set(gravity_acceleration(model))
+    ground = jnp.concatenate([gravity_acceleration(model)[:, None], jnp.zeros((6, m), q.dtype)], 1)
     root_factor = None
     if root is not None:              # its own elimination, 6 x 6 (received: I_root, F_2)
         S_r = kin.S[root]
@@ -209,6 +217,6 @@ def _recursion(model: Model, q: Array, v: Array, tau: Array, loads: Array,
     _, qdd = forward_pass(model.topology, substitute,
                           (ground, jnp.zeros((w, 1 + m), q.dtype)), (S, c, U, D, u))
     if root is not None:
-        qdd = _widen(qdd, model.width).at[root].set(u_dot_root)
+        qdd = _set_row(_widen(qdd, model.width), root, u_dot_root)
     flat = jax.vmap(model.flat_v, in_axes=-1)(qdd)          # (1 + m, nv)
     return (flat[0], flat[1:]), Factor(S, U, D, root_factor)

@@ -21,10 +21,13 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
+from mbjax.model.take import take
 from mbjax.tree.topology import Topology
 
 
 def _rows(tree, index):
+    if isinstance(index, np.ndarray):               # a static order: slices where it can be
+        return jax.tree.map(lambda a: take(a, index), tree)
     return jax.tree.map(lambda a: a[index], tree)
 
 
@@ -52,8 +55,8 @@ def forward_pass(topology: Topology, f: Callable, ground, inputs=None):
     order, mask = topology.schedule
     parents = np.asarray(topology.parents)
     parent_row = np.where(parents < 0, n, parents)[order]
-    values = jax.tree.map(lambda g: jnp.zeros((n + 1, *jnp.shape(g)), jnp.result_type(g))
-                          .at[n].set(g), ground)
+    values = jax.tree.map(lambda g: jnp.concatenate(
+        [jnp.zeros((n, *jnp.shape(g)), jnp.result_type(g)), jnp.asarray(g)[None]]), ground)
     step_inputs = None if inputs is None else _rows(inputs, order)
 
     if order.shape[1] == 1:                       # one body per step: single-row reads and writes
