@@ -72,13 +72,13 @@ def test_no_flag_once_the_backend_runs(monkeypatch):
 
 
 def test_kernel_counts_reads_loop_bodies():
-    """A scan whose body is one matrix product and one elementwise op: the body has kernels of
-    its own, counted apart from the entry computation's."""
+    """A scan whose body is one matrix product and one elementwise op: either XLA compiled the
+    loop as one kernel, or its body has kernels of its own, counted apart from the entry's."""
     def f(A, x):
         return jax.lax.scan(lambda x, _: (jnp.tanh(A @ x), None), x, None, length=5)[0]
 
     A, x = jnp.eye(3), jnp.ones(3)
     counts = kernel_counts(jax.jit(f).lower(A, x).compile().as_text())
-    assert len(counts["per_step"]) == 1
-    assert 1 <= counts["per_step"][0] <= 8
+    assert len(counts["per_step"]) + counts["one_kernel_loops"] == 1
+    assert all(1 <= k <= 8 for k in counts["per_step"])
     assert counts["entry"] >= 1

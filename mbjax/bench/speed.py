@@ -75,7 +75,9 @@ def robots(quick: bool) -> list[tuple[str, str, bool]]:
 
 def kernel_counts(hlo: str) -> dict:
     """Kernels in a compiled HLO module: per call in the entry computation, and in every while
-    loop's body (the tree passes: one iteration per body or depth level)."""
+    loop's body that runs kernel by kernel (the tree passes: one iteration per body or depth
+    level). A loop XLA compiled as one kernel (a call marked xla_cpu_small_call, see
+    `mbjax.runtime`) counts as one kernel where it is called; `one_kernel_loops` counts them."""
     blocks = dict(re.findall(r"\n(?:ENTRY )?%?([\w.\-]+) [^\n]*\{\n(.*?)\n\}", "\n" + hlo, re.S))
     entry = re.search(r"ENTRY %?([\w.\-]+)", hlo).group(1)
 
@@ -83,8 +85,18 @@ def kernel_counts(hlo: str) -> dict:
         ops = re.findall(r"= [^=]*? ([a-z][a-z0-9\-]*)\(", blocks.get(name, ""))
         return sum(op not in _FREE for op in ops)
 
-    bodies = re.findall(r"body=%?([\w.\-]+)", hlo)
-    return {"entry": kernels(entry), "per_step": [kernels(b) for b in bodies]}
+    # computations inside a one-kernel loop, and everything they call
+    inside = set(re.findall(r"to_apply=%?([\w.\-]+), frontend_attributes=\{xla_cpu_small_call", hlo))
+    hoisted, todo = len(inside), list(inside)
+    while todo:
+        for called in re.findall(r"(?:to_apply|body|condition|calls)=%?([\w.\-]+)",
+                                 blocks.get(todo.pop(), "")):
+            if called not in inside:
+                inside.add(called)
+                todo.append(called)
+    bodies = [b for b in re.findall(r"body=%?([\w.\-]+)", hlo) if b not in inside]
+    return {"entry": kernels(entry), "per_step": [kernels(b) for b in bodies],
+            "one_kernel_loops": hoisted}
 
 
 def _rollout(fd, steps: int, retract=None):
