@@ -26,22 +26,20 @@ from mbjax.model.joints import (
     joint_retract,
 )
 from mbjax.model.checks import check_body
-from mbjax.model.take import take
+from mbjax.tree.take import take
 from mbjax.spatial import inertia_matrix
 from mbjax.tree import Topology
 
 
 @lru_cache(maxsize=None)
 def _layout(joint_types: tuple[str, ...]):
-    """Static index maps: per-body gathers of q and v (padded, with masks) and the widths."""
+    """Static index maps: each joint type's bodies and coordinates, the orders that put them back
+    in body and coordinate order, the padded velocity columns' mask and the widths."""
     nqs = [JOINT_TYPES[k].nq for k in joint_types]
     nvs = [JOINT_TYPES[k].nv for k in joint_types]
     q0, v0 = np.cumsum([0, *nqs]), np.cumsum([0, *nvs])
     wq, wv = max(nqs), max(nvs)
-    q_index = np.array([[min(q0[k] + j, q0[-1] - 1) for j in range(wq)] for k in range(len(nqs))])
-    v_index = np.array([[min(v0[k] + j, v0[-1] - 1) for j in range(wv)] for k in range(len(nvs))])
     v_mask = np.array([[j < nvs[k] for j in range(wv)] for k in range(len(nvs))])
-    q_mask = np.array([[j < nqs[k] for j in range(wq)] for k in range(len(nqs))])
     groups = {kind: np.array([k for k, t in enumerate(joint_types) if t == kind])
               for kind in dict.fromkeys(joint_types)}
     # each joint type's own coordinates (bodies of the type, its nq or nv columns), and where the
@@ -52,8 +50,8 @@ def _layout(joint_types: tuple[str, ...]):
     def order(maps):
         return np.argsort(np.concatenate([m.ravel() for m in maps]), kind="stable")
     return dict(nq=int(q0[-1]), nv=int(v0[-1]), q_start=tuple(int(x) for x in q0[:-1]),
-                v_start=tuple(int(x) for x in v0[:-1]), q_index=q_index, v_index=v_index,
-                v_mask=v_mask, q_mask=q_mask, width=wv, groups=groups, q_own=q_own, v_own=v_own,
+                v_start=tuple(int(x) for x in v0[:-1]), v_mask=v_mask, q_width=wq, width=wv,
+                groups=groups, q_own=q_own, v_own=v_own,
                 body_order=order(groups.values()), q_order=order(q_own.values()),
                 v_order=order(v_own.values()))
 
@@ -310,7 +308,7 @@ class Model(eqx.Module):
         return self.flat_v(rates)
 
     def _pad_q(self, kind: str, qk: Array) -> Array:
-        return jnp.pad(qk, (0, _layout(self.joint_types)["q_index"].shape[1] - qk.shape[0]))
+        return jnp.pad(qk, (0, _layout(self.joint_types)["q_width"] - qk.shape[0]))
 
     def _flat_q(self, per_body: Array) -> Array:
         return _flat(_layout(self.joint_types), "q", per_body)

@@ -21,7 +21,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from mbjax.model.take import take
+from mbjax.tree.take import take
 from mbjax.tree.topology import Topology
 
 
