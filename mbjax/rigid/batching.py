@@ -10,8 +10,12 @@ B = 4096 (`mbjax bench speed`, benchmarks/README.md). `aba_vmappable` is `aba` w
 - the model itself is not batched (a sweep over model parameters keeps the plain vmap), its
   joints are all revolute or prismatic, and the batch has at least BATCH_CROSSOVER states (below
   that the two are within noise of each other and the plain vmap compiles faster);
-- anything else falls back to the plain vmap of `aba`, so the answer never depends on the route
-  (the two agree to rounding: tests/rigid/test_batching.py).
+- anything else (free, spherical or universal joints, a batched model, a small batch) runs one
+  state after another where XLA compiles loops as one kernel (`mbjax.runtime.hoisting`): a
+  `lax.map` of `aba`, each state costing what an evaluation costs in a rollout (the G1
+  humanoid's free base, B = 1024: 11.5 us per state against 37 for the plain vmap), and the
+  plain vmap of `aba` otherwise. The answer never depends on the route (the routes agree to
+  rounding: tests/rigid/test_batching.py).
 
 custom_vmap functions cannot be differentiated, so `forward_dynamics` wraps `aba_vmappable` in
 the derivative rule of `mbjax.rigid.adjoint` (a `jax.custom_jvp`): a derivative of any order,
@@ -41,6 +45,19 @@ BATCH_CROSSOVER = 64
 CHUNK = 64
 
 
+def _one_by_one(in_batched, *args) -> Array:
+    """aba over the batch one state after another: a `lax.map` that XLA compiles as one loop of
+    one kernel, each state costing what it costs in a rollout."""
+    leaves, tree = jax.tree.flatten(args)
+    flags = jax.tree.leaves(in_batched)
+
+    def one(xs):
+        rest = iter(xs)
+        return aba(*jax.tree.unflatten(tree, [next(rest) if b else x
+                                              for x, b in zip(leaves, flags, strict=True)]))
+    return jax.lax.map(one, [x for x, b in zip(leaves, flags, strict=True) if b])
+
+
 def batchable(model: Model) -> bool:
     """Whether `batch_aba` can run this model (revolute and prismatic joints only)."""
     return all(kind in JOINTS for kind in model.joint_types)
@@ -48,8 +65,8 @@ def batchable(model: Model) -> bool:
 
 @custom_vmap
 def aba_vmappable(model: Model, q: Array, v: Array, tau: Array) -> Array:
-    """`aba(model, q, v, tau)` (no external wrenches), batched by `jax.vmap` onto `batch_aba`
-    where that is faster (see the module). The model must be `batchable`."""
+    """`aba(model, q, v, tau)` (no external wrenches), batched by `jax.vmap` onto `batch_aba`,
+    or one state after another, where that is faster (see the module)."""
     return aba(model, q, v, tau)
 
 
@@ -58,7 +75,10 @@ def _vmap_rule(axis_size, in_batched, model, q, v, tau):
     model_batched, *batched = in_batched
     if not any(jax.tree.leaves(in_batched)):     # e.g. jacrev's vmap over cotangents only
         return aba(model, q, v, tau), False
-    if any(jax.tree.leaves(model_batched)) or axis_size < BATCH_CROSSOVER:
+    fast = batchable(model) and not any(jax.tree.leaves(model_batched))
+    if runtime.hoisting() and not (fast and axis_size >= BATCH_CROSSOVER):
+        return _one_by_one(in_batched, model, q, v, tau), True
+    if not fast or axis_size < BATCH_CROSSOVER:
         axes = (jax.tree.map(lambda b: 0 if b else None, model_batched),
                 *(0 if b else None for b in batched))
         return jax.vmap(aba, in_axes=axes)(model, q, v, tau), True

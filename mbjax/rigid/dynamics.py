@@ -13,7 +13,7 @@ from mbjax import runtime
 from mbjax.model import Model
 from mbjax.rigid.aba import aba
 from mbjax.rigid.adjoint import with_adjoint
-from mbjax.rigid.batching import aba_vmappable, batchable
+from mbjax.rigid.batching import aba_vmappable
 from mbjax.rigid.dense import dense_forward_dynamics
 from mbjax.rigid.operator import mass_matrix as _mass_matrix
 from mbjax.rigid.rnea import inverse_dynamics as _rnea
@@ -71,7 +71,7 @@ def forward_dynamics(model: Model, q: Array, q_dot: Array, tau: Array,
 
 
 def _primal(model: Model, q: Array, v: Array, tau: Array, f_ext: Array | None) -> Array:
-    if f_ext is None and batchable(model):     # jax.vmap's fast route (mbjax.rigid.batching)
+    if f_ext is None:                          # jax.vmap's fast routes (mbjax.rigid.batching)
         return aba_vmappable(model, q, v, tau)
     return aba(model, q, v, tau, f_ext)
 
