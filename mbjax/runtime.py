@@ -12,9 +12,11 @@ scatter, sort or library call) and whose cost analysis reads fewer bytes than a 
 by default, which no tree pass meets. mbjax raises it
 (``--xla_backend_extra_options=xla_cpu_small_while_loop_byte_threshold=1000000000``). Measured
 with `mbjax bench speed` (benchmarks/README.md, float64, 2-core x86_64 CPU), forward dynamics
-inside a jitted 1000-step rollout: the 7-link chain 7.1 -> 1.4 us per evaluation, the 30-link
-chain 37.7 -> 5.9 us, the Panda 14.2 -> 5.0 us (Pinocchio's `aba`: 2.7, 8.5, 3.4 us); compile
-times fall too (0.57 -> 0.40 s). Results are the same bit for bit in the tests' rollout.
+inside a jitted 1000-step rollout: the 7-link chain 7.1 -> 1.2 us per evaluation, the 30-link
+chain 37.7 -> 5.4 us, the Panda 14.2 -> 2.1 us, the G1 humanoid 32.6 -> 11.1 us (Pinocchio's
+`aba`: 2.7, 8.7, 3.3, 8.2 us); compile times fall too (0.57 -> 0.31 s). Results are the same bit
+for bit in the tests' rollout. For loops to qualify, mbjax's tree passes and their derivatives
+hold no scatter (`mbjax.tree.take`).
 
 The second is the scheduler (``--xla_cpu_enable_concurrency_optimized_scheduler=false``): XLA's
 CPU runtime schedules the kernels of a program for concurrency by default, which pays off for

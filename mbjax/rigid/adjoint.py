@@ -19,9 +19,9 @@ of the RNEA. The RNEA's linearization is recomputed in the reverse pass (`jax.ch
 intermediate of the recursion: 7-link chain, 1000 steps, the gradient costs 3.0x the rollout
 instead of 6.0x; 30 links, 2.2x instead of 5.4x (`mbjax bench speed`, with XLA running loops
 kernel by kernel). With each loop compiled as one kernel (`mbjax.runtime`; the rule's passes hold
-no gather or scatter in either direction, `mbjax.tree.take`), 3.4x and 3.3x of rollouts five
+no gather or scatter in either direction, `mbjax.tree.take`), 3.2x and 3.2x of rollouts five
 times faster: about 4 us a step for the 7-link chain. Storing the linearization instead is slower
-either way (4.8x against 3.0x; 4.8x against 3.3x).
+either way (4.8x against 3.0x; 4.8x against 3.3x in one A/B script).
 
 `with_adjoint(fd)` gives `fd` (any function computing the forward dynamics of a tree: `aba`, or
 its vmappable form) this rule as a `jax.custom_jvp`. Forward mode, reverse mode (JAX transposes
