@@ -321,8 +321,13 @@ class Model(eqx.Module):
         if not starts:
             return q
         idx = np.asarray(starts)[:, None] + np.arange(4)
-        quats = q[idx]
-        return q.at[idx].set(quats / jnp.linalg.norm(quats, axis=-1, keepdims=True))
+        quats = take(q, idx)
+        units = quats / jnp.linalg.norm(quats, axis=-1, keepdims=True)
+        # q with the quaternions' entries read from the unit ones appended after it: a static
+        # map (slices where it is a few runs), no scatter to keep a loop from one kernel
+        source = np.arange(q.shape[0])
+        source[idx.ravel()] = q.shape[0] + np.arange(idx.size)
+        return take(jnp.concatenate([q, units.ravel()]), source)
 
     def spatial_inertia(self) -> Array:
         """(n, 6, 6) spatial inertias about each body's origin, body coordinates."""
