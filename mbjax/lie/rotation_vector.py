@@ -107,19 +107,23 @@ def _rotation_tolerance(dtype) -> float:
     return max(1e-6, 1e4 * float(jnp.finfo(dtype).eps))
 
 
-def log(R: Array) -> Array:
+def log(R: Array, check: bool = True) -> Array:
     """Principal rotation vector r (|r| <= pi) with exp(r) = R.
 
     Computed through the quaternion of R (Shepperd's method), which is accurate and differentiable
     at every angle, including 0 and pi. A matrix that is not a rotation (R^T R != I or det R != 1
-    beyond round-off) raises a clear error, also under `jit`.
+    beyond round-off) raises a clear error, also under `jit`; check=False skips that test, for
+    callers whose R is a rotation by construction (a product of rotations): the run-time error is
+    a host callback, which keeps a compiled program out of the persistent compilation cache and
+    a loop around it from compiling as one kernel (`mbjax.runtime`).
     """
     R = jnp.asarray(R)
     if R.shape != (3, 3):
         raise ValueError(f"log expects a 3x3 rotation matrix, got shape {R.shape}")
-    tol = _rotation_tolerance(R.dtype)
-    orthogonality = jnp.max(jnp.abs(R.T @ R - jnp.eye(3, dtype=R.dtype)))
-    det_error = jnp.abs(jnp.linalg.det(R) - 1.0)
-    R = eqx.error_if(R, ~((orthogonality <= tol) & (det_error <= tol)),
-                     "mbjax.lie.log: the matrix is not a rotation (R^T R != I or det R != 1)")
+    if check:
+        tol = _rotation_tolerance(R.dtype)
+        orthogonality = jnp.max(jnp.abs(R.T @ R - jnp.eye(3, dtype=R.dtype)))
+        det_error = jnp.abs(jnp.dot(R[0], jnp.cross(R[1], R[2])) - 1.0)   # det R, the triple product
+        R = eqx.error_if(R, ~((orthogonality <= tol) & (det_error <= tol)),
+                         "mbjax.lie.log: the matrix is not a rotation (R^T R != I or det R != 1)")
     return rotvec_from_quat(quat_from_matrix(R))

@@ -60,7 +60,7 @@ def configuration(body: Body, ref: Reference, q: Array, t) -> tuple[Array, Array
 def increment(body: Body, ref: Reference, R: Array, x: Array) -> Array:
     """The incremental coordinates q = (r_*, x_*) of (R, x) at the reference's start, the inverse
     of `configuration` at t = 0 (principal rotation vector, |r_*| <= pi)."""
-    r = lie.log(R @ ref.R1.T)
+    r = lie.log(R @ ref.R1.T, check=False)
     return r if body.fixed_point else jnp.concatenate([r, x - ref.x1])
 
 
