@@ -30,34 +30,12 @@ import jax
 import jax.numpy as jnp
 from jax import Array
 
+from mbjax.linalg import spd_solve as _solve
 from mbjax.model import Model
 from mbjax.model.joints import JOINT_TYPES
 from mbjax.rigid.kinematics import body_kinematics, gravity_acceleration
 from mbjax.spatial import cross_force, shift_force
 from mbjax.tree import backward_pass, forward_pass
-
-
-def _solve(D: Array, b: Array) -> Array:
-    """D^-1 b for the joint block D (w x w, SPD, w <= 6): a division for 1-DOF joints, else
-    Cholesky written out over the block's w columns. A library solve is a call into LAPACK,
-    which XLA cannot put inside a loop compiled as one kernel (`mbjax.runtime`)."""
-    w = D.shape[-1]
-    if w == 1:
-        return b / D[..., 0, :]
-    if b.ndim < D.ndim:                          # a vector
-        return _solve(D, b[..., None])[..., 0]
-    L = [[None] * w for _ in range(w)]
-    for j in range(w):                           # D = L L^T, column by column
-        L[j][j] = jnp.sqrt(D[..., j, j] - sum(L[j][k] ** 2 for k in range(j)))
-        for i in range(j + 1, w):
-            L[i][j] = (D[..., i, j] - sum(L[i][k] * L[j][k] for k in range(j))) / L[j][j]
-    y = [None] * w
-    for i in range(w):                           # L y = b
-        y[i] = (b[..., i, :] - sum(L[i][k][..., None] * y[k] for k in range(i))) / L[i][i][..., None]
-    x = [None] * w
-    for i in reversed(range(w)):                 # L^T x = y
-        x[i] = (y[i] - sum(L[k][i][..., None] * x[k] for k in range(i + 1, w))) / L[i][i][..., None]
-    return jnp.stack(x, -2)
 
 
 class Factor(NamedTuple):

@@ -13,16 +13,20 @@ Lagrange's equations (eq 6.5) then give eq 6.16, tau = A(theta) theta_ddot + B(t
     A = d^2 T / d theta_dot^2,   B = (d^2 T / d theta_dot d theta) theta_dot - dT/d theta,
     C = dV / d theta,
 
-all by autodiff: none of the chapter's hand expansions (eqs 6.8-6.15, 6.22-6.42) is needed. The
+all by autodiff: none of the chapter's hand expansions (eqs 6.8-6.15, 6.22-6.42) is needed.
+`eom_terms` evaluates them from the pose's first and second derivatives (T is quadratic in
+theta_dot: A = J^T diag(m, I) J from the velocity Jacobians, B from dA/dtheta), and
+`inverse_dynamics` differentiates L itself, so the two are independent routes to the same
+equations (tests/wrist/test_dynamics.py). The
 legs are massless, so A is singular where a leg is (the inverse singularity, the workspace
 boundary); inside the workspace it is positive definite and eq 6.21 is solved by Cholesky.
 """
 
 import jax
 import jax.numpy as jnp
-import jax.scipy.linalg as jsl
 from jax import Array
 
+from mbjax.linalg import spd_solve
 from mbjax.wrist.kinematics import _dot, _matmul, com_and_rotation
 
 
@@ -61,17 +65,48 @@ def energy(wrist, theta: Array, theta_dot: Array) -> Array:
     return kinetic_energy(wrist, theta, theta_dot) + potential_energy(wrist, theta)
 
 
+def velocity_jacobians(wrist, theta: Array) -> tuple[Array, Array]:
+    """(J_G, J_D) with v_G = J_G theta_dot (in B) and omega_D = R^T omega = J_D theta_dot (in D):
+    one forward-mode Jacobian of the pose, column k of J_D being R^T omega_k with
+    [omega_k]x = dR/dtheta_k R^T, as in `tool_velocity`."""
+    dx, dR = jax.jacfwd(com_and_rotation, argnums=1)(wrist, theta)      # (3, 3), (3, 3, 3)
+    R = com_and_rotation(wrist, theta)[1]
+    J_D = jax.vmap(lambda dR_k: _dot(R.T, _vee(_matmul(dR_k, R.T))), out_axes=1)(jnp.moveaxis(dR, -1, 0))
+    return dx, J_D
+
+
+def _mass_matrix_and_jacobian(wrist, theta: Array) -> tuple[Array, Array]:
+    J_G, J_D = velocity_jacobians(wrist, theta)
+    A = wrist.tool_mass * _matmul(J_G.T, J_G) + _matmul(J_D.T, _matmul(wrist.tool_inertia, J_D))
+    return A, J_G
+
+
+def mass_matrix(wrist, theta: Array) -> Array:
+    """A(theta) of eq 6.16, the Hessian of T (eq 6.7) in theta_dot. T is quadratic in theta_dot,
+    1/2 theta_dot^T A theta_dot, so A = m J_G^T J_G + J_D^T I_D J_D (`velocity_jacobians`)."""
+    return _mass_matrix_and_jacobian(wrist, jnp.asarray(theta))[0]
+
+
 def eom_terms(wrist, theta: Array, theta_dot: Array) -> tuple[Array, Array, Array]:
     """(A, B, C) of eq 6.16: tau = A theta_ddot + B + C.
 
-    Forward mode throughout (jacfwd, jvp): with three coordinates it beats reverse mode, whose
-    transposed graph has about twice the kernels for the same numbers."""
+    Lagrange's equations (eq 6.5) with T = 1/2 theta_dot^T A(theta) theta_dot give
+    B = A_dot theta_dot - dT/dtheta, whose parts are both read from one forward-mode Jacobian
+    dA/dtheta: A_dot = dA/dtheta . theta_dot and dT/dtheta_k = 1/2 theta_dot^T dA/dtheta_k
+    theta_dot; C = dV/dtheta = m g (J_G)_3. Second derivatives of the kinematics, where
+    differentiating T itself (A = d^2T/dtheta_dot^2, B's mixed term) nests three: the same
+    numbers (tests/wrist/test_dynamics.py) from a graph that compiles about twice as fast."""
     theta, theta_dot = jnp.asarray(theta), jnp.asarray(theta_dot)
-    dT_dqd = jax.jacfwd(kinetic_energy, argnums=2)
-    A = jax.jacfwd(dT_dqd, argnums=2)(wrist, theta, theta_dot)
-    mixed = jax.jvp(lambda th: dT_dqd(wrist, th, theta_dot), (theta,), (theta_dot,))[1]
-    B = mixed - jax.jacfwd(kinetic_energy, argnums=1)(wrist, theta, theta_dot)
-    C = jax.jacfwd(potential_energy, argnums=1)(wrist, theta)
+
+    def inertia(th):
+        A, J_G = _mass_matrix_and_jacobian(wrist, th)
+        return A, (A, J_G)
+
+    dA, (A, J_G) = jax.jacfwd(inertia, has_aux=True)(theta)          # dA[i, j, k] = dA_ij/dtheta_k
+    A_dot = _dot(dA, theta_dot)
+    dT = 0.5 * _dot(_dot(jnp.moveaxis(dA, -1, 0), theta_dot), theta_dot)
+    B = _dot(A_dot, theta_dot) - dT
+    C = wrist.tool_mass * wrist.gravity * J_G[2]
     return A, B, C
 
 
@@ -93,16 +128,10 @@ def external_torques(wrist, theta: Array, wrench: Array, point: Array | None = N
     return jax.vjp(velocities, jnp.zeros_like(theta))[1]((wrench[:3], wrench[3:]))[0]
 
 
-def mass_matrix(wrist, theta: Array) -> Array:
-    """A(theta) of eq 6.16, the Hessian of T in theta_dot."""
-    theta = jnp.asarray(theta)
-    return jax.jacfwd(jax.jacfwd(kinetic_energy, argnums=2), argnums=2)(wrist, theta, jnp.zeros_like(theta))
-
-
 def forward_dynamics(wrist, theta: Array, theta_dot: Array, torque: Array) -> Array:
-    """theta_ddot = A^-1 (tau - B - C) (eqs 6.17-6.21), by Cholesky."""
+    """theta_ddot = A^-1 (tau - B - C) (eqs 6.17-6.21), by Cholesky (written out: `mbjax.linalg`)."""
     A, B, C = eom_terms(wrist, theta, theta_dot)
-    return jsl.cho_solve(jsl.cho_factor(A), jnp.asarray(torque) - B - C)
+    return spd_solve(A, jnp.asarray(torque) - B - C)
 
 
 def inverse_dynamics(wrist, theta: Array, theta_dot: Array, theta_ddot: Array) -> Array:

@@ -103,3 +103,24 @@ def test_gradients_of_the_dynamics_in_parameters_are_finite_and_match_finite_dif
     g = jax.jit(jax.jacfwd(accel))(1.5)
     h = 1e-6
     np.testing.assert_allclose(g, (accel(1.5 + h) - accel(1.5 - h)) / (2 * h), rtol=1e-6, atol=1e-7)
+
+
+def test_eom_terms_equal_the_derivatives_of_the_kinetic_energy():
+    """eom_terms reads A, B and C from the pose's derivatives (T quadratic in theta_dot); here
+    they are taken from T and V themselves, the Lagrangian form of eq 6.16, for both rotations."""
+    from mbjax.wrist import dynamics
+
+    def lagrange_terms(w, q, v):
+        dT_dv = jax.jacfwd(dynamics.kinetic_energy, argnums=2)
+        A = jax.jacfwd(dT_dv, argnums=2)(w, q, v)
+        mixed = jax.jvp(lambda th: dT_dv(w, th, v), (q,), (v,))[1]
+        B = mixed - jax.jacfwd(dynamics.kinetic_energy, argnums=1)(w, q, v)
+        return A, B, jax.grad(dynamics.potential_energy, argnums=1)(w, q)
+
+    for rotation_model in ("physical", "chapter"):
+        w = cw.wrist(rotation_model)
+        theta, theta_dot, _ = _states(w, n=6, seed=3)
+        ours = jax.jit(jax.vmap(w.eom_terms))(theta, theta_dot)
+        theirs = jax.jit(jax.vmap(lambda q, v, w=w: lagrange_terms(w, q, v)))(theta, theta_dot)
+        for a, b in zip(ours, theirs, strict=True):
+            np.testing.assert_allclose(a, b, rtol=1e-12, atol=1e-12)
