@@ -3,8 +3,9 @@
 Kernels are pure functions of equinox modules and arrays, so `jax.jit`, `jax.vmap` and `jax.grad`
 compose over all of them. mbjax changes no JAX setting: enable float64 yourself for accuracy work
 (``jax.config.update("jax_enable_x64", True)``). Imported before JAX starts its backend, it sets
-one XLA CPU runtime option that makes its small kernels run up to 2x faster (`mbjax.runtime`;
-MBJAX_XLA_DEFAULTS=0 turns that off).
+XLA's and JAX's CPU runtime options for small programs: loops compiled as one kernel, no
+concurrency scheduling, the classic fusion emitter, synchronous dispatch (`mbjax.runtime`;
+MBJAX_XLA_DEFAULTS=0 turns them off).
 """
 
 from mbjax import runtime  # first: it sets XLA_FLAGS before anything can start JAX's backend

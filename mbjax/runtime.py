@@ -14,9 +14,9 @@ by default, which no tree pass meets. mbjax raises it
 with `mbjax bench speed` (benchmarks/README.md, float64, 2-core x86_64 CPU), forward dynamics
 inside a jitted 1000-step rollout: the 7-link chain 7.1 -> 1.2 us per evaluation, the 30-link
 chain 37.7 -> 5.4 us, the Panda 14.2 -> 2.1 us, the G1 humanoid 32.6 -> 11.1 us (Pinocchio's
-`aba`: 2.7, 8.7, 3.3, 8.2 us); compile times fall too (0.57 -> 0.31 s). Results are the same bit
-for bit in the tests' rollout. For loops to qualify, mbjax's tree passes and their derivatives
-hold no scatter (`mbjax.tree.take`).
+`aba`: 2.7, 8.7, 3.3, 8.2 us); compile times fall too (0.57 -> 0.31 s). Results agree to a few
+ulps in the tests' rollout (to the bit with XLA's default emitters; see the third setting). For
+loops to qualify, mbjax's tree passes and their derivatives hold no scatter (`mbjax.tree.take`).
 
 The second is the scheduler (``--xla_cpu_enable_concurrency_optimized_scheduler=false``): XLA's
 CPU runtime schedules the kernels of a program for concurrency by default, which pays off for
@@ -25,7 +25,16 @@ chain's forward dynamics inside a jitted rollout 11.5 -> 7.1 us per evaluation (
 setting), one jitted call 60 -> 28 us; batched throughput unchanged. It changes the order kernels
 run in, not what they compute.
 
-The third is JAX's: its CPU client runs a program on a worker thread and hands the result back
+The third is how XLA emits the fusions outside such loops (``--xla_cpu_use_fusion_emitters=false``:
+the classic elemental emitter instead of the MLIR fusion emitters). It changes compile times, not
+run times, and rounds a few operations differently (a few ulps after a 200-step rollout): a program of one eager operation 20 -> 13 ms, the Carpal Wrist's forward dynamics
+0.73 -> 0.44 s, `mbjax tour --quick` from a cold cache 90 -> 67 s, against the same evaluation
+and `vmap` times within noise (7-link chain, `mbjax bench speed --quick`; 1.25 us per state at
+B = 4096 either way). A program of a few operations is mostly compile time, and programs outside
+`jit` (arrays handled op by op) are compiled one per operation and shape. The design notes'
+jaxlib 0.10 measurement found the same flag necessary for MJX's deep gather graphs.
+
+The fourth is JAX's: its CPU client runs a program on a worker thread and hands the result back
 (`jax_cpu_enable_async_dispatch`), so that Python can go on while a large program runs. For
 mbjax's calls, whose programs run for microseconds, the hand-off is the cost: one jitted
 forward-dynamics call of the 7-link chain, median of 2000, 62 -> 15.5 us with the model closed
@@ -43,10 +52,12 @@ import os
 
 HOIST_BYTES = 1_000_000_000
 FLAGS = (f"--xla_backend_extra_options=xla_cpu_small_while_loop_byte_threshold={HOIST_BYTES}",
-         "--xla_cpu_enable_concurrency_optimized_scheduler=false")
+         "--xla_cpu_enable_concurrency_optimized_scheduler=false",
+         "--xla_cpu_use_fusion_emitters=false")
 # what names each flag in XLA_FLAGS (the user's own setting of it wins); the extra options are
 # one flag, so a user's own --xla_backend_extra_options keeps the threshold at XLA's default
-NAMES = ("--xla_backend_extra_options", "--xla_cpu_enable_concurrency_optimized_scheduler")
+NAMES = ("--xla_backend_extra_options", "--xla_cpu_enable_concurrency_optimized_scheduler",
+         "--xla_cpu_use_fusion_emitters")
 FLAG = " ".join(FLAGS)
 # jaxlib releases whose XLA has the flags (checked on each; an unknown XLA flag is fatal)
 TESTED = ((0, 10),)

@@ -43,8 +43,8 @@ def _run(**env) -> dict:
                     reason="the flag is set only on jaxlib releases known to have it")
 def test_import_sets_the_flag_and_changes_no_result():
     """`import mbjax` adds its flags to XLA_FLAGS and makes CPU dispatch synchronous; the user's
-    own settings (flag by flag) and MBJAX_XLA_DEFAULTS=0 win; the same rollout is bit-for-bit the
-    same either way."""
+    own settings (flag by flag) and MBJAX_XLA_DEFAULTS=0 win; the same rollout gives the same
+    numbers either way (to the last bit where only the scheduling or the dispatch changes)."""
     default = _run()
     assert default["applied"] and default["flags"] == runtime.FLAG and default["synchronous"]
     off = _run(MBJAX_XLA_DEFAULTS="0")
@@ -54,12 +54,17 @@ def test_import_sets_the_flag_and_changes_no_result():
     mine = "--xla_cpu_enable_concurrency_optimized_scheduler=true"
     own = _run(XLA_FLAGS=mine)
     assert not own["applied"]
-    assert own["flags"] == f"{mine} {runtime.FLAGS[0]}"         # the other flag is still added
+    assert own["flags"] == " ".join([mine, runtime.FLAGS[0], *runtime.FLAGS[2:]])   # the others still added
     mine = "--xla_backend_extra_options=xla_cpu_small_while_loop_byte_threshold=2000"
     own_options = _run(XLA_FLAGS=mine)
-    assert own_options["flags"] == f"{mine} {runtime.FLAGS[1]}"
-    # loops compiled as one kernel or as many, kernels scheduled either way: the same numbers
-    assert default["q"] == off["q"] == own["q"] == own_options["q"] == asynchronous["q"]
+    assert own_options["flags"] == " ".join([mine, *runtime.FLAGS[1:]])
+    # kernels scheduled either way, dispatch either way: the same numbers bit for bit
+    assert default["q"] == own["q"] == asynchronous["q"]
+    # loops compiled as one kernel or as many, and XLA's two fusion emitters, round some
+    # operations differently: a few ulps after 200 steps
+    for other in (off, own_options):
+        assert max(abs(float.fromhex(a) - float.fromhex(b))
+                   for a, b in zip(default["q"], other["q"], strict=True)) < 1e-13
 
 
 def test_no_flag_once_the_backend_runs(monkeypatch):
