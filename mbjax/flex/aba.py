@@ -35,10 +35,15 @@ from jax import Array
 from mbjax.flex.body import inertial_stiffening, mass_matrix, velocity_terms
 from mbjax.flex.kinematics import flex_kinematics, inverse_motion
 from mbjax.flex.model import FlexibleModel
-from mbjax.linalg import spd_solve as _solve
 from mbjax.rigid.kinematics import gravity_acceleration
 from mbjax.spatial import shift_force, skew
 from mbjax.tree import backward_pass, forward_pass
+
+
+def _solve(D: Array, b: Array) -> Array:
+    if D.shape[-1] == 1:
+        return b / D[..., 0, :]
+    return jnp.linalg.solve(D, b)
 
 
 def body_blocks(model: FlexibleModel, kin) -> tuple[Array, Array]:
