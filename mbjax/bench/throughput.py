@@ -11,10 +11,10 @@ For regular n-link chains (`mbjax.model.chain(n)`, n = 7, 30, 100; float64 unles
 2. Rollouts of ROLLOUT_STEPS RK4 steps (dt = 1 ms, zero torque: the chain falls) of B states:
    one trajectory's `simulate(TreeSystem)` mapped over chunks of the batch (`mbjax_rollout_fn`)
    against `mujoco.rollout` (multi-threaded C, RK4, one MjData per
-   core) and MJX (`jit(vmap(scan(mjx.step)))`, RK4; one batch size, fewer steps: it compiles for
-   minutes and runs slowly on a CPU). Steps per second (B x steps / run time); the final states
+   core) and MJX (`jit(vmap(scan(mjx.step)))`, RK4; one batch size, fewer steps). Steps per second (B x steps / run time); the final states
    of mbjax and MuJoCo are compared.
-3. The gradient of loss = sum q(T)^2 over a 1000-step rollout with respect to (q0, v0), against
+3. The gradient of loss = sum q(T)^2 over a 1000-step rollout of one trajectory
+   (`simulate(TreeSystem)`) with respect to (q0, v0), against
    the forward rollout: run time and XLA's temporary memory (`memory_analysis`) of `jax.grad`
    plain and with `simulate(checkpoint=True)`, also at 250 and 4000 steps, where the memory's
    growth in T is fitted; and of forward mode (`jax.jacfwd`, 2n tangents carried with the state),
@@ -43,7 +43,7 @@ from mbjax.timing import write_jsonl
 from mbjax.integrate import RK4, simulate
 from mbjax.model import chain
 from mbjax.model.urdf import to_urdf
-from mbjax.rigid import BatchTreeSystem, TreeSystem, batch_aba, forward_dynamics
+from mbjax.rigid import TreeSystem, batch_aba, forward_dynamics
 
 NAME = "throughput"
 NS, QUICK_NS = (7, 30, 100), (7,)
@@ -54,7 +54,7 @@ ROLLOUT_BATCHES, QUICK_ROLLOUT_BATCHES = (1, 16, 64, 256, 1024, 4096), (16, 256)
 ROLLOUT_CHUNK = 128                # states per chunk of a batch of rollouts (`mbjax_rollout_fn`)
 ROLLOUT_MAX_WORK = 64 * 100       # B n at most, for n > 7 (rollouts at n = 100 cost seconds)
 MJX_BATCH, MJX_STEPS = 64, 20
-GRAD_N, GRAD_BATCH, GRAD_STEPS = 7, 1, 1000
+GRAD_N, GRAD_STEPS = 7, 1000
 MEMORY_STEPS = (250, 1000, 4000)
 PEER_STATES = 256
 THREADS = os.cpu_count() or 1
@@ -261,8 +261,10 @@ def _rollout_records(ns, batches, steps: int, repeats: int, budget_s: float, mjx
 # -- gradients ------------------------------------------------------------------------------------
 
 def _loss_fn(model, steps: int, checkpoint: bool):
+    """sum q(T)^2 of one trajectory through `TreeSystem`, whose forward dynamics carries the
+    derivatives of `mbjax.rigid.adjoint` (the batched layout has none of its own)."""
     def loss(q0, v0):
-        sol = simulate(BatchTreeSystem(model), RK4(), q0, v0, dt=DT, t1=steps * DT,
+        sol = simulate(TreeSystem(model), RK4(), q0, v0, dt=DT, t1=steps * DT,
                        saveat=np.array([steps * DT]), checkpoint=checkpoint)
         return jnp.sum(sol.qs[-1] ** 2)
     return loss
@@ -275,9 +277,9 @@ def temp_bytes(fn, *args) -> int:
 
 def _gradient_records(memory_steps, repeats: int, common: dict) -> list[dict]:
     model = chain(GRAD_N)
-    q0 = jnp.asarray(np.linspace(0.3, 1.0, GRAD_N))[:, None] * jnp.ones(GRAD_BATCH)
+    q0 = jnp.asarray(np.linspace(0.3, 1.0, GRAD_N))
     v0 = jnp.zeros_like(q0)
-    base = {**common, "kind": "gradient", "n": GRAD_N, "batch": GRAD_BATCH, "dt": DT,
+    base = {**common, "kind": "gradient", "n": GRAD_N, "batch": 1, "dt": DT,
             "integrator": "rk4", "loss": "sum(q(T)^2), grad wrt (q0, v0)"}
     loss = _loss_fn(model, GRAD_STEPS, False)
     _, fwd = timed(jax.jit(loss), q0, v0, repeats=repeats, budget_s=5.0)
