@@ -37,12 +37,6 @@ from mbjax.rigid.batched import JOINTS, batch_aba
 # against the plain vmap, 3.2 against 3.6 us per state at B = 64, 2.4 against 2.9 at 256, 3.0
 # against 7.2 at 4096 (one A/B script, 2-core CPU; 38 against 47 at B = 1, 8.2 against 7.1 at 16).
 BATCH_CROSSOVER = 64
-# Where XLA compiles a loop as one kernel (`mbjax.runtime.hoisting`), a batch runs as a loop over
-# chunks of CHUNK states, so that each chunk's intermediates stay in cache: us per state, one
-# kernel for the whole batch against chunks of 64 (7-link chain; 30-link): 2.03 against 1.53
-# (7.27 against 6.52) at B = 1024, 1.98 against 1.58 (9.10 against 6.14) at B = 4096; chunks of
-# 256: 1.63 (7.24). With kernels launched one by one, the whole batch at once is faster.
-CHUNK = 64
 
 
 def _one_by_one(in_batched, *args) -> Array:
@@ -87,14 +81,4 @@ def _vmap_rule(axis_size, in_batched, model, q, v, tau):
         return x.T if b else jnp.broadcast_to(x[:, None], (x.shape[0], axis_size))
 
     q, v, tau = (columns(x, b) for x, b in zip((q, v, tau), batched, strict=True))
-    if not runtime.hoisting() or axis_size <= CHUNK:
-        return batch_aba(model, q, v, tau).T, True
-    # chunks of CHUNK states, one after the other: each chunk's intermediates stay in cache
-    chunks = -(-axis_size // CHUNK)
-
-    def split(x):                 # (nv, B) -> (chunks, nv, CHUNK), the last padded by repeats
-        x = jnp.pad(x, ((0, 0), (0, chunks * CHUNK - axis_size)), mode="edge")
-        return jnp.moveaxis(x.reshape(x.shape[0], chunks, CHUNK), 1, 0)
-
-    out = jax.lax.map(lambda x: batch_aba(model, *x), (split(q), split(v), split(tau)))
-    return jnp.moveaxis(out, 0, 1).reshape(out.shape[1], -1)[:, :axis_size].T, True
+    return batch_aba(model, q, v, tau).T, True

@@ -12,6 +12,8 @@ from mbjax.integrate import RK4, simulate
 from mbjax.model import Model, chain, random_tree
 from mbjax.model.urdf import to_urdf
 from mbjax.rigid import BatchTreeSystem, TreeSystem, batch_aba, batched_forward_dynamics, forward_dynamics
+from mbjax.rigid.aba import aba
+from mbjax.rigid.batched import CHUNK
 
 MODELS = {
     "regular chain": lambda: chain(7),
@@ -36,6 +38,15 @@ def test_batched_equals_the_one_state_recursion(name):
     model = MODELS[name]()
     q, v, tau = _states(model, 33)
     reference = jax.jit(jax.vmap(forward_dynamics, in_axes=(None, 0, 0, 0)))(model, q, v, tau)
+    assert _relative(jax.jit(batched_forward_dynamics)(model, q, v, tau), reference) < 1e-12
+
+
+def test_a_batch_of_several_chunks_equals_the_one_state_recursion():
+    """More states than CHUNK, not a multiple of it: the chunks and the padded last one."""
+    model = chain(7, seed=3)
+    q, v, tau = _states(model, 2 * CHUNK + 22, seed=2)
+    # one state after another (lax.map does not batch, so no batched route is taken)
+    reference = jax.jit(lambda q, v, tau: jax.lax.map(lambda x: aba(model, *x), (q, v, tau)))(q, v, tau)
     assert _relative(jax.jit(batched_forward_dynamics)(model, q, v, tau), reference) < 1e-12
 
 
