@@ -27,10 +27,11 @@ run in, not what they compute.
 
 The third is how XLA emits the fusions outside such loops (``--xla_cpu_use_fusion_emitters=false``:
 the classic elemental emitter instead of the MLIR fusion emitters). It changes compile times, not
-run times, and rounds a few operations differently (a few ulps after a 200-step rollout): a program of one eager operation 20 -> 13 ms, the Carpal Wrist's forward dynamics
+run times: a program of one eager operation 20 -> 13 ms, the Carpal Wrist's forward dynamics
 0.73 -> 0.44 s, `mbjax tour --quick` from a cold cache 90 -> 67 s, against the same evaluation
 and `vmap` times within noise (7-link chain, `mbjax bench speed --quick`; 1.25 us per state at
-B = 4096 either way). A program of a few operations is mostly compile time, and programs outside
+B = 4096 either way). The two emitters round a few operations differently (a few ulps after a
+200-step rollout). A program of a few operations is mostly compile time, and programs outside
 `jit` (arrays handled op by op) are compiled one per operation and shape. The design notes'
 jaxlib 0.10 measurement found the same flag necessary for MJX's deep gather graphs.
 

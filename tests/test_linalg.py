@@ -24,6 +24,7 @@ def test_spd_solve_matches_numpy_for_vectors_matrices_and_batches(w):
     dx = jax.jvp(lambda A: spd_solve(A, b[0]), (jnp.asarray(A[0]),), (jnp.asarray(dA),))[1]
     np.testing.assert_allclose(dx, -np.linalg.solve(A[0], dA @ x), atol=1e-12)
 
+
 def test_written_out_blocks_hold_no_library_call():
     A = jnp.eye(UNROLL) * 2.0
     hlo = jax.jit(spd_solve).lower(A, jnp.ones(UNROLL)).compile().as_text()

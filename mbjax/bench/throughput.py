@@ -10,9 +10,9 @@ For regular n-link chains (`mbjax.model.chain(n)`, n = 7, 30, 100; float64 unles
    core). Time per state; accelerations checked against Pinocchio's.
 2. Rollouts of ROLLOUT_STEPS RK4 steps (dt = 1 ms, zero torque: the chain falls) of B states:
    one trajectory's `simulate(TreeSystem)` mapped over chunks of the batch (`mbjax_rollout_fn`)
-   against `mujoco.rollout` (multi-threaded C, RK4, one MjData per
-   core) and MJX (`jit(vmap(scan(mjx.step)))`, RK4; one batch size, fewer steps). Steps per second (B x steps / run time); the final states
-   of mbjax and MuJoCo are compared.
+   against `mujoco.rollout` (multi-threaded C, RK4, one MjData per core) and MJX
+   (`jit(vmap(scan(mjx.step)))`, RK4; one batch size, fewer steps). Steps per second
+   (B x steps / run time); the final states of mbjax and MuJoCo are compared.
 3. The gradient of loss = sum q(T)^2 over a 1000-step rollout of one trajectory
    (`simulate(TreeSystem)`) with respect to (q0, v0), against
    the forward rollout: run time and XLA's temporary memory (`memory_analysis`) of `jax.grad`

@@ -207,7 +207,7 @@ def throughput_figure(records: list[dict]) -> Figure:
     ax_fd.legend(fontsize=7)
 
     rollout = [r for r in records if r["kind"] == "rollout"]
-    for engine, color, label in (("mbjax", COLORS.get("rk4", "C0"), "mbjax simulate, lax.map over chunks of the batch"),
+    for engine, color, label in (("mbjax", COLORS.get("rk4", "C0"), "mbjax simulate, lax.map over chunks"),
                                  ("mujoco", COLORS.get("mujoco", "grey"), "mujoco.rollout"),
                                  ("mjx", "C4", "MJX jit(vmap)")):
         for n in sorted({r["n"] for r in rollout}):

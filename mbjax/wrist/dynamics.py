@@ -17,9 +17,9 @@ all by autodiff: none of the chapter's hand expansions (eqs 6.8-6.15, 6.22-6.42)
 `eom_terms` evaluates them from the pose's first and second derivatives (T is quadratic in
 theta_dot: A = J^T diag(m, I) J from the velocity Jacobians, B from dA/dtheta), and
 `inverse_dynamics` differentiates L itself, so the two are independent routes to the same
-equations (tests/wrist/test_dynamics.py). The
-legs are massless, so A is singular where a leg is (the inverse singularity, the workspace
-boundary); inside the workspace it is positive definite and eq 6.21 is solved by Cholesky.
+equations (tests/wrist/test_dynamics.py). The legs are massless, so A is singular where a leg is
+(the inverse singularity, the workspace boundary); inside the workspace it is positive definite
+and eq 6.21 is solved by Cholesky.
 """
 
 import jax
@@ -69,9 +69,13 @@ def velocity_jacobians(wrist, theta: Array) -> tuple[Array, Array]:
     """(J_G, J_D) with v_G = J_G theta_dot (in B) and omega_D = R^T omega = J_D theta_dot (in D):
     one forward-mode Jacobian of the pose, column k of J_D being R^T omega_k with
     [omega_k]x = dR/dtheta_k R^T, as in `tool_velocity`."""
-    dx, dR = jax.jacfwd(com_and_rotation, argnums=1)(wrist, theta)      # (3, 3), (3, 3, 3)
-    R = com_and_rotation(wrist, theta)[1]
-    J_D = jax.vmap(lambda dR_k: _dot(R.T, _vee(_matmul(dR_k, R.T))), out_axes=1)(jnp.moveaxis(dR, -1, 0))
+    def pose(th):
+        x_G, R = com_and_rotation(wrist, th)
+        return (x_G, R), R
+
+    (dx, dR), R = jax.jacfwd(pose, has_aux=True)(theta)               # (3, 3), (3, 3, 3)
+    J_D = jax.vmap(lambda dR_k: _dot(R.T, _vee(_matmul(dR_k, R.T))), out_axes=1)(
+        jnp.moveaxis(dR, -1, 0))
     return dx, J_D
 
 
