@@ -80,15 +80,21 @@ def _batch_fn(dtype):
         lambda model, q, v, tau: run(model, *(x.astype(jnp.float32) for x in (q, v, tau))))
 
 
+def _split(fn, devices, in_specs, out_specs):
+    """jit(fn) with its "batch" axis split over `devices` by `jax.shard_map`: each device runs its
+    part as the one-device program does. check_vma=False: mbjax's scans start from constants
+    (the ground's values), which shard_map's check of varying axes would reject as carries of
+    another type."""
+    return jax.jit(jax.shard_map(fn, mesh=jax.sharding.Mesh(devices, ("batch",)),
+                                 in_specs=in_specs, out_specs=out_specs, check_vma=False))
+
+
 def _sharded_fn(devices):
-    """`batch_aba` with the batch (last axis) split over `devices` by `jax.shard_map`: each device
-    runs its part as the one-device program does (a jit of the whole batch left the partitioning
-    to XLA, which did not split the chunked loop: 1.69 against 1.58 us per state on one device)."""
+    """`batch_aba` with the batch (last axis) split over `devices` (`_split`; a jit of the whole
+    batch left the partitioning to XLA, which did not split the chunked loop: 1.69 against 1.58
+    us per state on one device)."""
     spec = jax.sharding.PartitionSpec(None, "batch")
-    # check_vma=False: as in `mbjax_rollout_fn`
-    return jax.jit(jax.shard_map(batch_aba, mesh=jax.sharding.Mesh(devices, ("batch",)),
-                                 in_specs=(jax.sharding.PartitionSpec(), spec, spec, spec),
-                                 out_specs=spec, check_vma=False))
+    return _split(batch_aba, devices, (jax.sharding.PartitionSpec(), spec, spec, spec), spec)
 
 
 def _vmap_fn():
@@ -214,7 +220,7 @@ def mbjax_rollout_fn(model, steps: int, devices=None):
     `batch_aba` on the chunk, whose states stay in cache for the whole rollout, where all B states
     advancing step by step fall out of it: 7-link chain, B = 4096, one core, 0.95e5 -> 2.3e5
     steps/s). With several `devices` (one per core) and B divisible by their number, the batch is
-    split over them (`jax.shard_map`, inputs placed by `shard_batch(x, devices, axis=0)`)."""
+    split over them (`_split`, inputs placed by `shard_batch(x, devices, axis=0)`)."""
     def one(q0, v0):
         return simulate(TreeSystem(model), RK4(), q0, v0, dt=DT, t1=steps * DT,
                         saveat=np.array([steps * DT])).qs[-1]
@@ -227,10 +233,7 @@ def mbjax_rollout_fn(model, steps: int, devices=None):
     if len(devices) < 2:
         return local
     spec = jax.sharding.PartitionSpec("batch")
-    # check_vma=False: mbjax's scans start from constants (the ground's values), which
-    # shard_map's check of varying axes would reject as carries of another type
-    split = jax.jit(jax.shard_map(chunks, mesh=jax.sharding.Mesh(devices, ("batch",)),
-                                  in_specs=(spec, spec), out_specs=spec, check_vma=False))
+    split = _split(chunks, devices, (spec, spec), spec)
 
     def run(Q, V):
         return (local if Q.shape[0] % len(devices) else split)(Q, V)
