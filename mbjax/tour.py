@@ -48,11 +48,12 @@ def heavy_top_tour(out: Path, quick: bool) -> dict:
     body, q0, u0 = top.build()
     saveat = np.linspace(0.0, duration, 501)
     runs, rows = {}, {}
+    symmetry_axis = jax.jit(jax.vmap(lambda q: body.rotation_matrix(q)[:, 2]))
     for name, cls in INTEGRATORS.items():
         sol, timing = measure(partial(simulate, body, cls(), q0, u0, dt=dt, t1=duration,
                                       saveat=saveat), repeats=3)
         rel = np.asarray(body.relative_energy_error(sol.qs, sol.us))
-        axis = np.asarray(jax.jit(jax.vmap(lambda q: body.rotation_matrix(q)[:, 2]))(sol.qs))
+        axis = np.asarray(symmetry_axis(sol.qs))
         runs[name] = (np.asarray(sol.ts), axis, rel)
         rows[name] = {"energy_drift": float(np.max(np.abs(rel))),
                       "seconds": timing.run_s, "status": sol.messages()[0]}
@@ -86,20 +87,22 @@ def rigid_chain_tour(out: Path, quick: bool) -> dict:
         for dt in dts:
             sol, timing = measure(partial(simulate, system, INTEGRATORS[name](), q0, v0, dt=dt,
                                           t1=duration, saveat=saveat), repeats=3)
-            row = {"dt": dt, "error": float(jnp.max(jnp.abs(sol.qs[-1] - ref.qs[-1]))),
-                   "energy_error": float(jnp.max(jnp.abs(system.relative_energy_error(sol.qs, sol.us)))),
+            row = {"dt": dt, "error": float(np.max(np.abs(np.asarray(sol.qs[-1]) - np.asarray(ref.qs[-1])))),
+                   "energy_error": float(np.max(np.abs(system.relative_energy_error(sol.qs, sol.us)))),
                    "seconds": timing.run_s}
             runs[name].append(row)
             rows[f"{name} dt={dt * 1e3:g} ms"] = {"error_rad": row["error"],
                                                   "energy_error": row["energy_error"],
                                                   "seconds": timing.run_s, "status": sol.messages()[0]}
 
+    @jax.jit
+    @jax.vmap
     def points(q):
         R, p = forward_kinematics(model, q)
         tip = p[-1] + R[-1] @ jnp.array([0.0, 0.0, -rc.LINK_LENGTH])
-        return np.asarray(jnp.concatenate([jnp.zeros((1, 3)), p[1:], tip[None]]))
+        return jnp.concatenate([jnp.zeros((1, 3)), p[1:], tip[None]])
 
-    snapshots = [(float(t), points(q)) for t, q in zip(ref.ts, ref.qs, strict=True)]
+    snapshots = list(zip(np.asarray(ref.ts).tolist(), np.asarray(points(ref.qs)), strict=True))
     fig = rigid_chain_figure(snapshots, runs, f"{rc.N_LINKS}-link chain falling under gravity, "
                              f"{duration:g} s, forward dynamics \"{choose_method(model)}\"")
     fig.savefig(out / "rigid-chain.png", dpi=110)
@@ -164,7 +167,7 @@ def closed_loops_tour(out: Path, quick: bool) -> dict:
             sol, timing = measure(partial(simulate, system, RK4(), q0, v0, dt=dt, t1=duration,
                                           saveat=saveat), repeats=3)
             phi = np.asarray(residual(sol.qs))
-            row = {"dt": dt, "error": float(jnp.max(jnp.abs(sol.qs - ref.qs))),
+            row = {"dt": dt, "error": float(np.max(np.abs(np.asarray(sol.qs) - np.asarray(ref.qs)))),
                    "residual": float(phi.max()), "seconds": timing.run_s}
             runs[name].append(row)
             rows[f"{name} dt={dt * 1e3:g} ms"] = {"error_rad": row["error"],

@@ -85,6 +85,7 @@ class AncfBeam(eqx.Module):
         xi, w = np.polynomial.legendre.leggauss(self.n_gauss)
         return jnp.asarray((xi + 1) / 2), jnp.asarray(w / 2)
 
+    @eqx.filter_jit
     def initial_coordinates(self, origin=(0.0, 0.0), angle=0.0) -> Array:
         """Straight, unstrained beam from `origin` along direction `angle` (rad)."""
         t = jnp.stack([jnp.cos(angle), jnp.sin(angle)])
@@ -107,6 +108,7 @@ class AncfBeam(eqx.Module):
         (_, h_s, _), ek = self._interp(e, s)
         return h_s @ ek
 
+    @eqx.filter_jit
     def mass_matrix(self) -> Array:
         """Consistent mass M = sum_k int rhoA S^T S ds, scatter-added over elements (constant)."""
         xi, w = self._gauss()
@@ -175,12 +177,18 @@ def stable_step(beam: AncfBeam, e, prescribed=(), safety=0.5, G=None) -> float:
     the free columns (or a given de/dq). RK4's stability interval on the imaginary axis is
     |omega dt| < 2 sqrt 2."""
     G = np.eye(beam.n_coordinates)[:, _split(beam.n_coordinates, prescribed)[0]] if G is None else G
-    K = G.T @ jax.jit(jax.hessian(beam.elastic_energy))(jnp.asarray(e)) @ G
+    omega_max = float(_highest_frequency(beam, jnp.asarray(e), jnp.asarray(G)))
+    return safety * 2.0 * np.sqrt(2.0) / omega_max
+
+
+@jax.jit
+def _highest_frequency(beam: AncfBeam, e, G) -> Array:
+    """omega_max of `stable_step`, one compiled program."""
+    K = G.T @ jax.hessian(beam.elastic_energy)(e) @ G
     Lc = jnp.linalg.cholesky(G.T @ beam.mass_matrix() @ G)
     A = jax.scipy.linalg.solve_triangular(Lc, jax.scipy.linalg.solve_triangular(Lc, K, lower=True).T,
                                           lower=True)
-    omega_max = float(jnp.sqrt(jnp.max(jnp.linalg.eigvalsh((A + A.T) / 2))))
-    return safety * 2.0 * np.sqrt(2.0) / omega_max
+    return jnp.sqrt(jnp.max(jnp.linalg.eigvalsh((A + A.T) / 2)))
 
 
 def simulate_embedded(beam: AncfBeam, embed: Callable, q0, q_dot0, ts, *, dt: float | None = None,
@@ -195,12 +203,13 @@ def simulate_embedded(beam: AncfBeam, embed: Callable, q0, q_dot0, ts, *, dt: fl
     G^T M G is factored once."""
     ts = np.asarray(ts, float)
     q0, q_dot0 = jnp.asarray(q0, float), jnp.asarray(q_dot0, float)
-    G0 = jax.jacfwd(embed, argnums=1)(jnp.asarray(ts[0]), q0)
-    dt = stable_step(beam, embed(jnp.asarray(ts[0]), q0), safety=safety, G=G0) if dt is None else float(dt)
+    e0, G0 = jax.jit(lambda t, q: (embed(t, q), jax.jacfwd(embed, argnums=1)(t, q)))(
+        jnp.asarray(ts[0]), q0)
+    dt = stable_step(beam, e0, safety=safety, G=G0) if dt is None else float(dt)
     m = max(1, int(np.ceil(np.max(np.diff(ts), initial=0.0) / dt)))
     M = beam.mass_matrix()
     Qg = jnp.zeros(beam.n_coordinates) if gravity is None else beam.gravity_force(gravity)
-    L0 = jnp.linalg.cholesky(G0.T @ M @ G0)
+    L0 = jax.jit(lambda G: jnp.linalg.cholesky(G.T @ M @ G))(G0)
 
     def rhs(t, y):
         q, q_dot = y

@@ -131,6 +131,7 @@ class ModalBody(eqx.Module):
                          node_position=jnp.zeros((0, 3)), node_phi=jnp.zeros((0, 3, mu)),
                          node_psi=jnp.zeros((0, 3, mu)), distal_stiffening=jnp.zeros((0, 6, mu, mu)))
 
+    @eqx.filter_jit
     def padded(self, mu: int, nodes: int) -> "ModalBody":
         """The same body with mu >= self.mu modal columns (the extra ones decoupled and at rest)
         and `nodes` attachment points (the extra ones without shapes), so bodies stack."""

@@ -6,6 +6,7 @@ the distal unit-load geometric stiffness matrices (eq 33, Table 1), and the shap
 points where other bodies or cut joints attach.
 """
 
+import equinox as eqx
 import jax.numpy as jnp
 import numpy as np
 
@@ -16,6 +17,7 @@ from mbjax.flex.points import mass_points, node_shapes
 from mbjax.flex.stiffening import distal_stiffening, inertial_stiffening
 
 
+@eqx.filter_jit
 def beam_body(beam: Beam, basis: ModalBasis, nodes=(), *, clamped_node: int = 0,
               stiffening: bool = True, damping=None) -> ModalBody:
     """The modal body of `beam` in `basis` (clamped at `clamped_node`, the joint grid J^k), with

@@ -78,7 +78,8 @@ class FlexibleModel(eqx.Module):
                    else ModalBody.rigid(model.mass[k], model.com[k], model.inertia[k], mu)
                    .padded(mu, nodes) for k in range(n)]
         self.model = model
-        self.bodies = jax.tree.map(lambda *a: jnp.stack(a), *stacked)
+        self.bodies = eqx.filter_jit(lambda *bodies: jax.tree.map(lambda *a: jnp.stack(a), *bodies))(
+            *stacked)
         self.modes = tuple(flexible[k].mu if k in flexible else 0 for k in range(n))
         self.attach = tuple(attach.get(k, -1) for k in range(n))
         self.markers = markers

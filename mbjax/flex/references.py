@@ -50,16 +50,23 @@ def spin_up_beam_reference(n_elements=8, ts=None, *, dt=None, safety=0.5, length
         def embed(t, q):
             root = q[0] * jnp.stack([jnp.cos(theta(t)), jnp.sin(theta(t))])
             return jnp.concatenate([jnp.zeros(2), root, q[1:]])
-        q0 = jnp.concatenate([jnp.ones(1), e0[4:]])
-        sol = simulate_embedded(beam, embed, q0, jnp.zeros_like(q0), ts, dt=dt, safety=safety)
+        q0 = np.concatenate([np.ones(1), np.asarray(e0)[4:]])
+        sol = simulate_embedded(beam, embed, q0, np.zeros_like(q0), ts, dt=dt, safety=safety)
     else:
         def e_p(t):
             return jnp.stack([0.0 * t, 0.0 * t, jnp.cos(theta(t)), jnp.sin(theta(t))])
         sol = simulate(beam, e0, jnp.zeros_like(e0), ts, prescribed=range(4), e_p=e_p, dt=dt,
                        safety=safety)
-    tip, th = sol.e[:, -4:-2], theta(sol.ts)
-    return SpinUpResult(sol.ts, -jnp.sin(th) * tip[:, 0] + jnp.cos(th) * tip[:, 1],
-                        jnp.cos(th) * tip[:, 0] + jnp.sin(th) * tip[:, 1] - length, sol)
+    return SpinUpResult(sol.ts, *_rotating_tip(sol.ts, sol.e, length, T_s, omega_s), sol)
+
+
+@jax.jit
+def _rotating_tip(ts, e, length, T_s, omega_s):
+    """The tip's (deflection, axial displacement) in the frame spun by the hub, from the beam's
+    coordinates e (len(ts), 4 (n + 1))."""
+    tip, th = e[:, -4:-2], spin_up_theta(ts, T_s, omega_s)
+    return (-jnp.sin(th) * tip[:, 0] + jnp.cos(th) * tip[:, 1],
+            jnp.cos(th) * tip[:, 0] + jnp.sin(th) * tip[:, 1] - length)
 
 
 class SliderCrankResult(NamedTuple):

@@ -1,6 +1,7 @@
 """Adaptive, error-controlled reference solutions through diffrax."""
 
 import diffrax
+import equinox as eqx
 import jax
 import jax.numpy as jnp
 from jax import Array
@@ -9,6 +10,7 @@ from mbjax.integrate.solution import Solution, Status
 from mbjax.integrate.system import AbstractSystem
 
 
+@eqx.filter_jit
 def solve_reference(system: AbstractSystem, q0: Array, u0: Array, ts, *, rtol: float = 1e-11,
                     atol: float = 1e-11, solver=None, max_steps: int = 1_000_000) -> Solution:
     """Integrate q_dot = kinematics(q, u), u_dot = acceleration(t, q, u) with an adaptive

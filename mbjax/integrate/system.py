@@ -58,7 +58,9 @@ class AbstractSystem(eqx.Module):
         `mbjax.loops`); 0 here."""
         return jnp.array(0, jnp.int32)
 
+    @eqx.filter_jit
     def relative_energy_error(self, qs: Array, us: Array) -> Array:
-        """(E(t) - E(0)) / |E(0)| along a saved trajectory, for systems with an `energy(q, u)`."""
+        """(E(t) - E(0)) / |E(0)| along a saved trajectory, for systems with an `energy(q, u)`
+        (one compiled program, not one per array operation when called outside `jit`)."""
         E = jax.vmap(self.energy)(qs, us)
         return (E - E[0]) / jnp.abs(E[0])

@@ -5,12 +5,14 @@ exp(r). Products follow Hamilton's convention: quat_to_matrix(p * q) == quat_to_
 quat_to_matrix(q).
 """
 
+import jax
 import jax.numpy as jnp
 from jax import Array
 
 from mbjax.lie._series import COS_HALF, SIN_HALF_OVER_PHI, even_series
 
 
+@jax.jit
 def quat_multiply(p: Array, q: Array) -> Array:
     """Hamilton product p * q."""
     pw, pv = p[0], p[1:]
@@ -21,16 +23,19 @@ def quat_multiply(p: Array, q: Array) -> Array:
     ])
 
 
+@jax.jit
 def quat_conjugate(q: Array) -> Array:
     """The inverse rotation of a unit quaternion."""
     return q * jnp.array([1.0, -1.0, -1.0, -1.0], dtype=q.dtype)
 
 
+@jax.jit
 def quat_normalize(q: Array) -> Array:
     """Project q onto the unit sphere."""
     return q / jnp.linalg.norm(q)
 
 
+@jax.jit
 def quat_to_matrix(q: Array) -> Array:
     """Rotation matrix of a unit quaternion."""
     w, x, y, z = q
@@ -41,6 +46,7 @@ def quat_to_matrix(q: Array) -> Array:
     ])
 
 
+@jax.jit
 def quat_from_rotvec(r: Array) -> Array:
     """q = (cos(phi/2), sin(phi/2)/phi r), exact and differentiable at r = 0."""
     r = jnp.asarray(r)
@@ -50,6 +56,7 @@ def quat_from_rotvec(r: Array) -> Array:
     return jnp.concatenate([jnp.atleast_1d(w), s * r])
 
 
+@jax.jit
 def rotvec_from_quat(q: Array) -> Array:
     """Principal rotation vector (|r| <= pi) of a unit quaternion: r = 2 atan2(|v|, w) v / |v|."""
     q = jnp.asarray(q)
@@ -66,6 +73,7 @@ def rotvec_from_quat(q: Array) -> Array:
     return 2.0 * ratio * v
 
 
+@jax.jit
 def quat_from_matrix(R: Array) -> Array:
     """Unit quaternion of a rotation matrix by Shepperd's method.
 

@@ -6,7 +6,10 @@ omega = Gamma(r) r_dot (eq A.16-A.17); the same Gamma maps variations to virtual
 (eq A.19). All functions take a single vector or matrix; use `jax.vmap` for batches.
 """
 
+from functools import partial
+
 import equinox as eqx
+import jax
 import jax.numpy as jnp
 from jax import Array
 
@@ -20,6 +23,7 @@ from mbjax.lie._series import (
 from mbjax.lie.quaternion import quat_from_matrix, rotvec_from_quat
 
 
+@jax.jit
 def hat(v: Array) -> Array:
     """The skew matrix v x I, so that hat(v) @ w == cross(v, w)."""
     v = jnp.asarray(v)
@@ -31,6 +35,7 @@ def hat(v: Array) -> Array:
     ])
 
 
+@jax.jit
 def vee(S: Array) -> Array:
     """The vector of the skew part of S (inverse of `hat` on skew matrices)."""
     return 0.5 * jnp.array([S[2, 1] - S[1, 2], S[0, 2] - S[2, 0], S[1, 0] - S[0, 1]])
@@ -47,6 +52,7 @@ def _coefficients(r: Array):
     return a_o, a_1, b_1
 
 
+@jax.jit
 def exp(r: Array) -> Array:
     """Rotation matrix R = exp(r x I) = I + a_o (r x I) + a_1 (r x I)^2 (seed 000 eqs A.3, A.6)."""
     r = jnp.asarray(r)
@@ -55,6 +61,7 @@ def exp(r: Array) -> Array:
     return jnp.eye(3, dtype=K.dtype) + a_o * K + a_1 * (K @ K)
 
 
+@jax.jit
 def gamma(r: Array) -> Array:
     """Tangent map Gamma(r) = I + a_1 (r x I) + b_1 (r x I)^2, omega = Gamma r_dot (eqs 2.9, A.17)."""
     r = jnp.asarray(r)
@@ -63,6 +70,7 @@ def gamma(r: Array) -> Array:
     return jnp.eye(3, dtype=K.dtype) + a_1 * K + b_1 * (K @ K)
 
 
+@jax.jit
 def gamma_inv(r: Array) -> Array:
     """Gamma^-1 = I - (r x I)/2 + (1 - a_o / (2 a_1)) / phi^2 (r x I)^2 (seed 000 eq A.21).
 
@@ -82,12 +90,14 @@ def gamma_inv(r: Array) -> Array:
     return jnp.eye(3, dtype=K.dtype) - 0.5 * K + c * (K @ K)
 
 
+@jax.jit
 def det_gamma(r: Array) -> Array:
     """det Gamma(r) = 2 (1 - cos phi) / phi^2 (seed 000 eq A.28); zero at phi = 2 pi n, n >= 1."""
     r = jnp.asarray(r)
     return 2.0 * _coefficients(r)[1]
 
 
+@jax.jit
 def rescale(r: Array) -> Array:
     """The rescaled rotation vector r_p = r - 2 pi n e of seed 000 eq A.29.
 
@@ -107,6 +117,7 @@ def _rotation_tolerance(dtype) -> float:
     return max(1e-6, 1e4 * float(jnp.finfo(dtype).eps))
 
 
+@partial(jax.jit, static_argnames="check")
 def log(R: Array, check: bool = True) -> Array:
     """Principal rotation vector r (|r| <= pi) with exp(r) = R.
 

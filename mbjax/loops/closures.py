@@ -63,8 +63,8 @@ class CutJoint(eqx.Module):
         if body_a < 0:
             raise ValueError("body_a must be a body of the model (the ground can only be body_b)")
         self.kind, self.body_a, self.body_b = kind, int(body_a), int(body_b)
-        self.rotation_a = jnp.eye(3) if rotation_a is None else jnp.asarray(rotation_a, float)
-        self.rotation_b = jnp.eye(3) if rotation_b is None else jnp.asarray(rotation_b, float)
+        self.rotation_a = jnp.asarray(np.eye(3) if rotation_a is None else rotation_a, float)
+        self.rotation_b = jnp.asarray(np.eye(3) if rotation_b is None else rotation_b, float)
         self.origin_a = jnp.asarray(origin_a, float)
         self.origin_b = jnp.asarray(origin_b, float)
 

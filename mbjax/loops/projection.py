@@ -70,6 +70,7 @@ def gauss_newton(loops: Loops, q: Array, t=0.0, *, iterations: int = 30) -> Arra
     return jax.lax.scan(step, q, None, length=iterations)[0]
 
 
+@eqx.filter_jit
 def project_velocity(loops: Loops, q: Array, v: Array, t=0.0, mass=None) -> Array:
     """v with A v + B = 0, the smallest correction (in the metric of `mass` when given)."""
     A = loops.jacobian(q, t)

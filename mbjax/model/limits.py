@@ -6,10 +6,12 @@ URDF's <limit> and MJCF's range, actuatorfrcrange and velocity bounds are kept o
 smooth-almost-everywhere penalty for trajectory optimisation.
 """
 
+import jax
 import jax.numpy as jnp
 from jax import Array
 
 
+@jax.jit
 def excess(model, q: Array, v: Array, tau: Array | None = None) -> Array:
     """How far (q, v, tau) lie beyond the model's limits, per coordinate, concatenated
     (nq position, nv velocity, nv effort entries; zero inside the bounds)."""
@@ -20,6 +22,7 @@ def excess(model, q: Array, v: Array, tau: Array | None = None) -> Array:
     return jnp.concatenate(parts)
 
 
+@jax.jit
 def exceeded(model, q: Array, v: Array, tau: Array | None = None) -> Array:
     """True if any coordinate of (q, v, tau) is beyond the model's limits."""
     return jnp.any(excess(model, q, v, tau) > 0)

@@ -137,20 +137,27 @@ class Model(eqx.Module):
             raise ValueError(f"{len(self.names)} names and {len(self.joint_names)} joint names "
                              f"for {n} bodies")
 
-        def field(value, default, shape, what):
+        def field(value, default, shape, what, unit_rows=False):
+            # concrete data is shaped in NumPy (array operations outside jit would each compile
+            # a program); traced data (a model built inside jax.grad or vmap) in JAX
             value = default if value is None else value
-            arr = jnp.asarray(value, dtype=float)
+            xp = jnp if _traced(value) else np
+            arr = xp.asarray(value, dtype=float)
             if arr.shape != shape:
-                arr = jnp.broadcast_to(arr, shape) if arr.ndim < len(shape) else arr
+                arr = xp.broadcast_to(arr, shape) if arr.ndim < len(shape) else arr
             if arr.shape != shape:
                 raise ValueError(f"{what} must have shape {shape}, got {np.shape(value)}")
-            return arr
+            if unit_rows:           # a zero row is reported below, by name
+                with np.errstate(invalid="ignore", divide="ignore"):
+                    arr = arr / xp.linalg.norm(arr, axis=-1, keepdims=True)
+            return jnp.asarray(arr, dtype=float)
 
         self.mass = field(mass, None, (n,), "mass")
         self.inertia = field(inertia, None, (n, 3, 3), "inertia")
         self.com = field(com, np.zeros((n, 3)), (n, 3), "com")
-        self.axis = _unit_rows(field(axis, np.tile([0.0, 0.0, 1.0], (n, 1)), (n, 3), "axis"))
-        self.axis2 = _unit_rows(field(axis2, np.tile([0.0, 1.0, 0.0], (n, 1)), (n, 3), "axis2"))
+        self.axis = field(axis, np.tile([0.0, 0.0, 1.0], (n, 1)), (n, 3), "axis", unit_rows=True)
+        self.axis2 = field(axis2, np.tile([0.0, 1.0, 0.0], (n, 1)), (n, 3), "axis2",
+                           unit_rows=True)
         self.placement_rotation = field(placement_rotation, np.tile(np.eye(3), (n, 1, 1)),
                                         (n, 3, 3), "placement_rotation")
         self.placement_translation = field(placement_translation, np.zeros((n, 3)), (n, 3),
@@ -349,5 +356,7 @@ def _flat(layout: dict, which: str, per_body: Array) -> Array:
     return take(jnp.concatenate(blocks), layout[f"{which}_order"])
 
 
-def _unit_rows(a: Array) -> Array:
-    return a / jnp.linalg.norm(a, axis=-1, keepdims=True)
+def _traced(value) -> bool:
+    """Whether value (an array, or nested lists of numbers and arrays) holds a tracer of jit,
+    grad or vmap."""
+    return any(isinstance(leaf, jax.core.Tracer) for leaf in jax.tree.leaves(value))

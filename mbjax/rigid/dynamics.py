@@ -7,6 +7,9 @@ few array operations match the recursion's n sequential steps; above it O(n) win
 n = 300 in a loop).
 """
 
+from functools import partial
+
+import jax
 from jax import Array
 
 from mbjax import runtime
@@ -50,6 +53,7 @@ def _check(model: Model, **arrays) -> None:
                              f"shape {shape}; use jax.vmap for batches")
 
 
+@partial(jax.jit, static_argnames="method")
 def forward_dynamics(model: Model, q: Array, q_dot: Array, tau: Array,
                      method: str = "auto", f_ext: Array | None = None) -> Array:
     """Joint accelerations at configuration q and velocity q_dot under joint forces tau, gravity
@@ -81,6 +85,7 @@ def _primal(model: Model, q: Array, v: Array, tau: Array, f_ext: Array | None) -
 recursive_forward_dynamics = with_adjoint(_primal)
 
 
+@jax.jit
 def inverse_dynamics(model: Model, q: Array, q_dot: Array, q_ddot: Array,
                      f_ext: Array | None = None) -> Array:
     """Joint forces that produce accelerations q_ddot at (q, q_dot) under gravity and external
@@ -89,6 +94,7 @@ def inverse_dynamics(model: Model, q: Array, q_dot: Array, q_ddot: Array,
     return _rnea(model, q, q_dot, q_ddot, f_ext)
 
 
+@jax.jit
 def mass_matrix(model: Model, q: Array) -> Array:
     """The generalized mass matrix mu_hat_ff (seed 001 eq 55), nv x nv."""
     _check(model, q=q)

@@ -5,6 +5,9 @@ the fixed joints themselves, MJCF sites: `Model.frame_names`), then its bodies (
 the URDF links or MJCF bodies) and its joints (`Model.joint_names`, whose frame is the body's).
 """
 
+from functools import partial
+
+import jax
 import jax.numpy as jnp
 import numpy as np
 from jax import Array
@@ -33,6 +36,7 @@ def frame_placement(model: Model, name: str) -> tuple[int, Array, Array]:
                    f"{', '.join(known[:12])}{', ...' if len(known) > 12 else ''}")
 
 
+@partial(jax.jit, static_argnames="name")
 def frame_pose(model: Model, q: Array, name: str) -> tuple[Array, Array]:
     """World orientation (3, 3) and origin (3,) of the frame, body or joint called `name`."""
     body, R_f, p_f = frame_placement(model, name)
@@ -42,6 +46,7 @@ def frame_pose(model: Model, q: Array, name: str) -> tuple[Array, Array]:
     return R[body] @ R_f, p[body] + R[body] @ p_f
 
 
+@partial(jax.jit, static_argnames="name")
 def frame_jacobian(model: Model, q: Array, name: str) -> Array:
     """J (6, nv) with (omega; v) = J v: the frame's angular velocity and the velocity of its
     origin, world components (Pinocchio's LOCAL_WORLD_ALIGNED, in (angular; linear) order)."""
@@ -57,6 +62,7 @@ def frame_jacobian(model: Model, q: Array, name: str) -> Array:
     return jnp.where(support[:, None], columns, 0.0).T
 
 
+@jax.jit
 def frame_poses(model: Model, q: Array) -> tuple[Array, Array]:
     """World orientations (m, 3, 3) and origins (m, 3) of all the named frames
     (`Model.frame_names`) at once."""

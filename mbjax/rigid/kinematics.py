@@ -13,6 +13,7 @@ product (`forward_kinematics`); everything else is vectorized over the bodies.
 
 from typing import NamedTuple
 
+import jax
 import jax.numpy as jnp
 from jax import Array
 
@@ -31,6 +32,7 @@ class Kinematics(NamedTuple):
     v: Array      # (n, width) joint velocities, zero-padded
 
 
+@jax.jit
 def forward_kinematics(model: Model, q: Array) -> tuple[Array, Array]:
     """World orientation (n, 3, 3) and origin (n, 3) of every body frame."""
     R, p, _, _ = model.joints(q, jnp.zeros(model.nv, q.dtype))
@@ -55,6 +57,7 @@ def to_ground(R: Array, p: Array, m: Array) -> Array:
     return jnp.concatenate([w, skew(p) @ w + v], -2)
 
 
+@jax.jit
 def body_kinematics(model: Model, q: Array, v: Array) -> Kinematics:
     """Poses, motion subspaces, velocities, remainder accelerations and inertias of every body."""
     R_local, p_local, S_local, S_dot_local = model.joints(q, v)

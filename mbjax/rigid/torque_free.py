@@ -1,11 +1,13 @@
 """Closed-form motion of a torque-free rigid body with an axis of symmetry (seed 000 §8.1)."""
 
+import jax
 import jax.numpy as jnp
 from jax import Array
 
 from mbjax import lie
 
 
+@jax.jit
 def torque_free_motion(J_a, J_t, R0: Array, Omega0: Array, t: Array,
                        axis=(0.0, 0.0, 1.0)) -> tuple[Array, Array]:
     """Rotation R(t) and body angular velocity Omega(t) of a symmetric body with no torque.

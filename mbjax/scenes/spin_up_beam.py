@@ -15,6 +15,7 @@ about z, whose angle is the prescribed motion theta(t) (a rheonomic `Prescribed`
 read in the rotating body frame: y (transverse, negative when the tip lags) and x (axial).
 """
 
+import equinox as eqx
 import jax
 import jax.numpy as jnp
 import numpy as np
@@ -73,6 +74,7 @@ def build(n_bending: int = 4, n_axial: int = 1, n_elements: int = 10, stiffening
     return system, jnp.zeros(model.nq), jnp.zeros(model.nv)
 
 
+@eqx.filter_jit
 def tip(system, qs):
     """(transverse, axial) tip displacement in the rotating frame along a saved trajectory [m]."""
     model = system.tree.model
