@@ -4,9 +4,11 @@ Each suite is run(out: Path, quick: bool) -> list of records, written as out/SUI
 out/SUITE.png. Peers (MuJoCo, Pinocchio, exudyn) are measured in the same process when installed.
 """
 
-from mbjax.bench import flexible, integrators, loops, rigid, speed, tfe, throughput, wrist
+from mbjax.bench import (compile_time, flexible, integrators, loops, rigid, speed, tfe, throughput,
+                         wrist)
 
 SUITES = {
+    compile_time.NAME: compile_time.run,
     flexible.NAME: flexible.run,
     integrators.NAME: integrators.run,
     loops.NAME: loops.run,
