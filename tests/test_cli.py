@@ -477,8 +477,8 @@ def test_bench_speed_quick(tmp_path):
 @pytest.mark.slow
 def test_bench_compile(tmp_path):
     """`mbjax bench compile` (about 80 s on 2 cores): the warm tour loads from the persistent
-    cache every program the cold tour compiled, scene by scene; the first calls outside jit
-    are recorded; each scene's target is there."""
+    cache every program the cold tour compiled, scene by scene (no timing is asserted); the
+    first calls outside jit are recorded; each scene's target is there."""
     assert main(["bench", "compile", "--out", str(tmp_path)]) == 0
     records = [json.loads(line) for line in (tmp_path / "compile.jsonl").read_text().splitlines()]
     tours = {r["cache"]: r for r in records if r["kind"] == "tour"}
@@ -486,7 +486,7 @@ def test_bench_compile(tmp_path):
     assert {n: s["programs"] for n, s in tours["warm"]["scenes"].items()} == \
         {n: s["programs"] for n, s in tours["cold"]["scenes"].items()}
     first = next(r for r in records if r["kind"] == "first_calls")
-    assert first["forward_dynamics"]["call_s"] < first["forward_dynamics"]["first_s"]
+    assert set(first["forward_dynamics"]) == set(first["mass_matrix"]) == {"first_s", "call_s"}
     targets = {t["target"] for t in records[-1]["targets"]}
     assert {f"scene {name}, cold cache" for name in tours["cold"]["scenes"]} < targets
     assert (tmp_path / "compile.png").stat().st_size > 10_000
