@@ -118,3 +118,17 @@ def test_diffrax_reference():
     np.testing.assert_allclose(sol.qs, jax.vmap(lambda t: OSC.exact(Q0, U0, t))(ts), atol=1e-9)
     failed = solve_reference(OSC, Q0, U0, ts, max_steps=2)
     assert int(failed.status) & Status.SOLVER_FAILED
+    for bad in ([0.0, 1.0, 1.0], [1.0, 0.0], [0.0]):
+        with pytest.raises(ValueError, match="ts must be at least two increasing times"):
+            solve_reference(OSC, Q0, U0, bad)
+
+
+def test_diffrax_reference_program_holds_no_host_callback():
+    """The reference's compiled program can be kept in the persistent compilation cache: no
+    host callback (diffrax checks times it saves at inside a solve by callbacks, so the
+    reference saves at each interval's end instead)."""
+    from mbjax.integrate.reference import _solve
+
+    text = _solve.lower(OSC, Q0, U0, jnp.linspace(0.0, 3.0, 7), 1e-10, 1e-10, None,
+                        1000).as_text()
+    assert "callback" not in text
