@@ -11,6 +11,7 @@ Every measurement runs in a subprocess of its own, so nothing is compiled before
 """
 
 import json
+import os
 import subprocess
 import sys
 import tempfile
@@ -69,8 +70,6 @@ print(json.dumps(out))
 
 def _python(script: str, *args: str, env: dict | None = None) -> tuple[dict, float]:
     """(the JSON the script prints last, the process's wall time)."""
-    import os
-
     start = time.perf_counter()
     out = subprocess.run([sys.executable, "-c", script, *args], capture_output=True, text=True,
                          check=True, env={**os.environ, **(env or {})})

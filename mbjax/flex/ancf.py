@@ -203,13 +203,17 @@ def simulate_embedded(beam: AncfBeam, embed: Callable, q0, q_dot0, ts, *, dt: fl
     G^T M G is factored once."""
     ts = np.asarray(ts, float)
     q0, q_dot0 = jnp.asarray(q0, float), jnp.asarray(q_dot0, float)
-    e0, G0 = jax.jit(lambda t, q: (embed(t, q), jax.jacfwd(embed, argnums=1)(t, q)))(
-        jnp.asarray(ts[0]), q0)
+    M = beam.mass_matrix()
+
+    @jax.jit
+    def start(t, q):              # e, G = de/dq and the Cholesky factor of G^T M G at ts[0]
+        e, G = embed(t, q), jax.jacfwd(embed, argnums=1)(t, q)
+        return e, G, jnp.linalg.cholesky(G.T @ M @ G)
+
+    e0, G0, L0 = start(jnp.asarray(ts[0]), q0)
     dt = stable_step(beam, e0, safety=safety, G=G0) if dt is None else float(dt)
     m = max(1, int(np.ceil(np.max(np.diff(ts), initial=0.0) / dt)))
-    M = beam.mass_matrix()
     Qg = jnp.zeros(beam.n_coordinates) if gravity is None else beam.gravity_force(gravity)
-    L0 = jax.jit(lambda G: jnp.linalg.cholesky(G.T @ M @ G))(G0)
 
     def rhs(t, y):
         q, q_dot = y
