@@ -13,15 +13,17 @@ recursion. Reverse mode transposes the rule: the adjoint lambda = M^-1 u_dot_bar
 so the solve is its own transpose), then tau_bar = lambda and
 (model, q, v, f_ext)_bar = -RNEA_VJP(lambda), the RNEA's reverse pass at the solved accelerations.
 This is the analytic-derivative route of Carpentier and Mansard (RSS 2018, "Analytical
-derivatives of rigid body dynamics algorithms") that Pinocchio takes, with JAX's own derivatives
-of the RNEA. The RNEA's linearization is recomputed in the reverse pass (`jax.checkpoint`), so
-`jax.grad` through a rollout keeps per step only (q, v, u_dot) and the factor, not every
-intermediate of the recursion: 7-link chain, 1000 steps, the gradient costs 3.0x the rollout
-instead of 6.0x; 30 links, 2.2x instead of 5.4x (`mbjax bench speed`, with XLA running loops
-kernel by kernel). With each loop compiled as one kernel (`mbjax.runtime`; the rule's passes hold
-no gather or scatter in either direction, `mbjax.tree.take`), 3.2x and 3.2x of rollouts five
-times faster: about 4 us a step for the 7-link chain. Storing the linearization instead is slower
-either way (4.8x against 3.0x; 4.8x against 3.3x in one A/B script).
+derivatives of rigid body dynamics algorithms") that Pinocchio takes. For trees of revolute and
+prismatic joints with no external wrench, the RNEA's derivative in (q, v) is written out
+(`rnea_derivatives`: two vector passes, which reverse mode runs the other way); for other
+joints, for the model's parameters and for the external wrenches it is JAX's own derivative of
+the RNEA. Either is recomputed in the reverse pass (`jax.checkpoint`), so `jax.grad` through a
+rollout keeps per step only (q, v, u_dot) and the factor, not every intermediate of the
+recursion (storing them is slower: 4.8x against 3.0x in one A/B script). 7-link chain, 1000
+steps of semi-implicit Euler, each loop compiled as one kernel (`mbjax.runtime`; the rule's
+passes hold no gather or scatter in either direction, `mbjax.tree.take`): the gradient costs
+2.7x the rollout (3.2 us a step; 3.4x with JAX's derivative of the RNEA, 6.0x differentiating
+the recursion itself); 30 links, 2.7x (was 3.4x).
 
 `with_adjoint(fd)` gives `fd` (any function computing the forward dynamics of a tree: `aba`, or
 its vmappable form) this rule as a `jax.custom_jvp`. Forward mode, reverse mode (JAX transposes
@@ -40,6 +42,7 @@ from jax import Array
 from jax.custom_derivatives import SymbolicZero
 
 from mbjax.model import Model
+from mbjax.rigid import rnea_derivatives
 from mbjax.rigid.aba import aba_factored, solve
 from mbjax.rigid.rnea import inverse_dynamics
 
@@ -69,6 +72,11 @@ def with_adjoint(fd: Callable) -> Callable:
 
         rhs = tangents[3]
         rhs = jnp.zeros_like(u_dot) if _zero(rhs) else rhs
+        if f_ext is None and rnea_derivatives.applies(model) and {1, 2} & set(live):
+            # the (q, v) directions written out (`rnea_derivatives`), the model's by autodiff
+            dq, dv = (_instantiate(t, x) for t, x in ((dargs[1], q), (dargs[2], v)))
+            rhs = rhs - jax.checkpoint(rnea_derivatives.rnea_jvp)(model, q, v, u_dot, dq, dv)
+            live = [i for i in live if i not in (1, 2)]
         if live:
             _, d_rnea = jax.jvp(jax.checkpoint(rnea), [args[i] for i in live],
                                 [_instantiate(dargs[i], args[i]) for i in live])

@@ -6,11 +6,14 @@ import equinox as eqx
 import jax
 import jax.numpy as jnp
 import numpy as np
+import pytest
 
 from mbjax.model import random_tree
 from mbjax.rigid import forward_dynamics, mass_matrix
 from mbjax.rigid.aba import aba, aba_factored, solve
 from mbjax.rigid.dynamics import recursive_forward_dynamics
+from mbjax.rigid.rnea import inverse_dynamics
+from mbjax.rigid.rnea_derivatives import applies, rnea_jvp
 
 
 def _with_joint_data(model):
@@ -23,6 +26,8 @@ def _with_joint_data(model):
 # every joint type, a branching tree, joint damping and armature
 MODEL = _with_joint_data(
     random_tree(5, seed=4, joint_types=("free", "spherical", "universal", "revolute", "prismatic")))
+# revolute and prismatic joints only: the RNEA's (q, v) derivatives written out (`rnea_derivatives`)
+HINGES = _with_joint_data(random_tree(6, seed=2))
 
 
 def _state(model, seed):
@@ -53,50 +58,63 @@ def test_solve_with_the_factor_is_the_inverse_mass_matrix():
     assert _relative(ours, reference) < 1e-12
 
 
-def test_first_derivatives_are_the_recursions():
-    """jacfwd and jacrev in q, v, tau and the external wrenches, at a random state and at
-    q = neutral, v = 0 (zero rotations), against those of `aba` itself."""
-    q, v, tau, f_ext = _state(MODEL, 2)
-    neutral = (MODEL.neutral(), jnp.zeros(MODEL.nv), tau, f_ext)
+@pytest.mark.parametrize("model", [MODEL, HINGES], ids=["every joint", "hinges"])
+@pytest.mark.parametrize("wrenches", [True, False], ids=["f_ext", "no f_ext"])
+def test_first_derivatives_are_the_recursions(model, wrenches):
+    """jacfwd and jacrev in q, v, tau (and the external wrenches), at a random state and at
+    q = neutral, v = 0 (zero rotations), against those of `aba` itself; with no external wrench
+    a tree of hinges takes the RNEA's derivatives written out."""
+    q, v, tau, f_ext = _state(model, 2)
+    neutral = (model.neutral(), jnp.zeros(model.nv), tau, f_ext)
+    if not wrenches:
+        q, v, tau, f_ext = q, v, tau, None
+        neutral = neutral[:3] + (None,)
+    assert applies(model) == (model is HINGES)
 
     def ours(*x):
-        return recursive_forward_dynamics(MODEL, *x)
+        return recursive_forward_dynamics(model, *x)
 
     def recursion(*x):
-        return aba(MODEL, *x)
+        return aba(model, *x)
 
-    want = jax.jit(jax.jacfwd(recursion, argnums=(0, 1, 2, 3)))
+    argnums = (0, 1, 2, 3) if wrenches else (0, 1, 2)
+    want = jax.jit(jax.jacfwd(recursion, argnums=argnums))
     for transform in (jax.jacfwd, jax.jacrev):
-        got = jax.jit(transform(ours, argnums=(0, 1, 2, 3)))
+        got = jax.jit(transform(ours, argnums=argnums))
         for args in ((q, v, tau, f_ext), neutral):
             for g, w in zip(got(*args), want(*args), strict=True):
                 assert np.all(np.isfinite(g))
                 assert _relative(g, w) < 1e-11
 
 
-def test_model_gradient_is_the_recursions():
+@pytest.mark.parametrize("model", [MODEL, HINGES], ids=["every joint", "hinges"])
+def test_model_gradient_is_the_recursions(model):
     """Reverse mode in every model leaf (masses, inertias, placements, axes, gravity, damping,
-    armature) against the recursion's, and forward mode along one random model direction against
-    that gradient's projection. An inertia's gradient is meaningful up to its antisymmetric part:
-    the symmetric parts are compared, and the direction's inertias are symmetric."""
-    q, v, tau, f_ext = _state(MODEL, 3)
+    armature) and q together against the recursion's, and forward mode along one random model
+    direction against that gradient's projection. An inertia's gradient is meaningful up to its
+    antisymmetric part: the symmetric parts are compared, and the direction's inertias are
+    symmetric. The tree of hinges, with no external wrench, takes the written-out (q, v)
+    derivatives beside the model's by autodiff."""
+    q, v, tau, f_ext = _state(model, 3)
+    f_ext = f_ext if model is not HINGES else None
 
     def loss(fd):
-        return lambda model: jnp.sum(jnp.sin(fd(model, q, v, tau, f_ext)))
+        return lambda m, q=q: jnp.sum(jnp.sin(fd(m, q, v, tau, f_ext)))
 
-    got = jax.jit(jax.grad(loss(recursive_forward_dynamics)))(MODEL)
-    want = jax.jit(jax.grad(loss(aba)))(MODEL)
+    got, got_q = jax.jit(jax.grad(loss(recursive_forward_dynamics), argnums=(0, 1)))(model, q)
+    want, want_q = jax.jit(jax.grad(loss(aba), argnums=(0, 1)))(model, q)
+    assert _relative(got_q, want_q) < 1e-10
     got, want = (eqx.tree_at(lambda m: m.inertia, g, (g.inertia + jnp.swapaxes(g.inertia, -1, -2)) / 2)
                  for g in (got, want))
     for g, w in zip(jax.tree.leaves(got), jax.tree.leaves(want), strict=True):
         assert _relative(g, w) < 1e-10
 
     rng = np.random.default_rng(5)
-    direction = jax.tree.map(lambda x: jnp.asarray(rng.standard_normal(x.shape)), MODEL)
+    direction = jax.tree.map(lambda x: jnp.asarray(rng.standard_normal(x.shape)), model)
     direction = eqx.tree_at(lambda m: m.inertia, direction,
                             direction.inertia + jnp.swapaxes(direction.inertia, -1, -2))
     along = jax.jit(lambda m, d: jax.jvp(loss(recursive_forward_dynamics), (m,), (d,))[1])(
-        MODEL, direction)
+        model, direction)
     expected = sum(jnp.vdot(w, d) for w, d in zip(jax.tree.leaves(want),
                                                    jax.tree.leaves(direction), strict=True))
     assert _relative(along, expected) < 1e-10
@@ -120,3 +138,24 @@ def test_second_derivatives_against_central_differences():
                          for e in jnp.eye(model.nv)])
     assert _relative(H, central) < 1e-7
     assert _relative(H, H.T) < 1e-12
+
+
+@pytest.mark.parametrize("where", ["random", "zero rotation", "half turns"])
+def test_rnea_jvp_is_the_rneas_derivative(where):
+    """`rnea_jvp` (the RNEA's (q, v) derivative written out) against `jax.jvp` of the RNEA
+    itself, damping and armature included, at a random state, at q = 0 and at q = pi on every
+    joint; and its transpose (reverse mode, what the adjoint runs) against `jax.vjp`."""
+    rng = np.random.default_rng(11)
+    q, v, a, dq, dv, lam = (jnp.asarray(rng.standard_normal(HINGES.nv)) for _ in range(6))
+    q = {"random": q, "zero rotation": 0 * q, "half turns": jnp.full_like(q, np.pi)}[where]
+
+    def rnea(q, v):
+        return inverse_dynamics(HINGES, q, v, a)
+
+    _, want = jax.jvp(rnea, (q, v), (dq, dv))
+    got = jax.jit(rnea_jvp)(HINGES, q, v, a, dq, dv)
+    assert _relative(got, want) < 1e-12
+    _, vjp = jax.vjp(rnea, q, v)
+    _, transpose = jax.vjp(lambda dq, dv: rnea_jvp(HINGES, q, v, a, dq, dv), dq, dv)
+    for g, w in zip(transpose(lam), vjp(lam), strict=True):
+        assert _relative(g, w) < 1e-12
