@@ -1,67 +1,98 @@
 """The RNEA's directional derivative in (q, v), written out: two vector passes, no derivative of
 a rotation matrix.
 
-For trees of revolute and prismatic joints, in ground coordinates at the ground origin (see
-`kinematics`): turning joint j by dq_j moves its outward set rigidly about the screw S_j, so
-every ground-frame quantity X that rides on a body k of that set changes by S_j x X (motion
-vectors: S_j x m, forces: S_j x* f, inertias: S_j x* I - I S_j x). Differentiating the RNEA
-(`rnea`: V_k, A_k, f_k = I_k A_k + V_k x* I_k V_k, F_k the sum of the f of k's outward set,
-tau_k = S_k . F_k) with that rule and collecting the sums over outward sets (the analysis of
-Carpentier and Mansard, RSS 2018, "Analytical derivatives of rigid body dynamics algorithms",
-here for one direction at a time) gives, with U_j = V and B_j = A of j's parent (the ground's:
-0 and -g) and Y_j = S_j x U_j,
+For trees of revolute, prismatic, spherical and free joints, in ground coordinates at the ground
+origin (see `kinematics`): moving joint j along one column S_c of its motion subspace moves its
+outward set, body j included, rigidly about the screw S_c, so every ground-frame quantity X that
+rides on a body of that set changes by S_c x X (motion vectors: S_c x m, forces: S_c x* f,
+inertias: S_c x* I - I S_c x). This needs the columns fixed in body j (a universal joint's first
+axis is fixed in its parent instead: not covered). Differentiating the RNEA (`rnea`: V_k, A_k,
+f_k = I_k A_k + V_k x* I_k V_k, F_k the sum of the f of k's outward set, tau_k = S_k^T F_k)
+with that rule and collecting the sums over outward sets (the analysis of Carpentier and
+Mansard, RSS 2018, "Analytical derivatives of rigid body dynamics algorithms", here for one
+direction at a time) gives, with e_j the joint's increments along its columns (dq itself for a
+revolute or prismatic joint), U_j = V and B_j = A of j's parent (the ground's: 0 and -g),
+Y_j = S_j x U_j and h_k = I_k V_k,
 
-    g2_j = dq_j (Y_j x U_j - S_j x B_j) - 2 dv_j Y_j,      g3_j = dq_j Y_j - dv_j S_j
-    (P2, P3) = the outward sums of (g2, g3)                 (one outward pass)
-    L_k = I_k P2_k - P3_k x* h_k - I_k (P3_k x V_k) - V_k x* I_k P3_k + dq_k S_k x* F_k
-    dtau_k = S_k . (the sum of L over k's outward set) + damping_k dv_k      (one inward pass)
+    g2_j = (Y_j x U_j - S_j x B_j) e_j - (Y_j + S_j x V_j) dv_j,   g3_j = Y_j e_j - S_j dv_j
+    (P2, P3) = the outward sums of (g2, g3)                         (one outward pass)
+    o_k = (S_k x* F_k) e_k
+    L_k = I_k P2_k - P3_k x* h_k - I_k (P3_k x V_k) - V_k x* I_k P3_k + o_k
+    dtau_k = S_k^T (the sum of L over k's outward set - o_k) + damping_k dv_k   (one inward pass)
 
-with h_k = I_k V_k. It is linear in (dq, dv), so reverse mode transposes it into the same two
-passes run the other way: the adjoint's RNEA VJP at the solved accelerations
+(S_j x (.) acting column by column). It is linear in (dq, dv), so reverse mode transposes it
+into the same two passes run the other way: the adjoint's RNEA VJP at the solved accelerations
 (`mbjax.rigid.adjoint`) without differentiating the kinematics. Agrees with `jax.jvp` of
 `inverse_dynamics` to rounding (tests/rigid/test_adjoint.py).
 """
 
+import jax
 import jax.numpy as jnp
 import numpy as np
 from jax import Array
 
+from mbjax.lie import vee
 from mbjax.model import Model
 from mbjax.rigid.kinematics import body_kinematics, gravity_acceleration
 from mbjax.spatial import cross_force, cross_motion
 from mbjax.tree import backward_pass, forward_pass
 from mbjax.tree.take import take
 
-# the joints whose configuration moves their outward set along S alone (S constant in the body)
-JOINTS = ("revolute", "prismatic")
+# the joints whose motion subspace is fixed in the joint's own body
+JOINTS = ("revolute", "prismatic", "spherical", "free")
 
 
 def applies(model: Model) -> bool:
-    """Whether every joint of the tree is revolute or prismatic."""
+    """Whether every joint of the tree is revolute, prismatic, spherical or free."""
     return all(kind in JOINTS for kind in model.joint_types)
 
 
 def rnea_jvp(model: Model, q: Array, v: Array, a: Array, dq: Array, dv: Array) -> Array:
     """d tau = d/de RNEA(model, q + e dq, v + e dv, a) at e = 0 (armature and damping included),
-    for a tree of revolute and prismatic joints (`applies`)."""
+    for a tree of the joints `applies` accepts. dq is a tangent of the coordinates q (a
+    quaternion's included, as the RNEA reads it, normalized)."""
     kin = body_kinematics(model, q, v)
-    S, V, I = kin.S[..., 0], kin.V, kin.I           # noqa: E741 (the papers' name)
+    S, V, I = kin.S, kin.V, kin.I                     # noqa: E741 (the papers' name)
     ground = gravity_acceleration(model)
-    A = _outward_sum(model, S * model.body_v(a) + kin.c, ground)
+    A = _outward_sum(model, _columns(S, model.body_v(a)) + kin.c, ground)
     h = _times(I, V)
     F = _inward_sum(model, _times(I, A) + cross_force(V, h))
     U = _parent(model, V, jnp.zeros_like(ground))
     B = _parent(model, A, ground)
-    Y = cross_motion(S, U)
-    dq_, dv_ = model.body_v(dq), model.body_v(dv)   # (n, 1)
-    g = jnp.concatenate([dq_ * (cross_motion(Y, U) - cross_motion(S, B)) - 2 * dv_ * Y,
-                         dq_ * Y - dv_ * S], -1)
+    Y = _each(cross_motion, S, U)
+    e, dv_ = _increments(model, q, v, dq), model.body_v(dv)
+    g = jnp.concatenate([_columns(_each(cross_motion, Y, U) - _each(cross_motion, S, B), e)
+                         - _columns(Y + _each(cross_motion, S, V), dv_),
+                         _columns(Y, e) - _columns(S, dv_)], -1)
     P = _outward_sum(model, g, jnp.zeros(12, q.dtype))
     P2, P3 = P[:, :6], P[:, 6:]
+    own = _columns(_each(cross_force, S, F), e)
     L = (_times(I, P2) - cross_force(P3, h) - _times(I, cross_motion(P3, V))
-         - cross_force(V, _times(I, P3)) + dq_ * cross_force(S, F))
-    dtau = jnp.sum(S * _inward_sum(model, L), -1, keepdims=True)
+         - cross_force(V, _times(I, P3)) + own)
+    dtau = jnp.einsum("kic,ki->kc", S, _inward_sum(model, L) - own)
     return model.flat_v(dtau) + model.damping * dv
+
+
+def _increments(model: Model, q: Array, v: Array, dq: Array) -> Array:
+    """Each joint's increments (n, width) along its columns for the coordinate tangent dq: dq
+    itself for revolute and prismatic joints; otherwise S_local^T (vee(R^T dR); R^T dp) of the
+    joint's local pose (R, p), a quaternion's normalization included."""
+    if model.euclidean:
+        return model.body_v(dq)
+    (R, _, S_local, _), (dR, dp, _, _) = jax.jvp(lambda q: model.joints(q, v), (q,), (dq,))
+    Rt = jnp.swapaxes(R, -1, -2)
+    twist = jnp.concatenate([jax.vmap(vee)(Rt @ dR), jnp.einsum("kij,kj->ki", Rt, dp)], -1)
+    return jnp.einsum("kic,ki->kc", S_local, twist)
+
+
+def _columns(S: Array, x: Array) -> Array:
+    """sum_c S[k, :, c] x[k, c]: (n, 6, width), (n, width) -> (n, 6)."""
+    return jnp.einsum("kic,kc->ki", S, x)
+
+
+def _each(op, S: Array, x: Array) -> Array:
+    """op(S[k, :, c], x[k]) for every column c: (n, 6, width), (n, 6) -> (n, 6, width)."""
+    return jax.vmap(op, in_axes=(-1, None), out_axes=-1)(S, x)
 
 
 def _times(I: Array, x: Array) -> Array:       # noqa: E741

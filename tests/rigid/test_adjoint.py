@@ -26,8 +26,11 @@ def _with_joint_data(model):
 # every joint type, a branching tree, joint damping and armature
 MODEL = _with_joint_data(
     random_tree(5, seed=4, joint_types=("free", "spherical", "universal", "revolute", "prismatic")))
-# revolute and prismatic joints only: the RNEA's (q, v) derivatives written out (`rnea_derivatives`)
+# the joints whose RNEA derivatives in (q, v) are written out (`rnea_derivatives`): revolute and
+# prismatic only, and with spherical and free joints (quaternions) too
 HINGES = _with_joint_data(random_tree(6, seed=2))
+BALLS = _with_joint_data(
+    random_tree(6, seed=8, joint_types=("free", "spherical", "revolute", "prismatic")))
 
 
 def _state(model, seed):
@@ -58,18 +61,18 @@ def test_solve_with_the_factor_is_the_inverse_mass_matrix():
     assert _relative(ours, reference) < 1e-12
 
 
-@pytest.mark.parametrize("model", [MODEL, HINGES], ids=["every joint", "hinges"])
+@pytest.mark.parametrize("model", [MODEL, HINGES, BALLS], ids=["every joint", "hinges", "balls"])
 @pytest.mark.parametrize("wrenches", [True, False], ids=["f_ext", "no f_ext"])
 def test_first_derivatives_are_the_recursions(model, wrenches):
     """jacfwd and jacrev in q, v, tau (and the external wrenches), at a random state and at
     q = neutral, v = 0 (zero rotations), against those of `aba` itself; with no external wrench
-    a tree of hinges takes the RNEA's derivatives written out."""
+    a tree without universal joints takes the RNEA's derivatives written out."""
     q, v, tau, f_ext = _state(model, 2)
     neutral = (model.neutral(), jnp.zeros(model.nv), tau, f_ext)
     if not wrenches:
         q, v, tau, f_ext = q, v, tau, None
         neutral = neutral[:3] + (None,)
-    assert applies(model) == (model is HINGES)
+    assert applies(model) == (model is not MODEL)
 
     def ours(*x):
         return recursive_forward_dynamics(model, *x)
@@ -87,16 +90,16 @@ def test_first_derivatives_are_the_recursions(model, wrenches):
                 assert _relative(g, w) < 1e-11
 
 
-@pytest.mark.parametrize("model", [MODEL, HINGES], ids=["every joint", "hinges"])
+@pytest.mark.parametrize("model", [MODEL, BALLS], ids=["every joint", "balls"])
 def test_model_gradient_is_the_recursions(model):
     """Reverse mode in every model leaf (masses, inertias, placements, axes, gravity, damping,
     armature) and q together against the recursion's, and forward mode along one random model
     direction against that gradient's projection. An inertia's gradient is meaningful up to its
     antisymmetric part: the symmetric parts are compared, and the direction's inertias are
-    symmetric. The tree of hinges, with no external wrench, takes the written-out (q, v)
-    derivatives beside the model's by autodiff."""
+    symmetric. The tree without universal joints, with no external wrench, takes the
+    written-out (q, v) derivatives beside the model's by autodiff."""
     q, v, tau, f_ext = _state(model, 3)
-    f_ext = f_ext if model is not HINGES else None
+    f_ext = f_ext if model is MODEL else None
 
     def loss(fd):
         return lambda m, q=q: jnp.sum(jnp.sin(fd(m, q, v, tau, f_ext)))
@@ -140,22 +143,30 @@ def test_second_derivatives_against_central_differences():
     assert _relative(H, H.T) < 1e-12
 
 
+@pytest.mark.parametrize("model", [HINGES, BALLS], ids=["hinges", "balls"])
 @pytest.mark.parametrize("where", ["random", "zero rotation", "half turns"])
-def test_rnea_jvp_is_the_rneas_derivative(where):
+def test_rnea_jvp_is_the_rneas_derivative(model, where):
     """`rnea_jvp` (the RNEA's (q, v) derivative written out) against `jax.jvp` of the RNEA
-    itself, damping and armature included, at a random state, at q = 0 and at q = pi on every
-    joint; and its transpose (reverse mode, what the adjoint runs) against `jax.vjp`."""
+    itself, damping and armature included, at a random state (quaternions off the unit sphere,
+    as the RNEA reads them normalized), at the neutral configuration and at half turns of every
+    revolute joint and quaternion; and its transpose (reverse mode, what the adjoint runs)
+    against `jax.vjp`."""
     rng = np.random.default_rng(11)
-    q, v, a, dq, dv, lam = (jnp.asarray(rng.standard_normal(HINGES.nv)) for _ in range(6))
-    q = {"random": q, "zero rotation": 0 * q, "half turns": jnp.full_like(q, np.pi)}[where]
+    q, dq = (jnp.asarray(rng.standard_normal(model.nq)) for _ in range(2))
+    v, a, dv, lam = (jnp.asarray(rng.standard_normal(model.nv)) for _ in range(4))
+    half_turn = np.full(model.nq, np.pi)
+    for w in np.flatnonzero(np.asarray(model.neutral()) == 1.0):     # quaternions (0, 1, 0, 0)
+        half_turn[w:w + 4] = (0.0, 1.0, 0.0, 0.0)
+    q = {"random": 0.5 * q + model.neutral(), "zero rotation": model.neutral(),
+         "half turns": jnp.asarray(half_turn)}[where]
 
     def rnea(q, v):
-        return inverse_dynamics(HINGES, q, v, a)
+        return inverse_dynamics(model, q, v, a)
 
     _, want = jax.jvp(rnea, (q, v), (dq, dv))
-    got = jax.jit(rnea_jvp)(HINGES, q, v, a, dq, dv)
+    got = jax.jit(rnea_jvp)(model, q, v, a, dq, dv)
     assert _relative(got, want) < 1e-12
     _, vjp = jax.vjp(rnea, q, v)
-    _, transpose = jax.vjp(lambda dq, dv: rnea_jvp(HINGES, q, v, a, dq, dv), dq, dv)
+    _, transpose = jax.vjp(lambda dq, dv: rnea_jvp(model, q, v, a, dq, dv), dq, dv)
     for g, w in zip(transpose(lam), vjp(lam), strict=True):
         assert _relative(g, w) < 1e-12
