@@ -17,9 +17,9 @@ derivatives of rigid body dynamics algorithms") that Pinocchio takes. For trees 
 prismatic, spherical and free joints with no external wrench, the RNEA's derivative in (q, v)
 is written out (`rnea_derivatives`: two vector passes, which reverse mode runs the other way);
 for universal joints, for the model's parameters and for the external wrenches it is JAX's own
-derivative of the RNEA. Either is recomputed in the reverse pass (`jax.checkpoint`), so `jax.grad` through a
-rollout keeps per step only (q, v, u_dot) and the factor, not every intermediate of the
-recursion (storing them is slower: 4.8x against 3.0x in one A/B script). 7-link chain, 1000
+derivative of the RNEA. Either is recomputed in the reverse pass (`jax.checkpoint`), so
+`jax.grad` through a rollout keeps per step only (q, v, u_dot) and the factor, not every
+intermediate of the recursion (storing them is slower: 4.8x against 3.0x in one A/B script). 7-link chain, 1000
 steps of semi-implicit Euler, each loop compiled as one kernel (`mbjax.runtime`; the rule's
 passes hold no gather or scatter in either direction, `mbjax.tree.take`): the gradient costs
 2.7x the rollout (3.2 us a step; 3.4x with JAX's derivative of the RNEA, 6.0x differentiating
