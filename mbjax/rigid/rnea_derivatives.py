@@ -11,19 +11,21 @@ f_k = I_k A_k + V_k x* I_k V_k, F_k the sum of the f of k's outward set, tau_k =
 with that rule and collecting the sums over outward sets (the analysis of Carpentier and
 Mansard, RSS 2018, "Analytical derivatives of rigid body dynamics algorithms", here for one
 direction at a time) gives, with e_j the joint's increments along its columns (dq itself for a
-revolute or prismatic joint), U_j = V and B_j = A of j's parent (the ground's: 0 and -g),
-Y_j = S_j x U_j and h_k = I_k V_k,
+revolute or prismatic joint), U_j = V and B_j = A of j's parent (the ground's: 0 and -g) and
+h_k = I_k V_k,
 
-    g2_j = (Y_j x U_j - S_j x B_j) e_j - (Y_j + S_j x V_j) dv_j,   g3_j = Y_j e_j - S_j dv_j
+    s_j = S_j e_j,  w_j = S_j dv_j                                 (the joint's twists)
+    g2_j = (s_j x U_j) x U_j - s_j x B_j - w_j x U_j - w_j x V_j,   g3_j = s_j x U_j - w_j
     (P2, P3) = the outward sums of (g2, g3)                         (one outward pass)
-    o_k = (S_k x* F_k) e_k
+    o_k = s_k x* F_k
     L_k = I_k P2_k - P3_k x* h_k - I_k (P3_k x V_k) - V_k x* I_k P3_k + o_k
     dtau_k = S_k^T (the sum of L over k's outward set - o_k) + damping_k dv_k   (one inward pass)
 
-(S_j x (.) acting column by column). It is linear in (dq, dv), so reverse mode transposes it
-into the same two passes run the other way: the adjoint's RNEA VJP at the solved accelerations
-(`mbjax.rigid.adjoint`) without differentiating the kinematics. Agrees with `jax.jvp` of
-`inverse_dynamics` to rounding (tests/rigid/test_adjoint.py).
+The formulas are linear in the columns of S, so each joint enters through its two twists s and
+w. It is linear in (dq, dv), so reverse mode transposes it into the same two passes run the
+other way: the adjoint's RNEA VJP at the solved accelerations (`mbjax.rigid.adjoint`) without
+differentiating the kinematics. Agrees with `jax.jvp` of `inverse_dynamics` to rounding
+(tests/rigid/test_adjoint.py).
 """
 
 import jax
@@ -59,14 +61,14 @@ def rnea_jvp(model: Model, q: Array, v: Array, a: Array, dq: Array, dv: Array) -
     F = _inward_sum(model, _times(I, A) + cross_force(V, h))
     U = _parent(model, V, jnp.zeros_like(ground))
     B = _parent(model, A, ground)
-    Y = _each(cross_motion, S, U)
-    e, dv_ = _increments(model, q, v, dq), model.body_v(dv)
-    g = jnp.concatenate([_columns(_each(cross_motion, Y, U) - _each(cross_motion, S, B), e)
-                         - _columns(Y + _each(cross_motion, S, V), dv_),
-                         _columns(Y, e) - _columns(S, dv_)], -1)
+    # the joints' twists along (dq, dv): s = S e, w = S dv (the formulas are linear in S's columns)
+    s, w = _columns(S, _increments(model, q, v, dq)), _columns(S, model.body_v(dv))
+    sU = cross_motion(s, U)
+    g = jnp.concatenate([cross_motion(sU, U) - cross_motion(s, B) - cross_motion(w, U)
+                         - cross_motion(w, V), sU - w], -1)
     P = _outward_sum(model, g, jnp.zeros(12, q.dtype))
     P2, P3 = P[:, :6], P[:, 6:]
-    own = _columns(_each(cross_force, S, F), e)
+    own = cross_force(s, F)
     L = (_times(I, P2) - cross_force(P3, h) - _times(I, cross_motion(P3, V))
          - cross_force(V, _times(I, P3)) + own)
     dtau = jnp.einsum("kic,ki->kc", S, _inward_sum(model, L) - own)
@@ -88,11 +90,6 @@ def _increments(model: Model, q: Array, v: Array, dq: Array) -> Array:
 def _columns(S: Array, x: Array) -> Array:
     """sum_c S[k, :, c] x[k, c]: (n, 6, width), (n, width) -> (n, 6)."""
     return jnp.einsum("kic,kc->ki", S, x)
-
-
-def _each(op, S: Array, x: Array) -> Array:
-    """op(S[k, :, c], x[k]) for every column c: (n, 6, width), (n, 6) -> (n, 6, width)."""
-    return jax.vmap(op, in_axes=(-1, None), out_axes=-1)(S, x)
 
 
 def _times(I: Array, x: Array) -> Array:       # noqa: E741
