@@ -23,7 +23,7 @@ intermediate of the recursion (storing them is slower: 4.8x against 3.0x in one 
 steps of semi-implicit Euler, each loop compiled as one kernel (`mbjax.runtime`; the rule's
 passes hold no gather or scatter in either direction, `mbjax.tree.take`): the gradient costs
 2.7x the rollout (3.2 us a step; 3.4x with JAX's derivative of the RNEA, 6.0x differentiating
-the recursion itself); 30 links, 2.7-2.9x (was 3.4x); the Unitree G1 (a free base) 3.6x (was
+the recursion itself); 30 links, 2.7-2.9x (was 3.4x); the Unitree G1 (a free base) 3.2x (was
 3.9x).
 
 `with_adjoint(fd)` gives `fd` (any function computing the forward dynamics of a tree: `aba`, or

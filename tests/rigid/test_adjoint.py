@@ -70,8 +70,7 @@ def test_first_derivatives_are_the_recursions(model, wrenches):
     q, v, tau, f_ext = _state(model, 2)
     neutral = (model.neutral(), jnp.zeros(model.nv), tau, f_ext)
     if not wrenches:
-        q, v, tau, f_ext = q, v, tau, None
-        neutral = neutral[:3] + (None,)
+        f_ext, neutral = None, neutral[:3] + (None,)
     assert applies(model) == (model is not MODEL)
 
     def ours(*x):
