@@ -61,12 +61,13 @@ def test_solve_with_the_factor_is_the_inverse_mass_matrix():
     assert _relative(ours, reference) < 1e-12
 
 
-@pytest.mark.parametrize("model", [MODEL, HINGES, BALLS], ids=["every joint", "hinges", "balls"])
-@pytest.mark.parametrize("wrenches", [True, False], ids=["f_ext", "no f_ext"])
+@pytest.mark.parametrize(("model", "wrenches"), [(MODEL, True), (HINGES, False), (BALLS, False)],
+                         ids=["every joint, f_ext", "hinges", "balls"])
 def test_first_derivatives_are_the_recursions(model, wrenches):
     """jacfwd and jacrev in q, v, tau (and the external wrenches), at a random state and at
-    q = neutral, v = 0 (zero rotations), against those of `aba` itself; with no external wrench
-    a tree without universal joints takes the RNEA's derivatives written out."""
+    q = neutral, v = 0 (zero rotations), against those of `aba` itself: through JAX's
+    derivative of the RNEA (a universal joint, external wrenches) and through the RNEA's
+    derivatives written out (trees of hinges; with free and spherical joints)."""
     q, v, tau, f_ext = _state(model, 2)
     neutral = (model.neutral(), jnp.zeros(model.nv), tau, f_ext)
     if not wrenches:
@@ -159,13 +160,20 @@ def test_rnea_jvp_is_the_rneas_derivative(model, where):
     q = {"random": 0.5 * q + model.neutral(), "zero rotation": model.neutral(),
          "half turns": jnp.asarray(half_turn)}[where]
 
+    got, want, got_t, want_t = _rnea_derivatives(model, q, v, a, dq, dv, lam)
+    assert _relative(got, want) < 1e-12
+    for g, w in zip(got_t, want_t, strict=True):
+        assert _relative(g, w) < 1e-12
+
+
+@jax.jit
+def _rnea_derivatives(model, q, v, a, dq, dv, lam):
+    """(rnea_jvp, jax.jvp of the RNEA, rnea_jvp's transpose at lam, jax.vjp of the RNEA at lam),
+    one compiled program per model."""
     def rnea(q, v):
         return inverse_dynamics(model, q, v, a)
 
     _, want = jax.jvp(rnea, (q, v), (dq, dv))
-    got = jax.jit(rnea_jvp)(model, q, v, a, dq, dv)
-    assert _relative(got, want) < 1e-12
     _, vjp = jax.vjp(rnea, q, v)
     _, transpose = jax.vjp(lambda dq, dv: rnea_jvp(model, q, v, a, dq, dv), dq, dv)
-    for g, w in zip(transpose(lam), vjp(lam), strict=True):
-        assert _relative(g, w) < 1e-12
+    return rnea_jvp(model, q, v, a, dq, dv), want, transpose(lam), vjp(lam)
