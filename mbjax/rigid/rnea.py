@@ -17,7 +17,10 @@ from mbjax.spatial import cross_force, shift_force
 from mbjax.tree import backward_pass, forward_pass
 
 
-def _rnea(model: Model, q: Array, v: Array, a: Array, f_ext: Array | None) -> tuple[Array, Kinematics]:
+def rnea_passes(model: Model, q: Array, v: Array, a: Array,
+                f_ext: Array | None) -> tuple[Array, Kinematics, Array]:
+    """(f_bar, the kinematics, acc): the wrench f_bar (n, 6) that each body's outward set needs
+    and the body accelerations acc (n, 6, gravity in them), ground frame at the ground origin."""
     kin = body_kinematics(model, q, v)
     joint_acc = jnp.einsum("kij,kj->ki", kin.S, model.body_v(a)) + kin.c
     acc = forward_pass(model.topology, lambda a_parent, da: a_parent + da,
@@ -27,14 +30,14 @@ def _rnea(model: Model, q: Array, v: Array, a: Array, f_ext: Array | None) -> tu
     if f_ext is not None:
         f = f - shift_force(f_ext, kin.p)
     f_bar, _ = backward_pass(model.topology, lambda f_k, _: (f_k, f_k), f)
-    return f_bar, kin
+    return f_bar, kin, acc
 
 
 def joint_wrenches(model: Model, q: Array, v: Array, a: Array, f_ext: Array | None = None) -> Array:
     """The wrench each joint transmits to its outward system (n, 6) for joint accelerations a
     (nv,): (torque about the joint origin; force) in body coordinates. Its projection on the joint
     axes is tau; the rest are the constraint forces K_c of seed 001 eq 76."""
-    f_bar, kin = _rnea(model, q, v, a, f_ext)
+    f_bar, kin, _ = rnea_passes(model, q, v, a, f_ext)
     Rt = jnp.swapaxes(kin.R, -1, -2)
     torque = f_bar[:, :3] - jnp.cross(kin.p, f_bar[:, 3:])         # about the hinge
     return jnp.concatenate([jnp.einsum("kij,kj->ki", Rt, torque),
@@ -45,6 +48,6 @@ def inverse_dynamics(model: Model, q: Array, v: Array, a: Array, f_ext: Array | 
     """Joint forces tau (nv,) that give accelerations a at state (q, v) under gravity and the
     external wrenches f_ext (n, 6) (world frame, (torque about body k's origin; force)), with
     the joints' armature and damping."""
-    f_bar, kin = _rnea(model, q, v, a, f_ext)
+    f_bar, kin, _ = rnea_passes(model, q, v, a, f_ext)
     return (model.flat_v(jnp.einsum("kij,ki->kj", kin.S, f_bar))
             + model.armature * a + model.damping * v)

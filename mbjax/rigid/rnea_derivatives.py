@@ -6,13 +6,13 @@ origin (see `kinematics`): moving joint j along one column S_c of its motion sub
 outward set, body j included, rigidly about the screw S_c, so every ground-frame quantity X that
 rides on a body of that set changes by S_c x X (motion vectors: S_c x m, forces: S_c x* f,
 inertias: S_c x* I - I S_c x). This needs the columns fixed in body j (a universal joint's first
-axis is fixed in its parent instead: not covered). Differentiating the RNEA (`rnea`: V_k, A_k,
-f_k = I_k A_k + V_k x* I_k V_k, F_k the sum of the f of k's outward set, tau_k = S_k^T F_k)
-with that rule and collecting the sums over outward sets (the analysis of Carpentier and
-Mansard, RSS 2018, "Analytical derivatives of rigid body dynamics algorithms", here for one
-direction at a time) gives, with e_j the joint's increments along its columns (dq itself for a
-revolute or prismatic joint), U_j = V and B_j = A of j's parent (the ground's: 0 and -g) and
-h_k = I_k V_k,
+axis is fixed in its parent instead: not covered). Differentiating the RNEA
+(`rnea.rnea_passes`: V_k, A_k, f_k = I_k A_k + V_k x* I_k V_k, F_k the sum of the f of k's
+outward set, tau_k = S_k^T F_k) with that rule and collecting the sums over outward sets (the
+analysis of Carpentier and Mansard, RSS 2018, "Analytical derivatives of rigid body dynamics
+algorithms", here for one direction at a time) gives, with e_j the joint's increments along
+its columns (dq itself for a revolute or prismatic joint), U_j = V and B_j = A of j's parent
+(the ground's: 0 and -g) and h_k = I_k V_k,
 
     s_j = S_j e_j,  w_j = S_j dv_j                                 (the joint's twists)
     g2_j = (s_j x U_j) x U_j - s_j x B_j - w_j x U_j - w_j x V_j,   g3_j = s_j x U_j - w_j
@@ -35,7 +35,8 @@ from jax import Array
 
 from mbjax.lie import vee
 from mbjax.model import Model
-from mbjax.rigid.kinematics import body_kinematics, gravity_acceleration
+from mbjax.rigid.kinematics import gravity_acceleration
+from mbjax.rigid.rnea import rnea_passes
 from mbjax.spatial import cross_force, cross_motion
 from mbjax.tree import backward_pass, forward_pass
 from mbjax.tree.take import take
@@ -53,12 +54,10 @@ def rnea_jvp(model: Model, q: Array, v: Array, a: Array, dq: Array, dv: Array) -
     """d tau = d/de RNEA(model, q + e dq, v + e dv, a) at e = 0 (armature and damping included),
     for a tree of the joints `applies` accepts. dq is a tangent of the coordinates q (a
     quaternion's included, as the RNEA reads it, normalized)."""
-    kin = body_kinematics(model, q, v)
+    F, kin, A = rnea_passes(model, q, v, a, None)
     S, V, I = kin.S, kin.V, kin.I                     # noqa: E741 (the papers' name)
-    ground = gravity_acceleration(model)
-    A = _outward_sum(model, _columns(S, model.body_v(a)) + kin.c, ground)
     h = _times(I, V)
-    F = _inward_sum(model, _times(I, A) + cross_force(V, h))
+    ground = gravity_acceleration(model)
     U = _parent(model, V, jnp.zeros_like(ground))
     B = _parent(model, A, ground)
     # the joints' twists along (dq, dv): s = S e, w = S dv (the formulas are linear in S's columns)
