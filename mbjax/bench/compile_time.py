@@ -142,7 +142,8 @@ def plot(records: list[dict], path: Path) -> None:
 def report(records: list[dict]) -> str:
     """The tours and the targets as Markdown tables."""
     tours = {r["cache"]: r for r in records if r.get("kind") == "tour"}
-    lines = ["| scene | cold [s] | programs | warm [s] | programs |", "| --- | --- | --- | --- | --- |"]
+    lines = ["| scene | cold [s] | programs | warm [s] | programs |",
+             "| --- | --- | --- | --- | --- |"]
     for name, cold in tours["cold"]["scenes"].items():
         warm = tours["warm"]["scenes"][name]
         lines.append(f"| {name} | {cold['wall_s']:.1f} | {cold['programs']} | "
@@ -155,6 +156,6 @@ def report(records: list[dict]) -> str:
     lines += [f"| {name} | {first[name]['first_s'] * 1e3:.0f} | {first[name]['call_s'] * 1e6:.1f} |"
               for name in ("forward_dynamics", "mass_matrix")]
     lines += ["", "| target | measured [s] | limit [s] | met |", "| --- | --- | --- | --- |"]
-    lines += [f"| {t['target']} | {t['value']:.1f} | {t['limit']:g} | {'yes' if t['met'] else 'no'} |"
-              for t in records[-1]["targets"]]
+    lines += [f"| {t['target']} | {t['value']:.1f} | {t['limit']:g} | "
+              f"{'yes' if t['met'] else 'no'} |" for t in records[-1]["targets"]]
     return "\n".join(lines)

@@ -78,8 +78,7 @@ class FlexibleModel(eqx.Module):
                    else ModalBody.rigid(model.mass[k], model.com[k], model.inertia[k], mu)
                    .padded(mu, nodes) for k in range(n)]
         self.model = model
-        self.bodies = eqx.filter_jit(lambda *bodies: jax.tree.map(lambda *a: jnp.stack(a), *bodies))(
-            *stacked)
+        self.bodies = _stack(*stacked)
         self.modes = tuple(flexible[k].mu if k in flexible else 0 for k in range(n))
         self.attach = tuple(attach.get(k, -1) for k in range(n))
         self.markers = markers
@@ -159,3 +158,9 @@ class FlexibleModel(eqx.Module):
     def without_stiffening(self) -> "FlexibleModel":
         """Geometric stiffening switched off in every body."""
         return eqx.tree_at(lambda m: m.bodies, self, self.bodies.without_stiffening())
+
+
+@eqx.filter_jit
+def _stack(*bodies: ModalBody) -> ModalBody:
+    """The bodies' coefficients stacked along a new leading axis (one compiled program)."""
+    return jax.tree.map(lambda *a: jnp.stack(a), *bodies)
