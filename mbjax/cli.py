@@ -1,6 +1,6 @@
 """The `mbjax` command: the tour of every scene, paper reproductions and benchmark suites.
 
-    mbjax tour [--out DIR] [--quick] [--scene NAME ...]
+    mbjax tour [--out DIR] [--quick] [--scene NAME ...] [--jobs N]
     mbjax reproduce NAME [--out DIR] [--quick]    |    mbjax reproduce --list
     mbjax bench SUITE [--out DIR] [--quick]
 
@@ -12,7 +12,7 @@ names and bad options exit with status 2 and list the valid choices.
 import argparse
 import json
 import sys
-import time
+from functools import partial
 from pathlib import Path
 
 
@@ -27,6 +27,9 @@ def _parser(reproductions, suites, scenes) -> argparse.ArgumentParser:
     tour.add_argument("--quick", action="store_true", help="shorter runs (< 5 min on 2 cores)")
     tour.add_argument("--scene", action="append", choices=list(scenes), metavar="NAME",
                       help=f"run only this scene (repeatable), one of: {', '.join(scenes)}")
+    tour.add_argument("--jobs", type=_positive_int, default=None, metavar="N",
+                      help="scenes run at once, each in a process of its own (default: one per "
+                           "core; 1: one after another in this process, for quiet timings)")
 
     rep = commands.add_parser("reproduce", help="reproduce a paper figure or table")
     rep.add_argument("name", nargs="?", choices=sorted(reproductions), metavar="NAME",
@@ -43,18 +46,23 @@ def _parser(reproductions, suites, scenes) -> argparse.ArgumentParser:
     return parser
 
 
-def _tour(out: Path, quick: bool, scenes=None) -> None:
-    from mbjax.progress import progress
-    from mbjax.tour import TOUR
+def _positive_int(text: str) -> int:
+    value = int(text)
+    if value < 1:
+        raise argparse.ArgumentTypeError(f"must be at least 1, got {value}")
+    return value
+
+
+def _tour(out: Path, quick: bool, scenes=None, jobs=None) -> None:
+    from mbjax import parallel
+    from mbjax.tour import COST, TOUR, run_scene
 
     names = [name for name in TOUR if not scenes or name in scenes]
     out.mkdir(parents=True, exist_ok=True)
-    summary = {"quick": quick, "scenes": {}}
-    for name in progress(names, len(names), "mbjax tour"):
-        start = time.perf_counter()
-        result = TOUR[name](out, quick)
-        result["wall_seconds"] = time.perf_counter() - start
-        summary["scenes"][name] = result
+    # side by side, the longest first balances the workers; one at a time, the summary's order
+    order = names if jobs == 1 else sorted(names, key=lambda name: -COST.get(name, 0.0))
+    results = parallel.run(partial(run_scene, out=out, quick=quick), order, jobs, "mbjax tour")
+    summary = {"quick": quick, "scenes": {name: results[name] for name in names}}
     (out / "summary.json").write_text(json.dumps(summary, indent=1))
     (out / "summary.md").write_text(_summary_markdown(summary))
     print(f"tour written to {out}/: summary.json, summary.md and "
@@ -108,7 +116,7 @@ def main(argv=None) -> int:
     if args.command == "bench" and args.suite == "throughput":
         _one_device_per_core()
     if args.command == "tour":
-        _tour(args.out, args.quick, args.scene)
+        _tour(args.out, args.quick, args.scene, args.jobs)
     elif args.command == "reproduce":
         if args.list:
             print("\n".join(sorted(REPRODUCTIONS)))

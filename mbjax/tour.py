@@ -398,7 +398,7 @@ def _model_peers() -> dict:
     return out
 
 
-TOUR = {
+TOUR = {   # in the order the summary tells them
     "torque-free-body": torque_free_body_tour,
     "heavy-top": heavy_top_tour,
     "rigid-chain": rigid_chain_tour,
@@ -409,3 +409,17 @@ TOUR = {
     "controls": controls_tour,
     "models": models_tour,
 }
+
+# Each scene's wall time in a quick tour from a cold cache, one scene at a time (benchmarks/README
+# compile section): `mbjax tour` starts the longest first, which balances its workers best.
+COST = {"time-elements": 9.1, "carpal-wrist": 9.0, "closed-loops": 8.6, "flexible-bodies": 7.7,
+        "controls": 6.4, "rigid-chain": 4.8, "models": 2.6, "torque-free-body": 2.3,
+        "heavy-top": 1.6}
+
+
+def run_scene(name: str, out: Path, quick: bool) -> dict:
+    """The summary of scene `name`, with its wall time (compiling, running and drawing)."""
+    start = time.perf_counter()
+    result = TOUR[name](out, quick)
+    result["wall_seconds"] = time.perf_counter() - start
+    return result

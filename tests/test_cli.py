@@ -75,6 +75,9 @@ TOUR_GROUPS = {
 }
 
 
+TOUR_GROUPS_ALL = [scene for group in TOUR_GROUPS.values() for scene in group]
+
+
 def test_tour_groups_cover_every_scene():
     from mbjax.tour import TOUR
 
@@ -89,10 +92,28 @@ def test_tour_rejects_an_unknown_scene(capsys):
     assert exit_info.value.code == 2 and "carpal-wrist" in capsys.readouterr().err
 
 
+def test_tour_rejects_jobs_below_one(capsys):
+    with pytest.raises(SystemExit) as exit_info:
+        main(["tour", "--jobs", "0"])
+    assert exit_info.value.code == 2 and "--jobs: must be at least 1" in capsys.readouterr().err
+
+
+def test_tour_in_workers(tmp_path):
+    """Scenes side by side in worker processes (`mbjax.parallel`), the summary in the tour's
+    order whichever finishes first."""
+    assert main(["tour", "--quick", "--out", str(tmp_path), "--jobs", "2",
+                 "--scene", "heavy-top", "--scene", "torque-free-body"]) == 0
+    summary = json.loads((tmp_path / "summary.json").read_text())
+    assert list(summary["scenes"]) == ["torque-free-body", "heavy-top"]
+    for scene in summary["scenes"].values():
+        assert (tmp_path / scene["figure"]).stat().st_size > 10_000 and scene["wall_seconds"] > 0
+    assert summary["scenes"]["torque-free-body"]["integrators"]["rkmk4"]["final_error_rad"] < 1e-4
+
+
 @pytest.mark.parametrize("group", list(TOUR_GROUPS))
 def test_tour_quick(tmp_path, group):
-    scenes = TOUR_GROUPS[group]
-    assert main(["tour", "--quick", "--out", str(tmp_path),
+    scenes = TOUR_GROUPS[group]        # one after another here: xdist runs the groups side by side
+    assert main(["tour", "--quick", "--out", str(tmp_path), "--jobs", "1",
                  *[arg for scene in scenes for arg in ("--scene", scene)]]) == 0
     summary = json.loads((tmp_path / "summary.json").read_text())
     assert set(summary["scenes"]) == set(scenes)
@@ -476,17 +497,22 @@ def test_bench_speed_quick(tmp_path):
 
 @pytest.mark.slow
 def test_bench_compile(tmp_path):
-    """`mbjax bench compile` (about 80 s on 2 cores): the warm tour loads from the persistent
-    cache every program the cold tour compiled, scene by scene (no timing is asserted); the
-    first calls outside jit are recorded; each scene's target is there."""
+    """`mbjax bench compile` (about 2.5 min on 2 cores): the warm tour loads from the persistent
+    cache every program the cold tour compiled, scene by scene (no timing is asserted), with a
+    worker per core and one scene at a time; the first calls outside jit are recorded; each
+    scene's target is there."""
+    from mbjax.parallel import cores
+
     assert main(["bench", "compile", "--out", str(tmp_path)]) == 0
     records = [json.loads(line) for line in (tmp_path / "compile.jsonl").read_text().splitlines()]
-    tours = {r["cache"]: r for r in records if r["kind"] == "tour"}
-    assert set(tours) == {"cold", "warm"}
-    assert {n: s["programs"] for n, s in tours["warm"]["scenes"].items()} == \
-        {n: s["programs"] for n, s in tours["cold"]["scenes"].items()}
+    tours = {(r["jobs"], r["cache"]): r for r in records if r["kind"] == "tour"}
+    assert set(tours) == {(jobs, cache) for jobs in (1, cores()) for cache in ("cold", "warm")}
+    assert {n: s["programs"] for n, s in tours[1, "warm"]["scenes"].items()} == \
+        {n: s["programs"] for n, s in tours[1, "cold"]["scenes"].items()}
+    assert all(s["programs"] > 0 for s in tours[1, "cold"]["scenes"].values())
+    assert all(set(tour["scenes"]) == set(TOUR_GROUPS_ALL) for tour in tours.values())
     first = next(r for r in records if r["kind"] == "first_calls")
     assert set(first["forward_dynamics"]) == set(first["mass_matrix"]) == {"first_s", "call_s"}
     targets = {t["target"] for t in records[-1]["targets"]}
-    assert {f"scene {name}, cold cache" for name in tours["cold"]["scenes"]} < targets
+    assert {f"scene {name}, cold cache" for name in TOUR_GROUPS_ALL} < targets
     assert (tmp_path / "compile.png").stat().st_size > 10_000
