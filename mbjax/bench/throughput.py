@@ -21,7 +21,8 @@ For regular n-link chains (`mbjax.model.chain(n)`, n = 7, 30, 100; float64 unles
    the cheaper route for few inputs.
 
 With more than one CPU device (`mbjax bench throughput` starts one per core, `cli`), the rollouts
-and a "batch_aba sharded" series split the batch over them, as the peers use one thread per core.
+and a "vmap sharded" series (`jit(vmap(forward_dynamics))` with its batch split by
+`jax.shard_map`) split the batch over them, as the peers use one thread per core.
 
 JSON lines + PNG; the last record (kind "summary") holds the targets of issue 8, each met or
 missed with its ratio.
@@ -90,11 +91,14 @@ def _split(fn, devices, in_specs, out_specs):
 
 
 def _sharded_fn(devices):
-    """`batch_aba` with the batch (last axis) split over `devices` (`_split`; a jit of the whole
-    batch left the partitioning to XLA, which did not split the chunked loop: 1.69 against 1.58
-    us per state on one device)."""
-    spec = jax.sharding.PartitionSpec(None, "batch")
-    return _split(batch_aba, devices, (jax.sharding.PartitionSpec(), spec, spec, spec), spec)
+    """`jit(vmap(forward_dynamics))` with the batch (first axis) split over `devices` (`_split`;
+    a jit of the whole batch left the partitioning to XLA, which did not split the chunked loop:
+    1.69 against 1.58 us per state on one device). The vmap's own route on each device, not
+    `batch_aba` split by its last axis: 7-link chain, B = 4096, 0.70 against 0.93 us per state
+    (one A/B script, two devices)."""
+    spec = jax.sharding.PartitionSpec("batch")
+    fd = jax.vmap(partial(forward_dynamics, method="recursive"), in_axes=(None, 0, 0, 0))
+    return _split(fd, devices, (jax.sharding.PartitionSpec(), spec, spec, spec), spec)
 
 
 def _vmap_fn():
@@ -138,15 +142,16 @@ def _forward_records(ns, batches, repeats: int, budget_s: float, common: dict) -
         for method, dtype, fn in (("batch_aba", "float64", f64),
                                   ("batch_aba", "float32", _batch_fn("float32")),
                                   ("vmap", "float64", _vmap_fn()),
-                                  ("batch_aba sharded", "float64", _sharded_fn(jax.devices()))):
-            if method == "batch_aba sharded" and len(jax.devices()) < 2:
+                                  ("vmap sharded", "float64", _sharded_fn(jax.devices()))):
+            if method == "vmap sharded" and len(jax.devices()) < 2:
                 continue
             for batch in batches:
-                if method == "batch_aba sharded" and batch % len(jax.devices()):
+                if method == "vmap sharded" and batch % len(jax.devices()):
                     continue
                 args = (model, Q[:batch], V[:batch], T[:batch])
-                if method == "batch_aba sharded":
-                    args = (model, *(shard_batch(x[:batch].T, jax.devices()) for x in (Q, V, T)))
+                if method == "vmap sharded":
+                    args = (model, *(shard_batch(x[:batch], jax.devices(), axis=0)
+                                     for x in (Q, V, T)))
                 acc, timing = timed(fn, *args, repeats=repeats, budget_s=budget_s)
                 acc = np.asarray(acc)
                 if method.startswith("batch_aba"):

@@ -13,9 +13,10 @@ from mbjax.lie.quaternion import (
     rotvec_from_quat,
 )
 from mbjax.lie.rotation_vector import det_gamma, exp, gamma, gamma_inv, hat, log, rescale, vee
+from mbjax.lie.sincos import sincos
 
 __all__ = [
-    "det_gamma", "exp", "gamma", "gamma_inv", "hat", "log", "rescale", "vee",
+    "det_gamma", "exp", "gamma", "gamma_inv", "hat", "log", "rescale", "sincos", "vee",
     "quat_conjugate", "quat_from_matrix", "quat_from_rotvec", "quat_multiply", "quat_normalize",
     "quat_to_matrix", "rotvec_from_quat",
 ]

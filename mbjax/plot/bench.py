@@ -183,7 +183,7 @@ def throughput_figure(records: list[dict]) -> Figure:
     ns = sorted({r["n"] for r in forward})
     styles = {7: "-", 30: "--", 100: ":"}
     series = (("mbjax", "batch_aba", "float64", COLORS.get("rk4", "C0"), "mbjax batch_aba"),
-              ("mbjax", "batch_aba sharded", "float64", "C5", "mbjax batch_aba, one device per core"),
+              ("mbjax", "vmap sharded", "float64", "C5", "mbjax jit(vmap), one device per core"),
               ("mbjax", "batch_aba", "float32", "C2", "mbjax batch_aba float32"),
               ("mbjax", "vmap", "float64", "C1", "mbjax jit(vmap(forward_dynamics))"),
               ("pinocchio", "abaInParallel", "float64", "C3", "Pinocchio abaInParallel"))
