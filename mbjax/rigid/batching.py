@@ -4,12 +4,12 @@ A user batches with `jax.vmap(mbjax.forward_dynamics)`. Left to itself, vmap put
 in front of every 6x6 block of `aba` (mbjax.rigid.aba), many small batched matrix products per
 body; `batch_aba` (mbjax.rigid.batched) runs the same recursion of seed 002 §2.3 with the batch
 last, as straight-line elementwise code: 7.2 -> 1.4 us per state for the 7-link chain at
-B = 4096 (`mbjax bench speed`, benchmarks/README.md). `aba_vmappable` is `aba` whose vmap rule
+B = 4096, 0.65 us since its sines and symmetric blocks (`mbjax bench speed`, benchmarks/README.md). `aba_vmappable` is `aba` whose vmap rule
 (`jax.custom_batching.custom_vmap`) takes that route when it can:
 
 - the model itself is not batched (a sweep over model parameters keeps the plain vmap), its
   joints are all revolute or prismatic, and the batch has at least BATCH_CROSSOVER states (below
-  that the two are within noise of each other and the plain vmap compiles faster);
+  that one vmapped call costs less one state after another, see BATCH_CROSSOVER);
 - anything else (free, spherical or universal joints, a batched model, a small batch) runs one
   state after another where XLA compiles loops as one kernel (`mbjax.runtime.hoisting`): a
   `lax.map` of `aba`, each state costing what an evaluation costs in a rollout (the G1
@@ -33,10 +33,12 @@ from mbjax.model import Model
 from mbjax.rigid.aba import aba
 from mbjax.rigid.batched import JOINTS, batch_aba
 
-# Batch size from which jax.vmap runs batch_aba: jit(vmap) of the 7-link chain, batch_aba
-# against the plain vmap, 3.2 against 3.6 us per state at B = 64, 2.4 against 2.9 at 256, 3.0
-# against 7.2 at 4096 (one A/B script, 2-core CPU; 38 against 47 at B = 1, 8.2 against 7.1 at 16).
-BATCH_CROSSOVER = 64
+# Batch size from which jax.vmap runs batch_aba. 7-link chain, batch_aba against one state
+# after another (one A/B script, 2-core CPU, since batch_aba's vectorized sines and symmetric
+# blocks): one jitted vmap call, 4.7 against 2.3 us per state at B = 16, 1.9 against 1.8 at 32,
+# 1.6 against 2.0 at 64; inside a 1000-step rollout, 3.5e5 against 1.9e5 steps/s at B = 16 and
+# 4.1e5 against 1.9e5 at 32 (a call's fixed cost is paid once per loop there).
+BATCH_CROSSOVER = 32
 
 
 def _one_by_one(in_batched, *args) -> Array:
