@@ -145,7 +145,9 @@ class _Board:
         self.draw()
 
     def finished(self, key, began: float) -> None:
-        self.running.pop(key, None)
+        if key not in self.running:     # its result came before its notice
+            self.started(key, began)
+        self.running.pop(key)
         self.ended.add(key)
         self.done += 1
         if not self.tty:
