@@ -14,9 +14,9 @@ Cephes 2.8 `sin.c`): |x| is reduced by the nearest even multiple k of pi/4 in th
 z in [-pi/4, pi/4]; sin z = z + z^3 P(z^2) and cos z = 1 - z^2/2 + z^4 Q(z^2) with Cephes'
 coefficients; the quadrant k/2 mod 4 picks and signs them. Relative error about 2e-16 for
 |x| < 2^30 (Cephes' table); beyond that the reduction loses digits, so there (a whole array with
-any |x| >= 2^30, or a non-finite x) `jnp.sin` and `jnp.cos` answer instead. float32 and other
-dtypes go to `jnp.sin` and `jnp.cos` directly. Derivatives are exact: d sin = cos dx, d cos =
--sin dx, from the same pair.
+any |x| >= 2^30, or a non-finite x) `jnp.sin` and `jnp.cos` answer instead (a `lax.cond`, which
+`jax.vmap` turns into running both). float32 and other dtypes go to `jnp.sin` and `jnp.cos`
+directly. Derivatives are exact: d sin = cos dx, d cos = -sin dx, from the same pair.
 """
 
 import jax
