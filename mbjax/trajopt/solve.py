@@ -1,0 +1,21 @@
+"""The one entry point of trajectory optimisation: `solve(problem, solver, us0)`."""
+
+import equinox as eqx
+from jax import Array
+
+from mbjax.trajopt.ilqr import ILQR
+from mbjax.trajopt.problem import Problem
+from mbjax.trajopt.result import AbstractSolver, Result
+
+
+@eqx.filter_jit
+def solve(problem: Problem, solver: AbstractSolver = ILQR(), us0: Array | None = None) -> Result:
+    """Optimise `problem`'s controls with `solver` (a strategy: `ILQR()`, ...) from `us0`
+    (horizon, nu), zeros by default, clipped to the bounds. One compiled program: the solver's
+    iterations run inside it, so a second problem of the same shapes (another target, another
+    model parameter) reuses it, and `jax.vmap` solves many at once."""
+    if not isinstance(problem, Problem):
+        raise TypeError(f"problem must be a mbjax.trajopt.Problem, got {type(problem).__name__}")
+    if not isinstance(solver, AbstractSolver):
+        raise TypeError(f"solver must be a solver instance such as ILQR(), got {solver!r}")
+    return solver.solve(problem, problem.initial_controls(us0))

@@ -1,0 +1,152 @@
+"""`mbjax.trajopt.solve` with `ILQR`: the LQR optimum of a linear problem in closed form, the
+box-constrained optimum against SciPy's bounded quasi-Newton, a 7-dof arm's reach (stationary
+under the single-shooting gradient), many targets in one vmapped solve, and clear errors."""
+
+import jax
+import jax.numpy as jnp
+import numpy as np
+import pytest
+from scipy.optimize import minimize
+
+from mbjax.model import Model
+from mbjax.rigid import TreeSystem, inverse_dynamics
+from mbjax.scenes import arm as scene
+from mbjax.trajopt import ILQR, Problem, solve
+
+# a 2 kg slider without gravity: x = (q, v), q_ddot = u / m; RK4 with u held over the step is
+# exact for it, x_{k+1} = F x_k + G u_k
+MASS, DT, N = 2.0, 0.05, 40
+F = np.array([[1.0, DT], [0.0, 1.0]])
+G = np.array([[DT**2 / (2 * MASS)], [DT / MASS]])
+W_X, W_U, W_F = np.diag([1.0, 0.1]), 0.01, np.diag([100.0, 10.0])
+GOAL = np.array([1.0, 0.0])
+
+
+def _slider() -> TreeSystem:
+    return TreeSystem(Model([-1], "prismatic", mass=[MASS], inertia=[0.1 * np.eye(3)],
+                            axis=[[1.0, 0.0, 0.0]], gravity=(0.0, 0.0, 0.0)))
+
+
+def _slider_problem(**bounds) -> Problem:
+    def running(q, v, u):
+        e = jnp.concatenate([q, v]) - GOAL
+        return e @ W_X @ e + W_U * u @ u
+
+    def terminal(q, v):
+        e = jnp.concatenate([q, v]) - GOAL
+        return e @ W_F @ e
+
+    return Problem(_slider(), [0.0], [0.0], dt=DT, horizon=N, running=running,
+                   terminal=terminal, **bounds)
+
+
+def _slider_qp():
+    """The problem as a quadratic in the controls, 1/2 u^T H u + g^T u + c, built from F and G."""
+    Phi = np.vstack([np.linalg.matrix_power(F, k + 1) for k in range(N)])
+    Gamma = np.zeros((2 * N, N))
+    for k in range(N):
+        for j in range(k + 1):
+            Gamma[2 * k:2 * k + 2, j] = (np.linalg.matrix_power(F, k - j) @ G)[:, 0]
+    weights = np.kron(np.eye(N), W_X * DT)
+    weights[-2:, -2:] = W_F                                    # x_N's weight is the terminal one
+    offset = Phi @ np.zeros(2) - np.tile(GOAL, N)              # states x_1 ... x_N minus the goal
+    H = 2 * (Gamma.T @ weights @ Gamma + W_U * DT * np.eye(N))
+    g = 2 * Gamma.T @ weights @ offset
+    c = offset @ weights @ offset + GOAL @ W_X @ GOAL * DT      # x_0's running cost
+    return H, g, c
+
+
+def test_a_linear_quadratic_problem_lands_on_the_lqr_optimum():
+    result = solve(_slider_problem(), ILQR())
+    H, g, c = _slider_qp()
+    u = np.linalg.solve(H, -g)
+    assert result.messages() == ["success"] and int(result.iterations) <= 3
+    np.testing.assert_allclose(np.asarray(result.us[:, 0]), u, rtol=0, atol=1e-9)
+    assert abs(float(result.cost) - (0.5 * u @ H @ u + g @ u + c)) < 1e-10
+    costs = np.asarray(result.costs)
+    assert np.all(np.isnan(costs[int(result.iterations) + 1:]))
+    assert np.all(np.diff(costs[:int(result.iterations) + 1]) <= 0)
+
+
+def test_control_bounds_give_the_box_constrained_optimum():
+    result = solve(_slider_problem(lower=-1.5, upper=1.5), ILQR())
+    H, g, c = _slider_qp()
+    reference = minimize(lambda u: 0.5 * u @ H @ u + g @ u, np.zeros(N), jac=lambda u: H @ u + g,
+                         bounds=[(-1.5, 1.5)] * N, method="L-BFGS-B",
+                         options=dict(ftol=1e-15, gtol=1e-12, maxiter=10_000))
+    us = np.asarray(result.us[:, 0])
+    assert result.messages() == ["success"]
+    assert np.all(np.abs(us) <= 1.5) and np.sum(np.isclose(np.abs(us), 1.5)) >= 3
+    np.testing.assert_allclose(us, reference.x, atol=1e-6)
+    assert abs(float(result.cost) - (reference.fun + c)) < 1e-8
+
+
+def _reach_problem(target_offset, steps: int = 100) -> Problem:
+    """The arm (mbjax.data.ARM7) from rest at the scene's pose to its flange moved by
+    target_offset: least-squares residuals, Crocoddyl's weighting (a running reach term and
+    small state and control regularization, a heavy terminal reach and rest term)."""
+    arm = scene.model()
+    q0, v0 = jnp.asarray(scene.Q_REF), jnp.zeros(arm.nv)
+    target = scene.flange(arm, q0) + jnp.asarray(target_offset)
+    hold = inverse_dynamics(arm, q0, v0, v0)
+
+    def running(q, v, u):
+        return jnp.sqrt(2.0) * jnp.concatenate([0.1 * (scene.flange(arm, q) - target),
+                                                1e-2 * (q - q0), 1e-2 * v, 1e-2 * (u - hold)])
+
+    def terminal(q, v):
+        return jnp.sqrt(2.0) * jnp.concatenate([100.0 * (scene.flange(arm, q) - target), v])
+
+    return Problem(TreeSystem(arm), q0, v0, dt=0.01, horizon=steps, running=running,
+                   terminal=terminal)
+
+
+def test_the_arm_reaches_its_target_at_a_stationary_point():
+    problem = _reach_problem([0.0, 0.4, 0.0])
+    hold = inverse_dynamics(problem.system.model, problem.q0, problem.v0, problem.v0)
+    us0 = jnp.tile(hold, (problem.horizon, 1))
+    result = solve(problem, ILQR(), us0)
+    assert result.messages() == ["success"]
+    final = scene.flange(problem.system.model, result.qs[-1])
+    target = scene.flange(problem.system.model, problem.q0) + jnp.array([0.0, 0.4, 0.0])
+    assert float(jnp.linalg.norm(final - target)) < 1e-5
+    assert float(jnp.linalg.norm(result.vs[-1])) < 1e-2
+    # the single-shooting gradient (reverse mode through the rollout) vanishes at the optimum
+    start = jnp.linalg.norm(jax.grad(problem.objective)(us0))
+    assert float(jnp.linalg.norm(jax.grad(problem.objective)(result.us))) < 1e-4 * float(start)
+    # the trajectory is the rollout of its controls
+    np.testing.assert_allclose(np.asarray(problem.rollout(result.us)[:, :7]),
+                               np.asarray(result.qs), atol=1e-12)
+
+
+def test_many_targets_in_one_vmapped_solve():
+    offsets = jnp.array([[0.0, 0.2, 0.0], [0.1, 0.0, 0.1], [0.0, -0.15, 0.05]])
+
+    @jax.vmap
+    def reach(offset):
+        return solve(_reach_problem(offset, steps=40), ILQR())
+
+    results = reach(offsets)
+    assert results.messages() == ["success"] * 3
+    one = solve(_reach_problem(offsets[1], steps=40), ILQR(iterations=300))
+    np.testing.assert_allclose(np.asarray(results.us[1]), np.asarray(one.us), atol=1e-8)
+
+
+def test_bad_problems_are_refused_with_the_argument_named():
+    system = _slider()
+    costs = dict(running=lambda q, v, u: u @ u, terminal=lambda q, v: q @ q)
+    with pytest.raises(ValueError, match="horizon"):
+        Problem(system, [0.0], [0.0], dt=0.1, horizon=0, **costs)
+    with pytest.raises(ValueError, match="dt"):
+        Problem(system, [0.0], [0.0], dt=-0.1, horizon=5, **costs)
+    with pytest.raises(ValueError, match="lower"):
+        Problem(system, [0.0], [0.0], dt=0.1, horizon=5, lower=[1.0, 2.0], **costs)
+    with pytest.raises(ValueError, match="lower must not exceed upper"):
+        Problem(system, [0.0], [0.0], dt=0.1, horizon=5, lower=1.0, upper=-1.0, **costs)
+    with pytest.raises(TypeError, match="mbjax system"):
+        Problem(system.model, [0.0], [0.0], dt=0.1, horizon=5, **costs)
+    problem = Problem(system, [0.0], [0.0], dt=0.1, horizon=5, **costs)
+    with pytest.raises(ValueError, match="us0"):
+        solve(problem, ILQR(), jnp.zeros((4, 1)))
+    with pytest.raises(TypeError, match="solver"):
+        solve(problem, ILQR)
