@@ -18,15 +18,16 @@ from jax import Array
 UNROLL = 6
 
 
-def spd_solve(A: Array, b: Array) -> Array:
+def spd_solve(A: Array, b: Array, unroll: int = UNROLL) -> Array:
     """A^-1 b for a symmetric positive-definite A (..., w, w) and b (..., w) or (..., w, k): a
-    division for w = 1, Cholesky written out for w <= UNROLL, else LAPACK's Cholesky."""
+    division for w = 1, Cholesky written out for w <= unroll, else LAPACK's Cholesky. NaN where
+    A is not positive definite."""
     w = A.shape[-1]
     if w == 1:
         return b / (A[..., 0] if b.ndim < A.ndim else A)
     if b.ndim < A.ndim:                          # a vector
-        return spd_solve(A, b[..., None])[..., 0]
-    if w > UNROLL:
+        return spd_solve(A, b[..., None], unroll)[..., 0]
+    if w > unroll:
         return jax.scipy.linalg.cho_solve(jax.scipy.linalg.cho_factor(A), b)
     L = [[None] * w for _ in range(w)]
     for j in range(w):                           # A = L L^T, column by column

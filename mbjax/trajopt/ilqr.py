@@ -15,9 +15,8 @@ Tassa, Mansard and Todorov 2014):
    (a projected Newton method on the box, a fixed number of iterations), and the feedback
    K_k = -Q_uu_ff^-1 Q_ux on the controls it leaves free (zero rows on the clamped ones); the
    value function is carried back through the closed loop;
-3. a forward pass u = clip(u_k + alpha k_k + K_k (x - x_k)) for several step lengths alpha at
-   once (`vmap` over alpha), keeping the longest whose cost decrease is at least a fraction of
-   the model's prediction;
+3. a forward pass u = clip(u_k + alpha k_k + K_k (x - x_k)), the step length alpha backtracking
+   through `steps` until the cost decrease is at least a fraction of the model's prediction;
 4. mu, the regularization of Q_uu, shrinks after a success and grows after a failure (a Q_uu
    that is not positive definite, or no acceptable step).
 
@@ -38,32 +37,42 @@ from mbjax.trajopt.result import AbstractSolver, Result, history
 
 MU_MIN, MU_MAX, MU_FACTOR = 1e-9, 1e10, 10.0
 ARMIJO = 1e-4             # accept a step whose decrease is this fraction of the predicted one
+# the control blocks' Cholesky written out up to this size (`linalg.spd_solve`), so that the
+# backward pass compiles as one kernel (a LAPACK call would keep it kernel by kernel)
+UNROLL = 16
 
 
 def box_qp(H: Array, g: Array, lower: Array, upper: Array, iterations: int):
     """(d, free): argmin 1/2 d^T H d + g^T d over lower <= d <= upper for a positive-definite H,
-    by projected Newton steps on the controls not held at a bound (Bertsekas 1982), and the mask
-    of the controls left free. Unbounded, one Newton step."""
+    by projected Newton steps on the controls not held at a bound (Bertsekas 1982) until a step
+    changes nothing or `iterations` pass, and the mask of the controls left free. Where no
+    control is held at a bound, one Newton step."""
     eye = jnp.eye(g.shape[0], dtype=H.dtype)
 
     def clamped(d):
         grad = H @ d + g
         return ((d <= lower) & (grad > 0)) | ((d >= upper) & (grad < 0))
 
-    def newton(_, d):
+    def newton(carry):
+        d, _, i = carry
         free = ~clamped(d)
         H_free = jnp.where(free[:, None] & free[None, :], H, eye)
         rhs = jnp.where(free, -(g + H @ jnp.where(free, 0.0, d)), d)
-        return jnp.clip(spd_solve(H_free, rhs), lower, upper)
+        return jnp.clip(spd_solve(H_free, rhs, UNROLL), lower, upper), d, i + 1
 
-    d = jax.lax.fori_loop(0, iterations, newton, jnp.clip(spd_solve(H, -g), lower, upper))
+    def unsettled(carry):
+        d, previous, i = carry
+        return (i < iterations) & jnp.any(clamped(d)) & ((i == 0) | jnp.any(d != previous))
+
+    d = jnp.clip(spd_solve(H, -g, UNROLL), lower, upper)
+    d, _, _ = jax.lax.while_loop(unsettled, newton, (d, d, jnp.array(0)))
     return d, ~clamped(d)
 
 
 class ILQR(AbstractSolver):
     """See the module. `iterations`: at most this many; `tolerance`: the relative cost decrease
     below which it stops; `regularization`: mu's first value; `steps`: the step lengths alpha
-    tried at once in each forward pass; `qp_iterations`: projected Newton steps of the bounded
+    tried in turn in each forward pass; `qp_iterations`: projected Newton steps of the bounded
     control step."""
 
     iterations: int = eqx.field(static=True, default=200)
@@ -84,14 +93,23 @@ class ILQR(AbstractSolver):
 
         def iterate(s):
             k, K, decrease, ok = self._backward(problem, s["xs"], s["us"], s["mu"])
-            trials = jax.vmap(lambda a: self._forward(problem, s["xs"], s["us"], k, K, a))(alphas)
-            new_costs = trials[2]
-            predicted = -(alphas * decrease[0] + alphas**2 * decrease[1])
-            good = ok & jnp.isfinite(new_costs) & (s["cost"] - new_costs > ARMIJO * predicted)
-            best = jnp.argmax(good)                       # the longest acceptable step
-            accept = good[best]
-            xs, us, cost = (jnp.where(accept, t[best], old) for t, old in
-                            zip(trials, (s["xs"], s["us"], s["cost"]), strict=True))
+
+            def acceptable(trial):
+                _, _, cost, i = trial
+                alpha = alphas[jnp.maximum(i - 1, 0)]
+                predicted = -(alpha * decrease[0] + alpha**2 * decrease[1])
+                return (i > 0) & jnp.isfinite(cost) & (s["cost"] - cost > ARMIJO * predicted)
+
+            def next_step(trial):                          # the longest acceptable step first
+                i = trial[3]
+                return (*self._forward(problem, s["xs"], s["us"], k, K, alphas[i]), i + 1)
+
+            first = (s["xs"], s["us"], s["cost"], jnp.array(0))
+            xs, us, cost, tried = jax.lax.while_loop(
+                lambda t: ok & ~acceptable(t) & (t[3] < len(self.steps)), next_step, first)
+            accept = ok & acceptable((xs, us, cost, tried))
+            xs, us, cost = (jnp.where(accept, new, old) for new, old in
+                            zip((xs, us, cost), (s["xs"], s["us"], s["cost"]), strict=True))
             change = s["cost"] - cost
             # stationary: the model predicts (or the step made) a negligible decrease
             converged = ((ok & (-decrease[0] <= self.tolerance * jnp.abs(s["cost"])))
@@ -130,8 +148,8 @@ class ILQR(AbstractSolver):
             H = 0.5 * (Quu + Quu.T) + mu * eye
             k, free = box_qp(H, Qu, problem.lower - u, problem.upper - u, self.qp_iterations)
             H_free = jnp.where(free[:, None] & free[None, :], H, eye)
-            K = jnp.where(free[:, None], -spd_solve(H_free, jnp.where(free[:, None], Qux, 0.0)),
-                          0.0)
+            K = jnp.where(free[:, None],
+                          -spd_solve(H_free, jnp.where(free[:, None], Qux, 0.0), UNROLL), 0.0)
             Vx = Qx + K.T @ Quu @ k + K.T @ Qu + Qux.T @ k
             Vxx = Qxx + K.T @ Quu @ K + K.T @ Qux + Qux.T @ K
             return (Vx, 0.5 * (Vxx + Vxx.T)), (k, K, k @ Qu, 0.5 * k @ Quu @ k)
