@@ -516,3 +516,20 @@ def test_bench_compile(tmp_path):
     targets = {t["target"] for t in records[-1]["targets"]}
     assert {f"scene {name}, cold cache" for name in TOUR_GROUPS_ALL} < targets
     assert (tmp_path / "compile.png").stat().st_size > 10_000
+
+
+def test_reproduce_trajopt(tmp_path):
+    """`mbjax reproduce trajopt --quick`: each problem by each solver, the JSON's contract keys;
+    iLQR reaches the arm's target (to 1e-5 m) with the lowest cost."""
+    assert main(["reproduce", "trajopt", "--quick", "--out", str(tmp_path)]) == 0
+    data = json.loads((tmp_path / "trajopt.json").read_text())
+    rows = {(r["name"], r["solver"]): r for r in data["problems"]}
+    assert set(rows) == {("arm-reach", s) for s in ("ilqr", "lbfgs", "adam")}
+    for row in rows.values():
+        assert set(row) >= {"name", "solver", "iterations", "seconds", "final_error", "cost",
+                            "status"}
+        assert row["iterations"] > 0 and row["seconds"] > 0 and math.isfinite(row["cost"])
+    ilqr = rows["arm-reach", "ilqr"]
+    assert ilqr["status"] == "success" and ilqr["final_error"] < 1e-5
+    assert all(ilqr["cost"] <= row["cost"] for row in rows.values())
+    assert (tmp_path / "trajopt.png").stat().st_size > 10_000

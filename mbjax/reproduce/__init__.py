@@ -4,8 +4,8 @@ Each entry is reproduce(out: Path, quick: bool) -> dict (the JSON written).
 """
 
 from mbjax.reproduce import (andrews_squeezer, carpal_wrist, closed_chain, flexible_slider_crank, gradient_matrix,
-                             integrators, model_corpus, spin_up_beam, top_long_run, torque_free_tfe, tree_scaling,
-                             vertical_top)
+                             integrators, model_corpus, spin_up_beam, top_long_run, torque_free_tfe, trajopt,
+                             tree_scaling, vertical_top)
 
 REPRODUCTIONS = {
     integrators.NAME: integrators.reproduce,
@@ -20,6 +20,7 @@ REPRODUCTIONS = {
     carpal_wrist.NAME: carpal_wrist.reproduce,
     gradient_matrix.NAME: gradient_matrix.reproduce,
     model_corpus.NAME: model_corpus.reproduce,
+    trajopt.NAME: trajopt.reproduce,
 }
 
 __all__ = ["REPRODUCTIONS"]

@@ -3,7 +3,8 @@ servo with the gravity torque there as feed-forward, driven by a torque spline, 
 flange, and sampled the way MuJoCo applies a control (a zero-order hold per step).
 
 `build()` gives the servoed arm; `reach_loss` is the rollout loss whose gradient with respect to
-the spline's knots and a link mass the tour, the tests and notebook 09 take.
+the spline's knots and a link mass the tour, the tests and notebook 09 take; `reach_problem` is
+the arm-reach trajectory-optimisation problem (`mbjax.trajopt`).
 """
 
 import equinox as eqx
@@ -17,6 +18,7 @@ from mbjax.integrate import RK4, simulate
 from mbjax.model import Model
 from mbjax.model.urdf import load_urdf
 from mbjax.rigid import TreeSystem, forward_kinematics, inverse_dynamics, mass_matrix
+from mbjax.trajopt import Problem
 
 Q_REF = np.array([0.0, -0.4, 0.0, -2.0, 0.0, 1.6, 0.8])        # [rad], inside every joint's limits
 BANDWIDTH = 15.0                                                 # [rad/s] of each joint's servo
@@ -24,6 +26,8 @@ DAMPING_RATIO = 0.7
 FLANGE = np.array([0.0, 0.0, 0.107])                             # on the last link's z axis [m]
 DT = 2e-3                                                        # [s]
 TARGET_OFFSET = np.array([0.05, -0.05, 0.03])                    # the reach: from the pose [m]
+REACH = np.array([0.0, 0.4, 0.0])          # the trajectory-optimisation reach: 0.4 m sideways
+REACH_DT, REACH_STEPS = 0.01, 100
 
 
 def model() -> Model:
@@ -82,3 +86,34 @@ def reach_loss(arm: Model, knots: Array, link_mass: Array, steps: int, link: int
     sol = simulate(system, RK4(), jnp.asarray(Q_REF), jnp.zeros(arm.nv), dt=DT, t1=T, saveat=[T])
     miss = flange(arm, sol.qs[-1]) - flange(arm, jnp.asarray(Q_REF)) - jnp.asarray(TARGET_OFFSET)
     return 1e4 * miss @ miss + 1e-3 * jnp.sum(knots**2)
+
+
+def reach_problem(offset=REACH, steps: int = REACH_STEPS, arm: Model | None = None) -> Problem:
+    """The arm from rest at Q_REF, unpowered but for the controls, to its flange moved by
+    `offset` [m] at rest after `steps` steps of REACH_DT (RK4, torques held over each step).
+    Least-squares residuals weighted as Crocoddyl's arm examples weight theirs: along the way
+    the reach (0.1) and small state and control regularizations (1e-2, the controls about the
+    torque that holds Q_REF); at the end the reach (100) and the velocity (1). `hold(problem)`
+    is a good first guess."""
+    arm = model() if arm is None else arm
+    q0, v0 = jnp.asarray(Q_REF), jnp.zeros(arm.nv)
+    target = flange(arm, q0) + jnp.asarray(offset, dtype=float)
+    gravity = inverse_dynamics(arm, q0, v0, v0)
+    scale = jnp.sqrt(2.0)                           # 1/2 |r|^2 is the cost
+
+    def running(q, v, u):
+        return scale * jnp.concatenate([0.1 * (flange(arm, q) - target), 1e-2 * (q - q0),
+                                        1e-2 * v, 1e-2 * (u - gravity)])
+
+    def terminal(q, v):
+        return scale * jnp.concatenate([100.0 * (flange(arm, q) - target), v])
+
+    return Problem(TreeSystem(arm), q0, v0, dt=REACH_DT, horizon=steps, running=running,
+                   terminal=terminal)
+
+
+def hold(problem: Problem) -> Array:
+    """Controls (horizon, nv) that hold the start pose against gravity."""
+    arm = problem.system.model
+    return jnp.tile(inverse_dynamics(arm, problem.q0, problem.v0, problem.v0),
+                    (problem.horizon, 1))

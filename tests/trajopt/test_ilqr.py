@@ -9,7 +9,7 @@ import pytest
 from scipy.optimize import minimize
 
 from mbjax.model import Model
-from mbjax.rigid import TreeSystem, inverse_dynamics
+from mbjax.rigid import TreeSystem
 from mbjax.scenes import arm as scene
 from mbjax.trajopt import ILQR, Problem, solve
 
@@ -81,30 +81,13 @@ def test_control_bounds_give_the_box_constrained_optimum():
     assert abs(float(result.cost) - (reference.fun + c)) < 1e-8
 
 
-def _reach_problem(target_offset, steps: int = 100) -> Problem:
-    """The arm (mbjax.data.ARM7) from rest at the scene's pose to its flange moved by
-    target_offset: least-squares residuals, Crocoddyl's weighting (a running reach term and
-    small state and control regularization, a heavy terminal reach and rest term)."""
-    arm = scene.model()
-    q0, v0 = jnp.asarray(scene.Q_REF), jnp.zeros(arm.nv)
-    target = scene.flange(arm, q0) + jnp.asarray(target_offset)
-    hold = inverse_dynamics(arm, q0, v0, v0)
-
-    def running(q, v, u):
-        return jnp.sqrt(2.0) * jnp.concatenate([0.1 * (scene.flange(arm, q) - target),
-                                                1e-2 * (q - q0), 1e-2 * v, 1e-2 * (u - hold)])
-
-    def terminal(q, v):
-        return jnp.sqrt(2.0) * jnp.concatenate([100.0 * (scene.flange(arm, q) - target), v])
-
-    return Problem(TreeSystem(arm), q0, v0, dt=0.01, horizon=steps, running=running,
-                   terminal=terminal)
+def _reach_problem(offset, steps: int = 100) -> Problem:
+    return scene.reach_problem(offset, steps)
 
 
 def test_the_arm_reaches_its_target_at_a_stationary_point():
-    problem = _reach_problem([0.0, 0.4, 0.0])
-    hold = inverse_dynamics(problem.system.model, problem.q0, problem.v0, problem.v0)
-    us0 = jnp.tile(hold, (problem.horizon, 1))
+    problem = _reach_problem(scene.REACH)           # the arm-reach problem: 0.4 m, 100 steps
+    us0 = scene.hold(problem)
     result = solve(problem, ILQR(), us0)
     assert result.messages() == ["success"]
     final = scene.flange(problem.system.model, result.qs[-1])

@@ -1,0 +1,72 @@
+"""`mbjax reproduce trajopt`: trajectory-optimisation problems solved by each of mbjax's solvers.
+
+Each problem (a `mbjax.trajopt.Problem` built by its scene) is solved from the same first guess
+by iLQR (`ILQR`), single shooting with L-BFGS (`Shooting("lbfgs")`) and Adam
+(`Shooting("adam")`, the first-order baseline). Each solve is one compiled program, timed after
+compiling (`mbjax.timing.measure`); the cost after each iteration is plotted against the time it
+was reached, taken as the iteration's share of the solve's run time (iterations of one solver
+cost about the same). Per problem and solver the JSON gives
+{"name", "solver", "iterations", "seconds", "compile_seconds", "final_error", "cost", "status"}:
+final_error is the problem's own task error at the end (the flange's distance to its target
+[m] for the arm).
+
+Problems so far: `arm-reach`, the 7-dof arm (`mbjax.data.ARM7`) from rest to a flange target
+0.4 m away, at rest after 1 s (dt = 0.01 s, 100 knots; `mbjax.scenes.arm.reach_problem`).
+"""
+
+import json
+from pathlib import Path
+
+import jax.numpy as jnp
+import numpy as np
+
+from mbjax.timing import measure
+from mbjax.trajopt import ILQR, Shooting, solve
+
+NAME = "trajopt"
+SOLVERS = {"ilqr": ILQR(), "lbfgs": Shooting("lbfgs", iterations=1000),
+           "adam": Shooting("adam", iterations=1000, learning_rate=0.01)}
+QUICK_SOLVERS = {"ilqr": ILQR(), "lbfgs": Shooting("lbfgs", iterations=200),
+                 "adam": Shooting("adam", iterations=200, learning_rate=0.01)}
+
+
+def arm_reach():
+    """(problem, first guess, final_error(result))."""
+    from mbjax.scenes import arm
+
+    problem = arm.reach_problem()
+    model = problem.system.model
+    target = arm.flange(model, problem.q0) + jnp.asarray(arm.REACH)
+
+    def final_error(result):
+        return float(jnp.linalg.norm(arm.flange(model, result.qs[-1]) - target))
+
+    return problem, arm.hold(problem), final_error
+
+
+PROBLEMS = {"arm-reach": arm_reach}
+
+
+def reproduce(out: Path, quick: bool = False) -> dict:
+    from mbjax.plot.trajopt import trajopt_figure
+
+    rows, histories = [], {}
+    for name, build in PROBLEMS.items():
+        problem, guess, final_error = build()
+        for solver_name, solver in (QUICK_SOLVERS if quick else SOLVERS).items():
+            result, timing = measure(solve, problem, solver, guess, repeats=1 if quick else 3)
+            iterations = int(result.iterations)
+            rows.append({"name": name, "solver": solver_name, "iterations": iterations,
+                         "seconds": timing.run_s, "compile_seconds": timing.compile_s,
+                         "final_error": final_error(result), "cost": float(result.cost),
+                         "status": result.messages()[0]})
+            costs = np.asarray(result.costs)[:iterations + 1]
+            histories[(name, solver_name)] = (np.arange(iterations + 1) * timing.run_s
+                                              / max(iterations, 1), costs)
+    data = {"problems": rows,
+            "histories": [{"name": n, "solver": s, "seconds": t.tolist(), "cost": c.tolist()}
+                          for (n, s), (t, c) in histories.items()]}
+    out.mkdir(parents=True, exist_ok=True)
+    (out / f"{NAME}.json").write_text(json.dumps(data, indent=1))
+    trajopt_figure(data).savefig(out / f"{NAME}.png", dpi=120)
+    return data
