@@ -520,16 +520,19 @@ def test_bench_compile(tmp_path):
 
 def test_reproduce_trajopt(tmp_path):
     """`mbjax reproduce trajopt --quick`: each problem by each solver, the JSON's contract keys;
-    iLQR reaches the arm's target (to 1e-5 m) with the lowest cost."""
+    iLQR reaches the arm's target (to 1e-5 m) and the acrobot's upright pose (to 1e-2 m), with
+    the lowest cost."""
     assert main(["reproduce", "trajopt", "--quick", "--out", str(tmp_path)]) == 0
     data = json.loads((tmp_path / "trajopt.json").read_text())
     rows = {(r["name"], r["solver"]): r for r in data["problems"]}
-    assert set(rows) == {("arm-reach", s) for s in ("ilqr", "lbfgs", "adam")}
+    assert set(rows) == {(p, s) for p in ("arm-reach", "acrobot-swingup")
+                         for s in ("ilqr", "lbfgs", "adam")}
     for row in rows.values():
         assert set(row) >= {"name", "solver", "iterations", "seconds", "final_error", "cost",
                             "status"}
         assert row["iterations"] > 0 and row["seconds"] > 0 and math.isfinite(row["cost"])
-    ilqr = rows["arm-reach", "ilqr"]
-    assert ilqr["status"] == "success" and ilqr["final_error"] < 1e-5
-    assert all(ilqr["cost"] <= row["cost"] for row in rows.values())
+    for problem, error in (("arm-reach", 1e-5), ("acrobot-swingup", 1e-2)):
+        ilqr = rows[problem, "ilqr"]
+        assert ilqr["status"] == "success" and ilqr["final_error"] < error
+        assert all(ilqr["cost"] <= row["cost"] for (p, _), row in rows.items() if p == problem)
     assert (tmp_path / "trajopt.png").stat().st_size > 10_000

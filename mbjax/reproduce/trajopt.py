@@ -11,7 +11,9 @@ final_error is the problem's own task error at the end (the flange's distance to
 [m] for the arm).
 
 Problems so far: `arm-reach`, the 7-dof arm (`mbjax.data.ARM7`) from rest to a flange target
-0.4 m away, at rest after 1 s (dt = 0.01 s, 100 knots; `mbjax.scenes.arm.reach_problem`).
+0.4 m away, at rest after 1 s (dt = 0.01 s, 100 knots; `mbjax.scenes.arm.reach_problem`);
+`acrobot-swingup`, the double pendulum driven at its elbow from hanging to upright at rest in
+3 s (dt = 0.01 s, 300 knots, zero torque as the first guess; `mbjax.scenes.acrobot`).
 """
 
 import json
@@ -24,9 +26,9 @@ from mbjax.timing import measure
 from mbjax.trajopt import ILQR, Shooting, solve
 
 NAME = "trajopt"
-SOLVERS = {"ilqr": ILQR(), "lbfgs": Shooting("lbfgs", iterations=1000),
+SOLVERS = {"ilqr": ILQR(iterations=300), "lbfgs": Shooting("lbfgs", iterations=1000),
            "adam": Shooting("adam", iterations=1000, learning_rate=0.01)}
-QUICK_SOLVERS = {"ilqr": ILQR(), "lbfgs": Shooting("lbfgs", iterations=200),
+QUICK_SOLVERS = {"ilqr": ILQR(iterations=300), "lbfgs": Shooting("lbfgs", iterations=200),
                  "adam": Shooting("adam", iterations=200, learning_rate=0.01)}
 
 
@@ -44,7 +46,21 @@ def arm_reach():
     return problem, arm.hold(problem), final_error
 
 
-PROBLEMS = {"arm-reach": arm_reach}
+def acrobot_swingup():
+    """(problem, first guess, final_error(result)): the tip's distance to upright [m]."""
+    from mbjax.scenes import acrobot
+
+    problem = acrobot.swingup_problem()
+    model = problem.system.model
+    upright = jnp.array([0.0, 0.0, 2 * acrobot.LENGTH])
+
+    def final_error(result):
+        return float(jnp.linalg.norm(acrobot.tip(model, result.qs[-1]) - upright))
+
+    return problem, None, final_error
+
+
+PROBLEMS = {"arm-reach": arm_reach, "acrobot-swingup": acrobot_swingup}
 
 
 def reproduce(out: Path, quick: bool = False) -> dict:
