@@ -10,6 +10,7 @@ start at zero from a slightly tilted rest (a hanging pendulum at exactly q = 0 i
 point of the problem as well).
 """
 
+import equinox as eqx
 import jax.numpy as jnp
 import numpy as np
 from jax import Array
@@ -36,19 +37,22 @@ def tip(model: Model, q: Array) -> Array:
     return p[-1] + R[-1] @ jnp.array([0.0, 0.0, -LENGTH])
 
 
+def _running(q, v, u, *, acrobot, goal):
+    return jnp.concatenate([0.1 * (tip(acrobot, q) - goal), 0.01 * v, 0.1 * u])
+
+
+def _terminal(q, v, *, acrobot, goal):
+    return jnp.concatenate([100.0 * (tip(acrobot, q) - goal), 10.0 * v])
+
+
 def swingup_problem(arm: Model | None = None, steps: int = round(DURATION / DT),
                     torque_limit: float | None = None) -> Problem:
     """The swing-up as least-squares residuals: along the way 0.1 (tip - goal), 0.01 v and
     0.1 u; at the end 100 (tip - goal) and 10 v; the elbow's torque within +-torque_limit."""
     acrobot = model() if arm is None else arm
     goal = jnp.array([0.0, 0.0, 2 * LENGTH])
-
-    def running(q, v, u):
-        return jnp.concatenate([0.1 * (tip(acrobot, q) - goal), 0.01 * v, 0.1 * u])
-
-    def terminal(q, v):
-        return jnp.concatenate([100.0 * (tip(acrobot, q) - goal), 10.0 * v])
-
+    running = eqx.Partial(_running, acrobot=acrobot, goal=goal)
+    terminal = eqx.Partial(_terminal, acrobot=acrobot, goal=goal)
     bound = None if torque_limit is None else float(torque_limit)
     return Problem(TreeSystem(acrobot, actuation=[1]), Q0, np.zeros(2), dt=DT, horizon=steps,
                    running=running, terminal=terminal, lower=None if bound is None else -bound,

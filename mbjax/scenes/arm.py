@@ -88,28 +88,31 @@ def reach_loss(arm: Model, knots: Array, link_mass: Array, steps: int, link: int
     return 1e4 * miss @ miss + 1e-3 * jnp.sum(knots**2)
 
 
+def _reach_running(q, v, u, *, arm, target, q0, gravity):
+    return jnp.sqrt(2.0) * jnp.concatenate([0.1 * (flange(arm, q) - target), 1e-2 * (q - q0),
+                                            1e-2 * v, 1e-2 * (u - gravity)])
+
+
+def _reach_terminal(q, v, *, arm, target):
+    return jnp.sqrt(2.0) * jnp.concatenate([100.0 * (flange(arm, q) - target), v])
+
+
 def reach_problem(offset=REACH, steps: int = REACH_STEPS, arm: Model | None = None) -> Problem:
     """The arm from rest at Q_REF, unpowered but for the controls, to its flange moved by
     `offset` [m] at rest after `steps` steps of REACH_DT (RK4, torques held over each step).
-    Least-squares residuals weighted as Crocoddyl's arm examples weight theirs: along the way
-    the reach (0.1) and small state and control regularizations (1e-2, the controls about the
-    torque that holds Q_REF); at the end the reach (100) and the velocity (1). `hold(problem)`
-    is a good first guess."""
+    Least-squares residuals (1/2 |r|^2 is the cost) weighted as Crocoddyl's arm examples weight
+    theirs: along the way the reach (0.1) and small state and control regularizations (1e-2,
+    the controls about the torque that holds Q_REF); at the end the reach (100) and the velocity
+    (1). The costs are `eqx.Partial`s of module-level functions, so problems for other targets
+    or models share one compiled `solve`. `hold(problem)` is a good first guess."""
     arm = model() if arm is None else arm
     q0, v0 = jnp.asarray(Q_REF), jnp.zeros(arm.nv)
     target = flange(arm, q0) + jnp.asarray(offset, dtype=float)
     gravity = inverse_dynamics(arm, q0, v0, v0)
-    scale = jnp.sqrt(2.0)                           # 1/2 |r|^2 is the cost
-
-    def running(q, v, u):
-        return scale * jnp.concatenate([0.1 * (flange(arm, q) - target), 1e-2 * (q - q0),
-                                        1e-2 * v, 1e-2 * (u - gravity)])
-
-    def terminal(q, v):
-        return scale * jnp.concatenate([100.0 * (flange(arm, q) - target), v])
-
-    return Problem(TreeSystem(arm), q0, v0, dt=REACH_DT, horizon=steps, running=running,
-                   terminal=terminal)
+    return Problem(TreeSystem(arm), q0, v0, dt=REACH_DT, horizon=steps,
+                   running=eqx.Partial(_reach_running, arm=arm, target=target, q0=q0,
+                                       gravity=gravity),
+                   terminal=eqx.Partial(_reach_terminal, arm=arm, target=target))
 
 
 def hold(problem: Problem) -> Array:

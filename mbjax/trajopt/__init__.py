@@ -1,10 +1,11 @@
 """Trajectory optimisation for any system (`Problem`, `solve` with a solver strategy such as
-`ILQR`, `Shooting`), and the Carpal Wrist's synthesis, baseline, controller and sweeps (seed 003 §6)."""
+`ILQR`, `Shooting`; `optimal_cost` for co-design), and the Carpal Wrist's synthesis, baseline, controller and sweeps (seed 003 §6)."""
 
+from mbjax.trajopt.codesign import optimal_cost
 from mbjax.trajopt.ilqr import ILQR
 from mbjax.trajopt.problem import Problem
 from mbjax.trajopt.result import AbstractSolver, Result
 from mbjax.trajopt.shooting import Shooting
 from mbjax.trajopt.solve import solve
 
-__all__ = ["AbstractSolver", "ILQR", "Problem", "Result", "Shooting", "solve"]
+__all__ = ["AbstractSolver", "ILQR", "Problem", "Result", "Shooting", "optimal_cost", "solve"]

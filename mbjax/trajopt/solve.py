@@ -12,8 +12,11 @@ from mbjax.trajopt.result import AbstractSolver, Result
 def solve(problem: Problem, solver: AbstractSolver = ILQR(), us0: Array | None = None) -> Result:
     """Optimise `problem`'s controls with `solver` (a strategy: `ILQR()`, ...) from `us0`
     (horizon, nu), zeros by default, clipped to the bounds. One compiled program: the solver's
-    iterations run inside it, so a second problem of the same shapes (another target, another
-    model parameter) reuses it, and `jax.vmap` solves many at once."""
+    iterations run inside it, and `jax.vmap` solves many problems at once. A second problem of
+    the same shapes (another target, another model parameter) reuses the program where its
+    costs hold their data as leaves (equinox modules, or `eqx.Partial` of module-level
+    functions, as `mbjax.scenes.arm.reach_problem` builds them); a fresh closure is a new
+    function, and compiles anew."""
     if not isinstance(problem, Problem):
         raise TypeError(f"problem must be a mbjax.trajopt.Problem, got {type(problem).__name__}")
     if not isinstance(solver, AbstractSolver):
