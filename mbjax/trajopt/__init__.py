@@ -7,5 +7,7 @@ from mbjax.trajopt.problem import Problem
 from mbjax.trajopt.result import AbstractSolver, Result
 from mbjax.trajopt.shooting import Shooting
 from mbjax.trajopt.solve import solve
+from mbjax.trajopt.sweeps import sweep
 
-__all__ = ["AbstractSolver", "ILQR", "Problem", "Result", "Shooting", "optimal_cost", "solve"]
+__all__ = ["AbstractSolver", "ILQR", "Problem", "Result", "Shooting", "optimal_cost", "solve",
+           "sweep"]
