@@ -377,6 +377,33 @@ def models_tour(out: Path, quick: bool) -> dict:
             "peers_max_relative_difference": peers}
 
 
+def trajectory_optimisation_tour(out: Path, quick: bool) -> dict:
+    """The 7-dof arm's reach (`mbjax.scenes.arm.reach_problem`: the flange 0.4 m sideways at
+    rest after 1 s, 100 knots of 0.01 s) solved by iLQR (`mbjax.trajopt`) from the torques that
+    hold the start pose: the cost per iteration, the flange's approach, the torques."""
+    from mbjax.plot.trajopt import reach_figure
+    from mbjax.scenes import arm
+    from mbjax.trajopt import ILQR, solve
+
+    problem = arm.reach_problem()
+    result, timing = measure(partial(solve, problem, ILQR(), arm.hold(problem)), repeats=3)
+    model = problem.system.model
+    target = np.asarray(arm.flange(model, problem.q0)) + arm.REACH
+    flange = np.asarray(jax.jit(jax.vmap(lambda q: arm.flange(model, q)))(result.qs))
+    iterations = int(result.iterations)
+    ts = np.arange(problem.horizon + 1) * problem.dt
+    error = float(np.linalg.norm(flange[-1] - target))
+    fig = reach_figure(np.asarray(result.costs)[:iterations + 1], ts, flange, target,
+                       np.asarray(result.us),
+                       f"arm reach by iLQR: {iterations} iterations in {timing.run_s:.2f} s, "
+                       f"final error {error:.1e} m ({result.messages()[0]})")
+    fig.savefig(out / "trajectory-optimisation.png", dpi=110)
+    return {"figure": "trajectory-optimisation.png",
+            "runs": {"ilqr": {"iterations": iterations, "seconds": timing.run_s,
+                              "compile_seconds": timing.compile_s, "final_error_m": error,
+                              "cost": float(result.cost), "status": result.messages()[0]}}}
+
+
 def _model_peers() -> dict:
     """The arm against Pinocchio from the same URDF (`mbjax.reproduce.urdf_corpus`: forward and
     inverse dynamics, mass matrix, frames) and against MuJoCo through MuJoCo's compiler and
@@ -408,13 +435,14 @@ TOUR = {   # in the order the summary tells them
     "carpal-wrist": carpal_wrist_tour,
     "controls": controls_tour,
     "models": models_tour,
+    "trajectory-optimisation": trajectory_optimisation_tour,
 }
 
 # Each scene's wall time in a quick tour from a cold cache, one scene at a time (benchmarks/README
 # compile section): `mbjax tour` starts the longest first, which balances its workers best.
 COST = {"time-elements": 9.1, "carpal-wrist": 9.0, "closed-loops": 8.6, "flexible-bodies": 7.7,
-        "controls": 6.4, "rigid-chain": 4.8, "models": 2.6, "torque-free-body": 2.3,
-        "heavy-top": 1.6}
+        "controls": 6.4, "rigid-chain": 4.8, "trajectory-optimisation": 4.5, "models": 2.6,
+        "torque-free-body": 2.3, "heavy-top": 1.6}
 
 
 def run_scene(name: str, out: Path, quick: bool) -> dict:

@@ -71,7 +71,7 @@ def test_reproduce_tree_scaling(tmp_path):
 TOUR_GROUPS = {
     "rigid": ("torque-free-body", "heavy-top", "rigid-chain", "closed-loops"),
     "time-elements": ("time-elements", "flexible-bodies", "controls"),
-    "carpal-wrist": ("carpal-wrist", "models"),
+    "carpal-wrist": ("carpal-wrist", "models", "trajectory-optimisation"),
 }
 
 
@@ -83,7 +83,8 @@ def test_tour_groups_cover_every_scene():
 
     assert sorted(s for group in TOUR_GROUPS.values() for s in group) == sorted(TOUR)
     assert set(TOUR) == {"torque-free-body", "heavy-top", "rigid-chain", "time-elements",
-                         "closed-loops", "flexible-bodies", "carpal-wrist", "controls", "models"}
+                         "closed-loops", "flexible-bodies", "carpal-wrist", "controls", "models",
+                         "trajectory-optimisation"}
 
 
 def test_tour_rejects_an_unknown_scene(capsys):
@@ -177,6 +178,9 @@ def _check_carpal_wrist(scenes):
     for peer in ("pinocchio", "mujoco"):
         if peers.available(peer):
             assert models["peers_max_relative_difference"][peer] < 1e-12
+    # trajectory optimisation: iLQR brings the arm's flange to its target
+    reach = scenes["trajectory-optimisation"]["runs"]["ilqr"]
+    assert reach["status"] == "success" and reach["final_error_m"] < 1e-5
 
 
 TOUR_CHECKS = {"rigid": _check_rigid, "time-elements": _check_time_elements,
