@@ -111,8 +111,10 @@ class ILQR(AbstractSolver):
             xs, us, cost = (jnp.where(accept, new, old) for new, old in
                             zip((xs, us, cost), (s["xs"], s["us"], s["cost"]), strict=True))
             change = s["cost"] - cost
-            # stationary: the model predicts (or the step made) a negligible decrease
-            converged = ((ok & (-decrease[0] <= self.tolerance * jnp.abs(s["cost"])))
+            # stationary: the model, not shrunk by a raised regularization, predicts a
+            # negligible decrease, or an accepted step made one
+            converged = ((ok & (s["mu"] <= self.regularization)
+                          & (-decrease[0] <= self.tolerance * jnp.abs(s["cost"])))
                          | (accept & (change <= self.tolerance * jnp.abs(cost))))
             mu = jnp.where(accept, jnp.maximum(s["mu"] / MU_FACTOR, MU_MIN), s["mu"] * MU_FACTOR)
             i = s["iteration"] + 1
