@@ -16,7 +16,9 @@ class Result(WithStatus):
     the `iterations` taken and a `Status`: success when the solver's convergence test passed,
     NOT_CONVERGED when it ran out of iterations or could not make progress, NONFINITE when the
     cost or the trajectory blew up. `feedback`: the time-varying gains K_k (N, nu, nx) of
-    u = u_k + K_k (x - x_k) where the solver has them (DDP), else zeros."""
+    u = u_k + K_k (x - x_k) where the solver has them (DDP: from its last accepted iteration's
+    backward pass, about the trajectory before that step, the same at convergence), else
+    zeros."""
 
     qs: Array
     vs: Array
