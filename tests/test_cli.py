@@ -525,12 +525,12 @@ def test_bench_compile(tmp_path):
 def test_reproduce_trajopt(tmp_path):
     """`mbjax reproduce trajopt --quick`: each problem by each solver, the JSON's contract keys;
     iLQR reaches the arm's target (to 1e-5 m) and the acrobot's upright pose (to 1e-2 m), with
-    the lowest cost."""
+    the lowest cost, and the Carpal Wrist's goal pose under its torque limit."""
     assert main(["reproduce", "trajopt", "--quick", "--out", str(tmp_path)]) == 0
     data = json.loads((tmp_path / "trajopt.json").read_text())
     rows = {(r["name"], r["solver"]): r for r in data["problems"]}
     assert set(rows) == {(p, s) for p in ("arm-reach", "acrobot-swingup")
-                         for s in ("ilqr", "lbfgs", "adam")}
+                         for s in ("ilqr", "lbfgs", "adam")} | {("carpal-wrist", "ilqr")}
     for row in rows.values():
         assert set(row) >= {"name", "solver", "iterations", "seconds", "final_error", "cost",
                             "status"}
@@ -539,4 +539,7 @@ def test_reproduce_trajopt(tmp_path):
         ilqr = rows[problem, "ilqr"]
         assert ilqr["status"] == "success" and ilqr["final_error"] < error
         assert all(ilqr["cost"] <= row["cost"] for (p, _), row in rows.items() if p == problem)
+    # the Carpal Wrist's START -> GOAL under the torque limit: the issue asks 1e-3 (Adam's
+    # synthesis reached 4.9e-3); iLQR's tail, the effort among clamped torques, is slow
+    assert rows["carpal-wrist", "ilqr"]["final_error"] < 1e-4
     assert (tmp_path / "trajopt.png").stat().st_size > 10_000

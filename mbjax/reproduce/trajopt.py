@@ -13,7 +13,11 @@ final_error is the problem's own task error at the end (the flange's distance to
 Problems so far: `arm-reach`, the 7-dof arm (`mbjax.data.ARM7`) from rest to a flange target
 0.4 m away, at rest after 1 s (dt = 0.01 s, 100 knots; `mbjax.scenes.arm.reach_problem`);
 `acrobot-swingup`, the double pendulum driven at its elbow from hanging to upright at rest in
-3 s (dt = 0.01 s, 300 knots, zero torque as the first guess; `mbjax.scenes.acrobot`).
+3 s (dt = 0.01 s, 300 knots, zero torque as the first guess; `mbjax.scenes.acrobot`);
+`carpal-wrist`, the Carpal Wrist from START to GOAL at rest in 0.5 s under its 1.8 N m torque
+limit (100 knots; the inverse-dynamics feed-forward along a minimum-jerk path, clipped, as the
+first guess; `mbjax.scenes.carpal_wrist.synthesis_problem`), final_error the pose error
+(`mbjax.wrist.kinematics.pose_error`), by iLQR only (see SHOOTING).
 """
 
 import json
@@ -60,7 +64,30 @@ def acrobot_swingup():
     return problem, None, final_error
 
 
-PROBLEMS = {"arm-reach": arm_reach, "acrobot-swingup": acrobot_swingup}
+def carpal_wrist():
+    """(problem, first guess, final_error(result)): the pose error (`wrist.kinematics.
+    pose_error`) of the final pose against GOAL."""
+    from mbjax.scenes import carpal_wrist as cw
+    from mbjax.wrist import kinematics
+
+    problem = cw.synthesis_problem()
+    wrist = problem.system.wrist
+    goal = kinematics.pose_from_chart(wrist, jnp.asarray(cw.GOAL[0]), jnp.asarray(cw.GOAL[1]))
+
+    def final_error(result):
+        pose = kinematics.forward_kinematics(wrist, result.qs[-1])
+        return float(kinematics.pose_error(wrist, pose, goal))
+
+    return problem, cw.synthesis_guess(problem), final_error
+
+
+PROBLEMS = {"arm-reach": arm_reach, "acrobot-swingup": acrobot_swingup,
+            "carpal-wrist": carpal_wrist}
+# Single shooting differentiates the rollout in reverse mode; through the Carpal Wrist's
+# autodiff Lagrangian (third derivatives of its kinematics) XLA did not compile that program
+# within 10 minutes, so the wrist is solved by iLQR alone (its forward-mode linearization
+# compiles in about 10 s).
+SHOOTING = ("arm-reach", "acrobot-swingup")
 
 
 def reproduce(out: Path, quick: bool = False) -> dict:
@@ -70,6 +97,8 @@ def reproduce(out: Path, quick: bool = False) -> dict:
     for name, build in PROBLEMS.items():
         problem, guess, final_error = build()
         for solver_name, solver in (QUICK_SOLVERS if quick else SOLVERS).items():
+            if solver_name != "ilqr" and name not in SHOOTING:
+                continue
             result, timing = measure(solve, problem, solver, guess, repeats=1 if quick else 3)
             iterations = int(result.iterations)
             rows.append({"name": name, "solver": solver_name, "iterations": iterations,

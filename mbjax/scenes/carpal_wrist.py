@@ -8,13 +8,15 @@ physical mirror plate and the chapter's printed rotation give different dynamics
   and the motion stays inside the workspace for FREE_DURATION (the integrator accuracy study).
 - `servo`: a joint PD servo (stiffness SERVO_K, damping SERVO_D, gravity feed-forward) holding
   HOME, released from HOME + SERVO_OFFSET under gravity: the step-size stability study.
-- START and GOAL: two tool poses (plunge, slope) for trajectory synthesis, DURATION apart.
+- START and GOAL: two tool poses (plunge, slope) for trajectory synthesis, DURATION apart;
+  `synthesis_problem` poses the move as a `mbjax.trajopt.Problem` under TORQUE_LIMIT.
 """
 
+import equinox as eqx
 import jax.numpy as jnp
 import numpy as np
 
-from mbjax.wrist import CarpalWrist, WristSystem, servo as servo_law
+from mbjax.wrist import CarpalWrist, WristSystem, kinematics, servo as servo_law
 
 BASE_RADIUS = 0.06                           # [m]
 LINK_LENGTH = 0.10                           # [m]
@@ -64,3 +66,40 @@ def servo():
 def build():
     """The scene's default (system, theta0, theta_dot0): the free motion."""
     return free_motion()
+
+
+def _synthesis_running(q, v, u, *, limit):
+    return jnp.concatenate([0.3 * u / limit, 1e-3 * v])
+
+
+def _synthesis_terminal(q, v, *, wrist, goal_plunge, goal_slope):
+    plunge, slope = kinematics.midplane(wrist, q)
+    return jnp.concatenate([1e3 * jnp.atleast_1d(plunge - goal_plunge) / wrist.link_length,
+                            1e3 * (slope - goal_slope), 10.0 * v])
+
+
+def synthesis_problem(w: CarpalWrist | None = None, steps: int = 100):
+    """START -> GOAL at rest in DURATION, |tau_i| <= TORQUE_LIMIT, as a `mbjax.trajopt.Problem`
+    (RK4, `steps` knots of held torques): least-squares residuals, along the way the torques
+    scaled by the limit (0.3) and a trace of the speed (1e-3), at the end the midplane chart's
+    miss (1e3 per link length in plunge, 1e3 in slope) and the speed (10)."""
+    from mbjax.trajopt import Problem
+
+    w = wrist() if w is None else w
+    theta0 = w.solve_inverse_kinematics(*START)[0]
+    return Problem(WristSystem(w), theta0, jnp.zeros(3), dt=DURATION / steps, horizon=steps,
+                   running=eqx.Partial(_synthesis_running, limit=jnp.asarray(TORQUE_LIMIT)),
+                   terminal=eqx.Partial(_synthesis_terminal, wrist=w,
+                                        goal_plunge=jnp.asarray(GOAL[0]),
+                                        goal_slope=jnp.asarray(GOAL[1])),
+                   lower=-TORQUE_LIMIT, upper=TORQUE_LIMIT)
+
+
+def synthesis_guess(problem) -> jnp.ndarray:
+    """The inverse-dynamics feed-forward along the minimum-jerk tool path (`mbjax.trajopt.
+    baseline`) at the middle of each step, clipped to the torque limit."""
+    from mbjax.trajopt.baseline import ToolPath, feedforward_torques
+
+    ts = (np.arange(problem.horizon) + 0.5) * problem.dt
+    tau = feedforward_torques(problem.system.wrist, ToolPath(START, GOAL, DURATION), ts)
+    return jnp.clip(jnp.asarray(tau), -TORQUE_LIMIT, TORQUE_LIMIT)
