@@ -18,7 +18,8 @@ Tassa, Mansard and Todorov 2014):
 3. a forward pass u = clip(u_k + alpha k_k + K_k (x - x_k)), the step length alpha backtracking
    through `steps` until the cost decrease is at least a fraction of the model's prediction;
 4. mu, the regularization of Q_uu, shrinks after a success and grows after a failure (a Q_uu
-   that is not positive definite, or no acceptable step).
+   that is not positive definite, or no acceptable step); after a failure the next iteration
+   reuses step 1's expansion, the trajectory being the same.
 
 The iterations are one `lax.while_loop`, so `solve` compiles once. It stops with success when an
 accepted step lowers the cost by less than `tolerance` relative to it (or the model predicts
@@ -89,10 +90,11 @@ class ILQR(AbstractSolver):
         state = dict(xs=xs, us=us, cost=cost, mu=jnp.asarray(self.regularization, cost.dtype),
                      iteration=jnp.array(0), done=jnp.array(False), stalled=jnp.array(False),
                      costs=history(self.iterations + 1, cost),
-                     K=jnp.zeros((N, nu, nx), cost.dtype))
+                     K=jnp.zeros((N, nu, nx), cost.dtype),
+                     expansion=self._linearize(problem, xs, us))
 
         def iterate(s):
-            k, K, decrease, ok = self._backward(problem, s["xs"], s["us"], s["mu"])
+            k, K, decrease, ok = self._backward(problem, s["expansion"], s["us"], s["mu"])
 
             def acceptable(trial):
                 _, _, cost, i = trial
@@ -118,9 +120,13 @@ class ILQR(AbstractSolver):
                          | (accept & (change <= self.tolerance * jnp.abs(cost))))
             mu = jnp.where(accept, jnp.maximum(s["mu"] / MU_FACTOR, MU_MIN), s["mu"] * MU_FACTOR)
             i = s["iteration"] + 1
+            # a rejected step leaves the trajectory, and so its expansion, as they were
+            expansion = jax.lax.cond(accept & ~converged,
+                                     lambda: self._linearize(problem, xs, us),
+                                     lambda: s["expansion"])
             return dict(xs=xs, us=us, cost=cost, mu=mu, iteration=i, done=converged,
                         stalled=mu > MU_MAX, costs=s["costs"].at[i].set(cost),
-                        K=jnp.where(accept, K, s["K"]))
+                        K=jnp.where(accept, K, s["K"]), expansion=expansion)
 
         def running(s):
             return ~s["done"] & ~s["stalled"] & (s["iteration"] < self.iterations)
@@ -133,13 +139,19 @@ class ILQR(AbstractSolver):
         return Result(qs=q, vs=v, us=s["us"], cost=s["cost"], costs=s["costs"],
                       iterations=s["iteration"], feedback=s["K"], status=status)
 
-    def _backward(self, problem: Problem, xs: Array, us: Array, mu: Array):
-        """(k, K, (sum k^T Q_u, sum 1/2 k^T Q_uu k), ok): the Riccati pass about (xs, us)."""
+    @staticmethod
+    def _linearize(problem: Problem, xs: Array, us: Array) -> tuple:
+        """The dynamics' and costs' expansion about (xs, us): (A, B, l_x, l_u, l_xx, l_ux, l_uu)
+        per step and the terminal (V_x, V_xx)."""
         steps = jnp.arange(problem.horizon)
         A, B = jax.vmap(jax.jacfwd(problem.step, argnums=(0, 1)))(xs[:-1], us, steps)
-        lx, lu, lxx, lux, luu = jax.vmap(problem.stage_expansion)(xs[:-1], us)
-        Vx, Vxx = problem.final_expansion(xs[-1])
-        eye = jnp.eye(problem.nu, dtype=xs.dtype)
+        return (A, B, *jax.vmap(problem.stage_expansion)(xs[:-1], us)), problem.final_expansion(xs[-1])
+
+    def _backward(self, problem: Problem, expansion: tuple, us: Array, mu: Array):
+        """(k, K, (sum k^T Q_u, sum 1/2 k^T Q_uu k), ok): the Riccati pass over an `expansion`
+        about the trajectory of us."""
+        stages, (Vx, Vxx) = expansion
+        eye = jnp.eye(problem.nu, dtype=us.dtype)
 
         def back(carry, inputs):
             Vx, Vxx = carry
@@ -156,8 +168,7 @@ class ILQR(AbstractSolver):
             Vxx = Qxx + K.T @ Quu @ K + K.T @ Qux + Qux.T @ K
             return (Vx, 0.5 * (Vxx + Vxx.T)), (k, K, k @ Qu, 0.5 * k @ Quu @ k)
 
-        _, (k, K, d1, d2) = jax.lax.scan(back, (Vx, Vxx), (A, B, lx, lu, lxx, lux, luu, us),
-                                         reverse=True)
+        _, (k, K, d1, d2) = jax.lax.scan(back, (Vx, Vxx), (*stages, us), reverse=True)
         ok = jnp.all(jnp.isfinite(k)) & jnp.all(jnp.isfinite(K))
         return k, K, (jnp.sum(d1), jnp.sum(d2)), ok
 
