@@ -83,6 +83,10 @@ class ILQR(AbstractSolver):
     qp_iterations: int = eqx.field(static=True, default=8)
 
     def solve(self, problem: Problem, us: Array) -> Result:
+        if problem.nq != problem.nv:
+            raise ValueError(f"ILQR linearizes in the coordinates (q, v), which needs as many "
+                             f"configuration coordinates as velocities; this system has "
+                             f"nq = {problem.nq}, nv = {problem.nv} (quaternions): use Shooting")
         xs = problem.rollout(us)
         cost = problem.cost(xs, us)
         alphas = jnp.asarray(self.steps, cost.dtype)

@@ -47,9 +47,9 @@ def with_control(system: AbstractSystem, control) -> AbstractSystem:
 
 
 class Problem(eqx.Module):
-    """See the module. `q0`, `v0`: the initial state; `running(q, v, u)` a cost rate,
-    `terminal(q, v)` the final cost; `lower`, `upper`: bounds on each actuated force (scalars or
-    one per actuated coordinate; None for none)."""
+    """See the module. `q0`, `v0`: the initial state; `running(q, v, u)` a cost rate and
+    `terminal(q, v)` the final cost, each a scalar or a vector of residuals; `lower`, `upper`:
+    bounds on each actuated force (scalars or one per actuated coordinate; None for none)."""
 
     system: AbstractSystem
     q0: Array
@@ -76,7 +76,7 @@ class Problem(eqx.Module):
             raise ValueError(f"dt must be a positive number, got {dt!r}")
         if not (callable(running) and callable(terminal)):
             raise TypeError("running(q, v, u) and terminal(q, v) must be callables returning "
-                            "scalars")
+                            "a scalar cost or a vector of residuals")
         self.system = system
         self.q0, self.v0 = jnp.asarray(q0, dtype=float), jnp.asarray(v0, dtype=float)
         if self.q0.ndim != 1 or self.v0.ndim != 1:

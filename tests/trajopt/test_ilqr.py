@@ -133,6 +133,11 @@ def test_bad_problems_are_refused_with_the_argument_named():
         solve(problem, ILQR(), jnp.zeros((4, 1)))
     with pytest.raises(TypeError, match="solver"):
         solve(problem, ILQR)
+    free = TreeSystem(Model([-1], "free", mass=[1.0], inertia=[np.eye(3)]))      # a quaternion
+    floating = Problem(free, np.r_[0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0], np.zeros(6), dt=0.1,
+                       horizon=5, running=lambda q, v, u: u @ u, terminal=lambda q, v: v @ v)
+    with pytest.raises(ValueError, match="nq = 7, nv = 6"):
+        solve(floating, ILQR())
 
 
 def test_single_shooting_reaches_the_lqr_optimum_and_adam_descends():
