@@ -14,12 +14,12 @@ tasks; `jobs=1` runs everything in this process, one task after another.
 
 import multiprocessing
 import os
-import sys
-import threading
 import time
 from collections.abc import Callable, Hashable, Sequence
 from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
 from concurrent.futures.process import BrokenProcessPool
+
+from mbjax.progress import Board, progress
 
 # JAX settings a worker takes from the parent
 _SETTINGS = ("jax_enable_x64", "jax_compilation_cache_dir",
@@ -70,23 +70,10 @@ def run(task: Callable, keys: Sequence[Hashable], jobs: int | None = None,
     if jobs is not None and jobs < 1:
         raise ValueError(f"jobs must be at least 1, got {jobs}")
     jobs = max(min(jobs or cores(), len(keys)), 1)
-    board = _Board(desc, len(keys))
-    results = {}
     if jobs == 1:
-        stop = threading.Event()
-        ticker = threading.Thread(target=board.tick, args=(stop,), daemon=True)
-        ticker.start()
-        try:
-            for key in keys:
-                start = time.perf_counter()
-                board.started(key, start)
-                results[key] = task(key)
-                board.finished(key, start)
-        finally:
-            stop.set()
-            ticker.join()
-        board.close()
-        return results
+        return {key: task(key) for key in progress(keys, len(keys), desc)}
+    board = Board(desc, len(keys))
+    results = {}
     context = multiprocessing.get_context("spawn")      # JAX's threads do not survive a fork
     events = context.Queue()
     with ProcessPoolExecutor(jobs, context, initializer=_start_worker,
@@ -96,10 +83,14 @@ def run(task: Callable, keys: Sequence[Hashable], jobs: int | None = None,
             while pending:
                 done, _ = wait(pending, timeout=0.5, return_when=FIRST_COMPLETED)
                 while not events.empty():
-                    board.started(*events.get())
+                    key, start = events.get()
+                    if key not in results:          # a notice may come after its result
+                        board.started(key, start)
                 for future in done:
                     key = pending.pop(future)
                     start, results[key] = future.result()
+                    if key not in board.running:    # its result came before its notice
+                        board.started(key, start)
                     board.finished(key, start)
                 board.draw()
         except BrokenProcessPool as error:
@@ -112,60 +103,3 @@ def run(task: Callable, keys: Sequence[Hashable], jobs: int | None = None,
             raise
     board.close()
     return results
-
-
-class _Board:
-    """The progress display of `run`."""
-
-    width = 24
-
-    def __init__(self, desc: str, total: int):
-        self.desc, self.total, self.done = desc, total, 0
-        self.start = time.perf_counter()
-        self.running: dict = {}         # key: when it started
-        self.ended: set = set()
-        self.tty = sys.stderr.isatty()
-        self.lock = threading.Lock()
-
-    def _write(self, line: str, end: str = "") -> None:
-        with self.lock:
-            sys.stderr.write(("\r" + line + "\033[K" + end) if self.tty else line + "\n")
-            sys.stderr.flush()
-
-    def _bar(self) -> str:
-        filled = self.width * self.done // self.total
-        return f"{self.desc} [{'#' * filled}{'.' * (self.width - filled)}] {self.done}/{self.total}"
-
-    def started(self, key, at: float) -> None:
-        if key in self.ended:           # its notice came after its result
-            return
-        self.running[key] = at
-        if not self.tty:
-            self._write(f"{self._bar()} {key} started  {at - self.start:6.1f} s")
-        self.draw()
-
-    def finished(self, key, began: float) -> None:
-        if key not in self.running:     # its result came before its notice
-            self.started(key, began)
-        self.running.pop(key)
-        self.ended.add(key)
-        self.done += 1
-        if not self.tty:
-            now = time.perf_counter()
-            self._write(f"{self._bar()} {key} done in {now - began:.1f} s  {now - self.start:6.1f} s")
-        self.draw()
-
-    def draw(self) -> None:
-        if self.tty:
-            now = time.perf_counter()
-            tasks = ", ".join(f"{key} {now - at:.0f} s" for key, at in list(self.running.items()))
-            self._write(f"{self._bar()} {tasks}  {now - self.start:6.1f} s")
-
-    def tick(self, stop: threading.Event) -> None:
-        """Redraw twice a second until `stop` is set (a thread's target)."""
-        while not stop.wait(0.5):
-            self.draw()
-
-    def close(self) -> None:
-        self._write(f"{self.desc} [{'#' * self.width}] {self.total}/{self.total} "
-                    f"done in {time.perf_counter() - self.start:.1f} s", end="\n")

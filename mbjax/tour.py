@@ -388,7 +388,7 @@ def trajectory_optimisation_tour(out: Path, quick: bool) -> dict:
     problem = arm.reach_problem()
     result, timing = measure(partial(solve, problem, ILQR(), arm.hold(problem)), repeats=3)
     model = problem.system.model
-    target = np.asarray(arm.flange(model, problem.q0)) + arm.REACH
+    target = np.asarray(arm.reach_target(model))
     flange = np.asarray(jax.jit(jax.vmap(lambda q: arm.flange(model, q)))(result.qs))
     iterations = int(result.iterations)
     ts = np.arange(problem.horizon + 1) * problem.dt

@@ -48,14 +48,3 @@ def test_a_tasks_exception_reaches_the_caller(jobs):
 def test_jobs_below_one_are_refused():
     with pytest.raises(ValueError, match="jobs must be at least 1"):
         parallel.run(_worker_facts, ["a"], jobs=0)
-
-
-def test_a_result_before_its_notice_is_reported_once(capsys):
-    """A worker's start notice and its result travel on different queues, so the result may
-    arrive first: the task is reported started once, then done."""
-    board = parallel._Board("race", 1)
-    board.finished("a", board.start)
-    board.started("a", board.start)           # the late notice
-    err = capsys.readouterr().err
-    assert err.count("a started") == 1 and err.index("a started") < err.index("a done in")
-    assert board.running == {}

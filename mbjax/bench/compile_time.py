@@ -104,17 +104,17 @@ def run(out: Path, quick: bool = False) -> list[dict]:
     return records
 
 
-def _tours(records: list[dict], jobs: str) -> dict:
-    """{"cold": record, "warm": record} of the tours run one scene at a time ("one") or with a
-    worker per core ("cores")."""
+def _tours(records: list[dict], one_at_a_time: bool) -> dict:
+    """{"cold": record, "warm": record} of the tours run one scene at a time or with a worker
+    per core."""
     return {r["cache"]: r for r in records if r.get("kind") == "tour"
-            and (r["jobs"] == 1) == (jobs == "one")}
+            and (r["jobs"] == 1) == one_at_a_time}
 
 
 def summarize(records: list[dict]) -> dict:
     """Issue 21's compile-time targets, each met or missed: the tours as a user runs them, each
     scene alone (one at a time, from a cold cache)."""
-    tours, alone = _tours(records, "cores"), _tours(records, "one")
+    tours, alone = _tours(records, False), _tours(records, True)
     targets = [{"target": "tour --quick, cold cache", "value": tours["cold"]["wall_s"],
                 "limit": TARGET_TOUR_COLD},
                {"target": "tour --quick, warm cache", "value": tours["warm"]["wall_s"],
@@ -131,7 +131,7 @@ def plot(records: list[dict], path: Path) -> None:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    tours, alone = _tours(records, "cores"), _tours(records, "one")
+    tours, alone = _tours(records, False), _tours(records, True)
     names = list(alone["cold"]["scenes"])
     fig, ax = plt.subplots(figsize=(11, 4))
     width = 0.4
@@ -158,7 +158,7 @@ def plot(records: list[dict], path: Path) -> None:
 
 def report(records: list[dict]) -> str:
     """The tours and the targets as Markdown tables."""
-    tours, alone = _tours(records, "cores"), _tours(records, "one")
+    tours, alone = _tours(records, False), _tours(records, True)
     jobs = tours["cold"]["jobs"]
     lines = ["| scene (`--jobs 1`) | cold [s] | programs | warm [s] | programs |",
              "| --- | --- | --- | --- | --- |"]

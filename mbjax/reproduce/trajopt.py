@@ -42,7 +42,7 @@ def arm_reach():
 
     problem = arm.reach_problem()
     model = problem.system.model
-    target = arm.flange(model, problem.q0) + jnp.asarray(arm.REACH)
+    target = arm.reach_target(model)
 
     def final_error(result):
         return float(jnp.linalg.norm(arm.flange(model, result.qs[-1]) - target))
@@ -68,11 +68,12 @@ def carpal_wrist():
     """(problem, first guess, final_error(result)): the pose error (`wrist.kinematics.
     pose_error`) of the final pose against GOAL."""
     from mbjax.scenes import carpal_wrist as cw
+    from mbjax.trajopt.synthesis import goal_pose
     from mbjax.wrist import kinematics
 
     problem = cw.synthesis_problem()
     wrist = problem.system.wrist
-    goal = kinematics.pose_from_chart(wrist, jnp.asarray(cw.GOAL[0]), jnp.asarray(cw.GOAL[1]))
+    goal = goal_pose(wrist, cw.GOAL)
 
     def final_error(result):
         pose = kinematics.forward_kinematics(wrist, result.qs[-1])

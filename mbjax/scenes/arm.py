@@ -97,6 +97,11 @@ def _reach_terminal(q, v, *, arm, target):
     return jnp.sqrt(2.0) * jnp.concatenate([100.0 * (flange(arm, q) - target), v])
 
 
+def reach_target(arm: Model, offset=REACH) -> Array:
+    """Where the reach takes the flange: `offset` [m] from its place at Q_REF."""
+    return flange(arm, jnp.asarray(Q_REF)) + jnp.asarray(offset, dtype=float)
+
+
 def reach_problem(offset=REACH, steps: int = REACH_STEPS, arm: Model | None = None) -> Problem:
     """The arm from rest at Q_REF, unpowered but for the controls, to its flange moved by
     `offset` [m] at rest after `steps` steps of REACH_DT (RK4, torques held over each step).
@@ -107,7 +112,7 @@ def reach_problem(offset=REACH, steps: int = REACH_STEPS, arm: Model | None = No
     or models share one compiled `solve`. `hold(problem)` is a good first guess."""
     arm = model() if arm is None else arm
     q0, v0 = jnp.asarray(Q_REF), jnp.zeros(arm.nv)
-    target = flange(arm, q0) + jnp.asarray(offset, dtype=float)
+    target = reach_target(arm, offset)
     gravity = inverse_dynamics(arm, q0, v0, v0)
     return Problem(TreeSystem(arm), q0, v0, dt=REACH_DT, horizon=steps,
                    running=eqx.Partial(_reach_running, arm=arm, target=target, q0=q0,

@@ -1,8 +1,15 @@
-"""The one optimisation loop of `mbjax.trajopt`: Adam on a flat parameter vector."""
+"""Adam on a flat parameter vector, the Carpal Wrist synthesis' and controller's loop, and the
+cosine-decayed Adam it and `Shooting("adam")` share."""
 
 import jax
 import optax
 from jax import Array
+
+
+def cosine_adam(learning_rate: float, iterations: int, final_fraction: float):
+    """optax's Adam with its learning rate cosine-decayed to `final_fraction` of itself over
+    `iterations` steps."""
+    return optax.adam(optax.cosine_decay_schedule(learning_rate, iterations, alpha=final_fraction))
 
 
 def adam_descent(loss, x0: Array, *, learning_rate: float, iterations: int, final_fraction: float,
@@ -16,7 +23,7 @@ def adam_descent(loss, x0: Array, *, learning_rate: float, iterations: int, fina
     count, so it wins for a network's hundred-odd weights once compiled."""
     if gradient not in ("forward", "reverse"):
         raise ValueError(f"gradient must be 'forward' or 'reverse', got {gradient!r}")
-    optimizer = optax.adam(optax.cosine_decay_schedule(learning_rate, iterations, alpha=final_fraction))
+    optimizer = cosine_adam(learning_rate, iterations, final_fraction)
 
     def step(carry, _):
         x, state = carry

@@ -145,8 +145,7 @@ class Problem(eqx.Module):
         def residual(x, u):
             return self.running(*self.split(x), u)
         if _is_residual(residual, x, u):
-            r = residual(x, u)
-            Jx, Ju = jax.jacfwd(residual, argnums=(0, 1))(x, u)
+            (Jx, Ju), r = _jacobian_and_value(residual, x, u)
             dt = self.dt
             return (Jx.T @ r * dt, Ju.T @ r * dt, Jx.T @ Jx * dt, Ju.T @ Jx * dt, Ju.T @ Ju * dt)
         (lx, lu), ((lxx, _), (lux, luu)) = (jax.grad(self.stage_cost, argnums=(0, 1))(x, u),
@@ -158,7 +157,7 @@ class Problem(eqx.Module):
         def residual(x):
             return self.terminal(*self.split(x))
         if _is_residual(residual, x):
-            r, J = residual(x), jax.jacfwd(residual)(x)
+            (J,), r = _jacobian_and_value(residual, x)
             return J.T @ r, J.T @ J
         return jax.grad(self.final_cost)(x), jax.hessian(self.final_cost)(x)
 
@@ -199,3 +198,11 @@ def _value(c: Array) -> Array:
 
 def _is_residual(fn: Callable, *args) -> bool:
     return len(jax.eval_shape(fn, *args).shape) == 1
+
+
+def _jacobian_and_value(fn: Callable, *args):
+    """(dfn/d each arg, fn(*args)) from one forward-mode pass."""
+    def with_value(*args):
+        out = fn(*args)
+        return out, out
+    return jax.jacfwd(with_value, argnums=tuple(range(len(args))), has_aux=True)(*args)

@@ -18,6 +18,7 @@ import optax
 from jax import Array
 
 from mbjax.integrate.solution import Status
+from mbjax.trajopt.descent import cosine_adam
 from mbjax.trajopt.problem import Problem
 from mbjax.trajopt.result import AbstractSolver, Result, history
 
@@ -47,8 +48,7 @@ class Shooting(AbstractSolver):
             optimizer = optax.lbfgs()
             value_and_grad = optax.value_and_grad_from_state(objective)
         else:
-            optimizer = optax.adam(optax.cosine_decay_schedule(self.learning_rate, self.iterations,
-                                                               alpha=0.1))
+            optimizer = cosine_adam(self.learning_rate, self.iterations, 0.1)
             value_and_grad = jax.value_and_grad(objective)
         lower = jnp.broadcast_to(problem.lower, shape).ravel()
         upper = jnp.broadcast_to(problem.upper, shape).ravel()

@@ -81,12 +81,8 @@ def test_control_bounds_give_the_box_constrained_optimum():
     assert abs(float(result.cost) - (reference.fun + c)) < 1e-8
 
 
-def _reach_problem(offset, steps: int = 100) -> Problem:
-    return scene.reach_problem(offset, steps)
-
-
 def test_the_arm_reaches_its_target_at_a_stationary_point():
-    problem = _reach_problem(scene.REACH)           # the arm-reach problem: 0.4 m, 100 steps
+    problem = scene.reach_problem(scene.REACH)           # the arm-reach problem: 0.4 m, 100 steps
     us0 = scene.hold(problem)
     result = solve(problem, ILQR(), us0)
     assert result.messages() == ["success"]
@@ -107,11 +103,11 @@ def test_many_targets_in_one_vmapped_solve():
 
     @jax.vmap
     def reach(offset):
-        return solve(_reach_problem(offset, steps=40), ILQR())
+        return solve(scene.reach_problem(offset, steps=40), ILQR())
 
     results = reach(offsets)
     assert results.messages() == ["success"] * 3
-    one = solve(_reach_problem(offsets[1], steps=40), ILQR(iterations=300))
+    one = solve(scene.reach_problem(offsets[1], steps=40), ILQR(iterations=300))
     np.testing.assert_allclose(np.asarray(results.us[1]), np.asarray(one.us), atol=1e-8)
 
 
