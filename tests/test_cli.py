@@ -524,18 +524,22 @@ def test_bench_compile(tmp_path):
 
 def test_reproduce_trajopt(tmp_path):
     """`mbjax reproduce trajopt --quick`: each problem by each solver, the JSON's contract keys;
-    iLQR reaches the arm's target (to 1e-5 m) and the acrobot's upright pose (to 1e-2 m), with
-    the lowest cost, and the Carpal Wrist's goal pose under its torque limit."""
+    iLQR reaches the arm's target (to 1e-5 m), the acrobot's upright pose (to 1e-2 m), the
+    four-bar's crank angle (1e-4 rad) and the slewing beam's goal with its tip still (within
+    0.1 mm while it coasts), with the lowest cost, and the Carpal Wrist's goal pose under its
+    torque limit."""
     assert main(["reproduce", "trajopt", "--quick", "--out", str(tmp_path)]) == 0
     data = json.loads((tmp_path / "trajopt.json").read_text())
     rows = {(r["name"], r["solver"]): r for r in data["problems"]}
     assert set(rows) == {(p, s) for p in ("arm-reach", "acrobot-swingup")
-                         for s in ("ilqr", "lbfgs", "adam")} | {("carpal-wrist", "ilqr")}
+                         for s in ("ilqr", "lbfgs", "adam")} | {
+        (p, "ilqr") for p in ("four-bar", "slewing-beam", "carpal-wrist")}
     for row in rows.values():
         assert set(row) >= {"name", "solver", "iterations", "seconds", "final_error", "cost",
                             "status"}
         assert row["iterations"] > 0 and row["seconds"] > 0 and math.isfinite(row["cost"])
-    for problem, error in (("arm-reach", 1e-5), ("acrobot-swingup", 1e-2)):
+    for problem, error in (("arm-reach", 1e-5), ("acrobot-swingup", 1e-2), ("four-bar", 1e-4),
+                           ("slewing-beam", 1e-4)):
         ilqr = rows[problem, "ilqr"]
         assert ilqr["status"] == "success" and ilqr["final_error"] < error
         assert all(ilqr["cost"] <= row["cost"] for (p, _), row in rows.items() if p == problem)

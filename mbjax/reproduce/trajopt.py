@@ -10,14 +10,19 @@ cost about the same). Per problem and solver the JSON gives
 final_error is the problem's own task error at the end (the flange's distance to its target
 [m] for the arm).
 
-Problems so far: `arm-reach`, the 7-dof arm (`mbjax.data.ARM7`) from rest to a flange target
+Problems: `arm-reach`, the 7-dof arm (`mbjax.data.ARM7`) from rest to a flange target
 0.4 m away, at rest after 1 s (dt = 0.01 s, 100 knots; `mbjax.scenes.arm.reach_problem`);
 `acrobot-swingup`, the double pendulum driven at its elbow from hanging to upright at rest in
 3 s (dt = 0.01 s, 300 knots, zero torque as the first guess; `mbjax.scenes.acrobot`);
 `carpal-wrist`, the Carpal Wrist from START to GOAL at rest in 0.5 s under its 1.8 N m torque
 limit (100 knots; the inverse-dynamics feed-forward along a minimum-jerk path, clipped, as the
 first guess; `mbjax.scenes.carpal_wrist.synthesis_problem`), final_error the pose error
-(`mbjax.wrist.kinematics.pose_error`), by iLQR only (see SHOOTING).
+(`mbjax.wrist.kinematics.pose_error`), by iLQR only (see SHOOTING); `four-bar`, the closed
+loop on a table turned by its crank a quarter turn, rest to rest in 1 s with least effort,
+projection on (`mbjax.scenes.four_bar.crank_problem`), final_error the crank angle's miss
+[rad]; `slewing-beam`, the hub of a flexible arm slewed a quarter turn in 1 s with least torque
+and no vibration left (`mbjax.scenes.slewing_beam`; the rigid arm's least-effort torque as the
+first guess), final_error the tip's largest deflection [m] while the arm coasts for 1 s after.
 """
 
 import json
@@ -82,13 +87,41 @@ def carpal_wrist():
     return problem, cw.synthesis_guess(problem), final_error
 
 
-PROBLEMS = {"arm-reach": arm_reach, "acrobot-swingup": acrobot_swingup,
-            "carpal-wrist": carpal_wrist}
-# Single shooting differentiates the rollout in reverse mode; through the Carpal Wrist's
+def four_bar():
+    """(problem, first guess, final_error(result)): the crank angle's miss [rad]."""
+    from mbjax.scenes import four_bar as fb
+
+    problem = fb.crank_problem()
+
+    def final_error(result):
+        return float(abs(result.qs[-1, 0] - fb.CRANK_GOAL))
+
+    return problem, None, final_error
+
+
+def slewing_beam():
+    """(problem, first guess, final_error(result)): the residual vibration, the tip's largest
+    deflection [m] while the arm coasts for 1 s after the slew."""
+    from mbjax.scenes import slewing_beam as sb
+
+    problem = sb.slew_problem()
+
+    def final_error(result):
+        xN = jnp.concatenate([result.qs[-1], result.vs[-1]])
+        return float(sb.residual_vibration(problem, xN))
+
+    return problem, sb.rigid_guess(problem), final_error
+
+
+PROBLEMS = {"arm-reach": arm_reach, "acrobot-swingup": acrobot_swingup, "four-bar": four_bar,
+            "slewing-beam": slewing_beam, "carpal-wrist": carpal_wrist}
+# Single shooting differentiates the rollout in reverse mode: through the Carpal Wrist's
 # autodiff Lagrangian (third derivatives of its kinematics) XLA did not compile that program
 # within 10 minutes, so the wrist is solved by iLQR alone (its forward-mode linearization
-# compiles in about 10 s).
-SHOOTING = ("arm-reach", "acrobot-swingup")
+# compiles in about 10 s); through the four-bar's projection and the flexible recursion it
+# compiles in about 50 s each, so the quick run leaves them to iLQR.
+SHOOTING = ("arm-reach", "acrobot-swingup", "four-bar", "slewing-beam")
+QUICK_SHOOTING = ("arm-reach", "acrobot-swingup")
 
 
 def reproduce(out: Path, quick: bool = False) -> dict:
@@ -98,7 +131,7 @@ def reproduce(out: Path, quick: bool = False) -> dict:
     for name, build in PROBLEMS.items():
         problem, guess, final_error = build()
         for solver_name, solver in (QUICK_SOLVERS if quick else SOLVERS).items():
-            if solver_name != "ilqr" and name not in SHOOTING:
+            if solver_name != "ilqr" and name not in (QUICK_SHOOTING if quick else SHOOTING):
                 continue
             result, timing = measure(solve, problem, solver, guess, repeats=1 if quick else 3)
             iterations = int(result.iterations)

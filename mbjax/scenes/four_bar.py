@@ -31,14 +31,14 @@ THETA0, OMEGA0 = 0.3, 2.0                      # initial crank angle [rad] and r
 CLOSURES = ("point_on_line", "revolute")
 
 
-def model() -> Model:
+def model(gravity=(0.0, -GRAVITY, 0.0)) -> Model:
     """The tree: crank and coupler from the ground origin, rocker from (D, 0, 0)."""
     inertia = np.array([np.diag([1e-5, m * L**2 / 12, m * L**2 / 12])
                         for m, L in zip(MASSES, LENGTHS)])
     return Model([-1, 0, -1], "revolute", mass=MASSES, inertia=inertia,
                  com=np.stack([LENGTHS / 2, 0 * LENGTHS, 0 * LENGTHS], 1), axis=[0.0, 0.0, 1.0],
                  placement_translation=[[0, 0, 0], [A_, 0, 0], [D_, 0, 0]],
-                 gravity=(0.0, -GRAVITY, 0.0))
+                 gravity=gravity)
 
 
 def joint_angles(theta):
@@ -67,3 +67,34 @@ def build(closure: str = "point_on_line", theta0=THETA0, omega0=OMEGA0):
     q0 = joint_angles(jnp.asarray(theta0, float))
     v0 = jax.jacfwd(joint_angles)(jnp.asarray(theta0, float)) * omega0
     return system, q0, v0
+
+
+CRANK_GOAL = THETA0 + np.pi / 2                # [rad]: the trajectory-optimisation target
+CRANK_DT, CRANK_STEPS = 0.01, 100              # [s], knots: 1 s
+
+
+def _crank_running(q, v, u):
+    return u
+
+
+def _crank_terminal(q, v, *, goal):
+    return jnp.concatenate([100.0 * (q[:1] - goal), 10.0 * v])
+
+
+def crank_problem(goal=CRANK_GOAL, steps: int = CRANK_STEPS):
+    """The four-bar lying on a table (gravity -z, normal to its plane; planar pin closure,
+    projection on) driven by a torque on its crank from
+    rest at crank angle THETA0 to rest at `goal` [rad] after `steps` steps of CRANK_DT (RK4),
+    with least effort: the running residual is the torque u (cost 1/2 u^2 dt), the terminal
+    residuals 100 (theta_N - goal) and 10 v_N. Each step ends on the loop by the projection, so
+    iLQR's linearization is that of the projected step."""
+    from mbjax.rigid import TreeSystem
+    from mbjax.trajopt import Problem
+
+    cut = CutJoint("point_on_line", 1, 2, origin_a=(B_, 0.0, 0.0), origin_b=(C_, 0.0, 0.0))
+    table = model(gravity=(0.0, 0.0, -GRAVITY))
+    system = ClosedSystem(TreeSystem(table, actuation=[0]), [cut], projection=True)
+    q0 = joint_angles(jnp.asarray(THETA0, float))
+    return Problem(system, q0, jnp.zeros(3), dt=CRANK_DT, horizon=steps,
+                   running=_crank_running,
+                   terminal=jax.tree_util.Partial(_crank_terminal, goal=jnp.asarray(goal, float)))

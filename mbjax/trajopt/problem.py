@@ -35,15 +35,22 @@ from mbjax.control import Constant
 from mbjax.integrate import RK4
 from mbjax.integrate.base import AbstractIntegrator
 from mbjax.integrate.system import AbstractSystem
+from mbjax.loops import ClosedSystem
+
+
+def driven(system: AbstractSystem):
+    """The part of `system` that holds its control and actuation: the system itself, or a
+    closed system's tree."""
+    return system.tree if isinstance(system, ClosedSystem) else system
 
 
 def with_control(system: AbstractSystem, control) -> AbstractSystem:
     """`system` driven by `control` instead of its own."""
-    if not hasattr(system, "control"):
+    if not hasattr(driven(system), "control"):
         raise TypeError(f"{type(system).__name__} has no control to optimise: a problem needs a "
-                        "system with a `control` field (TreeSystem, FlexibleSystem, ClosedSystem, "
-                        "WristSystem, ...)")
-    return eqx.tree_at(lambda s: s.control, system, control, is_leaf=lambda x: x is None)
+                        "system with a `control` field (TreeSystem, FlexibleSystem, WristSystem, "
+                        "a ClosedSystem of one of these, ...)")
+    return eqx.tree_at(lambda s: driven(s).control, system, control, is_leaf=lambda x: x is None)
 
 
 class Problem(eqx.Module):
@@ -112,7 +119,7 @@ class Problem(eqx.Module):
 
     @property
     def nu(self) -> int:
-        actuation = getattr(self.system, "actuation", None)
+        actuation = getattr(driven(self.system), "actuation", None)
         return self.nv if actuation is None else len(actuation)
 
     @property
