@@ -1,11 +1,11 @@
 """Benchmark suites for `mbjax bench SUITE` (their timing helper is `mbjax.timing`).
 
 Each suite is run(out: Path, quick: bool) -> list of records, written as out/SUITE.jsonl and
-out/SUITE.png. Peers (MuJoCo, Pinocchio, exudyn) are measured in the same process when installed.
+out/SUITE.png. Peers (MuJoCo, Pinocchio, exudyn, Crocoddyl) are measured in the same process when installed.
 """
 
 from mbjax.bench import (compile_time, flexible, integrators, loops, rigid, speed, tfe, throughput,
-                         wrist)
+                         trajopt, wrist)
 
 SUITES = {
     compile_time.NAME: compile_time.run,
@@ -16,6 +16,7 @@ SUITES = {
     speed.NAME: speed.run,
     tfe.NAME: tfe.run,
     throughput.NAME: throughput.run,
+    trajopt.NAME: trajopt.run,
     wrist.NAME: wrist.run,
 }
 

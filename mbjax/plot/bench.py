@@ -247,3 +247,40 @@ def throughput_figure(records: list[dict]) -> Figure:
                title="accuracy of the accelerations")
     ax_acc.legend(fontsize=7)
     return fig
+
+
+def trajopt_bench_figure(records: list[dict]) -> Figure:
+    """`mbjax bench trajopt`: per problem, each engine's cost above the better optimum against
+    the iteration's share of its solve time; then the many-targets times."""
+    singles = [r for r in records if r["kind"] == "single" and "skipped" not in r]
+    problems = list(dict.fromkeys(r["problem"] for r in singles))
+    fig = Figure(figsize=(5.2 * (len(problems) + 1), 4.2), layout="constrained")
+    axes = fig.subplots(1, len(problems) + 1, squeeze=False)[0]
+    style = {"mbjax": ("#1f77b4", "o"), "crocoddyl": ("#d62728", "s")}
+    for ax, problem in zip(axes, problems, strict=False):
+        for r in (r for r in singles if r["problem"] == problem):
+            costs = np.asarray(r["history"])
+            gap = np.maximum((costs - r["best_cost"]) / abs(r["best_cost"]), 1e-12)
+            t = np.arange(len(costs)) * r["seconds"] / max(len(costs) - 1, 1)
+            color, marker = style.get(r["engine"], ("k", "x"))
+            ax.loglog(np.maximum(t, 1e-4), gap, color=color, marker=marker, ms=3,
+                      markevery=max(len(costs) // 12, 1),
+                      label=f"{r['engine']} {r['solver']}: {r['iterations']} it, "
+                            f"{r['seconds'] * 1e3:.0f} ms; to 1e-6 {r['seconds_to_tolerance'] * 1e3:.0f} ms")
+        ax.axhline(1e-6, color="0.5", lw=0.8, ls="--")
+        ax.set(xlabel="time [s] (each iteration its share of the solve)",
+               ylabel="(cost - best) / best", title=problem)
+        ax.legend(fontsize=7)
+    ax = axes[-1]
+    many = [r for r in records if r["kind"] == "many" and "skipped" not in r]
+    labels = [f"{r['engine']}\n{r['how']}" for r in many]
+    ax.bar(range(len(many)), [r["seconds"] for r in many],
+           color=[style.get(r["engine"], ("k", "x"))[0] for r in many])
+    ax.set_xticks(range(len(many)), labels, fontsize=7)
+    for i, r in enumerate(many):
+        ax.annotate(f"{r['seconds']:.2f} s\n{r['converged']}/{r['targets']} converged",
+                    (i, r["seconds"]), ha="center", va="bottom", fontsize=7)
+    if many:
+        ax.set_ylim(0, 1.2 * max(r["seconds"] for r in many))
+    ax.set(ylabel="wall time [s]", title=f"arm-reach, {many[0]['targets'] if many else 0} targets")
+    return fig

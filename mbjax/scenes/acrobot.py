@@ -15,6 +15,7 @@ import jax.numpy as jnp
 import numpy as np
 from jax import Array
 
+from mbjax.integrate import RK4
 from mbjax.model import Model
 from mbjax.rigid import TreeSystem, forward_kinematics
 from mbjax.trajopt import Problem
@@ -46,9 +47,10 @@ def _terminal(q, v, *, acrobot, goal):
 
 
 def swingup_problem(arm: Model | None = None, steps: int = round(DURATION / DT),
-                    torque_limit: float | None = None) -> Problem:
+                    torque_limit: float | None = None, integrator=RK4()) -> Problem:
     """The swing-up as least-squares residuals: along the way 0.1 (tip - goal), 0.01 v and
-    0.1 u; at the end 100 (tip - goal) and 10 v; the elbow's torque within +-torque_limit."""
+    0.1 u; at the end 100 (tip - goal) and 10 v; the elbow's torque within +-torque_limit;
+    steps of DT by `integrator`."""
     acrobot = model() if arm is None else arm
     goal = jnp.array([0.0, 0.0, 2 * LENGTH])
     running = eqx.Partial(_running, acrobot=acrobot, goal=goal)
@@ -56,4 +58,4 @@ def swingup_problem(arm: Model | None = None, steps: int = round(DURATION / DT),
     bound = None if torque_limit is None else float(torque_limit)
     return Problem(TreeSystem(acrobot, actuation=[1]), Q0, np.zeros(2), dt=DT, horizon=steps,
                    running=running, terminal=terminal, lower=None if bound is None else -bound,
-                   upper=bound)
+                   upper=bound, integrator=integrator)

@@ -102,9 +102,11 @@ def reach_target(arm: Model, offset=REACH) -> Array:
     return flange(arm, jnp.asarray(Q_REF)) + jnp.asarray(offset, dtype=float)
 
 
-def reach_problem(offset=REACH, steps: int = REACH_STEPS, arm: Model | None = None) -> Problem:
+def reach_problem(offset=REACH, steps: int = REACH_STEPS, arm: Model | None = None,
+                  integrator=RK4()) -> Problem:
     """The arm from rest at Q_REF, unpowered but for the controls, to its flange moved by
-    `offset` [m] at rest after `steps` steps of REACH_DT (RK4, torques held over each step).
+    `offset` [m] at rest after `steps` steps of REACH_DT (`integrator`, torques held over each
+    step).
     Least-squares residuals (1/2 |r|^2 is the cost) weighted as Crocoddyl's arm examples weight
     theirs: along the way the reach (0.1) and small state and control regularizations (1e-2,
     the controls about the torque that holds Q_REF); at the end the reach (100) and the velocity
@@ -117,7 +119,8 @@ def reach_problem(offset=REACH, steps: int = REACH_STEPS, arm: Model | None = No
     return Problem(TreeSystem(arm), q0, v0, dt=REACH_DT, horizon=steps,
                    running=eqx.Partial(_reach_running, arm=arm, target=target, q0=q0,
                                        gravity=gravity),
-                   terminal=eqx.Partial(_reach_terminal, arm=arm, target=target))
+                   terminal=eqx.Partial(_reach_terminal, arm=arm, target=target),
+                   integrator=integrator)
 
 
 def hold(problem: Problem) -> Array:
