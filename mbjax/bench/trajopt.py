@@ -188,8 +188,9 @@ def single(name: str, repeats: int, common: dict) -> list[dict]:
     return records
 
 
-def many(n: int, repeats: int, common: dict) -> list[dict]:
-    """The arm's reach to n targets: mbjax vmapped, mbjax one by one, Crocoddyl in a loop."""
+def many(n: int, repeats: int, common: dict, loop: bool = True) -> list[dict]:
+    """The arm's reach to n targets: mbjax vmapped, mbjax one by one (unless not `loop`: on a
+    GPU each solve is thousands of small kernels), Crocoddyl in a loop."""
     from mbjax.scenes import arm
 
     problem, us0, _, build = arm_reach()
@@ -210,12 +211,14 @@ def many(n: int, repeats: int, common: dict) -> list[dict]:
     results, timing = measure(batched, jnp.asarray(offsets), repeats=repeats)
     records = [summary("mbjax", "one vmapped solve", timing.run_s, np.asarray(results.iterations),
                        np.asarray(results.status) == 0, compile_s=timing.compile_s)]
-    single_solve = jax.jit(one)
-    jax.block_until_ready(single_solve(jnp.asarray(offsets[0])))
-    start = time.perf_counter()
-    looped = [jax.block_until_ready(single_solve(jnp.asarray(o))) for o in offsets]
-    records.append(summary("mbjax", "a loop of jitted solves", time.perf_counter() - start,
-                           [int(r.iterations) for r in looped], [int(r.status) == 0 for r in looped]))
+    if loop:
+        single_solve = jax.jit(one)
+        jax.block_until_ready(single_solve(jnp.asarray(offsets[0])))
+        start = time.perf_counter()
+        looped = [jax.block_until_ready(single_solve(jnp.asarray(o))) for o in offsets]
+        records.append(summary("mbjax", "a loop of jitted solves", time.perf_counter() - start,
+                               [int(r.iterations) for r in looped],
+                               [int(r.status) == 0 for r in looped]))
     why = peers.crocoddyl_working()
     if why is not None:
         records.append({**common, "kind": "many", "problem": "arm-reach", "engine": "crocoddyl",

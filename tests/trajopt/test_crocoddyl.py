@@ -1,0 +1,39 @@
+"""iLQR against an independent optimal-control library: Crocoddyl's FDDP (analytic derivatives
+on Pinocchio) on the arm reach built from the same URDF, residuals, weights, semi-implicit Euler
+steps and first guess (`mbjax.bench.peers.crocoddyl_reach`). Skipped where Crocoddyl is not
+installed or its pairing with Pinocchio is broken (`peers.crocoddyl_working` says which)."""
+
+import jax.numpy as jnp
+import numpy as np
+import pytest
+
+from mbjax.bench import peers
+from mbjax.bench.trajopt import _Crocoddyl, arm_reach
+from mbjax.trajopt import ILQR, solve
+
+WHY = peers.crocoddyl_working()
+pytestmark = pytest.mark.skipif(WHY is not None, reason=str(WHY))
+
+
+def test_arm_reach_matches_crocoddyl():
+    """One problem in two libraries: the first guess's rollout and cost agree to rounding, and
+    the two solvers' optima agree: cost to 1e-6 (relative), controls to 1e-3 of their largest,
+    both flanges on the target."""
+    problem, us0, final_error, build = arm_reach()
+    croc_problem, _ = build()
+    croc = _Crocoddyl(croc_problem, us0)
+    xs = np.asarray(problem.rollout(jnp.asarray(us0)))
+    np.testing.assert_allclose(np.array(croc_problem.rollout(croc.us0)), xs, atol=1e-9)
+    np.testing.assert_allclose(croc_problem.calc(list(xs), croc.us0),
+                               problem.cost(jnp.asarray(xs), jnp.asarray(us0)), rtol=1e-12)
+
+    result = solve(problem, ILQR(), us0)
+    assert result.messages() == ["success"]
+    assert croc.solve(200)
+    np.testing.assert_allclose(result.cost, croc.solver.cost, rtol=1e-6)
+    us = np.array(croc.solver.us)
+    np.testing.assert_allclose(np.asarray(result.us), us, atol=1e-3 * np.abs(us).max())
+    # both reach the target; the final joint angles differ by about 2e-4 rad along the
+    # redundant arm's self-motion, which only the 1e-4 state regularization prices
+    assert final_error(result.qs[-1]) < 1e-5
+    assert final_error(jnp.asarray(croc.solver.xs[-1])[:problem.nq]) < 1e-5
