@@ -149,11 +149,9 @@ class Problem(eqx.Module):
     def stage_expansion(self, x: Array, u: Array):
         """(l_x, l_u, l_xx, l_ux, l_uu) of the stage cost at (x, u): exact, or Gauss-Newton for
         residuals (see the module)."""
-        def residual(x, u):
-            return self.running(*self.split(x), u)
-        if _is_residual(residual, x, u):
-            (Jx, Ju), r = _jacobian_and_value(residual, x, u)
-            dt = self.dt
+        if _is_residual(self.running, *self.split(x), u):
+            (Jq, Jv, Ju), r = _jacobian_and_value(self.running, *self.split(x), u)
+            Jx, dt = jnp.concatenate([Jq, Jv], axis=1), self.dt
             return (Jx.T @ r * dt, Ju.T @ r * dt, Jx.T @ Jx * dt, Ju.T @ Jx * dt, Ju.T @ Ju * dt)
         (lx, lu), ((lxx, _), (lux, luu)) = (jax.grad(self.stage_cost, argnums=(0, 1))(x, u),
                                             jax.hessian(self.stage_cost, argnums=(0, 1))(x, u))
@@ -161,10 +159,9 @@ class Problem(eqx.Module):
 
     def final_expansion(self, x: Array):
         """(V_x, V_xx) of the terminal cost at x, as `stage_expansion`."""
-        def residual(x):
-            return self.terminal(*self.split(x))
-        if _is_residual(residual, x):
-            (J,), r = _jacobian_and_value(residual, x)
+        if _is_residual(self.terminal, *self.split(x)):
+            (Jq, Jv), r = _jacobian_and_value(self.terminal, *self.split(x))
+            J = jnp.concatenate([Jq, Jv], axis=1)
             return J.T @ r, J.T @ J
         return jax.grad(self.final_cost)(x), jax.hessian(self.final_cost)(x)
 
@@ -208,8 +205,13 @@ def _is_residual(fn: Callable, *args) -> bool:
 
 
 def _jacobian_and_value(fn: Callable, *args):
-    """(dfn/d each arg, fn(*args)) from one forward-mode pass."""
-    def with_value(*args):
-        out = fn(*args)
-        return out, out
-    return jax.jacfwd(with_value, argnums=tuple(range(len(args))), has_aux=True)(*args)
+    """(dfn/d each arg, fn(*args)): one forward-mode pass per argument, so that the tangents of
+    one argument do not travel through what only another touches (a cost's kinematics of q
+    are not pushed along the v and u directions)."""
+    def with_value(i):
+        def partial(x):
+            out = fn(*args[:i], x, *args[i + 1:])
+            return out, out
+        return jax.jacfwd(partial, has_aux=True)(args[i])
+    jacobians, values = zip(*(with_value(i) for i in range(len(args))), strict=True)
+    return jacobians, values[0]
