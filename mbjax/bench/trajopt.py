@@ -10,6 +10,10 @@ guess (the arm: the torque that holds its start; the acrobot: zero) and its roll
 checks that the two are one problem: the guess's rollouts agree (`dynamics_agreement`, largest
 state difference) and so do their costs (`cost_agreement`, relative).
 
+mbjax's iLQR runs with Crocoddyl's globalization (`ILQR(**CROCODDYL_SCHEDULE)`: the same
+step lengths, acceptance test and regularization schedule), so the two differ in their
+derivatives and their code, not in their strategy.
+
 Timing. Each solver runs until its own convergence test passes (mbjax: a relative decrease below
 1e-8; Crocoddyl: its stopping criterion, 1e-9 on the expected improvement) or 200 iterations, from
 the rolled-out guess. `seconds` is the median wall time of that solve (mbjax after compiling,
@@ -38,6 +42,7 @@ from mbjax.bench import peers
 from mbjax.integrate import SemiImplicitEuler
 from mbjax.timing import measure, write_jsonl
 from mbjax.trajopt import ILQR, solve
+from mbjax.trajopt.ilqr import CROCODDYL_SCHEDULE
 
 NAME = "trajopt"
 TOLERANCE = 1e-6
@@ -144,7 +149,8 @@ class _Crocoddyl:
 def single(name: str, repeats: int, common: dict) -> list[dict]:
     """Both engines on one problem: cost histories, times to convergence and to TOLERANCE."""
     problem, us0, final_error, build = PROBLEMS[name]()
-    result, timing = measure(solve, problem, ILQR(iterations=ITERATIONS), us0, repeats=repeats)
+    ilqr = ILQR(iterations=ITERATIONS, **CROCODDYL_SCHEDULE)
+    result, timing = measure(solve, problem, ilqr, us0, repeats=repeats)
     iterations = int(result.iterations)
     costs = np.asarray(result.costs)[:iterations + 1]
     mbjax = {**common, "kind": "single", "problem": name, "engine": "mbjax", "solver": "ILQR",
@@ -180,8 +186,9 @@ def single(name: str, repeats: int, common: dict) -> list[dict]:
         records[-1].update(iterations_to_tolerance=k,
                            seconds_to_tolerance=croc.timed(max(k, 1), repeats))
     k = _to_tolerance(costs, best)
-    truncated = timing.run_s if k >= iterations else measure(
-        solve, problem, ILQR(iterations=max(k, 1)), us0, repeats=repeats)[1].run_s
+    stopped = ILQR(iterations=max(k, 1), **CROCODDYL_SCHEDULE)
+    truncated = (timing.run_s if k >= iterations
+                 else measure(solve, problem, stopped, us0, repeats=repeats)[1].run_s)
     mbjax.update(iterations_to_tolerance=k, seconds_to_tolerance=truncated)
     for r in records:
         r["best_cost"] = best
@@ -199,7 +206,7 @@ def many(n: int, repeats: int, common: dict, loop: bool = True) -> list[dict]:
 
     def one(offset):
         return solve(arm.reach_problem(offset, arm=model, integrator=SemiImplicitEuler()),
-                     ILQR(iterations=ITERATIONS), us0)
+                     ILQR(iterations=ITERATIONS, **CROCODDYL_SCHEDULE), us0)
 
     def summary(engine, how, seconds, iterations, converged, **extra):
         return {**common, "kind": "many", "problem": "arm-reach", "engine": engine, "how": how,
