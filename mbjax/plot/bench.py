@@ -266,7 +266,8 @@ def trajopt_bench_figure(records: list[dict]) -> Figure:
             ax.loglog(np.maximum(t, 1e-4), gap, color=color, marker=marker, ms=3,
                       markevery=max(len(costs) // 12, 1),
                       label=f"{r['engine']} {r['solver']}: {r['iterations']} it, "
-                            f"{r['seconds'] * 1e3:.0f} ms; to 1e-6 {r['seconds_to_tolerance'] * 1e3:.0f} ms")
+                            f"{r['seconds'] * 1e3:.0f} ms; "
+                            f"to 1e-6 {r['seconds_to_tolerance'] * 1e3:.0f} ms")
         ax.axhline(1e-6, color="0.5", lw=0.8, ls="--")
         ax.set(xlabel="time [s] (each iteration its share of the solve)",
                ylabel="(cost - best) / best", title=problem)

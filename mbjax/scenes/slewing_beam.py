@@ -96,7 +96,8 @@ def rigid_guess(problem: Problem) -> Array:
     from 6 J slew / T^2 to its negative, J the hub's and beam's inertia about the axis): the
     first guess, and the baseline whose residual vibration the optimum suppresses."""
     arm = problem.system.model
-    J = arm.bodies.rotary[0, 2, 2] + arm.bodies.second[0, 0, 0, 0, 0] + arm.bodies.second[0, 1, 0, 1, 0]
+    second = arm.bodies.second[0]                        # sum m (rho, phi) (rho, phi)^T
+    J = arm.bodies.rotary[0, 2, 2] + second[0, 0, 0, 0] + second[1, 0, 1, 0]   # about z
     T = problem.horizon * problem.dt
     t = (jnp.arange(problem.horizon) + 0.5) * problem.dt
     slew = problem.terminal.keywords["goal"]

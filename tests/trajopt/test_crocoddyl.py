@@ -10,15 +10,17 @@ import pytest
 from mbjax.bench import peers
 from mbjax.bench.trajopt import _Crocoddyl, arm_reach
 from mbjax.trajopt import ILQR, solve
+from mbjax.trajopt.ilqr import CROCODDYL_SCHEDULE
 
 WHY = peers.crocoddyl_working()
 pytestmark = pytest.mark.skipif(WHY is not None, reason=str(WHY))
 
 
-def test_arm_reach_matches_crocoddyl():
+@pytest.mark.parametrize("schedule", [{}, CROCODDYL_SCHEDULE], ids=["default", "crocoddyl"])
+def test_arm_reach_matches_crocoddyl(schedule):
     """One problem in two libraries: the first guess's rollout and cost agree to rounding, and
-    the two solvers' optima agree: cost to 1e-6 (relative), controls to 1e-3 of their largest,
-    both flanges on the target."""
+    the two solvers' optima agree (iLQR with its default globalization and with Crocoddyl's):
+    cost to 1e-6 (relative), controls to 1e-3 of their largest, both flanges on the target."""
     problem, us0, final_error, build = arm_reach()
     croc_problem, _ = build()
     croc = _Crocoddyl(croc_problem, us0)
@@ -27,7 +29,7 @@ def test_arm_reach_matches_crocoddyl():
     np.testing.assert_allclose(croc_problem.calc(list(xs), croc.us0),
                                problem.cost(jnp.asarray(xs), jnp.asarray(us0)), rtol=1e-12)
 
-    result = solve(problem, ILQR(), us0)
+    result = solve(problem, ILQR(**schedule), us0)
     assert result.messages() == ["success"]
     assert croc.solve(200)
     np.testing.assert_allclose(result.cost, croc.solver.cost, rtol=1e-6)

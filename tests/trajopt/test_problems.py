@@ -19,7 +19,8 @@ def test_four_bar_matches_its_minimal_coordinate_optimum():
     pin closure projected after each step) against the one-coordinate problem: the crank's
     effective inertia J(theta) from the bars' kinetic energy and the position analysis, Lagrange's
     equation J theta'' + 1/2 J'(theta) theta'^2 = u, the same RK4 step, hold and costs as
-    least-squares residuals, solved by MINPACK's Levenberg-Marquardt (SciPy). The two optima agree to the discretizations' difference."""
+    least-squares residuals, solved by MINPACK's Levenberg-Marquardt (SciPy). The two optima
+    agree to the discretizations' difference."""
     problem = fb.crank_problem()
     result = solve(problem, ILQR())
     assert result.messages() == ["success"]
