@@ -532,7 +532,7 @@ def test_reproduce_trajopt(tmp_path):
     data = json.loads((tmp_path / "trajopt.json").read_text())
     rows = {(r["name"], r["solver"]): r for r in data["problems"]}
     assert set(rows) == {(p, s) for p in ("arm-reach", "acrobot-swingup")
-                         for s in ("ilqr", "lbfgs", "adam")} | {
+                         for s in ("ilqr", "multiple-shooting", "lbfgs", "adam")} | {
         (p, "ilqr") for p in ("four-bar", "slewing-beam", "carpal-wrist")}
     for row in rows.values():
         assert set(row) >= {"name", "solver", "iterations", "seconds", "final_error", "cost",

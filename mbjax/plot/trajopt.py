@@ -4,7 +4,8 @@ and one solved reach (the tour)."""
 import numpy as np
 from matplotlib.figure import Figure
 
-STYLE = {"ilqr": ("#1f77b4", "o"), "lbfgs": ("#ff7f0e", "s"), "adam": ("#7f7f7f", "^")}
+STYLE = {"ilqr": ("#1f77b4", "o"), "multiple-shooting": ("#2ca02c", "D"),
+         "lbfgs": ("#ff7f0e", "s"), "adam": ("#7f7f7f", "^")}
 
 
 def trajopt_figure(data: dict) -> Figure:

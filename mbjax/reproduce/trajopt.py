@@ -1,7 +1,8 @@
 """`mbjax reproduce trajopt`: trajectory-optimisation problems solved by each of mbjax's solvers.
 
 Each problem (a `mbjax.trajopt.Problem` built by its scene) is solved from the same first guess
-by iLQR (`ILQR`), single shooting with L-BFGS (`Shooting("lbfgs")`) and Adam
+by iLQR (`ILQR`), multiple shooting (`MultipleShooting`: Gauss-Newton on an augmented
+Lagrangian of the defects), single shooting with L-BFGS (`Shooting("lbfgs")`) and Adam
 (`Shooting("adam")`, the first-order baseline). Each solve is one compiled program, timed after
 compiling (`mbjax.timing.measure`); the cost after each iteration is plotted against the time it
 was reached, taken as the iteration's share of the solve's run time (iterations of one solver
@@ -32,12 +33,15 @@ import jax.numpy as jnp
 import numpy as np
 
 from mbjax.timing import measure
-from mbjax.trajopt import ILQR, Shooting, solve
+from mbjax.trajopt import ILQR, MultipleShooting, Shooting, solve
 
 NAME = "trajopt"
-SOLVERS = {"ilqr": ILQR(iterations=300), "lbfgs": Shooting("lbfgs", iterations=1000),
+SOLVERS = {"ilqr": ILQR(iterations=300), "multiple-shooting": MultipleShooting(iterations=600),
+           "lbfgs": Shooting("lbfgs", iterations=1000),
            "adam": Shooting("adam", iterations=1000, learning_rate=0.01)}
-QUICK_SOLVERS = {"ilqr": ILQR(iterations=300), "lbfgs": Shooting("lbfgs", iterations=200),
+QUICK_SOLVERS = {"ilqr": ILQR(iterations=300),
+                 "multiple-shooting": MultipleShooting(iterations=600),
+                 "lbfgs": Shooting("lbfgs", iterations=200),
                  "adam": Shooting("adam", iterations=200, learning_rate=0.01)}
 
 
@@ -119,7 +123,8 @@ PROBLEMS = {"arm-reach": arm_reach, "acrobot-swingup": acrobot_swingup, "four-ba
 # autodiff Lagrangian (third derivatives of its kinematics) XLA did not compile that program
 # within 10 minutes, so the wrist is solved by iLQR alone (its forward-mode linearization
 # compiles in about 10 s); through the four-bar's projection and the flexible recursion it
-# compiles in about 50 s each, so the quick run leaves them to iLQR.
+# compiles in about 50 s each, so the quick run leaves them to iLQR. Multiple shooting (forward
+# mode only) runs on the same problems, to keep the quick run's compilations few.
 SHOOTING = ("arm-reach", "acrobot-swingup", "four-bar", "slewing-beam")
 QUICK_SHOOTING = ("arm-reach", "acrobot-swingup")
 

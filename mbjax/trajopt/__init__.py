@@ -1,13 +1,14 @@
 """Trajectory optimisation for any system (`Problem`, `solve` with a solver strategy such as
-`ILQR`, `Shooting`; `optimal_cost` for co-design), and the Carpal Wrist's synthesis, baseline, controller and sweeps (seed 003 §6)."""
+`ILQR`, `MultipleShooting`, `Shooting`; `optimal_cost` for co-design), and the Carpal Wrist's synthesis, baseline, controller and sweeps (seed 003 §6)."""
 
 from mbjax.trajopt.codesign import optimal_cost
 from mbjax.trajopt.ilqr import ILQR
+from mbjax.trajopt.multiple_shooting import MultipleShooting
 from mbjax.trajopt.problem import Problem
 from mbjax.trajopt.result import AbstractSolver, Result
 from mbjax.trajopt.shooting import Shooting
 from mbjax.trajopt.solve import solve
 from mbjax.trajopt.sweeps import sweep
 
-__all__ = ["AbstractSolver", "ILQR", "Problem", "Result", "Shooting", "optimal_cost", "solve",
-           "sweep"]
+__all__ = ["AbstractSolver", "ILQR", "MultipleShooting", "Problem", "Result", "Shooting",
+           "optimal_cost", "solve", "sweep"]
