@@ -524,7 +524,7 @@ def test_bench_compile(tmp_path):
 
 def test_reproduce_trajopt(tmp_path):
     """`mbjax reproduce trajopt --quick`: each problem by each solver, the JSON's contract keys;
-    iLQR reaches the arm's target (to 1e-5 m), the acrobot's upright pose (to 1e-2 m), the
+    iLQR reaches the arm's target (to 1e-5 m; multiple shooting too, at iLQR's optimum), the acrobot's upright pose (to 1e-2 m), the
     four-bar's crank angle (1e-4 rad) and the slewing beam's goal with its tip still (within
     0.1 mm while it coasts), with the lowest cost, and the Carpal Wrist's goal pose under its
     torque limit."""
@@ -543,6 +543,10 @@ def test_reproduce_trajopt(tmp_path):
         ilqr = rows[problem, "ilqr"]
         assert ilqr["status"] == "success" and ilqr["final_error"] < error
         assert all(ilqr["cost"] <= row["cost"] for (p, _), row in rows.items() if p == problem)
+    # multiple shooting lands on iLQR's optimum of the arm's reach (to 1e-4: the merit's tail)
+    ms, ilqr = rows["arm-reach", "multiple-shooting"], rows["arm-reach", "ilqr"]
+    assert ms["status"] == "success" and ms["final_error"] < 1e-5
+    assert abs(ms["cost"] - ilqr["cost"]) <= 1e-4 * ilqr["cost"]
     # the Carpal Wrist's START -> GOAL under the torque limit: the issue asks 1e-3 (Adam's
     # synthesis reached 4.9e-3); iLQR's tail, the effort among clamped torques, is slow
     assert rows["carpal-wrist", "ilqr"]["final_error"] < 1e-4

@@ -32,8 +32,7 @@ import jax.numpy as jnp
 from jax import Array
 
 from mbjax.integrate.solution import Status
-from mbjax.linalg import spd_solve
-from mbjax.trajopt.ilqr import ILQR, UNROLL, box_qp
+from mbjax.trajopt.ilqr import ILQR, riccati_step
 from mbjax.trajopt.problem import Problem
 from mbjax.trajopt.result import AbstractSolver, Result, history
 
@@ -74,7 +73,7 @@ class MultipleShooting(AbstractSolver):
             """The Gauss-Newton step (dxs, dus) of the merit, and whether it is finite."""
             (A, B, lx, lu, lxx, lux, luu), (vx, Vxx) = ILQR._linearize(problem, xs, us)
             e = defects(xs, us)
-            eye_x, eye_u = jnp.eye(problem.nx, dtype=us.dtype), jnp.eye(problem.nu, dtype=us.dtype)
+            eye_x = jnp.eye(problem.nx, dtype=us.dtype)
 
             def back(carry, inputs):
                 v, V = carry
@@ -82,18 +81,10 @@ class MultipleShooting(AbstractSolver):
                 S = jnp.linalg.inv(rho * eye_x + V)
                 P = rho * S @ V
                 P = 0.5 * (P + P.T)
-                p = S @ (V @ lam + rho * v)
-                g = p + P @ e                                     # the value's gradient at w = e
-                Qx, Qu = lx + A.T @ g, lu + B.T @ g
-                Qxx, Qux, Quu = lxx + A.T @ P @ A, lux + B.T @ P @ A, luu + B.T @ P @ B
-                H = 0.5 * (Quu + Quu.T) + mu * eye_u
-                k, free = box_qp(H, Qu, problem.lower - u, problem.upper - u, self.qp_iterations)
-                H_free = jnp.where(free[:, None] & free[None, :], H, eye_u)
-                K = jnp.where(free[:, None],
-                              -spd_solve(H_free, jnp.where(free[:, None], Qux, 0.0), UNROLL), 0.0)
-                v = Qx + K.T @ Quu @ k + K.T @ Qu + Qux.T @ k
-                V = Qxx + K.T @ Quu @ K + K.T @ Qux + Qux.T @ K
-                return (v, 0.5 * (V + V.T)), (k, K, S, v, V)
+                g = S @ (V @ lam + rho * v) + P @ e          # the value's gradient at w = e
+                k, K, v, V, _, _ = riccati_step(problem, (A, B, lx, lu, lxx, lux, luu), u, g, P,
+                                                mu, self.qp_iterations)
+                return (v, V), (k, K, S, v, V)
 
             _, (k, K, S, v, V) = jax.lax.scan(back, (vx, Vxx), (A, B, lx, lu, lxx, lux, luu, us,
                                                                 e, lam), reverse=True)
