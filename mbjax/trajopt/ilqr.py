@@ -45,7 +45,7 @@ from jax import Array
 from mbjax.integrate.solution import Status
 from mbjax.linalg import spd_solve
 from mbjax.trajopt.problem import Problem
-from mbjax.trajopt.result import AbstractSolver, Result, history
+from mbjax.trajopt.result import AbstractSolver, Result, history, require_vector_state
 
 MU_MIN, MU_MAX, MU_FACTOR = 1e-9, 1e10, 10.0
 CROCODDYL_SCHEDULE = {"steps": tuple(0.5**k for k in range(10)), "acceptance": 0.1,
@@ -120,10 +120,7 @@ class ILQR(AbstractSolver):
     qp_iterations: int = eqx.field(static=True, default=8)
 
     def solve(self, problem: Problem, us: Array) -> Result:
-        if problem.nq != problem.nv:
-            raise ValueError(f"ILQR linearizes in the coordinates (q, v), which needs as many "
-                             f"configuration coordinates as velocities; this system has "
-                             f"nq = {problem.nq}, nv = {problem.nv} (quaternions): use Shooting")
+        require_vector_state(problem, "ILQR")
         xs = problem.rollout(us)
         cost = problem.cost(xs, us)
         alphas = jnp.asarray(self.steps, cost.dtype)

@@ -31,10 +31,10 @@ import jax
 import jax.numpy as jnp
 from jax import Array
 
-from mbjax.integrate.solution import Status
 from mbjax.trajopt.ilqr import ILQR, riccati_step
 from mbjax.trajopt.problem import Problem
-from mbjax.trajopt.result import AbstractSolver, Result, history
+from mbjax.trajopt.result import (AbstractSolver, Result, history, require_vector_state,
+                                  rollout_result)
 
 STEPS = tuple(0.5**k for k in range(10))
 
@@ -55,10 +55,7 @@ class MultipleShooting(AbstractSolver):
     qp_iterations: int = eqx.field(static=True, default=8)
 
     def solve(self, problem: Problem, us: Array) -> Result:
-        if problem.nq != problem.nv:
-            raise ValueError(f"MultipleShooting steps in the coordinates (q, v), which needs as "
-                             f"many configuration coordinates as velocities; this system has "
-                             f"nq = {problem.nq}, nv = {problem.nv} (quaternions): use Shooting")
+        require_vector_state(problem, "MultipleShooting")
         steps = jnp.arange(problem.horizon)
         alphas = jnp.asarray(STEPS, us.dtype)
 
@@ -159,13 +156,5 @@ class MultipleShooting(AbstractSolver):
              jnp.asarray(jnp.inf, us.dtype))
         s = jax.lax.while_loop(running, outer, s)
         us, settled, iterations, costs, defect = s[1], s[6], s[7], s[8], s[9]
-        xs = problem.rollout(us)
-        cost = problem.cost(xs, us)
-        converged = settled & (defect <= self.defect_tolerance)
-        finite = jnp.isfinite(cost) & jnp.all(jnp.isfinite(xs))
-        status = (jnp.where(converged, 0, int(Status.NOT_CONVERGED))
-                  | jnp.where(finite, 0, int(Status.NONFINITE)))
-        q, v = problem.split(xs)
-        return Result(qs=q, vs=v, us=us, cost=cost, costs=costs, iterations=iterations,
-                      feedback=jnp.zeros((problem.horizon, problem.nu, problem.nx), us.dtype),
-                      status=status)
+        return rollout_result(problem, us, costs, iterations,
+                              settled & (defect <= self.defect_tolerance))

@@ -6,7 +6,7 @@ import equinox as eqx
 import jax.numpy as jnp
 from jax import Array
 
-from mbjax.integrate.solution import WithStatus
+from mbjax.integrate.solution import Status, WithStatus
 from mbjax.trajopt.problem import Problem
 
 
@@ -41,3 +41,27 @@ class AbstractSolver(eqx.Module):
 def history(length: int, first: Array) -> Array:
     """A cost history of `length` entries: `first`, then NaN."""
     return jnp.full(length, jnp.nan, first.dtype).at[0].set(first)
+
+
+def require_vector_state(problem: Problem, solver: str) -> None:
+    """Refuse a problem whose configuration has more coordinates than velocities: `solver`
+    steps in the coordinates (q, v)."""
+    if problem.nq != problem.nv:
+        raise ValueError(f"{solver} steps in the coordinates (q, v), which needs as many "
+                         f"configuration coordinates as velocities; this system has "
+                         f"nq = {problem.nq}, nv = {problem.nv} (quaternions): use Shooting")
+
+
+def rollout_result(problem: Problem, us: Array, costs: Array, iterations: Array,
+                   converged: Array) -> Result:
+    """The Result of controls us found without feedback gains: their rollout and its cost, with
+    success where `converged` and NONFINITE where the rollout blew up."""
+    xs = problem.rollout(us)
+    cost = problem.cost(xs, us)
+    finite = jnp.isfinite(cost) & jnp.all(jnp.isfinite(xs))
+    status = (jnp.where(converged, 0, int(Status.NOT_CONVERGED))
+              | jnp.where(finite, 0, int(Status.NONFINITE)))
+    q, v = problem.split(xs)
+    return Result(qs=q, vs=v, us=us, cost=cost, costs=costs, iterations=iterations,
+                  feedback=jnp.zeros((problem.horizon, problem.nu, problem.nx), us.dtype),
+                  status=status)

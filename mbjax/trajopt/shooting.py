@@ -17,10 +17,9 @@ import jax.numpy as jnp
 import optax
 from jax import Array
 
-from mbjax.integrate.solution import Status
 from mbjax.trajopt.descent import cosine_adam
 from mbjax.trajopt.problem import Problem
-from mbjax.trajopt.result import AbstractSolver, Result, history
+from mbjax.trajopt.result import AbstractSolver, Result, history, rollout_result
 
 METHODS = ("lbfgs", "adam")
 
@@ -91,13 +90,4 @@ class Shooting(AbstractSolver):
 
         s = jax.lax.while_loop(running, iterate, (x0, state0, value0, grad0, jnp.array(0),
                                                   history(self.iterations + 1, value0)))
-        x, cost, iterations, costs = s[0], s[2], s[4], s[5]
-        xs = problem.rollout(x.reshape(shape))
-        finite = jnp.isfinite(cost) & jnp.all(jnp.isfinite(xs))
-        status = (jnp.where(converged(s), 0, int(Status.NOT_CONVERGED))
-                  | jnp.where(finite, 0, int(Status.NONFINITE)))
-        q, v = problem.split(xs)
-        return Result(qs=q, vs=v, us=x.reshape(shape), cost=cost, costs=costs,
-                      iterations=iterations,
-                      feedback=jnp.zeros((problem.horizon, problem.nu, problem.nx), x.dtype),
-                      status=status)
+        return rollout_result(problem, s[0].reshape(shape), s[5], s[4], converged(s))
