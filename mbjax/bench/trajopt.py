@@ -138,12 +138,8 @@ class _Crocoddyl:
         return [first] + costs
 
     def timed(self, iterations: int, repeats: int) -> float:
-        samples = []
-        for _ in range(repeats):
-            start = time.perf_counter()
-            self.solve(iterations)
-            samples.append(time.perf_counter() - start)
-        return float(np.median(samples))
+        """The median wall time of a solve of at most `iterations` (after one warm-up)."""
+        return measure(self.solve, iterations, repeats=repeats)[1].run_s
 
 
 def single(name: str, repeats: int, common: dict) -> list[dict]:
