@@ -40,12 +40,12 @@ import equinox as eqx
 import jax
 import jax.numpy as jnp
 from jax import Array
-from jax.custom_derivatives import SymbolicZero
 
 from mbjax.model import Model
 from mbjax.rigid import rnea_derivatives
 from mbjax.rigid.aba import aba_factored, solve
 from mbjax.rigid.rnea import inverse_dynamics
+from mbjax.rigid.tangents import instantiate, is_zero
 
 
 def with_adjoint(fd: Callable) -> Callable:
@@ -62,7 +62,7 @@ def with_adjoint(fd: Callable) -> Callable:
         u_dot, factor = aba_factored(model, q, v, tau, f_ext)
         # the RNEA's JVP in the arguments that carry a tangent; the others are held fixed
         args, dargs = [model, q, v, f_ext], list(tangents[:3]) + [tangents[4]]
-        live = [i for i, t in enumerate(dargs) if not _zero(t)]
+        live = [i for i, t in enumerate(dargs) if not is_zero(t)]
 
         def rnea(*moving):
             full = list(args)
@@ -72,15 +72,15 @@ def with_adjoint(fd: Callable) -> Callable:
             return inverse_dynamics(model_, q_, v_, u_dot, f_ext_)
 
         rhs = tangents[3]
-        rhs = jnp.zeros_like(u_dot) if _zero(rhs) else rhs
+        rhs = jnp.zeros_like(u_dot) if is_zero(rhs) else rhs
         if f_ext is None and rnea_derivatives.applies(model) and {1, 2} & set(live):
             # the (q, v) directions written out (`rnea_derivatives`), the model's by autodiff
-            dq, dv = (_instantiate(t, x) for t, x in ((dargs[1], q), (dargs[2], v)))
+            dq, dv = (instantiate(t, x) for t, x in ((dargs[1], q), (dargs[2], v)))
             rhs = rhs - jax.checkpoint(rnea_derivatives.rnea_jvp)(model, q, v, u_dot, dq, dv)
             live = [i for i in live if i not in (1, 2)]
         if live:
             _, d_rnea = jax.jvp(jax.checkpoint(rnea), [args[i] for i in live],
-                                [_instantiate(dargs[i], args[i]) for i in live])
+                                [instantiate(dargs[i], args[i]) for i in live])
             rhs = rhs - d_rnea
         du_dot = jax.lax.custom_linear_solve(
             lambda x: _mass_times(model, q, x), rhs,
@@ -89,18 +89,6 @@ def with_adjoint(fd: Callable) -> Callable:
 
     forward.defjvp(_jvp, symbolic_zeros=True)
     return forward
-
-
-def _zero(tangent) -> bool:
-    """Whether a tangent (a pytree for the model) is JAX's symbolic zero in every leaf."""
-    return all(isinstance(t, SymbolicZero)
-               for t in jax.tree.leaves(tangent, is_leaf=lambda t: isinstance(t, SymbolicZero)))
-
-
-def _instantiate(tangent, primal):
-    """Symbolic zeros in a tangent pytree made concrete."""
-    return jax.tree.map(lambda t, p: jnp.zeros_like(p) if isinstance(t, SymbolicZero) else t,
-                        tangent, primal, is_leaf=lambda t: isinstance(t, SymbolicZero))
 
 
 def _mass_times(model: Model, q: Array, x: Array) -> Array:

@@ -11,15 +11,23 @@ where S[k] is joint k's motion subspace at the ground origin. Only the poses nee
 product (`forward_kinematics`); everything else is vectorized over the bodies.
 """
 
+import functools
 from typing import NamedTuple
 
 import jax
 import jax.numpy as jnp
 from jax import Array
 
+from mbjax.lie import vee
 from mbjax.model import Model
+from mbjax.rigid.tangents import instantiate, is_zero
 from mbjax.spatial import cross_motion, inertia_matrix, skew
 from mbjax.tree import forward_pass
+
+# the joints whose motion subspace is fixed in the joint's own body: moving joint j along one of
+# its columns moves j's outward set rigidly about that screw (a universal joint's first axis is
+# fixed in its parent instead)
+JOINTS_FIXED_IN_BODY = ("revolute", "prismatic", "spherical", "free")
 
 
 class Kinematics(NamedTuple):
@@ -34,9 +42,69 @@ class Kinematics(NamedTuple):
 
 @jax.jit
 def forward_kinematics(model: Model, q: Array) -> tuple[Array, Array]:
-    """World orientation (n, 3, 3) and origin (n, 3) of every body frame."""
+    """World orientation (n, 3, 3) and origin (n, 3) of every body frame.
+
+    Its derivative in q is written out (for the joints `fixed_in_body` accepts): moving the
+    coordinates along dq moves body k rigidly by the twist xi_k, the sum of the joints' twists
+    S_j e_j over k's path from the ground (ground frame at the ground origin; e_j the joint's
+    increments along its columns, dq_j itself for a hinge), xi = pi (S e) with seed 001's path
+    matrix pi (eq 1); then dR_k = xi_k,w x R_k and dp_k = xi_k,w x p_k + xi_k,v. One product of
+    6-vectors per direction instead of the derivative of the products of rotations: the 7-dof
+    arm's flange Jacobian at 100 poses under `jax.jacfwd` 0.25 against 0.66 ms. The derivative
+    in the model's parameters is JAX's own."""
+    if fixed_in_body(model):
+        return _poses(model, q)
+    return _poses.fun(model, q)
+
+
+@jax.custom_jvp
+def _poses(model: Model, q: Array) -> tuple[Array, Array]:
     R, p, _, _ = model.joints(q, jnp.zeros(model.nv, q.dtype))
     return compose(model, R, p)
+
+
+@functools.partial(_poses.defjvp, symbolic_zeros=True)
+def _poses_jvp(primals, tangents):
+    model, q = primals
+    d_model, dq = tangents
+    still = jnp.zeros(model.nv, q.dtype)
+    R_local, p_local, S_local, _ = model.joints(q, still)
+    R, p = compose(model, R_local, p_local)
+    dR, dp = jnp.zeros_like(R), jnp.zeros_like(p)
+    if not is_zero(dq):
+        S = to_ground(R, p, S_local)
+        path = jnp.asarray(model.topology.path_matrix(), q.dtype)      # seed 001 eq 1
+        twist = path @ columns(S, joint_increments(model, q, still, dq))
+        w = twist[:, :3]
+        dR, dp = skew(w) @ R, jnp.cross(w, p) + twist[:, 3:]
+    if not is_zero(d_model):
+        _, (dR_m, dp_m) = jax.jvp(lambda m: _poses.fun(m, q), (model,),
+                                  (instantiate(d_model, model),))
+        dR, dp = dR + dR_m, dp + dp_m
+    return (R, p), (dR, dp)
+
+
+def fixed_in_body(model: Model) -> bool:
+    """Whether every joint's motion subspace is fixed in its own body (`JOINTS_FIXED_IN_BODY`):
+    the condition of the written-out derivatives here and in `rnea_derivatives`."""
+    return all(kind in JOINTS_FIXED_IN_BODY for kind in model.joint_types)
+
+
+def joint_increments(model: Model, q: Array, v: Array, dq: Array) -> Array:
+    """Each joint's increments (n, width) along its columns for the coordinate tangent dq: dq
+    itself for revolute and prismatic joints; otherwise S_local^T (vee(R^T dR); R^T dp) of the
+    joint's local pose (R, p), a quaternion's normalization included."""
+    if model.euclidean:
+        return model.body_v(dq)
+    (R, _, S_local, _), (dR, dp, _, _) = jax.jvp(lambda q: model.joints(q, v), (q,), (dq,))
+    Rt = jnp.swapaxes(R, -1, -2)
+    twist = jnp.concatenate([jax.vmap(vee)(Rt @ dR), jnp.einsum("kij,kj->ki", Rt, dp)], -1)
+    return jnp.einsum("kic,ki->kc", S_local, twist)
+
+
+def columns(S: Array, x: Array) -> Array:
+    """sum_c S[k, :, c] x[k, c]: (n, 6, width), (n, width) -> (n, 6)."""
+    return jnp.einsum("kic,kc->ki", S, x)
 
 
 def compose(model: Model, R: Array, p: Array) -> tuple[Array, Array]:

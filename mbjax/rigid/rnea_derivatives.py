@@ -28,26 +28,20 @@ differentiating the kinematics. Agrees with `jax.jvp` of `inverse_dynamics` to r
 (tests/rigid/test_adjoint.py).
 """
 
-import jax
 import jax.numpy as jnp
 import numpy as np
 from jax import Array
 
-from mbjax.lie import vee
 from mbjax.model import Model
-from mbjax.rigid.kinematics import gravity_acceleration
+from mbjax.rigid.kinematics import columns, fixed_in_body, gravity_acceleration, joint_increments
 from mbjax.rigid.rnea import rnea_passes
 from mbjax.spatial import cross_force, cross_motion
 from mbjax.tree import backward_pass, forward_pass
 from mbjax.tree.take import take
 
-# the joints whose motion subspace is fixed in the joint's own body
-JOINTS = ("revolute", "prismatic", "spherical", "free")
-
-
 def applies(model: Model) -> bool:
     """Whether every joint of the tree is revolute, prismatic, spherical or free."""
-    return all(kind in JOINTS for kind in model.joint_types)
+    return fixed_in_body(model)
 
 
 def rnea_jvp(model: Model, q: Array, v: Array, a: Array, dq: Array, dv: Array) -> Array:
@@ -61,7 +55,7 @@ def rnea_jvp(model: Model, q: Array, v: Array, a: Array, dq: Array, dv: Array) -
     U = _parent(model, V, jnp.zeros_like(ground))
     B = _parent(model, A, ground)
     # the joints' twists along (dq, dv): s = S e, w = S dv (the formulas are linear in S's columns)
-    s, w = _columns(S, _increments(model, q, v, dq)), _columns(S, model.body_v(dv))
+    s, w = columns(S, joint_increments(model, q, v, dq)), columns(S, model.body_v(dv))
     sU = cross_motion(s, U)
     g = jnp.concatenate([cross_motion(sU, U) - cross_motion(s, B) - cross_motion(w, U)
                          - cross_motion(w, V), sU - w], -1)
@@ -72,23 +66,6 @@ def rnea_jvp(model: Model, q: Array, v: Array, a: Array, dq: Array, dv: Array) -
          - cross_force(V, _times(I, P3)) + own)
     dtau = jnp.einsum("kic,ki->kc", S, _inward_sum(model, L) - own)
     return model.flat_v(dtau) + model.damping * dv
-
-
-def _increments(model: Model, q: Array, v: Array, dq: Array) -> Array:
-    """Each joint's increments (n, width) along its columns for the coordinate tangent dq: dq
-    itself for revolute and prismatic joints; otherwise S_local^T (vee(R^T dR); R^T dp) of the
-    joint's local pose (R, p), a quaternion's normalization included."""
-    if model.euclidean:
-        return model.body_v(dq)
-    (R, _, S_local, _), (dR, dp, _, _) = jax.jvp(lambda q: model.joints(q, v), (q,), (dq,))
-    Rt = jnp.swapaxes(R, -1, -2)
-    twist = jnp.concatenate([jax.vmap(vee)(Rt @ dR), jnp.einsum("kij,kj->ki", Rt, dp)], -1)
-    return jnp.einsum("kic,ki->kc", S_local, twist)
-
-
-def _columns(S: Array, x: Array) -> Array:
-    """sum_c S[k, :, c] x[k, c]: (n, 6, width), (n, width) -> (n, 6)."""
-    return jnp.einsum("kic,kc->ki", S, x)
 
 
 def _times(I: Array, x: Array) -> Array:       # noqa: E741

@@ -4,8 +4,8 @@ Each iteration (Li and Todorov 2004; Tassa, Erez and Todorov 2012; the control b
 Tassa, Mansard and Todorov 2014):
 
 1. linearize about the current trajectory: A_k = df/dx, B_k = df/du by `jax.jacfwd` of the
-   problem's integrator step, and the costs' gradients and Hessians (Gauss-Newton for residual
-   costs, `Problem`), all vmapped over time;
+   problem's integrator step (`Problem.step_jacobians`), and the costs' gradients and Hessians
+   (Gauss-Newton for residual costs, `Problem`), all vmapped over time;
 2. a backward Riccati pass (`lax.scan`, reversed) from V = the terminal cost's expansion:
 
        Q_x = l_x + A^T V_x,        Q_u = l_u + B^T V_x,
@@ -55,11 +55,11 @@ CROCODDYL_SCHEDULE = {"steps": tuple(0.5**k for k in range(10)), "acceptance": 0
 UNROLL = 16
 
 
-def box_qp(H: Array, g: Array, lower: Array, upper: Array, iterations: int):
+def box_qp(H: Array, g: Array, lower: Array, upper: Array, iterations: int, d: Array):
     """(d, free): argmin 1/2 d^T H d + g^T d over lower <= d <= upper for a positive-definite H,
-    by projected Newton steps on the controls not held at a bound (Bertsekas 1982) until a step
-    changes nothing or `iterations` pass, and the mask of the controls left free. Where no
-    control is held at a bound, one Newton step."""
+    from the unconstrained minimizer d = -H^-1 g, by projected Newton steps on the controls not
+    held at a bound (Bertsekas 1982) until a step changes nothing or `iterations` pass, and the
+    mask of the controls left free."""
     eye = jnp.eye(g.shape[0], dtype=H.dtype)
 
     def clamped(d):
@@ -77,7 +77,7 @@ def box_qp(H: Array, g: Array, lower: Array, upper: Array, iterations: int):
         d, previous, i = carry
         return (i < iterations) & jnp.any(clamped(d)) & ((i == 0) | jnp.any(d != previous))
 
-    d = jnp.clip(spd_solve(H, -g, UNROLL), lower, upper)
+    d = jnp.clip(d, lower, upper)
     d, _, _ = jax.lax.while_loop(unsettled, newton, (d, d, jnp.array(0)))
     return d, ~clamped(d)
 
@@ -87,17 +87,26 @@ def riccati_step(problem: Problem, stage: tuple, u: Array, Vx: Array, Vxx: Array
     """One stage of the backward pass (step 2 of the module) from the next value (Vx, Vxx) and
     the stage's expansion (A, B, l_x, l_u, l_xx, l_ux, l_uu) about the control u: the control
     step k within the bounds, the feedback K on the free controls, this stage's value
-    (Vx, Vxx), and Q_u, Q_uu."""
+    (Vx, Vxx), and Q_u, Q_uu. The unconstrained step and feedback come from one factorization
+    of Q_uu; the box's projected Newton steps run only where that step leaves the bounds."""
     A, B, lx, lu, lxx, lux, luu = stage
     eye = jnp.eye(problem.nu, dtype=u.dtype)
     Qx, Qu = lx + A.T @ Vx, lu + B.T @ Vx
-    Qxx, Qux = lxx + A.T @ Vxx @ A, lux + B.T @ Vxx @ A
+    VxxA = Vxx @ A
+    Qxx, Qux = lxx + A.T @ VxxA, lux + B.T @ VxxA
     Quu = luu + B.T @ Vxx @ B
     H = 0.5 * (Quu + Quu.T) + mu * eye
-    k, free = box_qp(H, Qu, problem.lower - u, problem.upper - u, qp_iterations)
-    H_free = jnp.where(free[:, None] & free[None, :], H, eye)
-    K = jnp.where(free[:, None], -spd_solve(H_free, jnp.where(free[:, None], Qux, 0.0), UNROLL),
-                  0.0)
+    kK = -spd_solve(H, jnp.concatenate([Qu[:, None], Qux], 1), UNROLL)
+    lower, upper = problem.lower - u, problem.upper - u
+
+    def within_bounds():
+        k, free = box_qp(H, Qu, lower, upper, qp_iterations, kK[:, 0])
+        H_free = jnp.where(free[:, None] & free[None, :], H, eye)
+        K = -spd_solve(H_free, jnp.where(free[:, None], Qux, 0.0), UNROLL)
+        return k, jnp.where(free[:, None], K, 0.0)
+
+    k, K = jax.lax.cond(jnp.any((kK[:, 0] < lower) | (kK[:, 0] > upper)), within_bounds,
+                        lambda: (kK[:, 0], kK[:, 1:]))
     Vx = Qx + K.T @ Quu @ k + K.T @ Qu + Qux.T @ k
     Vxx = Qxx + K.T @ Quu @ K + K.T @ Qux + Qux.T @ K
     return k, K, Vx, 0.5 * (Vxx + Vxx.T), Qu, Quu
@@ -187,7 +196,7 @@ class ILQR(AbstractSolver):
         """The dynamics' and costs' expansion about (xs, us): (A, B, l_x, l_u, l_xx, l_ux, l_uu)
         per step and the terminal (V_x, V_xx)."""
         steps = jnp.arange(problem.horizon)
-        A, B = jax.vmap(jax.jacfwd(problem.step, argnums=(0, 1)))(xs[:-1], us, steps)
+        A, B = jax.vmap(problem.step_jacobians)(xs[:-1], us, steps)
         return (A, B, *jax.vmap(problem.stage_expansion)(xs[:-1], us)), problem.final_expansion(xs[-1])
 
     def _backward(self, problem: Problem, expansion: tuple, us: Array, mu: Array):
