@@ -9,6 +9,14 @@ step (projected gradient for Adam; for L-BFGS a heuristic, sound where no bound 
 `ILQR` for problems whose optimum lies on its bounds). The iterations are one
 `lax.while_loop`: success when the gradient's norm falls below `tolerance` times its first
 value (its projection on the box, for bounded controls), NOT_CONVERGED when `iterations` run out.
+
+Gauss-Newton on the controls of single shooting is not offered: with the costs' residuals
+stacked into one vector r(u), optimistix's `LevenbergMarquardt` (its QR on the dense Jacobian of
+all N nu controls) took the acrobot 200 iterations to a cost of 8.8e3 and the arm 200 iterations
+and 110 s to 6.3 (semi-implicit Euler; iLQR: 0.477 in 95 iterations, 0.0029 in 28, 0.1 s). The
+stage structure is what Gauss-Newton needs here: `ILQR` is Gauss-Newton on the controls with the
+step solved by a Riccati recursion and applied through a closed-loop rollout, and
+`MultipleShooting` is Gauss-Newton on the knots' states and controls.
 """
 
 import equinox as eqx
