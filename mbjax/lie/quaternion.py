@@ -9,12 +9,14 @@ import jax
 import jax.numpy as jnp
 from jax import Array
 
+from mbjax.lie import _inputs
 from mbjax.lie._series import COS_HALF, SIN_HALF_OVER_PHI, even_series
 
 
 @jax.jit
 def quat_multiply(p: Array, q: Array) -> Array:
     """Hamilton product p * q."""
+    p, q = _inputs.quaternion(p, "quat_multiply", "p"), _inputs.quaternion(q, "quat_multiply")
     pw, pv = p[0], p[1:]
     qw, qv = q[0], q[1:]
     return jnp.concatenate([
@@ -26,18 +28,21 @@ def quat_multiply(p: Array, q: Array) -> Array:
 @jax.jit
 def quat_conjugate(q: Array) -> Array:
     """The inverse rotation of a unit quaternion."""
+    q = _inputs.quaternion(q, "quat_conjugate")
     return q * jnp.array([1.0, -1.0, -1.0, -1.0], dtype=q.dtype)
 
 
 @jax.jit
 def quat_normalize(q: Array) -> Array:
     """Project q onto the unit sphere."""
+    q = _inputs.quaternion(q, "quat_normalize")
     return q / jnp.linalg.norm(q)
 
 
 @jax.jit
 def quat_to_matrix(q: Array) -> Array:
     """Rotation matrix of a unit quaternion."""
+    q = _inputs.quaternion(q, "quat_to_matrix")
     w, x, y, z = q
     return jnp.array([
         [1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
@@ -49,7 +54,7 @@ def quat_to_matrix(q: Array) -> Array:
 @jax.jit
 def quat_from_rotvec(r: Array) -> Array:
     """q = (cos(phi/2), sin(phi/2)/phi r), exact and differentiable at r = 0."""
-    r = jnp.asarray(r)
+    r = _inputs.rotation_vector(r, "quat_from_rotvec")
     phi2 = jnp.dot(r, r)
     w = even_series(phi2, lambda p2: jnp.cos(0.5 * jnp.sqrt(p2)), COS_HALF)
     s = even_series(phi2, lambda p2: jnp.sin(0.5 * jnp.sqrt(p2)) / jnp.sqrt(p2), SIN_HALF_OVER_PHI)
@@ -59,16 +64,19 @@ def quat_from_rotvec(r: Array) -> Array:
 @jax.jit
 def rotvec_from_quat(q: Array) -> Array:
     """Principal rotation vector (|r| <= pi) of a unit quaternion: r = 2 atan2(|v|, w) v / |v|."""
-    q = jnp.asarray(q)
+    q = _inputs.quaternion(q, "rotvec_from_quat")
     q = jnp.where(q[0] < 0, -q, q)  # q and -q are the same rotation; w >= 0 picks |r| <= pi
     w, v = q[0], q[1:]
     s2 = jnp.dot(v, v)
     # atan2(s, w) / s; below s = 1e-2 its series in s2 / w^2 (arctan(x)/x) is exact to round-off.
+    # Each branch is fed a safe value where the other owns the result (w ~ 1 on the series'
+    # branch; w = 0 at a half turn on atan2's), so derivatives of every order stay finite.
     small = s2 < 1e-4
     safe_s2 = jnp.where(small, 1.0, s2)
-    x2 = s2 / (w * w)
+    safe_w = jnp.where(small, w, 1.0)
+    x2 = s2 / (safe_w * safe_w)
     series = 1.0 + x2 * (-1 / 3 + x2 * (1 / 5 + x2 * (-1 / 7 + x2 * (1 / 9 - x2 / 11))))
-    ratio = jnp.where(small, series / w,
+    ratio = jnp.where(small, series / safe_w,
                       jnp.arctan2(jnp.sqrt(safe_s2), w) / jnp.sqrt(safe_s2))
     return 2.0 * ratio * v
 
@@ -81,6 +89,7 @@ def quat_from_matrix(R: Array) -> Array:
     the square root and the division are always well conditioned; the others are fed a safe
     value so that their (discarded) derivatives stay finite.
     """
+    R = _inputs.matrix(R, "quat_from_matrix")
     tr = R[0, 0] + R[1, 1] + R[2, 2]
     d = jnp.array([1 + tr, 1 + 2 * R[0, 0] - tr, 1 + 2 * R[1, 1] - tr, 1 + 2 * R[2, 2] - tr])
     s = jnp.sqrt(jnp.where(d > 0.1, d, 1.0))  # s_k = 2 |q_k| on the chosen branch (d_k >= 1)

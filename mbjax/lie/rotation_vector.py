@@ -13,6 +13,7 @@ import jax
 import jax.numpy as jnp
 from jax import Array
 
+from mbjax.lie import _inputs
 from mbjax.lie._series import (
     GAMMA_INV_COEFF,
     ONE_MINUS_COS_OVER_PHI2,
@@ -26,7 +27,7 @@ from mbjax.lie.quaternion import quat_from_matrix, rotvec_from_quat
 @jax.jit
 def hat(v: Array) -> Array:
     """The skew matrix v x I, so that hat(v) @ w == cross(v, w)."""
-    v = jnp.asarray(v)
+    v = _inputs.real(v, (3,), "hat", "v", "a 3-vector")
     zero = jnp.zeros_like(v[0])
     return jnp.array([
         [zero, -v[2], v[1]],
@@ -38,6 +39,7 @@ def hat(v: Array) -> Array:
 @jax.jit
 def vee(S: Array) -> Array:
     """The vector of the skew part of S (inverse of `hat` on skew matrices)."""
+    S = _inputs.matrix(S, "vee", "S")
     return 0.5 * jnp.array([S[2, 1] - S[1, 2], S[0, 2] - S[2, 0], S[1, 0] - S[0, 1]])
 
 
@@ -55,7 +57,7 @@ def _coefficients(r: Array):
 @jax.jit
 def exp(r: Array) -> Array:
     """Rotation matrix R = exp(r x I) = I + a_o (r x I) + a_1 (r x I)^2 (seed 000 eqs A.3, A.6)."""
-    r = jnp.asarray(r)
+    r = _inputs.rotation_vector(r, "exp")
     a_o, a_1, _ = _coefficients(r)
     K = hat(r)
     return jnp.eye(3, dtype=K.dtype) + a_o * K + a_1 * (K @ K)
@@ -64,7 +66,7 @@ def exp(r: Array) -> Array:
 @jax.jit
 def gamma(r: Array) -> Array:
     """Tangent map Gamma(r) = I + a_1 (r x I) + b_1 (r x I)^2, omega = Gamma r_dot (eqs 2.9, A.17)."""
-    r = jnp.asarray(r)
+    r = _inputs.rotation_vector(r, "gamma")
     _, a_1, b_1 = _coefficients(r)
     K = hat(r)
     return jnp.eye(3, dtype=K.dtype) + a_1 * K + b_1 * (K @ K)
@@ -78,7 +80,7 @@ def gamma_inv(r: Array) -> Array:
     a_o / (2 b_o) with b_o = a_1, is a_o / (2 a_1) = (phi/2) cot(phi/2). Singular at
     phi = 2 pi n, n >= 1 (eq A.28); see `rescale`.
     """
-    r = jnp.asarray(r)
+    r = _inputs.rotation_vector(r, "gamma_inv")
     phi2 = jnp.dot(r, r)
 
     def closed_form(p2):
@@ -93,7 +95,7 @@ def gamma_inv(r: Array) -> Array:
 @jax.jit
 def det_gamma(r: Array) -> Array:
     """det Gamma(r) = 2 (1 - cos phi) / phi^2 (seed 000 eq A.28); zero at phi = 2 pi n, n >= 1."""
-    r = jnp.asarray(r)
+    r = _inputs.rotation_vector(r, "det_gamma")
     return 2.0 * _coefficients(r)[1]
 
 
@@ -105,7 +107,7 @@ def rescale(r: Array) -> Array:
     n = int(phi / 2 pi); here n is the nearest integer, which gives the principal vector
     (|r_p| <= pi) and so stays as far as possible from the singularity of Gamma at 2 pi.
     """
-    r = jnp.asarray(r)
+    r = _inputs.rotation_vector(r, "rescale")
     phi2 = jnp.dot(r, r)
     safe_phi = jnp.sqrt(jnp.where(phi2 > 0.0, phi2, 1.0))
     n = jnp.round(safe_phi / (2.0 * jnp.pi))
@@ -128,9 +130,7 @@ def log(R: Array, check: bool = True) -> Array:
     a host callback, which keeps a compiled program out of the persistent compilation cache and
     a loop around it from compiling as one kernel (`mbjax.runtime`).
     """
-    R = jnp.asarray(R)
-    if R.shape != (3, 3):
-        raise ValueError(f"log expects a 3x3 rotation matrix, got shape {R.shape}")
+    R = _inputs.matrix(R, "log")
     if check:
         tol = _rotation_tolerance(R.dtype)
         orthogonality = jnp.max(jnp.abs(R.T @ R - jnp.eye(3, dtype=R.dtype)))
