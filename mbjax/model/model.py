@@ -142,7 +142,11 @@ class Model(eqx.Module):
             # a program); traced data (a model built inside jax.grad or vmap) in JAX
             value = default if value is None else value
             xp = jnp if _traced(value) else np
-            arr = xp.asarray(value, dtype=float)
+            try:
+                arr = xp.asarray(value, dtype=float)
+            except (TypeError, ValueError) as error:
+                raise TypeError(f"{what} must be real numbers of shape {shape}, got "
+                                f"{value!r:.80}") from error
             if arr.shape != shape:
                 arr = xp.broadcast_to(arr, shape) if arr.ndim < len(shape) else arr
             if arr.shape != shape:
@@ -191,6 +195,8 @@ class Model(eqx.Module):
                     if kind in uses and not norms[k] > 0:
                         raise ValueError(f"body {self.names[k]!r}: the {kind} joint's {what} is "
                                          f"zero (or not finite); give a nonzero direction")
+        if not isinstance(self.placement_rotation, jax.core.Tracer):
+            self._check_geometry()
         if not isinstance(self.mass, jax.core.Tracer):
             mass, inertia = np.asarray(self.mass), np.asarray(self.inertia)
             rotor = np.asarray(self.armature) > 0
@@ -201,6 +207,47 @@ class Model(eqx.Module):
                            strict=strict)
         if not isinstance(self.lower, jax.core.Tracer):
             self._check_joint_data()
+
+    def _check_geometry(self) -> None:
+        """Finite placements, centres of mass, axes, frames and gravity; rotations that are
+        rotations (orthonormal, det +1, to ROTATION_TOLERANCE); a universal joint's two axes
+        not parallel (its motion subspace would lose a column)."""
+        per_body = (("placement_rotation", self.names), ("placement_translation", self.names),
+                    ("com", self.names), ("axis", self.names), ("axis2", self.names),
+                    ("frame_rotation", self.frame_names), ("frame_translation", self.frame_names))
+        for what, owners in per_body:
+            value = np.asarray(getattr(self, what))
+            if not value.size:
+                continue
+            bad = np.flatnonzero(~np.isfinite(value.reshape(len(value), -1)).all(-1))
+            if bad.size:
+                raise ValueError(f"{what} of {owners[bad[0]]!r} must be finite, got "
+                                 f"{value[bad[0]].tolist()}")
+        if not np.isfinite(np.asarray(self.gravity)).all():
+            raise ValueError(f"gravity must be finite, got {np.asarray(self.gravity).tolist()}")
+        for what, owners in (("placement_rotation", self.names),
+                             ("frame_rotation", self.frame_names)):
+            R = np.asarray(getattr(self, what))
+            if not len(R):
+                continue
+            orthogonality = np.abs(np.swapaxes(R, -1, -2) @ R - np.eye(3)).max(axis=(-1, -2))
+            det = np.linalg.det(R)
+            bad = np.flatnonzero((orthogonality > ROTATION_TOLERANCE)
+                                 | (np.abs(det - 1.0) > ROTATION_TOLERANCE))
+            if bad.size:
+                k = bad[0]
+                kind = "a reflection (det -1)" if det[k] < 0 else "not orthonormal"
+                raise ValueError(
+                    f"{what} of {owners[k]!r} is {kind}: R^T R - I up to {orthogonality[k]:.2g}, "
+                    f"det {det[k]:.6g}, for R = {R[k].tolist()}; give a rotation matrix (the "
+                    f"polar factor U V^T of an SVD R = U S V^T is the nearest one)")
+        axis, axis2 = np.asarray(self.axis), np.asarray(self.axis2)
+        for k, kind in enumerate(self.joint_types):
+            if kind == "universal" and np.linalg.norm(np.cross(axis[k], axis2[k])) < 1e-6:
+                raise ValueError(f"body {self.names[k]!r}: the universal joint's axis "
+                                 f"{axis[k].tolist()} and axis2 {axis2[k].tolist()} are parallel, "
+                                 "so it turns about one axis only; give two independent axes "
+                                 "(or a revolute joint)")
 
     def _check_joint_data(self) -> None:
         lower, upper = np.asarray(self.lower), np.asarray(self.upper)
@@ -354,6 +401,10 @@ def _flat(layout: dict, which: str, per_body: Array) -> Array:
               for idx, own in zip(layout["groups"].values(), layout[f"{which}_own"].values(),
                                   strict=True)]
     return take(jnp.concatenate(blocks), layout[f"{which}_order"])
+
+
+# how far a given rotation matrix may be from orthonormal with det +1 (rounded source data)
+ROTATION_TOLERANCE = 1e-6
 
 
 def _traced(value) -> bool:

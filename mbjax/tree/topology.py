@@ -18,7 +18,12 @@ class Topology:
     """Static, hashable description of a tree: `Topology(parents)` with parents[k] < k or -1."""
 
     def __init__(self, parents):
-        parents = tuple(int(p) for p in np.asarray(parents, dtype=np.int64).reshape(-1))
+        raw = np.asarray(parents)
+        if raw.dtype.kind not in "iub" and not (raw.dtype.kind == "f"
+                                                 and np.all(raw == np.round(raw))):
+            raise ValueError(f"parents must be body indices (integers, -1 for a base body), got "
+                             f"{raw.tolist()}")
+        parents = tuple(int(p) for p in raw.astype(np.int64).reshape(-1))
         if not parents:
             raise ValueError("a tree needs at least one body; parents is empty")
         for k, p in enumerate(parents):
