@@ -13,6 +13,53 @@ from mbjax.integrate.solution import Solution, Status
 from mbjax.integrate.system import AbstractSystem
 
 
+def _number(value, name: str) -> float:
+    """A concrete, finite real number (dt, t0, t1), or an error naming it."""
+    if isinstance(value, jax.core.Tracer):
+        raise TypeError(f"{name} fixes the number of steps and must be a concrete number, not a "
+                        "traced value (differentiate or vmap the state and the parameters)")
+    try:
+        if isinstance(value, str | bytes):
+            raise TypeError
+        number = float(value)
+    except (TypeError, ValueError) as error:
+        raise TypeError(f"{name} must be a real number, got {value!r:.60}") from error
+    if not math.isfinite(number):
+        raise ValueError(f"{name} must be finite, got {number}")
+    return number
+
+
+def _state(x, name: str, size: int | None) -> Array:
+    """q0 or u0 as a real array in the working precision (integers and float32 promoted, as
+    a carry of the time loop must keep its type), its length checked where the system has
+    one."""
+    try:
+        x = jnp.asarray(x)
+    except TypeError as error:
+        raise TypeError(f"{name} must be an array of real numbers, got {type(x).__name__}") \
+            from error
+    if jnp.iscomplexobj(x) or not (jnp.issubdtype(x.dtype, jnp.number) or x.dtype == bool):
+        raise TypeError(f"{name} must be real, got dtype {x.dtype}")
+    working = jnp.result_type(float)
+    if x.dtype != working and not (jnp.issubdtype(x.dtype, jnp.floating)
+                                   and jnp.finfo(x.dtype).bits > jnp.finfo(working).bits):
+        x = x.astype(working)
+    if size is not None and x.shape != (size,):
+        raise ValueError(f"{name} must have shape ({size},) for this system, got {x.shape}")
+    return x
+
+
+def _sizes(system: AbstractSystem) -> tuple[int | None, int | None]:
+    """(nq, nv) of a tree system (or a closed loop of one), else (None, None): other systems
+    (a batch, a momentum form) lay their states out their own way."""
+    from mbjax.integrate.tree_system import AbstractTreeSystem
+
+    tree = getattr(system, "tree", system)
+    if isinstance(tree, AbstractTreeSystem):
+        return tree.nq, tree.nv
+    return None, None
+
+
 def _save_indices(t0: float, t1: float, dt: float, saveat) -> tuple[int, np.ndarray]:
     """Number of steps and the step indices of the save times (validated on the step grid)."""
     if not dt > 0:
@@ -23,7 +70,16 @@ def _save_indices(t0: float, t1: float, dt: float, saveat) -> tuple[int, np.ndar
         raise ValueError(f"t1 - t0 = {span} must be a positive whole number of steps dt = {dt}")
     if saveat is None:
         return n_steps, np.arange(n_steps + 1)
-    ts = np.atleast_1d(np.asarray(saveat, dtype=float))
+    try:
+        ts = np.atleast_1d(np.asarray(saveat, dtype=float))
+    except (TypeError, ValueError) as error:
+        raise TypeError(f"saveat must be None or times (real numbers), got {saveat!r:.60}") \
+            from error
+    if ts.ndim != 1 or not ts.size:
+        raise ValueError(f"saveat must be None or a non-empty 1-D array of times, got shape "
+                         f"{ts.shape}")
+    if not np.all(np.isfinite(ts)):
+        raise ValueError(f"saveat times must be finite, got {ts}")
     idx = np.round((ts - t0) / dt).astype(int)
     off_grid = np.abs(t0 + idx * dt - ts) > 1e-9 * max(1.0, abs(span))
     if np.any(off_grid) or np.any(idx < 0) or np.any(idx > n_steps):
@@ -54,10 +110,20 @@ def simulate(system: AbstractSystem, integrator: AbstractIntegrator, q0: Array, 
     at the segment ends and recomputes one segment at a time: memory grows like sqrt(T) rather than
     T, for about one more forward pass. The values computed are the same.
     """
-    n_steps, idx = _save_indices(float(t0), float(t1), float(dt), saveat)
+    if not isinstance(system, AbstractSystem):
+        hint = (" (wrap a Model in TreeSystem(model))" if type(system).__name__ == "Model"
+                else " (an instance, not the class)" if isinstance(system, type) else "")
+        raise TypeError(f"system must be an mbjax system such as TreeSystem(model){hint}, got "
+                        f"{system.__name__ if isinstance(system, type) else type(system).__name__}")
+    if not isinstance(integrator, AbstractIntegrator):
+        hint = " (an instance: RK4(), not RK4)" if isinstance(integrator, type) else ""
+        raise TypeError(f"integrator must be an mbjax integrator such as RK4(){hint}, got "
+                        f"{integrator.__name__ if isinstance(integrator, type) else type(integrator).__name__}")
+    dt, t0, t1 = (_number(x, name) for x, name in ((dt, "dt"), (t0, "t0"), (t1, "t1")))
+    n_steps, idx = _save_indices(t0, t1, dt, saveat)
     block = math.gcd(*idx.tolist(), n_steps)
-    q0 = jnp.asarray(q0)
-    u0 = jnp.asarray(u0)
+    nq, nv = _sizes(system)
+    q0, u0 = _state(q0, "q0", nq), _state(u0, "u0", nv)
     qs, us, status = _rollout(system, integrator, q0, u0, float(t0), float(dt), block,
                               n_steps // block, tuple((idx // block).tolist()),
                               _segment(block) if checkpoint else block)
