@@ -91,7 +91,8 @@ def _save_indices(t0: float, t1: float, dt: float, saveat) -> tuple[int, np.ndar
 
 
 def simulate(system: AbstractSystem, integrator: AbstractIntegrator, q0: Array, u0: Array, *,
-             dt: float, t1: float, t0: float = 0.0, saveat=None, checkpoint: bool = False) -> Solution:
+             dt: float, t1: float, t0: float = 0.0, saveat=None, checkpoint: bool = False,
+             rtol: float | None = None, atol: float | None = None) -> Solution:
     """Integrate `system` from (q0, u0) at t0 to t1 with fixed steps dt.
 
     `saveat` is None (every step) or an array of times on the grid t0 + k dt. dt, t0, t1 and
@@ -104,6 +105,20 @@ def simulate(system: AbstractSystem, integrator: AbstractIntegrator, q0: Array, 
     whatever the system's `check` reports at the ends of the blocks (every saved state). Each step
     runs the system as `system.hold(t, q, u)` gives it (sampled controls frozen at the step's
     start), and the system's `constrain` after it.
+
+    rtol, atol: a tolerance on the final state's error; given either, the solution carries an
+    error estimate (`Solution.error`) and the status INACCURATE where it exceeds
+    atol + rtol |y| in some component. The estimate is step doubling (Richardson) at up to
+    `ERROR_SAMPLES` states along the run (the start and the saved states): from each, one step
+    of dt against two of dt / 2 gives the local error of a step, 2^p / (2^p - 1) times their
+    difference for a method of order p, and the global error is estimated as the sum of the
+    local errors over the run's steps (their mean over the samples times the number of steps;
+    errors amplified by an unstable or chaotic motion are not seen). It costs three steps per
+    sample and a second compilation of the step. Measured on a triple pendulum over 2 s
+    (tests/integrate/test_accuracy.py): RK4's estimate within a factor 4 of the true error at
+    dt = 0.1 ... 0.005; semi-implicit Euler's 10 to 50 times above it (a symplectic method's
+    local errors cancel along an oscillation instead of adding up), so its INACCURATE errs on
+    the safe side.
 
     checkpoint=True is for reverse-mode gradients of long rollouts: each block's steps run as a scan
     over segments of about sqrt(block) steps under `jax.checkpoint`, so `jax.grad` keeps the states
@@ -127,7 +142,49 @@ def simulate(system: AbstractSystem, integrator: AbstractIntegrator, q0: Array, 
     qs, us, status = _rollout(system, integrator, q0, u0, float(t0), float(dt), block,
                               n_steps // block, tuple((idx // block).tolist()),
                               _segment(block) if checkpoint else block)
-    return Solution(ts=jnp.asarray(t0 + idx * dt, dtype=q0.dtype), qs=qs, us=us, status=status)
+    ts = jnp.asarray(t0 + idx * dt, dtype=q0.dtype)
+    if rtol is None and atol is None:
+        return Solution(ts=ts, qs=qs, us=us, status=status)
+    rtol, atol = (0.0 if x is None else _number(x, name) for x, name in ((rtol, "rtol"),
+                                                                         (atol, "atol")))
+    if rtol < 0 or atol < 0 or rtol + atol == 0:
+        raise ValueError(f"rtol and atol must be non-negative and not both zero, got {rtol}, "
+                         f"{atol}")
+    # the samples: the start and the saved states before t1, at most ERROR_SAMPLES, spread out
+    before = np.flatnonzero(idx < n_steps)
+    picks = before[np.unique(np.linspace(0, len(before) - 1, min(ERROR_SAMPLES, len(before)))
+                             .round().astype(int))] if len(before) else np.zeros(0, int)
+    starts = (jnp.concatenate([q0[None], qs[picks]]), jnp.concatenate([u0[None], us[picks]]),
+              jnp.concatenate([jnp.asarray([t0], q0.dtype), ts[picks]]))
+    error, ratio = _error_estimate(system, integrator, *starts, float(dt), n_steps, rtol, atol)
+    status = status | jnp.where(ratio > 1.0, int(Status.INACCURATE), 0).astype(status.dtype)
+    return Solution(ts=ts, qs=qs, us=us, status=status, error=error)
+
+
+# the most states step doubling samples along a run (`simulate`'s rtol and atol)
+ERROR_SAMPLES = 8
+
+
+@eqx.filter_jit
+def _error_estimate(system, integrator, q, u, t, dt: float, n_steps: int, rtol, atol):
+    """(estimated global error, its ratio to the tolerance) from step doubling at the sampled
+    states (q, u, t) (see `simulate`)."""
+    p = integrator.order
+
+    def local(q, u, t):
+        def step(q, u, t, h):
+            q1, u1, _ = integrator.step(system.hold(t, q, u), t, q, u, h)
+            return system.constrain(t + h, q1, u1)
+
+        h = jnp.asarray(dt, q.dtype)
+        full = jnp.concatenate(step(q, u, t, h))
+        half = step(*step(q, u, t, h / 2), t + h / 2, h / 2)
+        e = (full - jnp.concatenate(half)) * (2.0**p / (2.0**p - 1.0))
+        scale = atol + rtol * jnp.maximum(jnp.abs(jnp.concatenate([q, u])), jnp.abs(full))
+        return jnp.max(jnp.abs(e)), jnp.max(jnp.abs(e) / scale)
+
+    errors, ratios = jax.vmap(local)(q, u, t)
+    return n_steps * jnp.mean(errors), n_steps * jnp.mean(ratios)
 
 
 def _segment(block: int) -> int:

@@ -19,11 +19,14 @@ class Status(enum.IntFlag):
                            # closures or a singular configuration); least-squares loads were used
     LIMIT_EXCEEDED = 32    # a note: a saved state or control is beyond the model's joint limits
                            # (position, velocity or effort; `mbjax.model.limits`)
+    INACCURATE = 64        # the estimated error exceeds the tolerance asked for (`simulate`'s
+                           # rtol and atol; `Solution.error`)
 
     @classmethod
     def failures(cls) -> int:
         """The flags that make a run fail (`REDUNDANT` and `LIMIT_EXCEEDED` only inform)."""
-        return cls.NONFINITE | cls.NOT_CONVERGED | cls.SOLVER_FAILED | cls.CONSTRAINT_VIOLATED
+        return (cls.NONFINITE | cls.NOT_CONVERGED | cls.SOLVER_FAILED | cls.CONSTRAINT_VIOLATED
+                | cls.INACCURATE)
 
 
 class WithStatus(eqx.Module):
@@ -48,9 +51,12 @@ class Solution(WithStatus):
     """States saved at times `ts`: `qs[i]`, `us[i]` are q(ts[i]), u(ts[i]).
 
     `status` is an integer array of `Status` flags (one per solution; batched under vmap).
+    `error`: the estimated global error of the final state (largest component, in the state's
+    units) where the run was asked for a tolerance (`simulate(..., rtol=, atol=)`), else NaN.
     """
 
     ts: Array
     qs: Array
     us: Array
     status: Array
+    error: Array = float("nan")
