@@ -135,7 +135,13 @@ def _check_rigid(scenes):
     assert loops["coupled, projection dt=2 ms"]["residual"] < 1e-10
     assert loops["coupled, none dt=2 ms"]["error_rad"] < 1e-4
     rows = chain["integrators"]
-    assert all(row["status"] == "success" for row in rows.values())
+    # the accuracy status (the tour asks rtol 1e-3, atol 1e-4): runs off by more than that say so
+    assert all(row["status"] == "inaccurate" for row in rows.values() if row["error_rad"] > 1e-3)
+    assert rows["rk4 dt=5 ms"]["status"] == "success"
+    top_ = scenes["heavy-top"]["integrators"]
+    assert top_["explicit_euler"]["energy_drift"] > 1 and top_["explicit_euler"]["status"] == \
+        "inaccurate"
+    assert top_["rk4"]["status"] == "success" and top_["rk4"]["energy_drift"] < 1e-6
     # RK4 at 5 ms follows the Dopri8 reference of the falling chain to micro-radians
     assert rows["rk4 dt=5 ms"]["error_rad"] < 1e-5 and rows["rk4 dt=5 ms"]["energy_error"] < 1e-5
 
