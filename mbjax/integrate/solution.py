@@ -21,12 +21,15 @@ class Status(enum.IntFlag):
                            # (position, velocity or effort; `mbjax.model.limits`)
     INACCURATE = 64        # the estimated error exceeds the tolerance asked for (`simulate`'s
                            # rtol and atol; `Solution.error`)
+    SINGULAR = 128         # a saved state at (or within the system's tolerance of) a singular
+                           # configuration, where the dynamics are not defined (the Carpal
+                           # Wrist's inverse or direct singularity: `WristSystem.check`)
 
     @classmethod
     def failures(cls) -> int:
         """The flags that make a run fail (`REDUNDANT` and `LIMIT_EXCEEDED` only inform)."""
         return (cls.NONFINITE | cls.NOT_CONVERGED | cls.SOLVER_FAILED | cls.CONSTRAINT_VIOLATED
-                | cls.INACCURATE)
+                | cls.INACCURATE | cls.SINGULAR)
 
 
 class WithStatus(eqx.Module):

@@ -170,11 +170,23 @@ def solve_inverse_kinematics(wrist, plunge: Array, g: Array) -> tuple[Array, Arr
     return jnp.arctan2(1.0, k) + acos, reachable
 
 
+def in_chart(alpha: Array, beta: Array, plunge: Array) -> Array:
+    """Whether (alpha, beta, p) is a tool pose the midplane chart describes: finite, with the
+    bend |beta| < pi (at pi the midplane is vertical; beyond it tan(beta / 2) changes sign and
+    the slope describes the pose bent by 2 pi - |beta| the other way)."""
+    return (jnp.isfinite(alpha) & jnp.isfinite(beta) & jnp.isfinite(plunge)
+            & (jnp.abs(beta) < jnp.pi))
+
+
 def inverse_kinematics(wrist, alpha, beta, plunge) -> Array:
-    """theta for tool pose (alpha, beta, p), knees-out branch; an unreachable pose raises
-    (`eqx.error_if`, also under jit). `solve_inverse_kinematics` returns a status instead."""
+    """theta for tool pose (alpha, beta, p), knees-out branch; an unreachable pose, or one
+    outside the chart (`in_chart`), raises (`eqx.error_if`, also under jit).
+    `solve_inverse_kinematics` returns a status instead."""
     alpha, beta, plunge = (jnp.asarray(x, dtype=float) for x in (alpha, beta, plunge))
     theta, reachable = solve_inverse_kinematics(wrist, plunge, slope_from_angles(alpha, beta))
+    theta = eqx.error_if(theta, ~in_chart(alpha, beta, plunge),
+                         "Carpal Wrist: the pose is outside the (alpha, beta, p) chart: it needs "
+                         "finite values and a bend |beta| < pi")
     return eqx.error_if(theta, ~reachable, "Carpal Wrist: pose out of reach (a knee circle misses "
                         "the midplane: |p + rb k_i| > l sqrt(1 + k_i^2) for some leg)")
 
@@ -215,7 +227,12 @@ class SingularityMeasures(eqx.Module):
     leg i's knee circle and the midplane (0: the circle touches the plane, the workspace boundary;
     negative: that knee is on the knees-in branch). direct: (rho1 rho2 + rho2 rho3 + rho3 rho1) /
     (rho1^2 + rho2^2 + rho3^2), proportional to det K (0: knees collinear with the plane's
-    vertical, the parallel singularity; 1: all rho_i equal). condition: 1 / cond(J), J of eq 6.34.
+    vertical, the parallel singularity; 1: all rho_i equal). condition: the smallest singular
+    value of J (eq 6.34, J = dN/dg K^-1 D) over the largest of J_max = dN/dg K^-1 D_max, the
+    Jacobian with every leg at its largest gain |D_ii| = l sqrt(1 + k_i^2), so in [0, 1]: 0 at
+    an inverse singularity (a D_ii = 0: J loses rank), and at a direct one (det K = 0: J_max
+    grows without bound), including all three legs singular at once, where J vanishes whole
+    and 1 / cond(J) would be 0 / 0.
     """
 
     inverse: Array
@@ -232,16 +249,22 @@ def singularity_measures(wrist, theta: Array) -> SingularityMeasures:
     rho = wrist.base_radius - wrist.link_length * jnp.cos(theta)
     direct = (rho[0] * rho[1] + rho[1] * rho[2] + rho[2] * rho[0]) / jnp.sum(rho * rho)
     sv = jnp.linalg.svd(jacobian_closed_form(wrist, theta), compute_uv=False)
-    return SingularityMeasures(inverse=jnp.min(-leg), direct=direct, condition=sv[-1] / sv[0])
+    s = jnp.sqrt(1.0 + g @ g)
+    dN_dg = -(jnp.eye(2, dtype=g.dtype) / s - jnp.outer(g, g) / s**3)
+    gains = _inverse3(_knee_matrix(wrist, theta)) * (wrist.link_length * jnp.sqrt(1 + k * k))
+    J_max = jnp.concatenate([dN_dg @ gains[1:], gains[:1]], axis=0)
+    largest = jnp.linalg.svd(J_max, compute_uv=False)[0]
+    return SingularityMeasures(inverse=jnp.min(-leg), direct=direct, condition=sv[-1] / largest)
 
 
 def reachable(wrist, alpha, beta, plunge) -> Array:
-    """True where the pose (alpha, beta, p) has a knees-out solution (broadcasts)."""
+    """True where the pose (alpha, beta, p) is in the chart (`in_chart`) and has a knees-out
+    solution (broadcasts)."""
     def one(a, b, p):
         return _ik_argument(wrist, p, slope_from_angles(a, b))[1]
     args = jnp.broadcast_arrays(*(jnp.asarray(x, dtype=float) for x in (alpha, beta, plunge)))
     a = jax.vmap(one)(*(x.ravel() for x in args))
-    return jnp.all(jnp.abs(a) <= 1.0, axis=-1).reshape(args[0].shape)
+    return (jnp.all(jnp.abs(a) <= 1.0, axis=-1).reshape(args[0].shape) & in_chart(*args))
 
 
 def rotation_angle(Ra: Array, Rb: Array) -> Array:

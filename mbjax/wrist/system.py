@@ -1,14 +1,21 @@
 """The Carpal Wrist as a system for `simulate` (seed 003 §6.4)."""
 
 import equinox as eqx
+import jax.numpy as jnp
 from jax import Array
 
 from mbjax.control import AbstractControl, as_control
 from mbjax.control.applied import (body_wrenches, check_actuation, check_control, check_points,
                                    generalized_control, hold)
+from mbjax.integrate.solution import Status
 from mbjax.integrate.system import AbstractSystem
-from mbjax.wrist import dynamics
+from mbjax.wrist import dynamics, kinematics
 from mbjax.wrist.model import CarpalWrist
+
+
+# how close (in `kinematics.singularity_measures`' inverse and direct measures, 1 far away) a
+# saved state may come to a singularity before `simulate` reports SINGULAR
+SINGULAR_TOLERANCE = 1e-3
 
 
 class WristSystem(AbstractSystem):
@@ -52,6 +59,15 @@ class WristSystem(AbstractSystem):
 
     def hold(self, t, q, u):
         return hold(self, t, q, u)
+
+    def check(self, t: Array, q: Array, u: Array) -> Array:
+        """SINGULAR where the wrist is within SINGULAR_TOLERANCE of an inverse or a direct
+        singularity (`kinematics.singularity_measures`): there the accelerations of eq 6.21
+        are not defined (1e17 rad/s^2 at the knees' tangency, measured)."""
+        m = kinematics.singularity_measures(self.wrist, q)
+        near = jnp.minimum(jnp.abs(m.inverse), jnp.abs(m.direct)) < SINGULAR_TOLERANCE
+        return jnp.where(near | ~jnp.isfinite(m.inverse), int(Status.SINGULAR), 0).astype(
+            jnp.int32)
 
     def energy(self, q: Array, u: Array) -> Array:
         """T + V of the tool; the work of the motors and the external wrench is not included."""

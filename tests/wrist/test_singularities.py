@@ -1,0 +1,58 @@
+"""The Carpal Wrist at and beyond its singularities (issue 23): measures right at both kinds,
+including all three legs singular at once, a SINGULAR status from `WristSystem`, and inverse
+kinematics that refuses a pose outside its chart instead of answering another pose."""
+
+import equinox as eqx
+import jax
+import jax.numpy as jnp
+import numpy as np
+import pytest
+
+from mbjax import simulate
+from mbjax.integrate import RK4, Status
+from mbjax.scenes import carpal_wrist as cw
+from mbjax.wrist import kinematics as kin
+from mbjax.wrist.system import WristSystem
+
+WRIST = cw.wrist()
+LEGS_UP = jnp.full(3, jnp.pi / 2)     # every knee at the top of its circle: all three tangent
+
+
+def test_measures_at_all_three_inverse_singularities_at_once():
+    m = WRIST.singularity_measures(LEGS_UP)
+    assert abs(float(m.inverse)) < 1e-12 and float(m.direct) == pytest.approx(1.0)
+    # J = dN/dg K^-1 D vanishes whole here; the condition measure still reads 0
+    assert np.allclose(kin.jacobian_closed_form(WRIST, LEGS_UP), 0.0, atol=1e-15)
+    assert float(m.condition) < 1e-12
+    home = WRIST.singularity_measures(cw.home(WRIST))
+    assert 0.01 < float(home.condition) <= 1.0 and float(home.inverse) > 0.5
+
+
+def test_the_condition_measure_vanishes_on_approach_to_either_kind():
+    """Along a path into each singularity the measure falls to 0 with the distance."""
+    rb, l = float(WRIST.base_radius), float(WRIST.link_length)
+    rho = 0.5 * rb * np.array([1.0, 1.0, -0.5])          # rho1 rho2 + rho2 rho3 + rho3 rho1 = 0
+    direct = np.arccos((rb - rho) / l)
+    home = np.asarray(cw.home(WRIST))
+    for target in (direct, np.asarray(LEGS_UP)):
+        values = [float(WRIST.singularity_measures(jnp.asarray(target + s * (home - target)))
+                        .condition) for s in (1e-1, 1e-2, 1e-3)]
+        assert values[0] > values[1] > values[2] and values[2] < 1e-2 * values[0], values
+
+
+def test_simulate_reports_singular_and_not_far_away():
+    system = WristSystem(WRIST)
+    at = simulate(system, RK4(), LEGS_UP, jnp.zeros(3), dt=1e-3, t1=0.01)
+    assert int(at.status) & Status.SINGULAR and not bool(at.ok)
+    away = simulate(system, RK4(), cw.home(WRIST), jnp.zeros(3), dt=1e-3, t1=0.01)
+    assert away.messages() == ["success"]
+
+
+@pytest.mark.parametrize("beta", [np.pi, 3.5, -4.0, 2 * np.pi - 0.1, np.nan])
+def test_inverse_kinematics_outside_the_chart(beta):
+    """|beta| >= pi (or NaN) is not a pose of the chart: refused, and not 'reachable'; at
+    2 pi - 0.1 the slope is that of the pose bent by 0.1 the other way, which is reachable."""
+    assert not bool(kin.reachable(WRIST, 0.3, beta, 0.075))
+    with pytest.raises(eqx.EquinoxRuntimeError, match="outside the .* chart"):
+        jax.block_until_ready(WRIST.inverse_kinematics(0.3, beta, 0.075))
+    assert bool(kin.reachable(WRIST, 0.3 + np.pi, 0.1, 0.075))
