@@ -9,7 +9,7 @@ import numpy as np
 from jax import Array
 
 from mbjax.integrate.base import AbstractIntegrator
-from mbjax.integrate.solution import Solution, Status
+from mbjax.integrate.solution import Solution, Status, raise_on_failure
 from mbjax.integrate.system import AbstractSystem
 
 
@@ -92,7 +92,8 @@ def _save_indices(t0: float, t1: float, dt: float, saveat) -> tuple[int, np.ndar
 
 def simulate(system: AbstractSystem, integrator: AbstractIntegrator, q0: Array, u0: Array, *,
              dt: float, t1: float, t0: float = 0.0, saveat=None, checkpoint: bool = False,
-             rtol: float | None = None, atol: float | None = None) -> Solution:
+             rtol: float | None = None, atol: float | None = None,
+             throw: bool = False) -> Solution:
     """Integrate `system` from (q0, u0) at t0 to t1 with fixed steps dt.
 
     `saveat` is None (every step) or an array of times on the grid t0 + k dt. dt, t0, t1 and
@@ -122,6 +123,9 @@ def simulate(system: AbstractSystem, integrator: AbstractIntegrator, q0: Array, 
     local errors cancel along an oscillation instead of adding up), so its INACCURATE errs on
     the safe side.
 
+    throw=True raises an error naming the failure (`Status.failures()`) instead of returning
+    a solution whose status carries it (also under `jit` and `vmap`, through `eqx.error_if`).
+
     checkpoint=True is for reverse-mode gradients of long rollouts: each block's steps run as a scan
     over segments of about sqrt(block) steps under `jax.checkpoint`, so `jax.grad` keeps the states
     at the segment ends and recomputes one segment at a time: memory grows like sqrt(T) rather than
@@ -146,7 +150,8 @@ def simulate(system: AbstractSystem, integrator: AbstractIntegrator, q0: Array, 
                               _segment(block) if checkpoint else block)
     ts = jnp.asarray(t0 + idx * dt, dtype=q0.dtype)
     if rtol is None and atol is None:
-        return Solution(ts=ts, qs=qs, us=us, status=status)
+        return raise_on_failure(Solution(ts=ts, qs=qs, us=us, status=status), throw,
+                                "mbjax.simulate")
     rtol, atol = (0.0 if x is None else _number(x, name) for x, name in ((rtol, "rtol"),
                                                                          (atol, "atol")))
     if rtol < 0 or atol < 0 or rtol + atol == 0:
@@ -160,7 +165,8 @@ def simulate(system: AbstractSystem, integrator: AbstractIntegrator, q0: Array, 
               jnp.concatenate([jnp.asarray([t0], q0.dtype), ts[picks]]))
     error, ratio = _error_estimate(system, integrator, *starts, float(dt), n_steps, rtol, atol)
     status = status | jnp.where(ratio > 1.0, int(Status.INACCURATE), 0).astype(status.dtype)
-    return Solution(ts=ts, qs=qs, us=us, status=status, error=error)
+    return raise_on_failure(Solution(ts=ts, qs=qs, us=us, status=status, error=error), throw,
+                            "mbjax.simulate")
 
 
 # the most states step doubling samples along a run (`simulate`'s rtol and atol)

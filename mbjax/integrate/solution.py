@@ -3,6 +3,7 @@
 import enum
 
 import equinox as eqx
+import jax.numpy as jnp
 import numpy as np
 from jax import Array
 
@@ -30,6 +31,21 @@ class Status(enum.IntFlag):
         """The flags that make a run fail (`REDUNDANT` and `LIMIT_EXCEEDED` only inform)."""
         return (cls.NONFINITE | cls.NOT_CONVERGED | cls.SOLVER_FAILED | cls.CONSTRAINT_VIOLATED
                 | cls.INACCURATE | cls.SINGULAR)
+
+
+def raise_on_failure(result, throw: bool, who: str):
+    """`result` (a `WithStatus`) as it is, or, with throw=True, an error (`eqx.error_if`, so also
+    under jit and vmap) naming the first failure flag set in its status, as diffrax's
+    throw=True does; the default returns the status for the caller to read."""
+    if not throw:
+        return result
+    failures = [flag for flag in Status if flag & Status.failures()]
+    failed = (result.status & Status.failures()) != 0
+    first = jnp.argmax(jnp.stack([(result.status & flag) != 0 for flag in failures]), axis=0)
+    messages = [f"{who}: the run failed with status {flag.name.lower().replace('_', ' ')} "
+                f"({flag.value}; throw=False returns the result with its status instead)"
+                for flag in failures]
+    return eqx.branched_error_if(result, jnp.any(failed), jnp.max(first), messages)
 
 
 class WithStatus(eqx.Module):

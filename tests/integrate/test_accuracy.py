@@ -56,3 +56,16 @@ def test_estimate_under_vmap_and_bad_tolerances():
     for rtol, atol in ((0.0, 0.0), (-1.0, 1e-3), (np.nan, 1e-3)):
         with pytest.raises(ValueError, match="rtol"):
             simulate(SYSTEM, RK4(), Q0, V0, dt=0.05, t1=T1, rtol=rtol, atol=atol)
+
+
+def test_throw_raises_the_failure_by_name_also_under_vmap():
+    import equinox as eqx
+
+    with pytest.raises(eqx.EquinoxRuntimeError, match="mbjax.simulate: .*status inaccurate"):
+        simulate(SYSTEM, RK4(), Q0, V0, dt=0.05, t1=T1, rtol=0.0, atol=1e-3, throw=True)
+    with pytest.raises(eqx.EquinoxRuntimeError, match="status nonfinite"):
+        jax.vmap(lambda q0: simulate(SYSTEM, RK4(), q0, V0, dt=0.05, t1=T1, throw=True))(
+            jnp.stack([Q0, jnp.full(3, jnp.nan)]))
+    fine = simulate(SYSTEM, RK4(), Q0, V0, dt=0.005, t1=T1, rtol=0.0, atol=1e-3, throw=True)
+    assert fine.messages() == ["success"]
+

@@ -118,3 +118,15 @@ def test_the_same_sweep_sharded_over_two_devices():
     out = subprocess.run([sys.executable, "-c", SHARDED], env=env, capture_output=True, text=True, timeout=600)
     assert out.returncode == 0, out.stderr[-3000:]
     assert "sharded ok" in out.stdout
+
+
+def test_trajopt_solve_throws_when_not_converged():
+    import equinox as eqx
+
+    from mbjax.scenes import acrobot
+    from mbjax.trajopt import ILQR, solve
+
+    problem = acrobot.swingup_problem(steps=50)
+    with pytest.raises(eqx.EquinoxRuntimeError, match="trajopt.solve: .*not converged"):
+        solve(problem, ILQR(iterations=2), throw=True)
+    assert solve(problem, ILQR(iterations=2)).messages() == ["not converged"]
