@@ -30,9 +30,9 @@ def test_measures_at_all_three_inverse_singularities_at_once():
 
 def test_the_condition_measure_vanishes_on_approach_to_either_kind():
     """Along a path into each singularity the measure falls to 0 with the distance."""
-    rb, l = float(WRIST.base_radius), float(WRIST.link_length)
+    rb, length = float(WRIST.base_radius), float(WRIST.link_length)
     rho = 0.5 * rb * np.array([1.0, 1.0, -0.5])          # rho1 rho2 + rho2 rho3 + rho3 rho1 = 0
-    direct = np.arccos((rb - rho) / l)
+    direct = np.arccos((rb - rho) / length)
     home = np.asarray(cw.home(WRIST))
     for target in (direct, np.asarray(LEGS_UP)):
         values = [float(WRIST.singularity_measures(jnp.asarray(target + s * (home - target)))
