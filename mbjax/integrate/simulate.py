@@ -103,9 +103,9 @@ def simulate(system: AbstractSystem, integrator: AbstractIntegrator, q0: Array, 
     The steps run as a `lax.scan` nested in blocks whose length is the greatest common divisor of
     the save indices, so only saved states are kept (memory O(len(saveat)) for uniform saves).
     The returned `Solution.status` flags non-finite states and unconverged implicit steps, and
-    whatever the system's `check` reports at the ends of the blocks (every saved state). Each step
-    runs the system as `system.hold(t, q, u)` gives it (sampled controls frozen at the step's
-    start), and the system's `constrain` after it.
+    whatever the system's `check` reports at the start and at the ends of the blocks (every
+    saved state). Each step runs the system as `system.hold(t, q, u)` gives it (sampled
+    controls frozen at the step's start), and the system's `constrain` after it.
 
     rtol, atol: a tolerance on the final state's error; given either, the solution carries an
     error estimate (`Solution.error`) and the status INACCURATE where it exceeds the
@@ -233,7 +233,9 @@ def _rollout(system, integrator, q0, u0, t0, dt, block: int, n_blocks: int, keep
         status = status | system.check(t, jax.lax.stop_gradient(q), jax.lax.stop_gradient(u))
         return (q, u, status), (q, u)
 
-    init = (q0, u0, jnp.array(0, dtype=jnp.int32))
+    # the start is a saved state too: the system's check sees it (a start on a singularity)
+    init = (q0, u0, system.check(jnp.asarray(t0, dtype), jax.lax.stop_gradient(q0),
+                                 jax.lax.stop_gradient(u0)).astype(jnp.int32))
     # Scans nest (blocks, segments, steps, an integrator's stages), and reverse mode traces a
     # scan's body several times per level: a level of length one is a plain call instead.
     if n_blocks == 1:

@@ -140,12 +140,11 @@ class Problem(eqx.Module):
         return jnp.concatenate([q1, v1])
 
     def step_jacobians(self, x: Array, u: Array, k) -> tuple[Array, Array]:
-        """(A, B) = (d step/dx, d step/du) at (x, u): one forward-mode pass per argument, so
-        that the control's directions skip the dynamics' derivative in the state (for a tree,
-        only a solve with M: 0.2 against 1.0 ms for the arm's 100 steps, measured with
-        `mbjax bench trajopt`'s problem)."""
-        return (jax.jacfwd(self.step, argnums=0)(x, u, k),
-                jax.jacfwd(self.step, argnums=1)(x, u, k))
+        """(A, B) = (d step/dx, d step/du) at (x, u), one forward-mode pass for both. (One pass
+        per argument skips the dynamics' derivative in the state for the control's directions,
+        0.2 ms less a linearization of the arm's 100 semi-implicit Euler steps, but traces the
+        step twice: with RK4, 2.5 s more compilation and a slower solve, 0.26 against 0.19 s.)"""
+        return jax.jacfwd(self.step, argnums=(0, 1))(x, u, k)
 
     def stage_cost(self, x: Array, u: Array) -> Array:
         """running(q, v, u) dt (1/2 |r|^2 dt for residuals r)."""

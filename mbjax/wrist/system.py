@@ -66,8 +66,7 @@ class WristSystem(AbstractSystem):
         are not defined (1e17 rad/s^2 at the knees' tangency, measured)."""
         m = kinematics.singularity_measures(self.wrist, q)
         near = jnp.minimum(jnp.abs(m.inverse), jnp.abs(m.direct)) < SINGULAR_TOLERANCE
-        return jnp.where(near | ~jnp.isfinite(m.inverse), int(Status.SINGULAR), 0).astype(
-            jnp.int32)
+        return jnp.where(near, int(Status.SINGULAR), 0).astype(jnp.int32)
 
     def energy(self, q: Array, u: Array) -> Array:
         """T + V of the tool; the work of the motors and the external wrench is not included."""
