@@ -55,10 +55,13 @@ class CarpalWrist(eqx.Module):
             self._validate()
 
     def _validate(self):
-        if np.any(np.asarray(self.base_radius) <= 0) or np.any(np.asarray(self.link_length) <= 0):
-            raise ValueError("base_radius and link_length must be positive")
-        if np.any(np.asarray(self.tool_mass) <= 0):
-            raise ValueError(f"tool_mass must be positive, got {self.tool_mass}")
+        for name in ("base_radius", "link_length", "tool_mass"):
+            value = np.asarray(getattr(self, name))
+            if not np.all(value > 0) or not np.all(np.isfinite(value)):   # NaN fails > 0 too
+                raise ValueError(f"{name} must be positive and finite, got {value}")
+        for name in ("phi0", "gravity", "tool_com", "tool_inertia"):
+            if not np.all(np.isfinite(np.asarray(getattr(self, name)))):
+                raise ValueError(f"{name} must be finite, got {np.asarray(getattr(self, name))}")
         inertia = np.asarray(self.tool_inertia)
         if not np.allclose(inertia, np.swapaxes(inertia, -1, -2), rtol=1e-12, atol=1e-15):
             raise ValueError("tool_inertia must be symmetric")

@@ -126,7 +126,9 @@ def test_trajopt_solve_throws_when_not_converged():
     from mbjax.scenes import acrobot
     from mbjax.trajopt import ILQR, solve
 
-    problem = acrobot.swingup_problem(steps=50)
+    from mbjax.integrate import SemiImplicitEuler
+
+    problem = acrobot.swingup_problem(steps=20, integrator=SemiImplicitEuler())
     with pytest.raises(eqx.EquinoxRuntimeError, match="trajopt.solve: .*not converged"):
         solve(problem, ILQR(iterations=2), throw=True)
     assert solve(problem, ILQR(iterations=2)).messages() == ["not converged"]

@@ -56,3 +56,20 @@ def test_inverse_kinematics_outside_the_chart(beta):
     with pytest.raises(eqx.EquinoxRuntimeError, match="outside the .* chart"):
         jax.block_until_ready(WRIST.inverse_kinematics(0.3, beta, 0.075))
     assert bool(kin.reachable(WRIST, 0.3 + np.pi, 0.1, 0.075))
+
+
+@pytest.mark.parametrize(("change", "message"), [
+    (dict(base_radius=-0.06), "base_radius must be positive"),
+    (dict(link_length=np.nan), "link_length must be positive and finite"),
+    (dict(tool_mass=0.0), "tool_mass must be positive"),
+    (dict(tool_inertia=np.eye(3) * np.nan), "tool_inertia must be finite"),
+    (dict(tool_com=(np.nan, 0.0, 0.0)), "tool_com must be finite"),
+    (dict(gravity=np.inf), "gravity must be finite"),
+])
+def test_wrist_parameters_are_validated(change, message):
+    from mbjax.wrist import CarpalWrist
+
+    args = {**dict(base_radius=0.06, link_length=0.1, tool_mass=1.0,
+                   tool_inertia=np.eye(3) * 1e-3), **change}
+    with pytest.raises(ValueError, match=message):
+        CarpalWrist(args.pop("base_radius"), args.pop("link_length"), **args)
