@@ -160,6 +160,9 @@ def _check_time_elements(scenes):
     assert flex["2 modes, stiffened"]["peak_relative_error"] < 5e-3
     assert flex["2 modes, stiffened"]["max_error_m"] < 0.02
     assert (flex["2 modes, no stiffening"]["max_error_m"] or math.inf) > 1.0
+    # ... and the summary says so next to the integration's own status
+    assert flex["2 modes, stiffened"]["against_reference"] == "agrees"
+    assert flex["2 modes, no stiffening"]["against_reference"] == "departs"
     # controls: the push moves the flange by millimetres and the servo catches it; a sampled
     # torque history gives MuJoCo's trajectory; jax.grad of the reach loss is the central difference
     controls = scenes["controls"]
