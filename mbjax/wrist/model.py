@@ -18,6 +18,21 @@ def _concrete(x) -> bool:
         return False
 
 
+def _validate(given: dict) -> None:
+    """The concrete parameters (NumPy arrays; a wrist built under jit or vmap is not checked)."""
+    for name in ("base_radius", "link_length", "tool_mass"):
+        if not np.all(given[name] > 0) or not np.all(np.isfinite(given[name])):  # NaN fails > 0
+            raise ValueError(f"{name} must be positive and finite, got {given[name]}")
+    for name in ("phi0", "gravity", "tool_com", "tool_inertia"):
+        if not np.all(np.isfinite(given[name])):
+            raise ValueError(f"{name} must be finite, got {given[name]}")
+    inertia = given["tool_inertia"]
+    if not np.allclose(inertia, np.swapaxes(inertia, -1, -2), rtol=1e-12, atol=1e-15):
+        raise ValueError("tool_inertia must be symmetric")
+    if np.any(np.linalg.eigvalsh(inertia) <= 0):
+        raise ValueError("tool_inertia must be positive definite")
+
+
 class CarpalWrist(eqx.Module):
     """A Carpal Wrist: three legs at azimuths phi0 + (0, 120, 240) deg on a base of radius
     `base_radius`, legs of `link_length` from base axis to knee, a rigid tool of `tool_mass`,
@@ -51,22 +66,10 @@ class CarpalWrist(eqx.Module):
         if self.tool_inertia.shape[-2:] != (3, 3) or self.tool_com.shape[-1:] != (3,):
             raise ValueError(f"tool_inertia must be 3x3 and tool_com a 3-vector, got shapes "
                              f"{self.tool_inertia.shape} and {self.tool_com.shape}")
-        if all(_concrete(x) for x in (base_radius, link_length, tool_mass, tool_inertia)):
-            self._validate()
-
-    def _validate(self):
-        for name in ("base_radius", "link_length", "tool_mass"):
-            value = np.asarray(getattr(self, name))
-            if not np.all(value > 0) or not np.all(np.isfinite(value)):   # NaN fails > 0 too
-                raise ValueError(f"{name} must be positive and finite, got {value}")
-        for name in ("phi0", "gravity", "tool_com", "tool_inertia"):
-            if not np.all(np.isfinite(np.asarray(getattr(self, name)))):
-                raise ValueError(f"{name} must be finite, got {np.asarray(getattr(self, name))}")
-        inertia = np.asarray(self.tool_inertia)
-        if not np.allclose(inertia, np.swapaxes(inertia, -1, -2), rtol=1e-12, atol=1e-15):
-            raise ValueError("tool_inertia must be symmetric")
-        if np.any(np.linalg.eigvalsh(inertia) <= 0):
-            raise ValueError("tool_inertia must be positive definite")
+        given = dict(base_radius=base_radius, link_length=link_length, tool_mass=tool_mass,
+                     tool_inertia=tool_inertia, phi0=phi0, gravity=gravity, tool_com=tool_com)
+        if all(_concrete(x) for x in given.values()):
+            _validate({name: np.asarray(x, dtype=float) for name, x in given.items()})
 
     # -- kinematics (closed form) --------------------------------------------------------------
     def forward_kinematics(self, theta) -> kinematics.Pose:
