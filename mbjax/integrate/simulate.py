@@ -11,6 +11,7 @@ from jax import Array
 from mbjax.integrate.base import AbstractIntegrator
 from mbjax.integrate.solution import Solution, Status, raise_on_failure
 from mbjax.integrate.system import AbstractSystem
+from mbjax.integrate.tree_system import AbstractTreeSystem
 
 
 def _number(value, name: str) -> float:
@@ -52,8 +53,6 @@ def _state(x, name: str, size: int | None) -> Array:
 def _sizes(system: AbstractSystem) -> tuple[int | None, int | None]:
     """(nq, nv) of a tree system (or a closed loop of one), else (None, None): other systems
     (a batch, a momentum form) lay their states out their own way."""
-    from mbjax.integrate.tree_system import AbstractTreeSystem
-
     tree = getattr(system, "tree", system)
     if isinstance(tree, AbstractTreeSystem):
         return tree.nq, tree.nv

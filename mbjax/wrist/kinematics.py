@@ -214,10 +214,15 @@ def jacobian_closed_form(wrist, theta: Array) -> Array:
     """J of eq 6.34 in closed form: dN_xy/dg (I / s - g g^T / s^3, s^2 = 1 + |g|^2, sign -)
     composed with K^-1 D; an independent check of `jacobian`."""
     _, g = midplane(wrist, theta)
+    return _normal_plunge_rows(g, chart_jacobian(wrist, theta))
+
+
+def _normal_plunge_rows(g: Array, chart_rows: Array) -> Array:
+    """Rows d(N_x, N_y, p) from rows d(p, gx, gy) at the slope g: dN_xy/dg = -(I / s -
+    g g^T / s^3), s^2 = 1 + |g|^2."""
     s = jnp.sqrt(1.0 + g @ g)
     dN_dg = -(jnp.eye(2, dtype=g.dtype) / s - jnp.outer(g, g) / s**3)
-    Jc = chart_jacobian(wrist, theta)                  # rows: p, gx, gy
-    return jnp.concatenate([dN_dg @ Jc[1:], Jc[:1]], axis=0)
+    return jnp.concatenate([dN_dg @ chart_rows[1:], chart_rows[:1]], axis=0)
 
 
 class SingularityMeasures(eqx.Module):
@@ -249,10 +254,8 @@ def singularity_measures(wrist, theta: Array) -> SingularityMeasures:
     rho = wrist.base_radius - wrist.link_length * jnp.cos(theta)
     direct = (rho[0] * rho[1] + rho[1] * rho[2] + rho[2] * rho[0]) / jnp.sum(rho * rho)
     sv = jnp.linalg.svd(jacobian_closed_form(wrist, theta), compute_uv=False)
-    s = jnp.sqrt(1.0 + g @ g)
-    dN_dg = -(jnp.eye(2, dtype=g.dtype) / s - jnp.outer(g, g) / s**3)
-    gains = _inverse3(_knee_matrix(wrist, theta)) * (wrist.link_length * jnp.sqrt(1 + k * k))
-    J_max = jnp.concatenate([dN_dg @ gains[1:], gains[:1]], axis=0)
+    K_inv = _inverse3(_knee_matrix(wrist, theta))
+    J_max = _normal_plunge_rows(g, K_inv * (wrist.link_length * jnp.sqrt(1 + k * k)))
     largest = jnp.linalg.svd(J_max, compute_uv=False)[0]
     return SingularityMeasures(inverse=jnp.min(-leg), direct=direct, condition=sv[-1] / largest)
 
