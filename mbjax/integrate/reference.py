@@ -7,12 +7,13 @@ import jax.numpy as jnp
 import numpy as np
 from jax import Array
 
-from mbjax.integrate.solution import Solution, Status
+from mbjax.integrate.solution import Solution, Status, raise_on_failure
 from mbjax.integrate.system import AbstractSystem
 
 
 def solve_reference(system: AbstractSystem, q0: Array, u0: Array, ts, *, rtol: float = 1e-11,
-                    atol: float = 1e-11, solver=None, max_steps: int = 1_000_000) -> Solution:
+                    atol: float = 1e-11, solver=None, max_steps: int = 1_000_000,
+                    throw: bool = False) -> Solution:
     """Integrate q_dot = kinematics(q, u), u_dot = acceleration(t, q, u) with an adaptive
     embedded Runge-Kutta method (default diffrax.Dopri8) and a PID step-size controller,
     saving at `ts` (ts[0] is the initial time, ts increasing). Coordinates are projected (e.g.
@@ -25,12 +26,15 @@ def solve_reference(system: AbstractSystem, q0: Array, u0: Array, ts, *, rtol: f
 
     Use it for references, not for rotation vectors through |r| = 2 pi: there the coordinate
     rate Gamma^-1 is singular and only fixed-step drivers, which rescale after each step, pass.
+    throw=True raises an error naming the failure instead of returning its status (as
+    `simulate`).
     """
     if not isinstance(ts, jax.core.Tracer):
         times = np.asarray(ts, dtype=float)
         if times.ndim != 1 or times.size < 2 or not np.all(np.diff(times) > 0):
             raise ValueError(f"ts must be at least two increasing times, got {ts!r}")
-    return _solve(system, q0, u0, ts, rtol, atol, solver, max_steps)
+    return raise_on_failure(_solve(system, q0, u0, ts, rtol, atol, solver, max_steps), throw,
+                            "mbjax.solve_reference")
 
 
 @eqx.filter_jit

@@ -16,7 +16,7 @@ import jax
 import jax.numpy as jnp
 from jax import Array
 
-from mbjax.integrate.solution import Status, WithStatus
+from mbjax.integrate.solution import Status, WithStatus, raise_on_failure
 from mbjax.tfe.body import Body
 from mbjax.tfe.elements import Element
 from mbjax.tfe.form import AbstractForm
@@ -107,7 +107,7 @@ def _march(body, state0, dt, tol, prescribed, *, form, element, n_elements, refe
 
 def solve_tfe(body: Body, state0: State, *, dt, n_elements: int, form: AbstractForm = Mixed(),
               element: Element = Element(4), reference: str | Reference = "constant_velocity",
-              tol=1e-10, max_iter: int = 20) -> TFESolution:
+              tol=1e-10, max_iter: int = 20, throw: bool = False) -> TFESolution:
     """March `n_elements` time elements of `element` (node spacing dt, so each spans
     (nodes - 1) dt) of the weak `form` from `state0`.
 
@@ -117,6 +117,8 @@ def solve_tfe(body: Body, state0: State, *, dt, n_elements: int, form: AbstractF
 
     Jitted once per (form, element, n_elements, reference, max_iter); dt, tol, the body and the
     state are traced, so sweeps over them do not recompile and they can be differentiated.
+    throw=True raises an error naming the failure (an element's Newton iteration not converged,
+    a non-finite state) instead of returning the solution with its status.
     """
     prescribed = reference if isinstance(reference, Reference) else None
     if prescribed is not None:
@@ -129,5 +131,7 @@ def solve_tfe(body: Body, state0: State, *, dt, n_elements: int, form: AbstractF
     if not isinstance(element, Element):
         raise TypeError(f"element must be a tfe.Element, got {type(element).__name__}")
     dt = jnp.asarray(dt, dtype=float)
-    return _march(body, state0, dt, jnp.asarray(tol, dtype=float), prescribed, form=form, element=element,
-                  n_elements=n_elements, reference=reference, max_iter=max_iter)
+    solution = _march(body, state0, dt, jnp.asarray(tol, dtype=float), prescribed, form=form,
+                      element=element, n_elements=n_elements, reference=reference,
+                      max_iter=max_iter)
+    return raise_on_failure(solution, throw, "mbjax.tfe.solve_tfe")

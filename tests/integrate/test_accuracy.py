@@ -69,3 +69,22 @@ def test_throw_raises_the_failure_by_name_also_under_vmap():
     fine = simulate(SYSTEM, RK4(), Q0, V0, dt=0.005, t1=T1, rtol=0.0, atol=1e-3, throw=True)
     assert fine.messages() == ["success"]
 
+
+
+def test_the_reference_solver_and_time_elements_throw_too():
+    """solve_reference stopped by max_steps, and a time-element march whose Newton iteration
+    cannot converge in one iteration, raise by name with throw=True."""
+    import equinox as eqx
+
+    from mbjax.integrate import solve_reference
+    from mbjax.scenes import torque_free_body as tfb
+    from mbjax.tfe import Body, initial_state, solve_tfe
+
+    ts = jnp.linspace(0.0, 0.5, 3)
+    with pytest.raises(eqx.EquinoxRuntimeError, match="solve_reference: .*solver failed"):
+        solve_reference(SYSTEM, Q0, V0, ts, max_steps=2, throw=True)
+    assert solve_reference(SYSTEM, Q0, V0, ts, max_steps=2).messages() == ["solver failed"]
+    body = Body(1.0, jnp.diag(jnp.array([tfb.J_TRANSVERSE, tfb.J_TRANSVERSE, tfb.J_AXIAL])))
+    state0 = initial_state(body, jnp.eye(3), jnp.array(tfb.OMEGA0))
+    with pytest.raises(eqx.EquinoxRuntimeError, match="solve_tfe: .*not converged"):
+        solve_tfe(body, state0, dt=0.2, n_elements=2, max_iter=1, throw=True)
