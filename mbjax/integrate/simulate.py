@@ -11,7 +11,7 @@ from jax import Array
 from mbjax.integrate.base import AbstractIntegrator
 from mbjax.integrate.solution import Solution, Status, raise_on_failure
 from mbjax.integrate.system import AbstractSystem
-from mbjax.integrate.tree_system import AbstractTreeSystem
+from mbjax.integrate.tree_system import state_sizes
 
 
 def _number(value, name: str) -> float:
@@ -48,15 +48,6 @@ def _state(x, name: str, size: int | None) -> Array:
     if size is not None and x.shape != (size,):
         raise ValueError(f"{name} must have shape ({size},) for this system, got {x.shape}")
     return x
-
-
-def _sizes(system: AbstractSystem) -> tuple[int | None, int | None]:
-    """(nq, nv) of a tree system (or a closed loop of one), else (None, None): other systems
-    (a batch, a momentum form) lay their states out their own way."""
-    tree = getattr(system, "tree", system)
-    if isinstance(tree, AbstractTreeSystem):
-        return tree.nq, tree.nv
-    return None, None
 
 
 def _save_indices(t0: float, t1: float, dt: float, saveat) -> tuple[int, np.ndarray]:
@@ -142,7 +133,7 @@ def simulate(system: AbstractSystem, integrator: AbstractIntegrator, q0: Array, 
     dt, t0, t1 = (_number(x, name) for x, name in ((dt, "dt"), (t0, "t0"), (t1, "t1")))
     n_steps, idx = _save_indices(t0, t1, dt, saveat)
     block = math.gcd(*idx.tolist(), n_steps)
-    nq, nv = _sizes(system)
+    nq, nv = state_sizes(system)
     q0, u0 = _state(q0, "q0", nq), _state(u0, "u0", nv)
     qs, us, status = _rollout(system, integrator, q0, u0, float(t0), float(dt), block,
                               n_steps // block, tuple((idx // block).tolist()),

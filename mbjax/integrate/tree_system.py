@@ -133,3 +133,11 @@ class AbstractTreeSystem(AbstractSystem):
     def hold(self, t, q, u):
         return hold(self, t, q, u)
 
+
+def state_sizes(system: AbstractSystem) -> tuple[int | None, int | None]:
+    """(nq, nv) of a tree system (or of a closed loop of one, its `tree`), else (None, None):
+    other systems (a batch, a momentum form) lay their states out their own way."""
+    tree = getattr(system, "tree", system)
+    if isinstance(tree, AbstractTreeSystem):
+        return tree.nq, tree.nv
+    return None, None

@@ -35,6 +35,7 @@ from mbjax.control import Constant
 from mbjax.integrate import RK4
 from mbjax.integrate.base import AbstractIntegrator
 from mbjax.integrate.system import AbstractSystem
+from mbjax.integrate.tree_system import state_sizes
 from mbjax.loops import ClosedSystem
 
 
@@ -79,7 +80,7 @@ class Problem(eqx.Module):
             raise TypeError(f"integrator must be an instance such as RK4(), got {integrator!r}")
         if not (isinstance(horizon, int | np.integer) and horizon >= 1):
             raise ValueError(f"horizon must be a positive int (the number of steps), got {horizon!r}")
-        if not (np.ndim(dt) == 0 and float(dt) > 0):
+        if isinstance(dt, str | bytes) or not (np.ndim(dt) == 0 and float(dt) > 0):
             raise ValueError(f"dt must be a positive number, got {dt!r}")
         if not (callable(running) and callable(terminal)):
             raise TypeError("running(q, v, u) and terminal(q, v) must be callables returning "
@@ -89,6 +90,10 @@ class Problem(eqx.Module):
         if self.q0.ndim != 1 or self.v0.ndim != 1:
             raise ValueError(f"q0 and v0 must be vectors, got shapes {self.q0.shape} and "
                              f"{self.v0.shape}")
+        nq, nv = state_sizes(system)
+        if nq is not None and (self.q0.shape != (nq,) or self.v0.shape != (nv,)):
+            raise ValueError(f"q0 and v0 must have shapes ({nq},) and ({nv},) for this system, "
+                             f"got {self.q0.shape} and {self.v0.shape}")
         self.running, self.terminal = running, terminal
         self.integrator = integrator
         self.dt, self.horizon = float(dt), int(horizon)

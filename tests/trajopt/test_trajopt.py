@@ -132,3 +132,24 @@ def test_trajopt_solve_throws_when_not_converged():
     with pytest.raises(eqx.EquinoxRuntimeError, match="trajopt.solve: .*not converged"):
         solve(problem, ILQR(iterations=2), throw=True)
     assert solve(problem, ILQR(iterations=2)).messages() == ["not converged"]
+
+
+@pytest.mark.parametrize(("change", "error", "message"), [
+    (dict(q0=jnp.zeros(3)), ValueError, r"q0 and v0 must have shapes \(2,\) and \(2,\)"),
+    (dict(dt="0.01"), ValueError, "dt must be a positive number"),
+    (dict(dt=0.0), ValueError, "dt must be a positive number"),
+    (dict(horizon=20.0), ValueError, "horizon must be a positive int"),
+    (dict(lower=1.0, upper=-1.0), ValueError, "lower must not exceed upper"),
+    (dict(integrator=None), TypeError, "integrator must be an instance"),
+])
+def test_a_bad_problem_is_refused_by_name(change, error, message):
+    from mbjax.integrate import SemiImplicitEuler
+    from mbjax.scenes import acrobot
+    from mbjax.trajopt import Problem
+
+    base = acrobot.swingup_problem(steps=20, integrator=SemiImplicitEuler())
+    args = {**dict(q0=base.q0, v0=base.v0, dt=0.01, horizon=20, integrator=SemiImplicitEuler()),
+            **change}
+    with pytest.raises(error, match=message):
+        Problem(base.system, args.pop("q0"), args.pop("v0"), running=base.running,
+                terminal=base.terminal, **args)
