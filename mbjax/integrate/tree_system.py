@@ -135,9 +135,13 @@ class AbstractTreeSystem(AbstractSystem):
 
 
 def state_sizes(system: AbstractSystem) -> tuple[int | None, int | None]:
-    """(nq, nv) of a tree system (or of a closed loop of one, its `tree`), else (None, None):
-    other systems (a batch, a momentum form) lay their states out their own way."""
-    tree = getattr(system, "tree", system)
+    """The lengths (of q, of u) a system's state must have, None where it is the system's own
+    affair: (nq, nv) for a tree system; (nq, None) for a closed loop of one (its method may add
+    to u, as the epsilon-dynamics add the constraint loads); (None, None) for the others (a
+    batch, a momentum form)."""
+    if isinstance(system, AbstractTreeSystem):
+        return system.nq, system.nv
+    tree = getattr(system, "tree", None)
     if isinstance(tree, AbstractTreeSystem):
-        return tree.nq, tree.nv
+        return tree.nq, None
     return None, None

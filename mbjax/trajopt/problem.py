@@ -90,7 +90,7 @@ class Problem(eqx.Module):
         if self.q0.ndim != 1 or self.v0.ndim != 1:
             raise ValueError(f"q0 and v0 must be vectors, got shapes {self.q0.shape} and "
                              f"{self.v0.shape}")
-        nq, nv = state_sizes(system)
+        nq, nv = state_sizes(driven(system))       # a closed loop's x is its tree's (q, v)
         if nq is not None and (self.q0.shape != (nq,) or self.v0.shape != (nv,)):
             raise ValueError(f"q0 and v0 must have shapes ({nq},) and ({nv},) for this system, "
                              f"got {self.q0.shape} and {self.v0.shape}")
