@@ -66,6 +66,10 @@ class FlexibleSystem(AbstractTreeSystem):
         qf = self.model.split(q)[1]
         return jnp.sum(jax.vmap(body_kinetic_energy)(self.model.bodies, qf, w))
 
+    def dissipative(self):
+        """Joint damping or modal damping."""
+        return jnp.any(self.model.model.damping != 0) | jnp.any(self.model.bodies.damping != 0)
+
     def energy(self, q, v):
         """Kinetic, gravitational and modal strain energy."""
         return self.kinetic_energy(q, v) + potential_energy(self.model, q)

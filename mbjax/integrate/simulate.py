@@ -9,6 +9,7 @@ import numpy as np
 from jax import Array
 
 from mbjax.integrate.base import AbstractIntegrator
+from mbjax.integrate.invariants import relative_drift
 from mbjax.integrate.solution import Solution, Status, raise_on_failure
 from mbjax.integrate.system import AbstractSystem
 from mbjax.integrate.tree_system import state_sizes
@@ -111,7 +112,12 @@ def simulate(system: AbstractSystem, integrator: AbstractIntegrator, q0: Array, 
     (tests/integrate/test_accuracy.py): RK4's estimate within a factor 4 of the true error at
     dt = 0.1 ... 0.005; semi-implicit Euler's 10 to 50 times above it (a symplectic method's
     local errors cancel along an oscillation instead of adding up), so its INACCURATE errs on
-    the safe side.
+    the safe side. The second measure sees what step doubling misses: the drift of the
+    invariants the system has (`AbstractSystem.invariants`: a passive system's energy, a
+    floating tree's momenta; the constraint residual is the closed loops' own status) over
+    the start and the saved states, relative to the motion's scale
+    (`mbjax.integrate.invariants`), is `Solution.drift`, and INACCURATE is also set where it
+    exceeds a positive rtol (atol, in the state's units, does not apply to it).
 
     throw=True raises an error naming the failure (`Status.failures()`) instead of returning
     a solution whose status carries it (also under `jit` and `vmap`, through `eqx.error_if`).
@@ -154,9 +160,12 @@ def simulate(system: AbstractSystem, integrator: AbstractIntegrator, q0: Array, 
     starts = (jnp.concatenate([q0[None], qs[picks]]), jnp.concatenate([u0[None], us[picks]]),
               jnp.concatenate([jnp.asarray([t0], q0.dtype), ts[picks]]))
     error, ratio = _error_estimate(system, integrator, *starts, float(dt), n_steps, rtol, atol)
-    status = status | jnp.where(ratio > 1.0, int(Status.INACCURATE), 0).astype(status.dtype)
-    return raise_on_failure(Solution(ts=ts, qs=qs, us=us, status=status, error=error), throw,
-                            "mbjax.simulate")
+    drift = _drift(system, jnp.concatenate([jnp.asarray([t0], q0.dtype), ts]),
+                   jnp.concatenate([q0[None], qs]), jnp.concatenate([u0[None], us]))
+    inaccurate = (ratio > 1.0) | (drift > rtol) & (rtol > 0)
+    status = status | jnp.where(inaccurate, int(Status.INACCURATE), 0).astype(status.dtype)
+    return raise_on_failure(Solution(ts=ts, qs=qs, us=us, status=status, error=error,
+                                     drift=drift), throw, "mbjax.simulate")
 
 
 # the most states step doubling samples along a run (`simulate`'s rtol and atol)
@@ -183,6 +192,15 @@ def _error_estimate(system, integrator, q, u, t, dt: float, n_steps: int, rtol, 
 
     errors, ratios = jax.vmap(local)(q, u, t)
     return n_steps * jnp.mean(errors), n_steps * jnp.mean(ratios)
+
+
+@eqx.filter_jit
+def _drift(system, ts, qs, us):
+    """The invariants' largest relative drift over the start and the saved states
+    (`mbjax.integrate.invariants.relative_drift`); NaN for a system that knows none."""
+    if system.invariants(ts[0], qs[0], us[0]) is None:
+        return jnp.asarray(jnp.nan, qs.dtype)
+    return relative_drift(jax.vmap(system.invariants)(ts, qs, us))
 
 
 def _segment(block: int) -> int:

@@ -72,6 +72,9 @@ class Solution(WithStatus):
     `status` is an integer array of `Status` flags (one per solution; batched under vmap).
     `error`: the estimated global error of the final state (largest component, in the state's
     units) where the run was asked for a tolerance (`simulate(..., rtol=, atol=)`), else NaN.
+    `drift`: with a tolerance, the largest relative drift of the system's invariants (its
+    energy, its momenta: `mbjax.integrate.invariants`) over the saved states; NaN where it has
+    none or no tolerance was asked.
     """
 
     ts: Array
@@ -79,3 +82,4 @@ class Solution(WithStatus):
     us: Array
     status: Array
     error: Array = float("nan")
+    drift: Array = float("nan")

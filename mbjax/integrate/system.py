@@ -18,6 +18,8 @@ import jax
 import jax.numpy as jnp
 from jax import Array
 
+from mbjax.integrate.invariants import Invariants
+
 
 class AbstractSystem(eqx.Module):
     """A first-order mechanical system in (q, u); see the module docstring."""
@@ -57,6 +59,12 @@ class AbstractSystem(eqx.Module):
         """`Status` flags for a state `simulate` saves (a violated or redundant constraint,
         `mbjax.loops`); 0 here."""
         return jnp.array(0, jnp.int32)
+
+    def invariants(self, t: Array, q: Array, u: Array) -> Invariants | None:
+        """The quantities the exact motion conserves at a state (`mbjax.integrate.invariants`:
+        the energy of a passive system, a free tree's momentum), whose drift `simulate(...,
+        rtol=)` holds to rtol; None here: none known."""
+        return None
 
     @eqx.filter_jit
     def relative_energy_error(self, qs: Array, us: Array) -> Array:

@@ -24,6 +24,7 @@ from jax import Array
 
 from mbjax.control import AbstractControl
 from mbjax.control.applied import about_origins, body_wrenches, generalized_control, hold
+from mbjax.integrate.invariants import energy_invariant
 from mbjax.integrate.system import AbstractSystem
 
 
@@ -88,6 +89,25 @@ class AbstractTreeSystem(AbstractSystem):
     def energy(self, q: Array, v: Array) -> Array:
         """Kinetic plus gravitational (plus strain) energy; the work of the applied forces is
         not included."""
+
+    @abc.abstractmethod
+    def kinetic_energy(self, q: Array, v: Array) -> Array:
+        """The kinetic energy."""
+
+    @abc.abstractmethod
+    def dissipative(self) -> Array:
+        """True where the tree has damping (joint or modal), so that its energy can only fall."""
+
+    @property
+    def passive(self) -> bool:
+        """No control and no external load: the energy is conserved (or falls, with damping)."""
+        return self.control is None and self.external is None
+
+    def invariants(self, t, q, u):
+        """The energy of a passive tree (measured against its kinetic energy); None otherwise."""
+        if not self.passive:
+            return None
+        return energy_invariant(self.energy(q, u), self.kinetic_energy(q, u), self.dissipative())
 
     @abc.abstractmethod
     def mass_matrix(self, q: Array) -> Array:

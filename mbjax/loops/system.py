@@ -19,9 +19,11 @@ from jax import Array
 
 from mbjax.control import as_control
 from mbjax.control.applied import check_points
+from mbjax.integrate.invariants import energy_invariant
 from mbjax.integrate.solution import Status
 from mbjax.integrate.system import AbstractSystem
 from mbjax.integrate.tree_system import AbstractTreeSystem
+from mbjax.loops.closures import Prescribed
 from mbjax.loops.constraints import Loops
 from mbjax.loops.coupled import Coupled
 from mbjax.loops.method import AbstractLoopMethod
@@ -152,4 +154,14 @@ class ClosedSystem(AbstractSystem):
         """The tree's energy (kinetic, gravitational, strain) at the state's velocities; the work
         of the applied forces and prescribed motions is not included."""
         return self.tree.energy(q, self.velocity(q, u))
+
+    def invariants(self, t, q, u):
+        """The tree's energy where the tree is passive and no closure is a prescribed motion
+        (the closures' loads do no work then); None otherwise. The constraint residual is the
+        other invariant, held to `tolerance` by `check`."""
+        if not self.tree.passive or any(isinstance(c, Prescribed) for c in self.closures):
+            return None
+        v = self.velocity(q, u)
+        return energy_invariant(self.tree.energy(q, v), self.tree.kinetic_energy(q, v),
+                                self.tree.dissipative())
 

@@ -7,7 +7,10 @@ ground origin; linear) momenta, ground frame.
 
 import jax
 import jax.numpy as jnp
+import numpy as np
 from jax import Array
+
+from mbjax.integrate.invariants import Invariants
 
 from mbjax.model import Model
 from mbjax.rigid.kinematics import body_kinematics, forward_kinematics
@@ -38,3 +41,32 @@ def spatial_momentum(model: Model, q: Array, v: Array) -> Array:
     """(angular momentum about the ground origin; linear momentum), ground frame."""
     kin = body_kinematics(model, q, v)
     return jnp.einsum("kij,kj->i", kin.I, kin.V)
+
+
+def floating(model: Model) -> bool:
+    """Every base body (parent: the ground) hangs from a free joint: no joint holds the tree to
+    the ground, so only gravity changes its momentum."""
+    return all(kind == "free" for kind, parent in zip(model.joint_types, model.topology.parents)
+               if parent < 0)
+
+
+def free_momenta(model: Model, t: Array, q: Array, v: Array) -> Invariants:
+    """A floating tree's conserved momenta (`floating`): the linear momentum less the weight's
+    impulse, P - M g t, and the angular momentum about the ground origin, H, of which only the
+    component along gravity is conserved where there is gravity (the weight's moment
+    c x M g is normal to g). Each is measured against the sum of the bodies' momentum
+    magnitudes; none is held where a base's free joint is damped."""
+    kin = body_kinematics(model, q, v)
+    G = jnp.einsum("kij,kj->ki", kin.I, kin.V)                 # each body's (H about 0; P)
+    H, P = jnp.sum(G[:, :3], 0), jnp.sum(G[:, 3:], 0)
+    g = model.gravity
+    has_gravity = jnp.any(g != 0)
+    axis = g / jnp.where(has_gravity, jnp.linalg.norm(g), 1.0)
+    H = jnp.where(has_gravity, axis * (axis @ H), H)
+    P = P - jnp.sum(model.mass) * g * t
+    scale = jnp.concatenate([jnp.full(3, jnp.sum(jnp.linalg.norm(G[:, :3], axis=-1))),
+                             jnp.full(3, jnp.sum(jnp.linalg.norm(G[:, 3:], axis=-1)))])
+    bases = np.flatnonzero(np.asarray(model.topology.parents) < 0)
+    undamped = jnp.all(model.body_v(model.damping)[bases] == 0)
+    return Invariants(values=jnp.concatenate([H, P]), scale=scale,
+                      conserved=jnp.full(6, undamped), decreasing=jnp.zeros(6, bool))

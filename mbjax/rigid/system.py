@@ -26,6 +26,7 @@ from mbjax.control.applied import (
     generalized_control,
     hold,
 )
+from mbjax.integrate.invariants import join
 from mbjax.integrate.system import AbstractSystem
 from mbjax.integrate.tree_system import AbstractTreeSystem
 from mbjax.integrate.solution import Status
@@ -35,7 +36,7 @@ from mbjax.rigid.aba import aba_responses
 from mbjax.rigid.batched import batch_aba
 from mbjax.rigid.dense import dense_responses
 from mbjax.rigid.dynamics import METHODS, choose_method, forward_dynamics, mass_matrix
-from mbjax.rigid.energy import energy
+from mbjax.rigid.energy import energy, floating, free_momenta, kinetic_energy
 from mbjax.rigid.kinematics import forward_kinematics
 from mbjax.rigid.momentum import momentum_rate, velocity_from_momentum
 from mbjax.rigid.rnea import inverse_dynamics
@@ -90,6 +91,20 @@ class TreeSystem(AbstractTreeSystem):
 
     def energy(self, q, v):
         return energy(self.model, q, v)
+
+    def kinetic_energy(self, q, v):
+        return kinetic_energy(self.model, q, v)
+
+    def dissipative(self):
+        return jnp.any(self.model.damping != 0)
+
+    def invariants(self, t, q, u):
+        """The energy of a passive tree, and, where every base body hangs from a free joint,
+        the momenta of `free_momenta`."""
+        energy_part = super().invariants(t, q, u)
+        if energy_part is None or not floating(self.model):
+            return energy_part
+        return join(energy_part, free_momenta(self.model, t, q, u))
 
     def mass_matrix(self, q):
         return mass_matrix(self.model, q)
@@ -179,3 +194,8 @@ class MomentumSystem(AbstractSystem):
 
     def energy(self, q, u):
         return energy(self.model, q, self.velocity(q, u))
+
+    def invariants(self, t, q, u):
+        """As `TreeSystem`'s, at the velocities of the momenta."""
+        return TreeSystem(self.model, self.control, external=self.external).invariants(
+            t, q, self.velocity(q, u))

@@ -7,6 +7,7 @@ from jax import Array
 from mbjax.control import AbstractControl, as_control
 from mbjax.control.applied import (body_wrenches, check_actuation, check_control, check_points,
                                    generalized_control, hold)
+from mbjax.integrate.invariants import energy_invariant
 from mbjax.integrate.solution import Status
 from mbjax.integrate.system import AbstractSystem
 from mbjax.wrist import dynamics, kinematics
@@ -71,4 +72,11 @@ class WristSystem(AbstractSystem):
     def energy(self, q: Array, u: Array) -> Array:
         """T + V of the tool; the work of the motors and the external wrench is not included."""
         return dynamics.energy(self.wrist, q, u)
+
+    def invariants(self, t, q, u):
+        """The tool's energy with unpowered motors and no external wrench; None otherwise."""
+        if self.control is not None or self.external is not None:
+            return None
+        return energy_invariant(dynamics.energy(self.wrist, q, u),
+                                dynamics.kinetic_energy(self.wrist, q, u), False)
 

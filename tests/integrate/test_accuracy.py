@@ -88,3 +88,79 @@ def test_the_reference_solver_and_time_elements_throw_too():
     state0 = initial_state(body, jnp.eye(3), jnp.array(tfb.OMEGA0))
     with pytest.raises(eqx.EquinoxRuntimeError, match="solve_tfe: .*not converged"):
         solve_tfe(body, state0, dt=0.2, n_elements=2, max_iter=1, throw=True)
+
+
+# -- the invariants' drift -------------------------------------------------------------------------
+
+def _energy_drift(system, sol):
+    """The energy's largest change over the run relative to the largest kinetic energy, from the
+    system's energy functions directly."""
+    E = jax.vmap(system.energy)(sol.qs, sol.us)
+    T = jax.vmap(system.kinetic_energy)(sol.qs, sol.us)
+    return float(jnp.max(jnp.abs(E - E[0])) / jnp.max(T))
+
+
+def test_energy_drift_flags_what_a_loose_step_doubling_tolerance_lets_through():
+    """Explicit Euler on the triple pendulum gains energy (about 17 % of its kinetic energy
+    here); with atol = 10 the step-doubling estimate passes, the energy's drift does not."""
+    from mbjax.integrate import ExplicitEuler
+
+    sol = simulate(SYSTEM, ExplicitEuler(), Q0, V0, dt=0.005, t1=T1, rtol=1e-3, atol=10.0)
+    assert float(sol.drift) == pytest.approx(_energy_drift(SYSTEM, sol), rel=1e-12)
+    assert float(sol.drift) > 0.1 and sol.messages() == ["inaccurate"]
+    # step doubling alone passes it (rtol = 0: the drift is reported, not held to anything)
+    alone = simulate(SYSTEM, ExplicitEuler(), Q0, V0, dt=0.005, t1=T1, rtol=0.0, atol=10.0)
+    assert alone.messages() == ["success"] and float(alone.drift) > 0.1
+    fine = simulate(SYSTEM, RK4(), Q0, V0, dt=0.005, t1=T1, rtol=1e-3, atol=10.0)
+    assert float(fine.drift) < 1e-6 and fine.messages() == ["success"]
+    assert float(fine.drift) == pytest.approx(_energy_drift(SYSTEM, fine), rel=1e-6)
+
+
+def test_damped_energy_may_fall_but_not_rise():
+    import equinox as eqx
+
+    damped = TreeSystem(eqx.tree_at(lambda m: m.damping, SYSTEM.model, jnp.full(3, 0.5)))
+    sol = simulate(damped, RK4(), Q0, V0, dt=0.005, t1=T1, rtol=1e-4, atol=1e-4)
+    assert _energy_drift(damped, sol) > 0.1             # the damping has taken energy out
+    assert float(sol.drift) < 1e-7 and sol.messages() == ["success"]
+
+
+def test_momentum_of_a_floating_tree_with_and_without_gravity():
+    """A free base carrying two hinged links: H along gravity and P - M g t are conserved (all
+    of H without gravity); RK4's drift falls at fourth order, and a wrong weight impulse would
+    be seen (M g t = 29 N s at t = 1 s)."""
+    import equinox as eqx
+
+    from mbjax.rigid.energy import free_momenta
+
+    model = chain(3, joint_types=("free", "revolute", "revolute"))
+    q0 = model.neutral()
+    v0 = jnp.array([0.3, -0.2, 0.5, 0.1, 0.2, 0.3, 1.0, -2.0])
+    for gravity in (model.gravity, jnp.zeros(3)):
+        system = TreeSystem(eqx.tree_at(lambda m: m.gravity, model, gravity))
+        drifts = []
+        for dt in (0.02, 0.01):
+            sol = simulate(system, RK4(), q0, v0, dt=dt, t1=1.0, rtol=1e-6, atol=1e-6)
+            moments = jax.vmap(lambda t, q, v: free_momenta(system.model, t, q, v))(
+                sol.ts, sol.qs, sol.us)
+            change = jnp.max(jnp.abs(moments.values - moments.values[0]))
+            drifts.append(float(change / jnp.max(moments.scale)))
+            assert float(sol.drift) >= drifts[-1] * (1 - 1e-9)   # the energy's drift joins it
+        assert 8 < drifts[0] / drifts[1] < 40, drifts
+        assert drifts[1] < 1e-6
+    # the gravity terms are right: without `- M g t`, P changes by the weight's impulse
+    sol = simulate(TreeSystem(model), RK4(), q0, v0, dt=0.01, t1=1.0)
+    P = jax.vmap(lambda q, v: free_momenta(model, 0.0, q, v).values[3:])(sol.qs, sol.us)
+    np.testing.assert_allclose(P[-1] - P[0], jnp.sum(model.mass) * model.gravity * 1.0,
+                               rtol=1e-6, atol=1e-7)
+
+
+def test_no_invariant_under_a_control_and_the_closed_loop_energy():
+    from mbjax.scenes import four_bar
+
+    driven = TreeSystem(SYSTEM.model, jnp.ones(3))
+    sol = simulate(driven, RK4(), Q0, V0, dt=0.01, t1=0.5, rtol=1e-3, atol=1e-3)
+    assert np.isnan(sol.drift) and driven.invariants(0.0, Q0, V0) is None
+    system, q0, u0 = four_bar.build()
+    sol = simulate(system, RK4(), q0, u0, dt=0.002, t1=0.5, rtol=1e-3, atol=1e-3)
+    assert 0 <= float(sol.drift) < 1e-3, float(sol.drift)

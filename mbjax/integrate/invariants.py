@@ -1,0 +1,56 @@
+"""The invariants of a system's exact motion, whose drift along a simulation measures its error.
+
+A passive system (no control, no external load, no prescribed motion) conserves its energy, or
+with damping can only lose it; a free-floating tree also conserves its angular momentum about
+the gravity axis (all of it without gravity) and its linear momentum less the weight's impulse
+M g t. `simulate(..., rtol=)` compares each invariant along the saved states with its value at
+the start, relative to a scale of the motion (the largest kinetic energy for the energy, the
+sum of the bodies' momentum magnitudes for the momentum), and reports the largest ratio as
+`Solution.drift` and `Status.INACCURATE` where it exceeds rtol.
+"""
+
+import equinox as eqx
+import jax.numpy as jnp
+from jax import Array
+
+
+class Invariants(eqx.Module):
+    """k quantities at one state (batched over a trajectory by `jax.vmap`).
+
+    values: the quantities; scale: the magnitude each drift is measured against (non-negative);
+    conserved: where False the quantity is not held to anything (a momentum whose root joint is
+    damped); decreasing: where True only a rise counts as drift (the energy of a damped
+    system)."""
+
+    values: Array
+    scale: Array
+    conserved: Array
+    decreasing: Array
+
+    def __check_init__(self):
+        if jnp.shape(self.values) != jnp.shape(self.scale):
+            raise ValueError(f"values and scale must have one shape, got "
+                             f"{jnp.shape(self.values)} and {jnp.shape(self.scale)}")
+
+
+def energy_invariant(energy: Array, kinetic: Array, dissipative) -> Invariants:
+    """The energy, measured against the kinetic energy; with `dissipative` it may fall."""
+    return Invariants(values=jnp.atleast_1d(energy), scale=jnp.atleast_1d(jnp.abs(kinetic)),
+                      conserved=jnp.ones(1, bool),
+                      decreasing=jnp.atleast_1d(jnp.asarray(dissipative, bool)))
+
+
+def join(*parts: Invariants) -> Invariants:
+    """Several systems' or several kinds' invariants as one."""
+    return Invariants(*(jnp.concatenate([getattr(p, name) for p in parts])
+                        for name in ("values", "scale", "conserved", "decreasing")))
+
+
+def relative_drift(history: Invariants) -> Array:
+    """max over the invariants of max_t |I(t) - I(t_0)| / max_t scale(t) for a trajectory's
+    invariants (leading axis: time); a `decreasing` one counts only its rises. 0 for none."""
+    change = history.values - history.values[:1]
+    change = jnp.where(history.decreasing[0], jnp.maximum(change, 0.0), jnp.abs(change))
+    scale = jnp.maximum(jnp.max(history.scale, axis=0), jnp.finfo(change.dtype).eps)
+    ratio = jnp.where(history.conserved[0], jnp.max(change, axis=0) / scale, 0.0)
+    return jnp.max(ratio, initial=0.0)
