@@ -259,16 +259,20 @@ def test_reproduce_vertical_top(tmp_path):
 @pytest.mark.slow
 def test_reproduce_torque_free_tfe(tmp_path):
     """Seed 000 Fig. 1 over the quick run's 2 s: the issue's keys, every case converged, errors
-    well below 0.2 rad, and the mixed 4-node element ahead of the primal one at every spacing."""
+    well below 0.2 rad, and the mixed 4-node element ahead of the primal one at every spacing;
+    the accuracy status (rtol 1e-3, atol 1e-4) is inaccurate exactly where the error against
+    the closed form is past 1e-3 rad, and the estimate within a factor 10 of that error."""
     assert main(["reproduce", "torque-free-tfe", "--quick", "--out", str(tmp_path)]) == 0
     data = json.loads((tmp_path / "torque-free-tfe.json").read_text())
     cases = {(c["form"], c["nodes"], c["spacing"]): c for c in data["cases"]}
     assert {(n, s) for _, n, s in cases} == {(2, 0.015), (3, 0.015), (4, 0.015), (4, 0.03), (4, 0.045)}
     for case in cases.values():
         assert set(case) >= {"form", "nodes", "spacing", "t", "error", "max_error", "seconds"}
-        assert case["status"] == "success" and case["seconds"] > 0
+        assert case["seconds"] > 0
         assert len(case["t"]) == len(case["error"]) and case["max_error"] == max(case["error"])
         assert case["max_error"] < 0.2
+        assert case["status"] == ("inaccurate" if case["max_error"] > 1e-3 else "success"), case
+        assert case["max_error"] / 10 < case["error_estimate"] < 10 * case["max_error"]
     for spacing in (0.015, 0.03, 0.045):
         assert cases[("mixed", 4, spacing)]["max_error"] < cases[("primal", 4, spacing)]["max_error"]
     assert (tmp_path / "torque-free-tfe.png").stat().st_size > 10_000
@@ -277,11 +281,15 @@ def test_reproduce_torque_free_tfe(tmp_path):
 @pytest.mark.slow
 def test_reproduce_top_long_run(tmp_path):
     """Every run's measured growth matches its one-element map; the mixed form about the steady
-    rotation conserves energy and vertical angular momentum."""
+    rotation conserves energy and vertical angular momentum; the accuracy status (the tilt to
+    about 0.01 rad) is inaccurate exactly for the runs whose tilt leaves 0.01 rad (the physical
+    one stays below 1e-3)."""
     assert main(["reproduce", "top-long-run", "--quick", "--out", str(tmp_path)]) == 0
     data = json.loads((tmp_path / "top-long-run.json").read_text())
     runs = {(r["form"], r["march"]): r for r in data["runs"]}
-    assert len(runs) == 6 and all(r["status"] == "success" for r in runs.values())
+    assert len(runs) == 6
+    for r in runs.values():
+        assert r["status"] == ("inaccurate" if r["max_tilt"] > 0.01 else "success"), r["form"]
     for r in runs.values():
         if r["predicted_growth"] > 0.05:
             assert abs(r["measured_growth"] / r["predicted_growth"] - 1) < 0.1, r["form"]

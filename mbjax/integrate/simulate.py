@@ -10,7 +10,8 @@ from jax import Array
 
 from mbjax.integrate.base import AbstractIntegrator
 from mbjax.integrate.invariants import relative_drift
-from mbjax.integrate.solution import Solution, Status, raise_on_failure
+from mbjax.integrate.solution import (Solution, Status, raise_on_failure,
+                                     sample_indices, tolerances)
 from mbjax.integrate.system import AbstractSystem
 from mbjax.integrate.tree_system import state_sizes
 
@@ -148,15 +149,10 @@ def simulate(system: AbstractSystem, integrator: AbstractIntegrator, q0: Array, 
     if rtol is None and atol is None:
         return raise_on_failure(Solution(ts=ts, qs=qs, us=us, status=status), throw,
                                 "mbjax.simulate")
-    rtol, atol = (0.0 if x is None else _number(x, name) for x, name in ((rtol, "rtol"),
-                                                                         (atol, "atol")))
-    if rtol < 0 or atol < 0 or rtol + atol == 0:
-        raise ValueError(f"rtol and atol must be non-negative and not both zero, got {rtol}, "
-                         f"{atol}")
+    rtol, atol = tolerances(rtol, atol)
     # the samples: the start and the saved states before t1, at most ERROR_SAMPLES, spread out
     before = np.flatnonzero(idx < n_steps)
-    picks = before[np.unique(np.linspace(0, len(before) - 1, min(ERROR_SAMPLES, len(before)))
-                             .round().astype(int))] if len(before) else np.zeros(0, int)
+    picks = before[sample_indices(len(before))]
     starts = (jnp.concatenate([q0[None], qs[picks]]), jnp.concatenate([u0[None], us[picks]]),
               jnp.concatenate([jnp.asarray([t0], q0.dtype), ts[picks]]))
     error, ratio = _error_estimate(system, integrator, *starts, float(dt), n_steps, rtol, atol)
@@ -168,24 +164,21 @@ def simulate(system: AbstractSystem, integrator: AbstractIntegrator, q0: Array, 
                                      drift=drift), throw, "mbjax.simulate")
 
 
-# the most states step doubling samples along a run (`simulate`'s rtol and atol)
-ERROR_SAMPLES = 8
-
-
 @eqx.filter_jit
 def _error_estimate(system, integrator, q, u, t, dt: float, n_steps: int, rtol, atol):
     """(estimated global error, its ratio to the tolerance) from step doubling at the sampled
     states (q, u, t) (see `simulate`)."""
     p = integrator.order
 
-    def local(q, u, t):
-        def step(q, u, t, h):
-            q1, u1, _ = integrator.step(system.hold(t, q, u), t, q, u, h)
-            return system.constrain(t + h, q1, u1)
+    def step(state, t, h):
+        q, u = state
+        q1, u1, _ = integrator.step(system.hold(t, q, u), t, q, u, h)
+        return system.constrain(t + h, q1, u1)
 
+    def local(q, u, t):
         h = jnp.asarray(dt, q.dtype)
-        full = jnp.concatenate(step(q, u, t, h))
-        half = step(*step(q, u, t, h / 2), t + h / 2, h / 2)
+        full, _, half = doubled(step, (q, u), t, h, h)
+        full = jnp.concatenate(full)
         e = (full - jnp.concatenate(half)) * (2.0**p / (2.0**p - 1.0))
         scale = atol + rtol * jnp.maximum(jnp.abs(jnp.concatenate([q, u])), jnp.abs(full))
         return jnp.max(jnp.abs(e)), jnp.sqrt(jnp.mean((e / scale) ** 2))
@@ -201,6 +194,20 @@ def _drift(system, ts, qs, us):
     if system.invariants(ts[0], qs[0], us[0]) is None:
         return jnp.asarray(jnp.nan, qs.dtype)
     return relative_drift(jax.vmap(system.invariants)(ts, qs, us))
+
+
+def doubled(step, state, t, h, span):
+    """(one step of h, the first of two of h / 2, the second) from `state` at t, for step
+    doubling: step(state, t, h) -> state, whose end time is t + span (span = h for a time
+    step; a time element of node spacing h spans a multiple of it). The three steps run as one
+    scan, so `step` is traced (and compiled) once, not three times."""
+    def one(previous, k):
+        start = jax.tree.map(lambda a, b: jnp.where(k == 2, a, b), previous, state)
+        new = step(start, jnp.where(k == 2, t + span / 2, t), jnp.where(k == 0, h, h / 2))
+        return new, new
+
+    _, ends = jax.lax.scan(one, state, jnp.arange(3))
+    return tuple(jax.tree.map(lambda x, i=i: x[i], ends) for i in range(3))
 
 
 def _segment(block: int) -> int:

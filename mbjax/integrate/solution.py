@@ -33,6 +33,35 @@ class Status(enum.IntFlag):
                 | cls.INACCURATE | cls.SINGULAR)
 
 
+# the most states a step-doubling error estimate samples along a run (`simulate`, `solve_tfe`)
+ERROR_SAMPLES = 8
+
+
+def sample_indices(n: int) -> np.ndarray:
+    """Up to `ERROR_SAMPLES` indices spread evenly over range(n)."""
+    if n < 1:
+        return np.zeros(0, int)
+    return np.unique(np.linspace(0, n - 1, min(ERROR_SAMPLES, n)).round().astype(int))
+
+
+def tolerances(rtol, atol) -> tuple[float, float]:
+    """(rtol, atol) as floats, None as 0; an error unless both are finite, non-negative and not
+    both zero."""
+    values = []
+    for x, name in ((rtol, "rtol"), (atol, "atol")):
+        try:
+            if isinstance(x, str | bytes):
+                raise TypeError
+            values.append(0.0 if x is None else float(x))
+        except (TypeError, ValueError) as error:
+            raise TypeError(f"{name} must be a real number, got {x!r:.60}") from error
+    rtol, atol = values
+    if not (rtol >= 0 and atol >= 0 and rtol + atol > 0) or not np.isfinite(rtol + atol):
+        raise ValueError(f"rtol and atol must be finite, non-negative and not both zero, got "
+                         f"{rtol}, {atol}")
+    return rtol, atol
+
+
 def raise_on_failure(result, throw: bool, who: str):
     """`result` (a `WithStatus`) as it is, or, with throw=True, an error (`eqx.error_if`, so also
     under jit and vmap) naming the first failure flag set in its status, as diffrax's

@@ -21,6 +21,7 @@ from mbjax import lie
 from mbjax.control import AbstractControl, as_control
 from mbjax.control.applied import (about_origins, body_wrenches, check_actuation, check_control,
                                    check_points, generalized_control, hold)
+from mbjax.integrate.invariants import Invariants, energy_invariant, join
 from mbjax.integrate.system import AbstractSystem
 from mbjax.spatial import check_inertia
 
@@ -171,3 +172,27 @@ class RigidBody(AbstractSystem):
         """Spatial angular momentum about the origin (the fixed point, if any)."""
         h = self.rotation_matrix(q) @ (self.inertia @ u[:3])
         return h if self.fixed_point else h + self.mass * jnp.cross(q[self.n_rot:], u[3:])
+
+    def invariants(self, t, q, u):
+        """Without control or external load: the energy (against the kinetic energy), the
+        angular momentum about the origin along gravity (all of it without gravity: gravity's
+        moment is normal to it) and, for a free body, the momentum less the weight's impulse,
+        m (v - g t) (against the momenta's magnitudes). None otherwise."""
+        if self.control is not None or self.external is not None:
+            return None
+        spin = self.rotation_matrix(q) @ (self.inertia @ u[:3])
+        orbital = (jnp.zeros(3, u.dtype) if self.fixed_point
+                   else self.mass * jnp.cross(q[self.n_rot:], u[3:]))
+        g = self.gravity
+        has_gravity = jnp.any(g != 0)
+        axis = g / jnp.where(has_gravity, jnp.linalg.norm(g), 1.0)
+        H = spin + orbital
+        H = jnp.where(has_gravity, axis * (axis @ H), H)
+        parts = [energy_invariant(self.energy(q, u), self.kinetic_energy(q, u), False),
+                 Invariants(H, jnp.full(3, jnp.linalg.norm(spin) + jnp.linalg.norm(orbital)),
+                            jnp.ones(3, bool), jnp.zeros(3, bool))]
+        if not self.fixed_point:
+            P = self.mass * (u[3:] - g * t)
+            parts.append(Invariants(P, jnp.full(3, self.mass * jnp.linalg.norm(u[3:])),
+                                    jnp.ones(3, bool), jnp.zeros(3, bool)))
+        return join(*parts)

@@ -18,6 +18,7 @@ import numpy as np
 from jax import Array
 
 from mbjax import lie
+from mbjax.integrate.invariants import Invariants, energy_invariant, join
 from mbjax.rigid import RigidBody
 from mbjax.spatial import check_inertia
 
@@ -88,8 +89,30 @@ class Body(eqx.Module):
         m = jnp.cross(R @ self.com, b)
         return m if self.fixed_point else jnp.concatenate([m, b])
 
+    def kinetic_energy(self, R: Array, p_hat: Array) -> Array:
+        """p_hat . M6^-1 p_hat / 2 (eq 3.25)."""
+        return 0.5 * p_hat @ self.momentum_to_velocity(R, p_hat)
+
     def energy(self, R: Array, x: Array, p_hat: Array) -> Array:
         """Kinetic (eq 3.25: p_hat . M6^-1 p_hat / 2) plus potential energy."""
         centre = R @ self.com + (0.0 if self.fixed_point else x)
-        return (0.5 * p_hat @ self.momentum_to_velocity(R, p_hat)
-                - self.mass * self.gravity @ centre)
+        return self.kinetic_energy(R, p_hat) - self.mass * self.gravity @ centre
+
+    def invariants(self, t, R: Array, x: Array, p_hat: Array) -> Invariants:
+        """What the motion conserves (as `mbjax.rigid.RigidBody.invariants`): the energy, the
+        angular momentum about the origin h + x x l along gravity (all of it without gravity)
+        and, for a free body, l - M g t."""
+        h = p_hat[:3]
+        orbital = jnp.zeros(3, h.dtype) if self.fixed_point else jnp.cross(x, p_hat[3:])
+        g = self.gravity
+        has_gravity = jnp.any(g != 0)
+        axis = g / jnp.where(has_gravity, jnp.linalg.norm(g), 1.0)
+        H = jnp.where(has_gravity, axis * (axis @ (h + orbital)), h + orbital)
+        parts = [energy_invariant(self.energy(R, x, p_hat), self.kinetic_energy(R, p_hat), False),
+                 Invariants(H, jnp.full(3, jnp.linalg.norm(h) + jnp.linalg.norm(orbital)),
+                            jnp.ones(3, bool), jnp.zeros(3, bool))]
+        if not self.fixed_point:
+            parts.append(Invariants(p_hat[3:] - self.mass * g * t,
+                                    jnp.full(3, jnp.linalg.norm(p_hat[3:])),
+                                    jnp.ones(3, bool), jnp.zeros(3, bool)))
+        return join(*parts)

@@ -16,7 +16,10 @@ import jax
 import jax.numpy as jnp
 from jax import Array
 
-from mbjax.integrate.solution import Status, WithStatus, raise_on_failure
+from mbjax.integrate.invariants import relative_drift
+from mbjax.integrate.simulate import doubled
+from mbjax.integrate.solution import (Status, WithStatus, raise_on_failure, sample_indices,
+                                     tolerances)
 from mbjax.tfe.body import Body
 from mbjax.tfe.elements import Element
 from mbjax.tfe.form import AbstractForm
@@ -47,7 +50,8 @@ def initial_state(body: Body, R0, Omega0, x0=(0.0, 0.0, 0.0), v0=(0.0, 0.0, 0.0)
 class TFESolution(WithStatus):
     """States at the element boundaries ts (n_elements + 1), per-element Newton records and a
     `Status`: NOT_CONVERGED where an element's Newton missed its tolerance, NONFINITE where the
-    state blew up."""
+    state blew up, INACCURATE past the tolerance asked for; `error` and `drift` as
+    `mbjax.integrate.Solution`'s (NaN where no tolerance was asked)."""
 
     ts: Array
     R: Array
@@ -56,6 +60,8 @@ class TFESolution(WithStatus):
     iterations: Array
     residual: Array
     status: Array
+    error: Array = float("nan")
+    drift: Array = float("nan")
 
     def energy(self, body: Body) -> Array:
         """Total energy at every boundary."""
@@ -77,23 +83,34 @@ def element_map(form: AbstractForm, body: Body, ref: Reference, element: Element
     return form.final(body, ref, element, dt, U, z1), info
 
 
-@partial(jax.jit, static_argnames=("form", "element", "n_elements", "reference", "max_iter"))
-def _march(body, state0, dt, tol, prescribed, *, form, element, n_elements, reference, max_iter):
+def _advance(body, state: State, t, dt, tol, prescribed, *, form, element, reference,
+             max_iter) -> tuple[State, NewtonInfo]:
+    """One element of node spacing dt from `state` at time t (its reference built from the
+    state, or the prescribed one shifted to t)."""
     nq = body.nq
+    if prescribed is None:
+        ref = make_reference(reference, body, state.R, state.x, state.p_hat)
+        q1 = jnp.zeros(nq, state.p_hat.dtype)
+    else:
+        ref = prescribed.shifted(t)
+        q1 = increment(body, ref, state.R, state.x)
+    z1 = jnp.concatenate([form.to_form(body, q1, state.p_hat), q1])
+    z2, info = element_map(form, body, ref, element, dt, z1, tol=tol, max_iter=max_iter)
+    q2 = z2[nq:]
+    R2, x2 = configuration(body, ref, q2, element.length(dt))
+    return State(R2, x2, form.from_form(body, q2, z2[:nq])), info
+
+
+_STATIC = ("form", "element", "reference", "max_iter")
+
+
+@partial(jax.jit, static_argnames=(*_STATIC, "n_elements"))
+def _march(body, state0, dt, tol, prescribed, *, form, element, n_elements, reference, max_iter):
     h = element.length(dt)
 
     def step(state, k):
-        if prescribed is None:
-            ref = make_reference(reference, body, state.R, state.x, state.p_hat)
-            q1 = jnp.zeros(nq, state.p_hat.dtype)
-        else:
-            ref = prescribed.shifted(k * h)
-            q1 = increment(body, ref, state.R, state.x)
-        z1 = jnp.concatenate([form.to_form(body, q1, state.p_hat), q1])
-        z2, info = element_map(form, body, ref, element, dt, z1, tol=tol, max_iter=max_iter)
-        q2 = z2[nq:]
-        R2, x2 = configuration(body, ref, q2, h)
-        new = State(R2, x2, form.from_form(body, q2, z2[:nq]))
+        new, info = _advance(body, state, k * h, dt, tol, prescribed, form=form, element=element,
+                             reference=reference, max_iter=max_iter)
         return new, (new, info.iterations, info.residual, info.converged)
 
     _, (states, iterations, residual, converged) = jax.lax.scan(step, state0, jnp.arange(n_elements))
@@ -105,9 +122,40 @@ def _march(body, state0, dt, tol, prescribed, *, form, element, n_elements, refe
     return TFESolution(jnp.arange(n_elements + 1) * h, R, x, p_hat, iterations, residual, status)
 
 
+@partial(jax.jit, static_argnames=(*_STATIC, "n_elements"))
+def _error_estimate(body, states: State, ts, dt, tol, prescribed, rtol, atol, *, form, element,
+                    n_elements, reference, max_iter):
+    """(estimated global error, its ratio to the tolerance) by step doubling from the sampled
+    boundary states (see `solve_tfe`)."""
+    advance = partial(_advance, body, tol=tol, prescribed=prescribed, form=form, element=element,
+                      reference=reference, max_iter=max_iter)
+    h = element.length(dt)
+
+    def flat(s):
+        return jnp.concatenate([s.R.ravel(), s.x, s.p_hat])
+
+    def local(state, t):
+        full, _, half = doubled(lambda s, t, dt: advance(s, t, dt)[0], state, t, dt, h)
+        full, half = flat(full), flat(half)
+        e = full - half
+        scale = atol + rtol * jnp.maximum(jnp.abs(flat(state)), jnp.abs(full))
+        return jnp.max(jnp.abs(e)), jnp.sqrt(jnp.mean((e / scale) ** 2))
+
+    errors, ratios = jax.vmap(local)(states, ts)
+    return n_elements * jnp.mean(errors), n_elements * jnp.mean(ratios)
+
+
+@jax.jit
+def _drift(body, solution):
+    """The body's invariants' largest relative drift over the boundaries (`Body.invariants`)."""
+    return relative_drift(jax.vmap(body.invariants)(solution.ts, solution.R, solution.x,
+                                                    solution.p_hat))
+
+
 def solve_tfe(body: Body, state0: State, *, dt, n_elements: int, form: AbstractForm = Mixed(),
               element: Element = Element(4), reference: str | Reference = "constant_velocity",
-              tol=1e-10, max_iter: int = 20, throw: bool = False) -> TFESolution:
+              tol=1e-10, max_iter: int = 20, rtol: float | None = None,
+              atol: float | None = None, throw: bool = False) -> TFESolution:
     """March `n_elements` time elements of `element` (node spacing dt, so each spans
     (nodes - 1) dt) of the weak `form` from `state0`.
 
@@ -118,7 +166,17 @@ def solve_tfe(body: Body, state0: State, *, dt, n_elements: int, form: AbstractF
     Jitted once per (form, element, n_elements, reference, max_iter); dt, tol, the body and the
     state are traced, so sweeps over them do not recompile and they can be differentiated.
     throw=True raises an error naming the failure (an element's Newton iteration not converged,
-    a non-finite state) instead of returning the solution with its status.
+    a non-finite state, an inaccurate run) instead of returning the solution with its status.
+
+    rtol, atol: a tolerance, as `mbjax.simulate`'s. Given either, the solution carries
+    `error`, a step-doubling estimate of the final state's error (at up to `ERROR_SAMPLES`
+    boundaries, one element against two of half the spacing; their difference is taken as the
+    element's local error, the elements being of high order, and summed over the march; the
+    rotation matrix, position and momentum components together), and `drift`, the largest
+    relative drift of the body's invariants (`Body.invariants`: the energy, the momenta), and
+    the status INACCURATE where the first exceeds the tolerance (root mean square norm) or the
+    second exceeds a positive rtol. The primal form past its stability boundary is caught
+    this way (tests/tfe/test_accuracy.py).
     """
     prescribed = reference if isinstance(reference, Reference) else None
     if prescribed is not None:
@@ -131,7 +189,21 @@ def solve_tfe(body: Body, state0: State, *, dt, n_elements: int, form: AbstractF
     if not isinstance(element, Element):
         raise TypeError(f"element must be a tfe.Element, got {type(element).__name__}")
     dt = jnp.asarray(dt, dtype=float)
-    solution = _march(body, state0, dt, jnp.asarray(tol, dtype=float), prescribed, form=form,
-                      element=element, n_elements=n_elements, reference=reference,
-                      max_iter=max_iter)
+    checked = rtol is not None or atol is not None
+    if checked:
+        rtol, atol = tolerances(rtol, atol)
+    tol = jnp.asarray(tol, dtype=float)
+    static = dict(form=form, element=element, n_elements=n_elements, reference=reference,
+                  max_iter=max_iter)
+    solution = _march(body, state0, dt, tol, prescribed, **static)
+    if checked:
+        picks = jnp.asarray(sample_indices(n_elements))
+        states = State(solution.R[picks], solution.x[picks], solution.p_hat[picks])
+        error, ratio = _error_estimate(body, states, solution.ts[picks], dt, tol, prescribed,
+                                       rtol, atol, **static)
+        drift = _drift(body, solution)
+        inaccurate = (ratio > 1.0) | (drift > rtol) & (rtol > 0)
+        status = solution.status | jnp.where(inaccurate, int(Status.INACCURATE), 0)
+        solution = eqx.tree_at(lambda s: (s.status, s.error, s.drift), solution,
+                               (status.astype(solution.status.dtype), error, drift))
     return raise_on_failure(solution, throw, "mbjax.tfe.solve_tfe")
