@@ -338,7 +338,7 @@ def test_reproduce_closed_chain(tmp_path):
     stabilization drifts above it."""
     assert main(["reproduce", "closed-chain", "--quick", "--out", str(tmp_path)]) == 0
     data = json.loads((tmp_path / "closed-chain.json").read_text())
-    assert set(data) == {"n", "recursive_s", "dense_s", "max_abs_diff", "drift"}
+    assert set(data) == {"n", "recursive_s", "dense_s", "max_abs_diff", "drift", "drift_status"}
     assert len({len(data[k]) for k in ("n", "recursive_s", "dense_s", "max_abs_diff")}) == 1
     assert max(data["max_abs_diff"]) < 1e-8
     final = {name: rows[-1][1] for name, rows in data["drift"].items()}
@@ -346,6 +346,11 @@ def test_reproduce_closed_chain(tmp_path):
     assert final["baumgarte"] < final["none"]
     # seed 002's epsilon-dynamics: the position feedback bounds the drift the paper's form leaves
     assert final["epsilon=0.2,kappa=10"] < final["epsilon=0.2"] / 5
+    # each run's status says what its residual shows (the closed system's tolerance is 1e-6)
+    for name, check in data["drift_status"].items():
+        assert ("constraint violated" in check["status"]) == (
+            max(r for _, r in data["drift"][name]) > 1e-6), (name, check)
+    assert data["drift_status"]["projection"]["energy_drift"] < 1e-3
     assert (tmp_path / "closed-chain.png").stat().st_size > 10_000
 
 
