@@ -92,7 +92,6 @@ def test_recursion_matches_the_lagrangian_route(stiffening):
     np.testing.assert_allclose(recursive, dense, rtol=1e-11, atol=1e-11)
 
 
-@pytest.mark.slow          # 45-100 s of compilation on 2 cores
 def test_energy_is_conserved_without_stiffening():
     """Gravity, elasticity and the coupling of the swinging beam and its tip pendulum conserve
     T + V (geometric stiffening, a linearized prestress, is not conservative); RK4's energy error
@@ -122,26 +121,27 @@ def cantilever(E=7e10, n_elements=4, n_modes=2):
     return FlexibleModel(rigid, {0: body}, attach={1: 0})
 
 
-@pytest.mark.slow          # 45-100 s of compilation on 2 cores
-def test_gradient_through_a_flexible_rollout_matches_finite_differences():
-    """d(tip angle at 0.1 s)/dE through the whole pipeline: beam matrices, the eigenproblem, the
+@pytest.mark.parametrize("t1, mode", [(0.02, jax.jacfwd),
+                                      pytest.param(0.1, jax.grad, marks=pytest.mark.slow)])
+def test_gradient_through_a_flexible_rollout_matches_finite_differences(t1, mode):
+    """d(tip angle at t1)/dE through the whole pipeline: beam matrices, the eigenproblem, the
     modal coefficients and the geometric stiffening (distal load of the tip body), the recursion
-    and the rollout."""
+    and the rollout: by default 40 steps in forward mode (a third of the compilation); reverse
+    mode over 200 steps in the slow run."""
     def tip(E):
         model = cantilever(E)
         q0 = model.neutral().at[0].set(0.2)
-        sol = simulate(FlexibleSystem(model), RK4(), q0, jnp.zeros(model.nv), dt=5e-4, t1=0.1,
-                       saveat=[0.1])
+        sol = simulate(FlexibleSystem(model), RK4(), q0, jnp.zeros(model.nv), dt=5e-4, t1=t1,
+                       saveat=[t1])
         return sol.qs[-1, 1]
 
     E, h = 7e10, 7e5
-    grad = jax.grad(tip)(E)
+    grad = mode(tip)(E)
     fd = (tip(E + h) - tip(E - h)) / (2 * h)
     assert np.isfinite(grad) and grad != 0
     np.testing.assert_allclose(grad, fd, rtol=1e-5)
 
 
-@pytest.mark.slow          # 45-100 s of compilation on 2 cores
 def test_distal_stiffening_equals_the_reaction_of_the_child():
     """The recursion's distal-load stiffening (eq 33's F^J terms) is K_G(F) q with F the child's
     reaction at the grid point: add that generalized force to the Lagrangian route (which has no
@@ -151,10 +151,10 @@ def test_distal_stiffening_equals_the_reaction_of_the_child():
     q = model.neutral().at[0].set(0.4).at[1].set(-0.3).at[2:].set(jnp.asarray(rng.normal(size=2)) * 1e-3)
     v = jnp.asarray(rng.normal(size=model.nv))
     tau = jnp.zeros(model.nv)
-    v_dot = flexible_aba(model, q, v, tau)
+    v_dot = jax.jit(flexible_aba)(model, q, v, tau)
     # The child's reaction from Newton-Euler on the tip body alone (independent of the recursion).
-    from mbjax.flex.lagrange import _body_motion
-    R, p, omega, velocity, alpha, a = _body_motion(model, q, v, v_dot)
+    from mbjax.flex.lagrange import _body_motion, residual
+    R, p, omega, velocity, alpha, a = jax.jit(_body_motion)(model, q, v, v_dot)
     child = model.model
     m, c, Ic = child.mass[1], child.com[1], child.inertia[1]
     w, al, acc = omega[1], alpha[1], a[1]                     # body-frame, gravity folded into a
@@ -165,8 +165,7 @@ def test_distal_stiffening_equals_the_reaction_of_the_child():
     F = jnp.concatenate([-R_rel @ force_on_child, -R_rel @ moment_on_child])   # on the beam, beam frame
     qf = q[model.modal_slice(0)]
     K_G = jnp.einsum("j,jst->st", F, model.bodies.distal_stiffening[0, 0])
-    from mbjax.flex.lagrange import residual
-    r = residual(model, q, v, v_dot, tau).at[model.modal_slice(0)].add(K_G @ qf)
+    r = jax.jit(residual)(model, q, v, v_dot, tau).at[model.modal_slice(0)].add(K_G @ qf)
     np.testing.assert_allclose(r, 0.0, atol=1e-9 * float(jnp.max(jnp.abs(v_dot))))
     assert float(jnp.max(jnp.abs(K_G))) > 0                   # the tip load does stiffen the beam
 

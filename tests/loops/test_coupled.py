@@ -78,7 +78,6 @@ def test_constraint_derivatives_by_autodiff_match_finite_differences():
     np.testing.assert_allclose(second, (up - 2 * mid + down) / h**2, atol=1e-5)
 
 
-@pytest.mark.slow
 def test_gradient_through_a_constrained_rollout_matches_finite_differences():
     system = SYSTEM
     direction = jax.jit(jax.jacfwd(joint_angles))(THETA0)

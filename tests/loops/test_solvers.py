@@ -40,7 +40,6 @@ def test_momentum_form_multipliers_equal_the_velocity_forms():
     assert int(rank) == LOOPS.m
 
 
-@pytest.mark.slow     # the multipliers' identity above covers the form by default
 def test_momentum_form_follows_the_same_motion():
     """Two discretizations of one motion: RK4 on (q, G) and on (q, v) agree to O(dt^4)."""
     system = ClosedSystem(TREE, CHAIN.closures, Momentum())
@@ -127,7 +126,6 @@ def test_bad_system_parameters():
         ClosedSystem(TREE, CHAIN.closures, control=TAU)
 
 
-@pytest.mark.slow
 def test_epsilon_dynamics_with_position_feedback_keeps_its_invariant():
     """epsilon f_c_dot = A u_dot + b + kappa (A u + B) integrates to
     A u + B + kappa Phi - epsilon f_c = const: the position error is bounded by the loads."""
@@ -141,3 +139,39 @@ def test_epsilon_dynamics_with_position_feedback_keeps_its_invariant():
 
     values = jax.jit(jax.vmap(invariant))(sol.qs, sol.us)
     np.testing.assert_allclose(values, values[0] + 0 * values, atol=1e-8 * np.abs(values).max())
+
+
+def test_baumgarte_gives_the_constraint_its_error_dynamics():
+    """Coupled(baumgarte=(alpha, beta)) makes Phi_ddot + 2 alpha Phi_dot + beta^2 Phi = 0 at any
+    state, on the manifold or off it: Phi's time derivatives taken here by forward-mode autodiff
+    of Phi along the motion, not from the method's A and b."""
+    alpha, beta = 10.0, 7.0
+    system = ClosedSystem(TREE, CHAIN.closures, Coupled(baumgarte=(alpha, beta)))
+    rng = np.random.default_rng(5)
+    q = Q0 + 0.05 * jnp.asarray(rng.normal(size=Q0.shape))      # off the constraints
+    v = V0 + 0.3 * jnp.asarray(rng.normal(size=V0.shape))
+
+    @jax.jit
+    def error_dynamics(q, v):
+        v_dot = system.acceleration(0.0, q, v)
+
+        def phi_dot(q, v):
+            return jax.jvp(LOOPS.phi, (q,), (MODEL.q_dot(q, v),))[1]
+
+        phi_ddot = jax.jvp(phi_dot, (q, v), (MODEL.q_dot(q, v), v_dot))[1]
+        return LOOPS.phi(q), phi_dot(q, v), phi_ddot
+
+    phi, phi_dot, phi_ddot = error_dynamics(q, v)
+    assert float(jnp.max(jnp.abs(phi))) > 1e-3                  # truly off the manifold
+    np.testing.assert_allclose(phi_ddot + 2 * alpha * phi_dot + beta**2 * phi, 0.0,
+                               atol=1e-9 * float(jnp.max(jnp.abs(phi_ddot))))
+    # so along a rollout Phi(t) is the linear ODE's solution c1 exp(r1 t) + c2 exp(r2 t)
+    ts = np.linspace(0.0, 0.5, 6)
+    held = simulate(system, RK4(), q, v, dt=1e-3, t1=0.5, saveat=ts)
+    residual = np.asarray(jax.jit(jax.vmap(LOOPS.phi))(held.qs))
+    r1, r2 = -alpha + np.sqrt(alpha**2 - beta**2), -alpha - np.sqrt(alpha**2 - beta**2)
+    c1 = (np.asarray(phi_dot) - r2 * np.asarray(phi)) / (r1 - r2)
+    c2 = np.asarray(phi) - c1
+    expected = c1 * np.exp(r1 * ts[:, None]) + c2 * np.exp(r2 * ts[:, None])
+    np.testing.assert_allclose(residual, expected, atol=1e-7)
+    assert np.abs(residual[-1]).max() < 0.3 * np.abs(residual[0]).max()

@@ -384,7 +384,6 @@ def test_energy_conservation_converges_at_fourth_order(gravity):
     assert 3.5 < order < 4.8, (errors, order)
 
 
-@pytest.mark.slow
 def test_momentum_and_velocity_forms_agree():
     """MomentumSystem (seed 001 eqs 72-73) and TreeSystem integrate the same motion: they differ
     by RK4's error only (falling about 2^4 when dt halves), and both keep the energy."""
