@@ -197,6 +197,25 @@ TOUR_CHECKS = {"rigid": _check_rigid, "time-elements": _check_time_elements,
                "carpal-wrist": _check_carpal_wrist}
 
 
+def test_bench_wrist_quick(tmp_path):
+    """`mbjax bench wrist --quick` (a README claim; about 15 s): RK4's error falls at fourth
+    order, the Lagrange and Newton-Euler inverse dynamics agree, the sweep covers every variant
+    with finite, distinct peak torques."""
+    assert main(["bench", "wrist", "--quick", "--out", str(tmp_path)]) == 0
+    records = [json.loads(line) for line in (tmp_path / "wrist.jsonl").read_text().splitlines()
+               if line]
+    wp = sorted((r for r in records if r["kind"] == "work-precision"), key=lambda r: r["dt"])
+    assert len(wp) == 2 and all(r["status"] == "success" for r in wp)
+    ratio = wp[1]["error"] / wp[0]["error"]
+    assert 4**4 / 3 < ratio < 4**4 * 3, ratio                    # dt 4x: error 256x
+    routes = [r for r in records if r["kind"] == "route"]
+    assert len(routes) == 3 and all(r["lagrange_newton_euler_max_diff"] < 1e-9 for r in routes)
+    sweep = [r for r in records if r["kind"] == "sweep"]
+    assert sweep and sweep[0]["variants"] == 125
+    assert 0 < sweep[0]["peak_torque_min"] < sweep[0]["peak_torque_max"] < np.inf
+    assert (tmp_path / "wrist.png").stat().st_size > 10_000
+
+
 def test_bench_integrators_quick(tmp_path):
     assert main(["bench", "integrators", "--quick", "--out", str(tmp_path)]) == 0
     records = [json.loads(line) for line in (tmp_path / "integrators.jsonl").read_text().split("\n")
