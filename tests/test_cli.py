@@ -56,7 +56,9 @@ def test_reproduce_integrators(tmp_path):
 
 
 def test_reproduce_tree_scaling(tmp_path):
-    """The JSON of the issue: exactly these keys, finite positive times, one per n."""
+    """The JSON of the issue: exactly these keys, finite positive times, one per n; the timed
+    computations agree with each other and with Pinocchio (the run checks it and stops on a
+    disagreement: `check_agreement`, given one made on purpose, raises)."""
     assert main(["reproduce", "tree-scaling", "--quick", "--out", str(tmp_path)]) == 0
     data = json.loads((tmp_path / "tree-scaling.json").read_text())
     keys = {"n", "recursive_s", "dense_s"} | ({"pinocchio_aba_s"} if peers.available("pinocchio") else set())
@@ -66,6 +68,12 @@ def test_reproduce_tree_scaling(tmp_path):
     for key in keys - {"n"}:
         assert all(math.isfinite(t) and t > 0 for t in data[key]), (key, data[key])
     assert (tmp_path / "tree-scaling.png").stat().st_size > 10_000
+    from mbjax.reproduce import tree_scaling
+
+    with pytest.raises(RuntimeError, match="at n = 3 the dense accelerations differ"):
+        tree_scaling.check_agreement(3, {"recursive": np.ones(3),
+                                         "dense": np.array([1.0, 1.0, 1.0 + 1e-6])})
+    tree_scaling.check_agreement(3, {"recursive": np.ones(3), "dense": np.ones(3) + 1e-12})
 
 
 # The tour's scenes in three groups of similar cost, so the two xdist workers share them.
