@@ -30,13 +30,14 @@ step ~ n): the 20 s spin-up takes ~30 s at 4 elements, ~90 s at 8 on a shared 2-
 """
 
 from collections.abc import Callable
-from typing import NamedTuple
 
 import equinox as eqx
 import jax
 import jax.numpy as jnp
 import numpy as np
 from jax import Array
+
+from mbjax.integrate.solution import Status, WithStatus, raise_on_failure
 
 
 def _hermite(xi, l):  # noqa: E741 (the element length, as in the ANCF papers)
@@ -147,11 +148,15 @@ class AncfBeam(eqx.Module):
         return self.mass_matrix() @ eg
 
 
-class AncfSolution(NamedTuple):
+class AncfSolution(WithStatus):
+    """The beam's coordinates e and rates e_dot at the save times ts; `status` NONFINITE where
+    the run blew up (a step past RK4's stability, `stable_step`)."""
+
     ts: Array       # (n_saves,)
     e: Array        # (n_saves, n_coordinates)
     e_dot: Array    # (n_saves, n_coordinates)
-    dt: float       # the largest RK4 step used
+    status: Array
+    dt: float = eqx.field(static=True)      # the largest RK4 step used
 
 
 def _split(n, prescribed):
@@ -193,14 +198,15 @@ def _highest_frequency(beam: AncfBeam, e, G) -> Array:
 
 def simulate_embedded(beam: AncfBeam, embed: Callable, q0, q_dot0, ts, *, dt: float | None = None,
                       safety: float = 0.5, gravity=None, force: Callable | None = None,
-                      constant_mass: bool = False) -> AncfSolution:
+                      constant_mass: bool = False, throw: bool = False) -> AncfSolution:
     """Beam coordinates given by generalized coordinates q through e = embed(t, q), affine in q
     (prescribed coordinates, a prescribed slope direction with free magnitude, ...). Lagrange's
     equations: (G^T M G) q_ddot = G^T (Q - M c), G = de/dq, c as in `_kinematics`, Q = -dU/de +
     M e_g (`gravity` g) + `force(t, e, e_dot)`. Classical RK4 in one jitted lax.scan; each interval
     of the concrete, increasing save times ts is split into the same number of equal steps <= dt,
     dt defaulting to `stable_step` at t = ts[0]. `constant_mass`: G does not depend on t, so
-    G^T M G is factored once."""
+    G^T M G is factored once. The status says NONFINITE where the run blew up; throw=True
+    raises instead (as `mbjax.simulate`)."""
     ts = np.asarray(ts, float)
     q0, q_dot0 = jnp.asarray(q0, float), jnp.asarray(q_dot0, float)
     M = beam.mass_matrix()
@@ -246,7 +252,10 @@ def simulate_embedded(beam: AncfBeam, embed: Callable, q0, q_dot0, ts, *, dt: fl
         return jnp.concatenate([e_0[None], es]), jnp.concatenate([ed_0[None], eds])
 
     es, eds = run((q0, q_dot0))
-    return AncfSolution(jnp.asarray(ts), es, eds, dt)
+    finite = jnp.all(jnp.isfinite(es)) & jnp.all(jnp.isfinite(eds))
+    status = jnp.where(finite, 0, int(Status.NONFINITE)).astype(jnp.int32)
+    return raise_on_failure(AncfSolution(ts=jnp.asarray(ts), e=es, e_dot=eds, status=status,
+                                         dt=dt), throw, "mbjax.flex.simulate_ancf")
 
 
 def simulate(beam: AncfBeam, e0, e_dot0, ts, *, prescribed=(), e_p: Callable | None = None,
@@ -254,7 +263,7 @@ def simulate(beam: AncfBeam, e0, e_dot0, ts, *, prescribed=(), e_p: Callable | N
     """M_ff e_f'' = -dU/de_f - M_fp e_p''(t) + Q_f from (e0, e_dot0) at ts[0]: `prescribed` static
     global indices whose values the user's `e_p(t)` gives (positions only; velocities and
     accelerations by jax.jvp), the rest free. The prescribed entries of e0, e_dot0 are ignored.
-    Keyword arguments (dt, safety, gravity, force) as in `simulate_embedded`."""
+    Keyword arguments (dt, safety, gravity, force, throw) as in `simulate_embedded`."""
     f, p = _split(beam.n_coordinates, prescribed)
     if len(p) and e_p is None:
         raise ValueError("prescribed coordinates need e_p(t)")

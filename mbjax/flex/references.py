@@ -32,7 +32,7 @@ class SpinUpResult(NamedTuple):
 
 def spin_up_beam_reference(n_elements=8, ts=None, *, dt=None, safety=0.5, length=10.0, E=7.0e10,
                            A=4.0e-4, I=2.0e-7, mass=12.0, T_s=15.0, omega_s=6.0,  # noqa: E741
-                           free_root_stretch=True) -> SpinUpResult:
+                           free_root_stretch=True, throw: bool = False) -> SpinUpResult:
     """Kane's spin-up beam (seed 002 §3.2, eq 109; Kane, Ryan & Banerjee 1987) as an ANCF beam in
     the x-y plane: node 0 clamped on the axis (position 0, slope (cos theta, sin theta)
     prescribed), starting straight along x at rest. ts defaults to 0 ... 20 s every 0.1 s.
@@ -51,12 +51,13 @@ def spin_up_beam_reference(n_elements=8, ts=None, *, dt=None, safety=0.5, length
             root = q[0] * jnp.stack([jnp.cos(theta(t)), jnp.sin(theta(t))])
             return jnp.concatenate([jnp.zeros(2), root, q[1:]])
         q0 = np.concatenate([np.ones(1), np.asarray(e0)[4:]])
-        sol = simulate_embedded(beam, embed, q0, np.zeros_like(q0), ts, dt=dt, safety=safety)
+        sol = simulate_embedded(beam, embed, q0, np.zeros_like(q0), ts, dt=dt, safety=safety,
+                                throw=throw)
     else:
         def e_p(t):
             return jnp.stack([0.0 * t, 0.0 * t, jnp.cos(theta(t)), jnp.sin(theta(t))])
         sol = simulate(beam, e0, jnp.zeros_like(e0), ts, prescribed=range(4), e_p=e_p, dt=dt,
-                       safety=safety)
+                       safety=safety, throw=throw)
     return SpinUpResult(sol.ts, *_rotating_tip(sol.ts, sol.e, length, T_s, omega_s), sol)
 
 
@@ -77,7 +78,8 @@ class SliderCrankResult(NamedTuple):
 
 def slider_crank_reference(n_elements=4, ts=None, *, dt=None, safety=0.5, crank=6 * INCH,
                            rod=12 * INCH, diameter=0.25 * INCH, E=3.0e7 * 4.4482216152605 / INCH**2,
-                           mass=0.1667 * 0.45359237, Omega=125.6) -> SliderCrankResult:
+                           mass=0.1667 * 0.45359237, Omega=125.6,
+                           throw: bool = False) -> SliderCrankResult:
     """Seed 002 §3.1 flexible slider-crank (SI inside, deflection reported in inches): rigid crank
     O-P at constant Omega counter-clockwise from P(0) = (0, crank); elastic rod P-Q as an ANCF
     beam with P's position prescribed and Q's y prescribed 0 (massless slider on the x axis), both
@@ -99,7 +101,7 @@ def slider_crank_reference(n_elements=4, ts=None, *, dt=None, safety=0.5, crank=
     e0, e_dot0 = jax.jvp(rigid, (jnp.array(0.0),), (jnp.array(1.0),))
     q_y = 4 * n_elements + 1
     sol = simulate(beam, e0, e_dot0, ts, prescribed=(0, 1, q_y), dt=dt, safety=safety,
-                   e_p=lambda t: jnp.concatenate([P(t), jnp.zeros(1) * t]))
+                   e_p=lambda t: jnp.concatenate([P(t), jnp.zeros(1) * t]), throw=throw)
     p, q = sol.e[:, :2], sol.e[:, q_y - 1:q_y + 1]
     u = (q - p) / jnp.linalg.norm(q - p, axis=1, keepdims=True)
     mid = jax.vmap(beam.position, (0, None))(sol.e, rod / 2)

@@ -85,6 +85,22 @@ def test_free_oscillation_conserves_energy():
     assert drift[0] < 1e-3 and drift[1] < drift[0] / 3
 
 
+def test_a_run_past_the_stable_step_says_so_or_raises():
+    """Twice RK4's stable step (safety 2 in `stable_step`): the status says nonfinite, and
+    throw=True raises by name; at the stable step the same run succeeds."""
+    import equinox as eqx
+
+    beam = AncfBeam(1.0, 1e4, 10.0, 1.0, 3)
+    e0 = beam.initial_coordinates((0.0, 0.0), 0.3)
+    e_dot0 = jnp.zeros(beam.n_coordinates).at[1::4].set(1.0)
+    ts = np.linspace(0.0, 1.0, 3)
+    assert simulate_ancf(beam, e0, e_dot0, ts, safety=0.5).messages() == ["success"]
+    blown = simulate_ancf(beam, e0, e_dot0, ts, safety=2.0)
+    assert blown.messages() == ["nonfinite"] and not bool(blown.ok)
+    with pytest.raises(eqx.EquinoxRuntimeError, match="simulate_ancf: .*status nonfinite"):
+        simulate_ancf(beam, e0, e_dot0, ts, safety=2.0, throw=True)
+
+
 @pytest.mark.slow
 def test_spin_up_converges_with_mesh_and_step():
     ts = np.linspace(0.0, 2.0, 5)
