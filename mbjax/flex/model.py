@@ -12,6 +12,7 @@ in body order), v likewise (u^{B^k} = q_dot^{B^k}, eq 19). Per body the modal co
 padded to the largest count mu, so every body is a (6 + mu)-block of one stacked `ModalBody`.
 """
 
+import warnings
 from functools import cached_property
 
 import equinox as eqx
@@ -31,6 +32,12 @@ class FlexibleModel(eqx.Module):
     parent's ModalBody nodes} for every child of a flexible body; markers: ((body, node), ...)
     extra frames at grid points for cut joints (frame index n + i), or ((body, -1), ...) for a
     body's own frame.
+
+    A flexible body's mass, centre of mass and inertia are its ModalBody's (its rigid-body
+    terms); the rigid `model`'s values for that body are not used. A rigid part that moves with
+    the body (a hub at the clamp) goes into the ModalBody (`rotary`, as
+    `mbjax.scenes.slewing_beam` does); a rigid mass that differs from the ModalBody's by more
+    than `MASS_MISMATCH` (relative) gets a warning, so that such a part is not dropped unseen.
     """
 
     model: Model
@@ -74,6 +81,7 @@ class FlexibleModel(eqx.Module):
                 raise ValueError(f"marker on body {b}: not in the model (0 ... {n - 1})")
             if h >= 0 and (b not in flexible or h >= flexible[b].node_position.shape[0]):
                 raise ValueError(f"marker ({b}, {h}): body {b} has no attachment point {h}")
+        _warn_on_replaced_mass(model, flexible)
         stacked = [flexible[k].padded(mu, nodes) if k in flexible
                    else ModalBody.rigid(model.mass[k], model.com[k], model.inertia[k], mu)
                    .padded(mu, nodes) for k in range(n)]
@@ -158,6 +166,25 @@ class FlexibleModel(eqx.Module):
     def without_stiffening(self) -> "FlexibleModel":
         """Geometric stiffening switched off in every body."""
         return eqx.tree_at(lambda m: m.bodies, self, self.bodies.without_stiffening())
+
+
+# how far (relative) a flexible body's rigid mass may be from its ModalBody's before a warning
+MASS_MISMATCH = 0.01
+
+
+def _warn_on_replaced_mass(model: Model, flexible: dict) -> None:
+    """Warn where the rigid model gives a flexible body a mass its ModalBody does not have
+    (concrete values only: under a trace there is nothing to compare)."""
+    for k, body in flexible.items():
+        try:
+            rigid, modal = float(model.mass[k]), float(body.mass)
+        except (jax.errors.ConcretizationTypeError, TypeError):
+            continue
+        if abs(rigid - modal) > MASS_MISMATCH * abs(modal):
+            warnings.warn(f"FlexibleModel: body {k}'s mass in the rigid model, {rigid:g}, is "
+                          f"not used: its ModalBody's, {modal:g}, replaces it (with its centre "
+                          "of mass and inertia); put a rigid part that moves with the body into "
+                          "the ModalBody", stacklevel=4)
 
 
 @eqx.filter_jit

@@ -51,16 +51,17 @@ def random_tree(stiffening=True, gravity=(0.0, 0.0, -9.81)):
     and 4 attached at grid points of flexible parents."""
     rng = np.random.default_rng(0)
     parents, n = (-1, 0, 1, 1, 3), 5
+    k1, k2 = jax.random.split(jax.random.PRNGKey(1))
+    flexible = {1: random_body(k1, 6, 3, 2, stiffening), 3: random_body(k2, 5, 2, 2, stiffening)}
+    mass = np.ones(n)
+    mass[[1, 3]] = [float(flexible[1].mass), float(flexible[3].mass)]   # the ModalBodies' own
     rigid = Model(parents, ("revolute", "revolute", "prismatic", "revolute", "universal"),
-                  mass=np.ones(n), inertia=np.tile(np.eye(3) * 0.1, (n, 1, 1)),
+                  mass=mass, inertia=np.tile(np.eye(3) * 0.1, (n, 1, 1)),
                   com=rng.normal(size=(n, 3)) * 0.2, axis=rng.normal(size=(n, 3)),
                   axis2=rng.normal(size=(n, 3)), placement_translation=rng.normal(size=(n, 3)) * 0.5,
                   placement_rotation=np.stack([np.asarray(exp(jnp.asarray(rng.normal(size=3))))
                                                for _ in range(n)]), gravity=gravity)
-    k1, k2 = jax.random.split(jax.random.PRNGKey(1))
-    return FlexibleModel(rigid, {1: random_body(k1, 6, 3, 2, stiffening),
-                                 3: random_body(k2, 5, 2, 2, stiffening)},
-                         attach={2: 0, 3: 1, 4: 1})
+    return FlexibleModel(rigid, flexible, attach={2: 0, 3: 1, 4: 1})
 
 
 def test_modal_mass_matrix_is_the_sum_over_mass_points():
@@ -107,13 +108,18 @@ def test_energy_is_conserved_without_stiffening():
     assert errors[1] < 1e-7 and 10 < errors[0] / errors[1] < 25      # fourth order: ratio ~ 16
 
 
+def cantilever_body(E=7e10, n_elements=4, n_modes=2) -> ModalBody:
+    """The cantilever's beam: 1 m of aluminium, 2 cm round, clamped at its hinge."""
+    structure = Beam.round(1.0, 0.02, E, 2700.0, nu=0.33, n_elements=n_elements)
+    basis = craig_bampton(structure, n_modes=n_modes, planar="xz")
+    return beam_body(structure, basis, nodes=(n_elements,))
+
+
 def cantilever(E=7e10, n_elements=4, n_modes=2):
     """A 1 m aluminium cantilever on a revolute hinge (about y), with a rigid pendulum attached at
     its last grid point through a revolute joint (about y); its fastest mode is 1.7e3 rad/s, so
     RK4 needs dt < 1.6 ms."""
-    structure = Beam.round(1.0, 0.02, E, 2700.0, nu=0.33, n_elements=n_elements)
-    basis = craig_bampton(structure, n_modes=n_modes, planar="xz")
-    body = beam_body(structure, basis, nodes=(n_elements,))
+    body = cantilever_body(E, n_elements, n_modes)
     rigid = Model([-1, 0], ["revolute", "revolute"], mass=[0.85, 0.5],
                   com=[[0.5, 0, 0], [0.05, 0, 0]],
                   inertia=[np.diag([1e-5, 0.07, 0.07]), np.diag([1e-4, 1e-3, 1e-3])],
@@ -170,9 +176,22 @@ def test_distal_stiffening_equals_the_reaction_of_the_child():
     assert float(jnp.max(jnp.abs(K_G))) > 0                   # the tip load does stiffen the beam
 
 
+def test_a_rigid_mass_the_flexible_body_replaces_is_not_dropped_unseen():
+    """The rigid model's mass of a flexible body is not used (the ModalBody's is): where they
+    differ, a warning says so; the dynamics are the ModalBody's either way."""
+    model = cantilever()
+    heavier = eqx.tree_at(lambda m: m.mass, model.model, model.model.mass.at[0].set(5.0))
+    with pytest.warns(UserWarning, match="body 0's mass in the rigid model, 5, is not used"):
+        other = FlexibleModel(heavier, {0: cantilever_body()}, attach={1: 0})
+    q, v = model.neutral().at[0].set(0.3), jnp.ones(model.nv)
+    np.testing.assert_allclose(jax.jit(flexible_aba)(other, q, v, jnp.zeros(model.nv)),
+                               jax.jit(flexible_aba)(model, q, v, jnp.zeros(model.nv)), rtol=1e-12)
+
+
 def test_bad_input_is_a_clear_error():
-    rigid = Model([-1, 0], "revolute", mass=[1.0, 1.0], inertia=[np.eye(3), np.eye(3)])
     body = random_body(jax.random.PRNGKey(0), H=1)
+    rigid = Model([-1, 0], "revolute", mass=[float(body.mass), 1.0],
+                  inertia=[np.eye(3), np.eye(3)])
     with pytest.raises(ValueError, match="attach"):
         FlexibleModel(rigid, {0: body})
     with pytest.raises(ValueError, match="grid point 3"):
