@@ -255,7 +255,7 @@ def simulate_embedded(beam: AncfBeam, embed: Callable, q0, q_dot0, ts, *, dt: fl
     finite = jnp.all(jnp.isfinite(es)) & jnp.all(jnp.isfinite(eds))
     status = jnp.where(finite, 0, int(Status.NONFINITE)).astype(jnp.int32)
     return raise_on_failure(AncfSolution(ts=jnp.asarray(ts), e=es, e_dot=eds, status=status,
-                                         dt=dt), throw, "mbjax.flex.simulate_ancf")
+                                         dt=float(dt)), throw, "mbjax.flex.simulate_ancf")
 
 
 def simulate(beam: AncfBeam, e0, e_dot0, ts, *, prescribed=(), e_p: Callable | None = None,
