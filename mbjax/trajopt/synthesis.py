@@ -21,7 +21,7 @@ import numpy as np
 from jax import Array
 
 from mbjax.integrate import RK4, simulate
-from mbjax.integrate.solution import WithStatus
+from mbjax.integrate.solution import WithStatus, raise_on_failure
 from mbjax.trajopt.descent import adam_descent
 from mbjax.control import CubicSpline
 from mbjax.wrist import WristSystem, kinematics
@@ -66,7 +66,7 @@ def goal_pose(wrist, goal) -> kinematics.Pose:
 def synthesize(wrist, theta0: Array, goal, *, duration: float, torque_limit: float, n_knots: int = 12,
                steps: int = 50, iterations: int = 400, learning_rate: float = 0.02,
                pose_tolerance: float = 1e-3, speed_tolerance: float = 1e-2, effort_weight: float = 0.1,
-               integrator=RK4(), init: CubicSpline | None = None) -> Synthesis:
+               integrator=RK4(), init: CubicSpline | None = None, throw: bool = False) -> Synthesis:
     """Torque splines that move the wrist from rest at theta0 to rest at goal = (plunge, slope)
     in `duration` with least effort, |tau_i| <= torque_limit; see the module docstring.
 
@@ -77,7 +77,9 @@ def synthesize(wrist, theta0: Array, goal, *, duration: float, torque_limit: flo
     The gradient is forward mode (`jax.jacfwd` over the 3 n_knots spline values): for a few dozen
     parameters it compiles several times faster than reverse mode through the rollout's scan.
     The result's figures come from the same discrete rollout; re-simulate `spline` with a finer
-    or higher-order integrator to see the continuous-time miss (`mbjax reproduce carpal-wrist`)."""
+    or higher-order integrator to see the continuous-time miss (`mbjax reproduce carpal-wrist`).
+    The status is the final rollout's (a non-finite state, a singular configuration); throw=True
+    raises on a failure instead (as `mbjax.simulate`)."""
     theta0 = jnp.asarray(theta0, dtype=float)
     goal_p, goal_g = (jnp.asarray(x, dtype=float) for x in goal)
     if init is None:
@@ -104,5 +106,7 @@ def synthesize(wrist, theta0: Array, goal, *, duration: float, torque_limit: flo
     theta, theta_dot, status = rollout(wrist, spline, theta0, duration, steps, integrator)
     work, peak = effort(spline, duration)
     error = kinematics.pose_error(wrist, kinematics.forward_kinematics(wrist, theta), goal_pose(wrist, goal))
-    return Synthesis(spline=spline, losses=losses, theta_final=theta, theta_dot_final=theta_dot,
-                     final_pose_error=error, effort=work, peak_torque=peak, status=status)
+    return raise_on_failure(
+        Synthesis(spline=spline, losses=losses, theta_final=theta, theta_dot_final=theta_dot,
+                  final_pose_error=error, effort=work, peak_torque=peak, status=status),
+        throw, "mbjax.trajopt.synthesize")

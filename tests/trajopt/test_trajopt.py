@@ -69,7 +69,7 @@ def test_synthesis_repairs_the_clipped_baseline_inside_the_torque_limit():
 
     before = miss(init)
     result = synthesize(w, theta0, cw.GOAL, duration=cw.DURATION, torque_limit=cw.TORQUE_LIMIT,
-                        iterations=40, init=init)
+                        iterations=40, init=init, throw=True)    # a success: nothing raised
     assert result.messages() == ["success"]
     after = miss(result.spline)
     assert before > 0.1 and after < 0.1 * before, (before, after)
