@@ -73,3 +73,38 @@ def test_wrist_parameters_are_validated(change, message):
                    tool_inertia=np.eye(3) * 1e-3), **change}
     with pytest.raises(ValueError, match=message):
         CarpalWrist(args.pop("base_radius"), args.pop("link_length"), **args)
+
+
+_CHART = jax.jit(lambda a, b, p: (kin.in_chart(a, b, p),
+                                  *kin.solve_inverse_kinematics(WRIST, p,
+                                                                kin.slope_from_angles(a, b))))
+_MIDPLANE = jax.jit(lambda theta: kin.midplane(WRIST, theta))
+
+
+def _wide_floats(low, high):
+    from hypothesis import strategies as st
+
+    return st.one_of(st.floats(low, high), st.sampled_from([np.nan, np.inf, -np.inf, high * 3]))
+
+
+def test_inverse_kinematics_never_answers_another_pose():
+    """Hypothesis over chart coordinates, in, at the edge of and far outside the chart and the
+    workspace (NaN and infinities included): inverse kinematics either raises or returns joint
+    angles whose forward kinematics is the pose asked for; never a silent other pose."""
+    from hypothesis import HealthCheck, given, settings
+
+    @settings(max_examples=60, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+    @given(_wide_floats(-4.0, 4.0), _wide_floats(-4.0, 4.0), _wide_floats(-0.3, 0.3))
+    def check(alpha, beta, plunge):
+        inside, theta, reachable = _CHART(alpha, beta, plunge)
+        if bool(inside) and bool(reachable):
+            p, g = _MIDPLANE(theta)
+            assert abs(float(p) - plunge) < 1e-9
+            np.testing.assert_allclose(g, kin.slope_from_angles(alpha, beta), atol=1e-9)
+            np.testing.assert_allclose(WRIST.inverse_kinematics(alpha, beta, plunge), theta,
+                                       rtol=0, atol=1e-12)
+        else:
+            with pytest.raises(eqx.EquinoxRuntimeError, match="outside the .* chart|out of reach"):
+                jax.block_until_ready(WRIST.inverse_kinematics(alpha, beta, plunge))
+
+    check()
