@@ -196,6 +196,8 @@ class MomentumSystem(AbstractSystem):
         return energy(self.model, q, self.velocity(q, u))
 
     def invariants(self, t, q, u):
-        """As `TreeSystem`'s, at the velocities of the momenta."""
-        return TreeSystem(self.model, self.control, external=self.external).invariants(
-            t, q, self.velocity(q, u))
+        """As `TreeSystem`'s, at the velocities of the momenta (none under a control or an
+        external load)."""
+        if self.control is not None or self.external is not None:
+            return None
+        return TreeSystem(self.model).invariants(t, q, self.velocity(q, u))
