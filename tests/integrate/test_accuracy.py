@@ -148,6 +148,13 @@ def test_momentum_of_a_floating_tree_with_and_without_gravity():
             assert float(sol.drift) >= drifts[-1] * (1 - 1e-9)   # the energy's drift joins it
         assert 8 < drifts[0] / drifts[1] < 40, drifts
         assert drifts[1] < 1e-6
+    # the momentum form (u = M v) has the same invariants, at its velocities
+    from mbjax.rigid import MomentumSystem
+
+    momentum = MomentumSystem(model)
+    sol = simulate(momentum, RK4(), q0, TreeSystem(model).mass_matrix(q0) @ v0, dt=0.01, t1=1.0,
+                   rtol=1e-6, atol=1e-6)
+    assert 0 < float(sol.drift) < 1e-6, float(sol.drift)
     # the gravity terms are right: without `- M g t`, P changes by the weight's impulse
     sol = simulate(TreeSystem(model), RK4(), q0, v0, dt=0.01, t1=1.0)
     P = jax.vmap(lambda q, v: free_momenta(model, 0.0, q, v).values[3:])(sol.qs, sol.us)
