@@ -40,6 +40,15 @@ def energy_invariant(energy: Array, kinetic: Array, dissipative) -> Invariants:
                       decreasing=jnp.atleast_1d(jnp.asarray(dissipative, bool)))
 
 
+def along_gravity(H: Array, gravity: Array) -> Array:
+    """The conserved part of an angular momentum H about a fixed point under uniform gravity
+    (and no other load): its component along gravity, since the weight's moment c x M g is
+    normal to g; all of H without gravity."""
+    has_gravity = jnp.any(gravity != 0)
+    axis = gravity / jnp.where(has_gravity, jnp.linalg.norm(gravity), 1.0)
+    return jnp.where(has_gravity, axis * (axis @ H), H)
+
+
 def join(*parts: Invariants) -> Invariants:
     """Several systems' or several kinds' invariants as one."""
     return Invariants(*(jnp.concatenate([getattr(p, name) for p in parts])

@@ -21,7 +21,7 @@ from mbjax import lie
 from mbjax.control import AbstractControl, as_control
 from mbjax.control.applied import (about_origins, body_wrenches, check_actuation, check_control,
                                    check_points, generalized_control, hold)
-from mbjax.integrate.invariants import Invariants, energy_invariant, join
+from mbjax.integrate.invariants import Invariants, along_gravity, energy_invariant, join
 from mbjax.integrate.system import AbstractSystem
 from mbjax.spatial import check_inertia
 
@@ -184,10 +184,7 @@ class RigidBody(AbstractSystem):
         orbital = (jnp.zeros(3, u.dtype) if self.fixed_point
                    else self.mass * jnp.cross(q[self.n_rot:], u[3:]))
         g = self.gravity
-        has_gravity = jnp.any(g != 0)
-        axis = g / jnp.where(has_gravity, jnp.linalg.norm(g), 1.0)
-        H = spin + orbital
-        H = jnp.where(has_gravity, axis * (axis @ H), H)
+        H = along_gravity(spin + orbital, g)
         parts = [energy_invariant(self.energy(q, u), self.kinetic_energy(q, u), False),
                  Invariants(H, jnp.full(3, jnp.linalg.norm(spin) + jnp.linalg.norm(orbital)),
                             jnp.ones(3, bool), jnp.zeros(3, bool))]

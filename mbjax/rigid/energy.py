@@ -10,7 +10,7 @@ import jax.numpy as jnp
 import numpy as np
 from jax import Array
 
-from mbjax.integrate.invariants import Invariants
+from mbjax.integrate.invariants import Invariants, along_gravity
 
 from mbjax.model import Model
 from mbjax.rigid.kinematics import body_kinematics, forward_kinematics
@@ -60,9 +60,7 @@ def free_momenta(model: Model, t: Array, q: Array, v: Array) -> Invariants:
     G = jnp.einsum("kij,kj->ki", kin.I, kin.V)                 # each body's (H about 0; P)
     H, P = jnp.sum(G[:, :3], 0), jnp.sum(G[:, 3:], 0)
     g = model.gravity
-    has_gravity = jnp.any(g != 0)
-    axis = g / jnp.where(has_gravity, jnp.linalg.norm(g), 1.0)
-    H = jnp.where(has_gravity, axis * (axis @ H), H)
+    H = along_gravity(H, g)
     P = P - jnp.sum(model.mass) * g * t
     scale = jnp.concatenate([jnp.full(3, jnp.sum(jnp.linalg.norm(G[:, :3], axis=-1))),
                              jnp.full(3, jnp.sum(jnp.linalg.norm(G[:, 3:], axis=-1)))])

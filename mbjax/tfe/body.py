@@ -18,7 +18,7 @@ import numpy as np
 from jax import Array
 
 from mbjax import lie
-from mbjax.integrate.invariants import Invariants, energy_invariant, join
+from mbjax.integrate.invariants import Invariants, along_gravity, energy_invariant, join
 from mbjax.rigid import RigidBody
 from mbjax.spatial import check_inertia
 
@@ -105,9 +105,7 @@ class Body(eqx.Module):
         h = p_hat[:3]
         orbital = jnp.zeros(3, h.dtype) if self.fixed_point else jnp.cross(x, p_hat[3:])
         g = self.gravity
-        has_gravity = jnp.any(g != 0)
-        axis = g / jnp.where(has_gravity, jnp.linalg.norm(g), 1.0)
-        H = jnp.where(has_gravity, axis * (axis @ (h + orbital)), h + orbital)
+        H = along_gravity(h + orbital, g)
         parts = [energy_invariant(self.energy(R, x, p_hat), self.kinetic_energy(R, p_hat), False),
                  Invariants(H, jnp.full(3, jnp.linalg.norm(h) + jnp.linalg.norm(orbital)),
                             jnp.ones(3, bool), jnp.zeros(3, bool))]
