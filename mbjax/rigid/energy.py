@@ -11,7 +11,6 @@ import numpy as np
 from jax import Array
 
 from mbjax.integrate.invariants import Invariants, along_gravity
-
 from mbjax.model import Model
 from mbjax.rigid.kinematics import body_kinematics, forward_kinematics
 
