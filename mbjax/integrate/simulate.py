@@ -10,7 +10,7 @@ from jax import Array
 
 from mbjax.integrate.base import AbstractIntegrator
 from mbjax.integrate.invariants import relative_drift
-from mbjax.integrate.solution import (Solution, Status, raise_on_failure,
+from mbjax.integrate.solution import (ERROR_SAMPLES, Solution, Status, raise_on_failure,
                                      sample_indices, tolerances)
 from mbjax.integrate.system import AbstractSystem
 from mbjax.integrate.tree_system import state_sizes
@@ -104,7 +104,8 @@ def simulate(system: AbstractSystem, integrator: AbstractIntegrator, q0: Array, 
     tolerance: the root mean square over the state's components of error / (atol + rtol |y|)
     above 1, the norm of Hairer, Norsett and Wanner (Solving ODEs I, II.4) that diffrax and
     SciPy use. The estimate is step doubling (Richardson) at up to
-    `ERROR_SAMPLES` states along the run (the start and the saved states): from each, one step
+    `ERROR_SAMPLES` states along the run (the start, the saved states, and where those are
+    sparse, states the rollout keeps for it at evenly spaced steps): from each, one step
     of dt against two of dt / 2 gives the local error of a step, 2^p / (2^p - 1) times their
     difference for a method of order p, and the global error is estimated as the sum of the
     local errors over the run's steps (their mean over the samples times the number of steps;
@@ -139,25 +140,34 @@ def simulate(system: AbstractSystem, integrator: AbstractIntegrator, q0: Array, 
                         f"{integrator.__name__ if isinstance(integrator, type) else type(integrator).__name__}")
     dt, t0, t1 = (_number(x, name) for x, name in ((dt, "dt"), (t0, "t0"), (t1, "t1")))
     n_steps, idx = _save_indices(t0, t1, dt, saveat)
-    block = math.gcd(*idx.tolist(), n_steps)
+    checked = rtol is not None or atol is not None
+    if checked:
+        rtol, atol = tolerances(rtol, atol)
+    # with a tolerance the rollout also keeps the states the error estimate samples
+    kept = np.union1d(idx, _sample_steps(n_steps, idx)) if checked else idx
+    block = math.gcd(*kept.tolist(), n_steps)
     nq, nv = state_sizes(system)
     q0, u0 = _state(q0, "q0", nq), _state(u0, "u0", nv)
     qs, us, status = _rollout(system, integrator, q0, u0, float(t0), float(dt), block,
-                              n_steps // block, tuple((idx // block).tolist()),
+                              n_steps // block, tuple((kept // block).tolist()),
                               _segment(block) if checkpoint else block)
     ts = jnp.asarray(t0 + idx * dt, dtype=q0.dtype)
-    if rtol is None and atol is None:
+    if not checked:
         return raise_on_failure(Solution(ts=ts, qs=qs, us=us, status=status), throw,
                                 "mbjax.simulate")
-    rtol, atol = tolerances(rtol, atol)
-    # the samples: the start and the saved states before t1, at most ERROR_SAMPLES, spread out
-    before = np.flatnonzero(idx < n_steps)
+    all_qs, all_us, all_ts = qs, us, jnp.asarray(t0 + kept * dt, dtype=q0.dtype)
+    if len(kept) != len(idx):
+        at = np.searchsorted(kept, idx)
+        qs, us = all_qs[at], all_us[at]
+    # the samples: the start and the kept states before t1, at most ERROR_SAMPLES, spread out
+    before = np.flatnonzero((kept > 0) & (kept < n_steps))
     picks = before[sample_indices(len(before))]
-    starts = (jnp.concatenate([q0[None], qs[picks]]), jnp.concatenate([u0[None], us[picks]]),
-              jnp.concatenate([jnp.asarray([t0], q0.dtype), ts[picks]]))
+    starts = (jnp.concatenate([q0[None], all_qs[picks]]),
+              jnp.concatenate([u0[None], all_us[picks]]),
+              jnp.concatenate([jnp.asarray([t0], q0.dtype), all_ts[picks]]))
     error, ratio = _error_estimate(system, integrator, *starts, float(dt), n_steps, rtol, atol)
-    drift = _drift(system, jnp.concatenate([jnp.asarray([t0], q0.dtype), ts]),
-                   jnp.concatenate([q0[None], qs]), jnp.concatenate([u0[None], us]))
+    drift = _drift(system, jnp.concatenate([jnp.asarray([t0], q0.dtype), all_ts]),
+                   jnp.concatenate([q0[None], all_qs]), jnp.concatenate([u0[None], all_us]))
     inaccurate = (ratio > 1.0) | (drift > rtol) & (rtol > 0)
     status = status | jnp.where(inaccurate, int(Status.INACCURATE), 0).astype(status.dtype)
     return raise_on_failure(Solution(ts=ts, qs=qs, us=us, status=status, error=error,
@@ -208,6 +218,22 @@ def doubled(step, state, t, h, span):
 
     _, ends = jax.lax.scan(one, state, jnp.arange(3))
     return tuple(jax.tree.map(lambda x, i=i: x[i], ends) for i in range(3))
+
+
+def _sample_steps(n_steps: int, idx: np.ndarray) -> np.ndarray:
+    """Steps inside the run where the error estimate samples the state when the saved ones are
+    too sparse for it (fewer than about ERROR_SAMPLES along the run): multiples of the largest
+    divisor d of the saves' common step count with d <= n_steps / ERROR_SAMPLES, so that the
+    rollout's blocks stay whole; none where the saves are dense enough, or where no such
+    divisor is within a factor 8 of that spacing (the saved states then serve alone)."""
+    spacing = max(n_steps // ERROR_SAMPLES, 1)
+    common = math.gcd(*idx.tolist(), n_steps)
+    if common <= spacing:
+        return np.zeros(0, int)
+    d = max(k for k in range(1, spacing + 1) if common % k == 0)
+    if 8 * d < spacing:
+        return np.zeros(0, int)
+    return np.arange(d, n_steps, d)
 
 
 def _segment(block: int) -> int:

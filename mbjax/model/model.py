@@ -250,15 +250,29 @@ class Model(eqx.Module):
                                  "(or a revolute joint)")
 
     def _check_joint_data(self) -> None:
+        """Limits in order; limits non-negative (infinite: none); damping, armature and
+        friction non-negative and finite. Errors name the joint of the offending coordinate."""
+        layout = _layout(self.joint_types)
+
+        def joint(index: int, starts) -> str:
+            return repr(self.joint_names[int(np.searchsorted(starts, index, side="right")) - 1])
+
         lower, upper = np.asarray(self.lower), np.asarray(self.upper)
         bad = np.flatnonzero(~(lower <= upper))
         if bad.size:
-            raise ValueError(f"lower must not exceed upper; coordinate {bad[0]}: lower "
-                             f"{lower[bad[0]]}, upper {upper[bad[0]]}")
+            raise ValueError(f"lower must not exceed upper; joint {joint(bad[0], layout['q_start'])}"
+                             f" (coordinate {bad[0]}): lower {lower[bad[0]]}, upper "
+                             f"{upper[bad[0]]}")
         for what in ("velocity_limit", "effort_limit", "damping", "armature", "friction"):
             value = np.asarray(getattr(self, what))
-            if np.isnan(value).any() or (value < 0).any():
-                raise ValueError(f"{what} must be non-negative, got {value}")
+            infinite_allowed = what.endswith("limit")           # an infinite limit: none
+            bad = np.flatnonzero(np.isnan(value) | (value < 0)
+                                 | (np.isinf(value) & (not infinite_allowed)))
+            if bad.size:
+                raise ValueError(f"{what} must be non-negative"
+                                 f"{'' if infinite_allowed else ' and finite'}; joint "
+                                 f"{joint(bad[0], layout['v_start'])} (coordinate {bad[0]}) has "
+                                 f"{value[bad[0]]}")
 
     # -- sizes and layout -----------------------------------------------------------------------
 

@@ -390,3 +390,60 @@ def test_to_urdf_rejects_joints_without_urdf_counterpart():
     model = Model([-1, 0], ("revolute", "spherical"), mass=[1.0, 1.0], inertia=I3)
     with pytest.raises(ValueError, match="a 'spherical' joint has no URDF counterpart"):
         to_urdf(model)
+
+
+def test_malformed_urdf_numbers_are_refused_by_name_or_read_exactly():
+    """Hypothesis puts arbitrary text, NaN, infinities and huge or negative numbers where a URDF
+    has numbers (mass, an inertia, a joint origin, an axis, damping): the model either loads with
+    exactly the numbers written, or the error names the link or joint and the field."""
+    import math
+    import warnings
+
+    from hypothesis import given, settings
+    from hypothesis import strategies as st
+
+    numbers = st.one_of(st.floats(allow_nan=True, allow_infinity=True).map(repr),
+                        st.sampled_from(["", "x", "1e400", "-0", "1,5", "0x10", " 2 "]))
+    fields = st.sampled_from(["mass", "ixx", "origin", "axis", "damping"])
+
+    @settings(max_examples=80, deadline=None)
+    @given(fields, numbers)
+    def check(field, text):
+        mass, ixx, xyz, axis, damping = "1.0", "0.01", "0 0 0", "0 0 1", "0.1"
+        if field == "mass":
+            mass = text
+        elif field == "ixx":
+            ixx = text
+        elif field == "origin":
+            xyz = f"0 {text} 0"
+        elif field == "axis":
+            axis = f"0 {text} 1"
+        else:
+            damping = text
+        joint = _joint("j", "revolute", "base", "a", axis=axis, xyz=xyz).replace(
+            "</joint>", f'<dynamics damping="{damping}"/></joint>')
+        xml = _robot(_link("base"), _link("a", _inertial(
+            mass=mass, inertia=f'ixx="{ixx}" iyy="0.01" izz="0.01"')), joint)
+        try:
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore")
+                model = mbjax.load_urdf(xml)
+        except ValueError as error:
+            assert ("'a'" in str(error) or "'j'" in str(error)), str(error)
+            return
+        # loaded: every number is the one written, and finite
+        value = float(text) if text.strip() not in ("", "x", "1,5", "0x10") else None
+        assert value is not None and math.isfinite(value), (field, text)
+        if field == "mass":
+            assert float(model.mass[0]) == value
+        elif field == "origin":
+            assert float(model.placement_translation[0, 1]) == value
+        elif field == "damping":
+            assert float(model.damping[0]) == value
+        elif field == "axis":
+            expected = np.array([0.0, value, 1.0]) / math.hypot(value, 1.0)
+            np.testing.assert_allclose(model.axis[0], expected, rtol=1e-12)
+        else:
+            assert np.all(np.isfinite(np.asarray(model.inertia[0])))
+
+    check()

@@ -37,6 +37,10 @@ def _model(parents=(-1, 0), joint_types="revolute", **kw):
      "frame_translation of 'tool' must be finite"),
     (dict(frame_names=("tool",), frame_parents=(1,), frame_rotation=[3 * np.eye(3)]),
      "frame_rotation of 'tool' is not orthonormal"),
+    (dict(damping=[0.0, np.inf]), r"damping must be non-negative and finite; joint 'joint1'"),
+    (dict(friction=[-1.0, 0.0]), r"friction must be non-negative and finite; joint 'joint0'"),
+    (dict(effort_limit=[1.0, np.nan]), r"effort_limit must be non-negative; joint 'joint1'"),
+    (dict(lower=[0.0, 1.0], upper=[1.0, 0.5]), r"lower must not exceed upper; joint 'joint1'"),
 ])
 def test_bad_model_data_is_refused_by_name(kwargs, message):
     with pytest.raises((ValueError, TypeError), match=message):
