@@ -153,6 +153,8 @@ class Model(eqx.Module):
                 raise ValueError(f"{what} must have shape {shape}, got {np.shape(value)}")
             if unit_rows:           # a zero row is reported below, by name
                 with np.errstate(invalid="ignore", divide="ignore"):
+                    # scaled by the largest component first: |a|^2 overflows from 1.3e154
+                    arr = arr / xp.max(xp.abs(arr), axis=-1, keepdims=True)
                     arr = arr / xp.linalg.norm(arr, axis=-1, keepdims=True)
             return jnp.asarray(arr, dtype=float)
 
@@ -190,7 +192,7 @@ class Model(eqx.Module):
         for what, raw, uses in (("axis", axis, ("revolute", "prismatic", "universal")),
                                 ("axis2", axis2, ("universal",))):
             if raw is not None and not isinstance(raw, jax.core.Tracer):
-                norms = np.linalg.norm(np.broadcast_to(np.asarray(raw, float), (n, 3)), axis=-1)
+                norms = np.max(np.abs(np.broadcast_to(np.asarray(raw, float), (n, 3))), axis=-1)
                 for k, kind in enumerate(joint_types):
                     if kind in uses and not norms[k] > 0:
                         raise ValueError(f"body {self.names[k]!r}: the {kind} joint's {what} is "

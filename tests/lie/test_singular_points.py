@@ -96,3 +96,47 @@ def test_complex_values_are_refused_and_integers_promoted():
 
 def re_shape(x) -> str:
     return str(np.shape(x)).replace("(", r"\(").replace(")", r"\)")
+
+
+def test_malformed_arguments_are_refused_by_name_or_answered_exactly():
+    """Hypothesis over shapes (scalars to 3-D), dtypes (bool, int, float32, complex) and values
+    (NaN and infinities included) for every entry point: a wrongly shaped or complex argument
+    is an error naming the function and the shape or dtype; a well-shaped real one gives the
+    answer of the same values in float64 (booleans and integers promoted; float32 kept).""" 
+    from hypothesis import given, settings
+    from hypothesis import strategies as st
+    from hypothesis.extra import numpy as hnp
+
+    functions = {"exp": (lie.exp, (3,)), "hat": (lie.hat, (3,)), "gamma": (lie.gamma, (3,)),
+                 "gamma_inv": (lie.gamma_inv, (3,)), "quat_from_rotvec": (lie.quat_from_rotvec, (3,)),
+                 "quat_to_matrix": (lie.quat_to_matrix, (4,)),
+                 "rotvec_from_quat": (lie.rotvec_from_quat, (4,)),
+                 "log": (lambda R: lie.log(R, check=False), (3, 3))}
+    dtypes = st.sampled_from([np.bool_, np.int32, np.float32, np.float64, np.complex128])
+
+    @settings(max_examples=120, deadline=None)
+    @given(st.sampled_from(sorted(functions)), dtypes,
+           hnp.array_shapes(min_dims=0, max_dims=3, min_side=1, max_side=4), st.data())
+    def check(name, dtype, shape, data):
+        function, wanted = functions[name]
+        if data.draw(st.booleans()):
+            shape = wanted
+        x = data.draw(hnp.arrays(dtype, shape, elements=hnp.from_dtype(
+            np.dtype(dtype), allow_nan=True, allow_infinity=True)
+            if np.dtype(dtype).kind in "fc" else None))
+        if np.iscomplexobj(x):
+            with pytest.raises(TypeError, match=f"mbjax.lie.{name}: .* must be real"):
+                function(x)
+        elif x.shape != wanted:
+            pattern = str(wanted).replace("(", r"\(").replace(")", r"\)")
+            with pytest.raises(ValueError, match=rf"mbjax.lie.{name}: .* of shape {pattern}"):
+                function(x)
+        elif x.dtype == np.float32:                 # the caller's precision is kept
+            assert function(x).dtype == jnp.float32
+        else:
+            out = function(x)
+            assert out.dtype == jnp.float64
+            expected = function(jnp.asarray(np.asarray(x, np.float64)))
+            np.testing.assert_array_equal(out, expected)
+
+    check()

@@ -399,7 +399,7 @@ def test_malformed_urdf_numbers_are_refused_by_name_or_read_exactly():
     import math
     import warnings
 
-    from hypothesis import given, settings
+    from hypothesis import example, given, settings
     from hypothesis import strategies as st
 
     numbers = st.one_of(st.floats(allow_nan=True, allow_infinity=True).map(repr),
@@ -408,6 +408,8 @@ def test_malformed_urdf_numbers_are_refused_by_name_or_read_exactly():
 
     @settings(max_examples=80, deadline=None)
     @given(fields, numbers)
+    @example("axis", "1.3407807929942597e+154")   # |axis|^2 overflowed: normalized to zero
+    @example("axis", "1e-320")                    # |axis|^2 underflowed: refused as zero
     def check(field, text):
         mass, ixx, xyz, axis, damping = "1.0", "0.01", "0 0 0", "0 0 1", "0.1"
         if field == "mass":
