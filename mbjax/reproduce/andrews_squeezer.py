@@ -19,7 +19,8 @@ quick: dt = QUICK_DT (10 us) and QUICK_STEPS, no second routes.
 
 JSON: {"t", "q" (beta, Theta, gamma, Phi, delta, Omega, epsilon at t), "reference", "max_abs_error",
 "seconds" (run time after compilation), "compile_seconds", "dt", "steps", "error_estimate"
-(`simulate`'s step-doubling estimate of the end state's error), "status" (held to 1e-8),
+(`simulate`'s step-doubling estimate of the end state's largest error, angles and rates),
+"status" (the state held to 1e-7, relative or absolute),
 "constraint_residual", "convergence": [{"dt", "steps", "max_abs_error", "diff_from_finest"}],
 "observed_order", "history": {"t", "q"}, and (full run) "routes": {"projection", "stabilized"}
 (largest difference from the plain run's end state)}.
@@ -98,8 +99,9 @@ def reproduce(out: Path, quick: bool = False) -> dict:
     steps = QUICK_DT_STEPS if quick else DT_STEPS
     sol, timing = run(system, steps, repeats=1 if quick else 3)
     # the accuracy status, from one more run (its estimate is not in the timing): the state to
-    # 1e-8 (the reference's floor is 1.4e-9)
-    checked = run(system, steps, history=False, rtol=1e-8, atol=1e-8)[0]
+    # 1e-7, relative or absolute (against 24000 steps the quick run's rates, up to 1400 rad/s,
+    # are off by 1e-6 and its angles by 2e-9: 0.29 of that tolerance, estimated 0.54)
+    checked = run(system, steps, history=False, rtol=1e-7, atol=1e-7)[0]
     q = np.asarray(scene.to_testset(sol.qs[-1]))
     rows = convergence(system, QUICK_STEPS if quick else STEPS, {steps: q})
     data = {"t": scene.T1, "q": q.tolist(), "reference": list(scene.REFERENCE),

@@ -238,7 +238,8 @@ def test_cli_reproduction_writes_the_contract(tmp_path, quick_run):
     assert data["t"] == 0.03 and len(data["q"]) == len(data["reference"]) == 7
     assert data["reference"] == list(S.REFERENCE)
     assert data["max_abs_error"] < TOLERANCE and data["seconds"] > 0
-    # RK4's truncation error at the quick run's 10 us is 2.2e-9; held to 1e-8
-    assert data["status"] == "success" and 2.2e-10 < data["error_estimate"] < 2.2e-8
+    # RK4's truncation error at the quick run's 10 us, against 24000 steps: 2.1e-9 rad in the
+    # angles, 1.0e-6 rad/s in the rates, which the estimate (the largest of both) follows
+    assert data["status"] == "success" and 1e-7 < data["error_estimate"] < 1e-5
     assert [r["steps"] for r in data["convergence"]] == list(reproduction.QUICK_STEPS)
     assert (tmp_path / "andrews-squeezer.png").stat().st_size > 10_000
