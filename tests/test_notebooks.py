@@ -8,6 +8,7 @@ from pathlib import Path
 
 import nbformat
 import pytest
+from jupyter_client import KernelManager
 from nbclient import NotebookClient
 
 NOTEBOOKS = sorted((Path(__file__).parent.parent / "notebooks").glob("*.ipynb"))
@@ -22,7 +23,10 @@ def _run(path, tmp_path, monkeypatch, smoke: bool):
     nb = nbformat.read(path, as_version=4)
     if smoke:
         nb.cells = [c for c in nb.cells if "slow" not in c.metadata.get("tags", [])]
-    NotebookClient(nb, timeout=600, kernel_name="python3",
+    # the kernel talks over Unix sockets in tmp_path, not TCP ports: two xdist workers starting
+    # kernels at once raced for one port ("Address already in use"; the kernel died)
+    km = KernelManager(kernel_name="python3", transport="ipc", ip=str(tmp_path / "kernel"))
+    NotebookClient(nb, km=km, timeout=600, kernel_name="python3",
                    resources={"metadata": {"path": str(tmp_path)}}).execute()
     errors = [o for cell in nb.cells if cell.cell_type == "code"
               for o in cell.get("outputs", []) if o.get("output_type") == "error"]
