@@ -22,7 +22,11 @@ def test_four_bar_matches_its_minimal_coordinate_optimum():
     least-squares residuals, solved by MINPACK's Levenberg-Marquardt (SciPy). The two optima
     agree to the discretizations' difference."""
     problem = fb.crank_problem()
-    result = solve(problem, ILQR())
+    # the solver of `mbjax reproduce trajopt`: one program, compiled once for both (the
+    # suite's persistent cache), whichever runs first
+    from mbjax.reproduce.trajopt import QUICK_SOLVERS
+
+    result = solve(problem, QUICK_SOLVERS["ilqr"])
     assert result.messages() == ["success"]
     # the trajectory stays on the loop and arrives
     np.testing.assert_allclose(result.qs, jax.vmap(fb.joint_angles)(result.qs[:, 0]), atol=1e-10)
