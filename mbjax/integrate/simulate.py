@@ -10,26 +10,10 @@ from jax import Array
 
 from mbjax.integrate.base import AbstractIntegrator
 from mbjax.integrate.invariants import relative_drift
-from mbjax.integrate.solution import (ERROR_SAMPLES, Solution, Status, raise_on_failure,
-                                     sample_indices, tolerances)
+from mbjax.integrate.solution import (ERROR_SAMPLES, Solution, Status, number,
+                                     raise_on_failure, sample_indices, tolerances)
 from mbjax.integrate.system import AbstractSystem
 from mbjax.integrate.tree_system import state_sizes
-
-
-def _number(value, name: str) -> float:
-    """A concrete, finite real number (dt, t0, t1), or an error naming it."""
-    if isinstance(value, jax.core.Tracer):
-        raise TypeError(f"{name} fixes the number of steps and must be a concrete number, not a "
-                        "traced value (differentiate or vmap the state and the parameters)")
-    try:
-        if isinstance(value, str | bytes):
-            raise TypeError
-        number = float(value)
-    except (TypeError, ValueError) as error:
-        raise TypeError(f"{name} must be a real number, got {value!r:.60}") from error
-    if not math.isfinite(number):
-        raise ValueError(f"{name} must be finite, got {number}")
-    return number
 
 
 def _state(x, name: str, size: int | None) -> Array:
@@ -138,7 +122,7 @@ def simulate(system: AbstractSystem, integrator: AbstractIntegrator, q0: Array, 
         hint = " (an instance: RK4(), not RK4)" if isinstance(integrator, type) else ""
         raise TypeError(f"integrator must be an mbjax integrator such as RK4(){hint}, got "
                         f"{integrator.__name__ if isinstance(integrator, type) else type(integrator).__name__}")
-    dt, t0, t1 = (_number(x, name) for x, name in ((dt, "dt"), (t0, "t0"), (t1, "t1")))
+    dt, t0, t1 = (number(x, name) for x, name in ((dt, "dt"), (t0, "t0"), (t1, "t1")))
     n_steps, idx = _save_indices(t0, t1, dt, saveat)
     checked = rtol is not None or atol is not None
     if checked:

@@ -1,8 +1,10 @@
 """The result of a simulation and its status."""
 
 import enum
+import math
 
 import equinox as eqx
+import jax
 import jax.numpy as jnp
 import numpy as np
 from jax import Array
@@ -44,19 +46,29 @@ def sample_indices(n: int) -> np.ndarray:
     return np.unique(np.linspace(0, n - 1, min(ERROR_SAMPLES, n)).round().astype(int))
 
 
+def number(value, name: str) -> float:
+    """A concrete, finite real number (dt, t0, t1, rtol, atol: they fix the shape of the
+    computation or its checks), or an error naming it."""
+    if isinstance(value, jax.core.Tracer):
+        raise TypeError(f"{name} must be a concrete number, not a traced value (differentiate or "
+                        "vmap the state and the parameters)")
+    try:
+        if isinstance(value, str | bytes):
+            raise TypeError
+        x = float(value)
+    except (TypeError, ValueError) as error:
+        raise TypeError(f"{name} must be a real number, got {value!r:.60}") from error
+    if not math.isfinite(x):
+        raise ValueError(f"{name} must be finite, got {x}")
+    return x
+
+
 def tolerances(rtol, atol) -> tuple[float, float]:
     """(rtol, atol) as floats, None as 0; an error unless both are finite, non-negative and not
     both zero."""
-    values = []
-    for x, name in ((rtol, "rtol"), (atol, "atol")):
-        try:
-            if isinstance(x, str | bytes):
-                raise TypeError
-            values.append(0.0 if x is None else float(x))
-        except (TypeError, ValueError) as error:
-            raise TypeError(f"{name} must be a real number, got {x!r:.60}") from error
-    rtol, atol = values
-    if not (rtol >= 0 and atol >= 0 and rtol + atol > 0) or not np.isfinite(rtol + atol):
+    rtol, atol = (0.0 if x is None else number(x, name) for x, name in ((rtol, "rtol"),
+                                                                        (atol, "atol")))
+    if not (rtol >= 0 and atol >= 0 and rtol + atol > 0):
         raise ValueError(f"rtol and atol must be finite, non-negative and not both zero, got "
                          f"{rtol}, {atol}")
     return rtol, atol
