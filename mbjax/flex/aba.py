@@ -6,7 +6,8 @@ spatial acceleration A and its modal accelerations u_dot.
 (ii) inward, per body k (eqs 48-81): the body's own generalized mass and remainder force (the
      `ModalBody` in its frame, moved to ground components: I = X^-T M X^-1), its elastic force
      K q + D u and the geometric stiffening K_G q = G_s A + g_s (eqs 32-33, 46-47), plus what its
-     children sent. The modal accelerations are eliminated first (eq 53's inverse of the modal
+     children sent (their reactions stiffen the body through the attachment's second-order
+     displacement, `mbjax.flex.kinematics.grid_point`, i.e. inside G). The modal accelerations are eliminated first (eq 53's inverse of the modal
      mass M^{B^k}, now including the children's articulated inertia):
 
          u_dot = -Y_A A - Y_p,   [Y_A, Y_p] = IA_ff^-1 [IA_fA, pA_f - Q_f]
@@ -15,11 +16,11 @@ spatial acceleration A and its modal accelerations u_dot.
      then the joint's, exactly as for a rigid body (U = I6 S, D = S^T I6 S, ...). The child hands
      its articulated inertia Ia and force pa to its parent through the attachment (eq 47):
 
-         parent += L Ia [1, G],   L pa,   L = [1; G^T - Kd T_h]
+         parent += L Ia [1, G],   L pa,   L = [1; G^T]
 
-     where G are the attachment's partial velocities and Kd T_h the distal-load stiffening of the
-     parent (eq 33's F^J terms: the child's reaction at grid point h, parent-frame components).
-     Stiffening makes the blocks unsymmetric, so the eliminations use general solves.
+     where G are the attachment's partial velocities; G^T on the child's reaction F gives
+     phi_h^T F - K_G(F) q, eq 33's distal-load (F^J) terms. The inertial stiffening makes the
+     blocks unsymmetric, so the eliminations use general solves.
 (iii) outward (eqs 82-86): A' = A_parent + G u_dot_parent + c, q_ddot = D^-1 (u - S^T I6 A'),
      A = A' + S q_ddot, u_dot = -Y_A A - Y_p.
 
@@ -29,14 +30,13 @@ columns (seed 002's unit constraint loads, eqs 101-107), which the stabilized lo
 
 import jax
 import jax.numpy as jnp
-import numpy as np
 from jax import Array
 
 from mbjax.flex.body import inertial_stiffening, mass_matrix, velocity_terms
 from mbjax.flex.kinematics import flex_kinematics, inverse_motion
 from mbjax.flex.model import FlexibleModel
 from mbjax.rigid.kinematics import gravity_acceleration
-from mbjax.spatial import shift_force, skew
+from mbjax.spatial import shift_force
 from mbjax.tree import backward_pass, forward_pass
 
 
@@ -68,20 +68,6 @@ def body_blocks(model: FlexibleModel, kin) -> tuple[Array, Array]:
     return jax.vmap(one)(model.bodies, kin.X, kin.V, kin.q, kin.u)
 
 
-def _distal(model: FlexibleModel, kin) -> Array:
-    """Per body k: Kd T_h (mu, 6), the stiffening of k's parent by k's reaction at grid point h:
-    T_h takes the reaction (ground components at the ground origin) to (force; moment about the
-    grid point) in the parent's frame, the order of eq 33's distal unit loads."""
-    parents = np.asarray(model.model.topology.parents)
-    parent, h = np.maximum(parents, 0), np.maximum(np.asarray(model.attach), 0)
-    has = np.asarray(model.attach) >= 0
-    Kd = jnp.einsum("kjst,kt->ksj", model.bodies.distal_stiffening[parent, h], kin.q_parent)
-    Rt = jnp.swapaxes(kin.R[parent], -1, -2)
-    T = jnp.concatenate([jnp.concatenate([jnp.zeros_like(Rt), Rt], -1),
-                         jnp.concatenate([Rt, -Rt @ skew(kin.x_node)], -1)], -2)
-    return jnp.where(has[:, None, None], Kd @ T, 0.0)
-
-
 def flexible_aba_responses(model: FlexibleModel, q: Array, v: Array, tau: Array,
                            loads: Array, f_ext: Array | None = None) -> tuple[Array, Array]:
     """(v_dot (nv,), responses (m, nv)): the accelerations under tau, gravity, velocity,
@@ -94,7 +80,6 @@ def flexible_aba_responses(model: FlexibleModel, q: Array, v: Array, tau: Array,
     n, mu, m = model.n, model.mu, loads.shape[0]
     dtype = q.dtype
     M_g, b_g = body_blocks(model, kin)
-    KdT = _distal(model, kin)
     pad = (~model.model.v_mask).astype(dtype)
     cols = 1 + m
     tau_cols = jnp.concatenate([tau[None], loads])                         # (cols, nv)
@@ -107,7 +92,7 @@ def flexible_aba_responses(model: FlexibleModel, q: Array, v: Array, tau: Array,
     c = jnp.zeros((n, 6, cols), dtype).at[:, :, 0].set(kin.c)
 
     def triangularize(received, inp):
-        (IA, pA), (S, c, t, padding, G, KdT) = received, inp
+        (IA, pA), (S, c, t, padding, G) = received, inp
         Y = jnp.linalg.solve(IA[6:, 6:], jnp.concatenate([IA[6:, :6], pA[6:]], -1))
         Y_A, Y_p = Y[:, :6], Y[:, 6:]
         I6 = IA[:6, :6] - IA[:6, 6:] @ Y_A
@@ -117,12 +102,12 @@ def flexible_aba_responses(model: FlexibleModel, q: Array, v: Array, tau: Array,
         u = t - S.T @ p6
         Ia = I6 - U @ _solve(D, W)
         pa = p6 + Ia @ c + U @ _solve(D, u)
-        L = jnp.concatenate([jnp.eye(6, dtype=dtype), G.T - KdT])
+        L = jnp.concatenate([jnp.eye(6, dtype=dtype), G.T])
         right = jnp.concatenate([jnp.eye(6, dtype=dtype), G], -1)
         return (Y_A, Y_p, W, D, u), (L @ Ia @ right, L @ pa)
 
     (Y_A, Y_p, W, D, u), _ = backward_pass(model.model.topology, triangularize, (M_g, own_p),
-                                           (kin.S, c, t_joint, pad, kin.G, KdT))
+                                           (kin.S, c, t_joint, pad, kin.G))
 
     def substitute(parent, inp):
         (A_parent, u_dot_parent, _), (S, c, G, Y_A, Y_p, W, D, u) = parent, inp

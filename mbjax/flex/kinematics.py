@@ -3,11 +3,15 @@
 As for rigid trees (`mbjax.rigid.kinematics`), spatial vectors are in ground components at the
 ground origin, so the recursions carry no frame shifts. A body attached at grid point h of a
 flexible parent sees the parent's frame moved by the deformation there: translation
-o_h = rho_h + phi_h q (eqs 5-7) and rotation exp(psi_h q) (eq 8, taken exact so the attachment
-frame stays a rotation). Its joint frame therefore moves relative to the parent's frame with the
-spatial velocity G u (G: the attachment's partial velocities, 6 x mu, eqs 20 and 22):
+o_h = rho_h + phi_h q (eqs 5-7) and rotation exp(r_h), r_h = psi_h q (eq 8, taken exact so the
+attachment frame stays a rotation), each with the second-order part whose Hessian is the grid
+point's unit-load geometric stiffness (`grid_point`), so that every load at a grid point stiffens
+the body by its own virtual work (eq 33's distal terms; a cut joint's constraint load and an
+applied wrench as well as a child's reaction). Its joint frame therefore moves relative to the
+parent's frame with the spatial velocity G u (G: the attachment's partial velocities, 6 x mu,
+eqs 20 and 22):
 
-    G_body = (Gamma(psi_h q) psi_h;  phi_h + o_h~ Gamma(psi_h q) psi_h)    (at the parent origin)
+    G_body = (Gamma(r_h) dr_h/dq;  do_h/dq + o_h~ Gamma(r_h) dr_h/dq)    (at the parent origin)
 
 and the recursions of the rigid tree gain the parent's modal rates (eqs 21-31):
 
@@ -25,7 +29,7 @@ import numpy as np
 from jax import Array
 
 from mbjax.flex.model import FlexibleModel
-from mbjax.lie import exp, gamma
+from mbjax.lie import exp, gamma, vee
 from mbjax.rigid.kinematics import compose, to_ground
 from mbjax.spatial import cross_motion, skew
 from mbjax.tree import forward_pass
@@ -43,7 +47,6 @@ class FlexKinematics(NamedTuple):
     q: Array          # (n, mu) own modal coordinates
     u: Array          # (n, mu) own modal rates
     q_parent: Array   # (n, mu) the parent's modal coordinates (zero for base bodies)
-    x_node: Array     # (n, 3) where body k's joint is attached on its parent, ground frame
 
 
 def _parents(model: FlexibleModel) -> tuple[np.ndarray, np.ndarray]:
@@ -51,25 +54,50 @@ def _parents(model: FlexibleModel) -> tuple[np.ndarray, np.ndarray]:
     return np.where(parents < 0, 0, parents), parents >= 0
 
 
-def attachment(model: FlexibleModel, q_parent: Array):
-    """Per body: the attachment's (rotation E, origin o, rho_h, psi_h, phi_h) on the parent; the
-    identity at zero shapes for bodies whose parent is rigid or the ground."""
-    parent, _ = _parents(model)
-    h = np.maximum(np.asarray(model.attach), 0)
-    has = (np.asarray(model.attach) >= 0)
+def grid_point(rho: Array, phi: Array, psi: Array, K: Array, q: Array) -> tuple[Array, Array]:
+    """(rotation vector r, origin o) of a grid point in its body's frame at modal coordinates q:
+    seed 002 eqs 5-8 (o = rho + phi q, r = psi q) plus the second-order part whose Hessian is the
+    point's unit-load geometric stiffness K (6, mu, mu) (eq 33's K_distal: force x, y, z, then
+    moment x, y, z):
+
+        (o; r) += -1/2 (q^T K_j q)_j.
+
+    A load F (6,) at the point then does work through phi^T F - sum_j F_j K_j q: eq 33's
+    stiffening K_G(F) q comes from the load's own virtual work, for every load at the point (a
+    child's reaction, a cut joint's constraint load, an applied wrench). On a straight beam only
+    K_0 is nonzero (axial prestress, eq 32), and -1/2 q^T K_0 q is the foreshortening
+    -1/2 integral w'^2 dx of the bent beam between the clamp and the point."""
+    second = -0.5 * jnp.einsum("jst,s,t->j", K, q, q)
+    return psi @ q + second[3:], rho + phi @ q + second[:3]
+
+
+def _grid_shapes(model: FlexibleModel, body: np.ndarray, h: np.ndarray, on_node: np.ndarray):
+    """(rho, phi, psi, K) of grid points h of bodies `body`; zero where on_node is False."""
     b = model.bodies
-    rho = jnp.where(has[:, None], b.node_position[parent, h], 0.0)
-    phi = jnp.where(has[:, None, None], b.node_phi[parent, h], 0.0)
-    psi = jnp.where(has[:, None, None], b.node_psi[parent, h], 0.0)
-    r = jnp.einsum("kis,ks->ki", psi, q_parent)
-    o = rho + jnp.einsum("kis,ks->ki", phi, q_parent)
-    return jax.vmap(exp)(r), o, rho, psi, phi
+    return (jnp.where(on_node[:, None], b.node_position[body, h], 0.0),
+            jnp.where(on_node[:, None, None], b.node_phi[body, h], 0.0),
+            jnp.where(on_node[:, None, None], b.node_psi[body, h], 0.0),
+            jnp.where(on_node[:, None, None, None], b.distal_stiffening[body, h], 0.0))
 
 
-def _partial_velocities(psi: Array, phi: Array, rho: Array, q: Array) -> Array:
-    """G (6, mu) of one attachment at the parent's modal coordinates q, parent frame."""
-    Gw = gamma(psi @ q) @ psi
-    return jnp.concatenate([Gw, phi + skew(rho + phi @ q) @ Gw])
+def attachment(model: FlexibleModel, q_parent: Array):
+    """Per body: the attachment's rotation E and origin o on the parent, and the grid point's
+    shapes (rho, phi, psi, K) (`grid_point`); the identity at zero shapes for bodies whose parent
+    is rigid or the ground."""
+    parent, _ = _parents(model)
+    shapes = _grid_shapes(model, parent, np.maximum(np.asarray(model.attach), 0),
+                          np.asarray(model.attach) >= 0)
+    r, o = jax.vmap(grid_point)(*shapes, q_parent)
+    return jax.vmap(exp)(r), o, shapes
+
+
+def _partial_velocities(shapes, q: Array) -> Array:
+    """G (6, mu) of one attachment at the parent's modal coordinates q, parent frame: the rates of
+    the grid point's (r, o) (`grid_point`) as a spatial velocity at the parent's origin."""
+    r, o = grid_point(*shapes, q)
+    dr, do = jax.jacfwd(lambda q_: grid_point(*shapes, q_))(q)
+    Gw = gamma(r) @ dr
+    return jnp.concatenate([Gw, do + skew(o) @ Gw])
 
 
 def frame_poses(model: FlexibleModel, q: Array) -> tuple[Array, Array, Array, Array]:
@@ -85,9 +113,9 @@ def _poses(model: FlexibleModel, q: Array, v: Array):
     R_local, p_local, S_local, S_dot_local = rigid.joints(qj, vj)
     parent, has_parent = _parents(model)
     q_parent = jnp.where(has_parent[:, None], qf[parent], 0.0)
-    E, o, rho, psi, phi = attachment(model, q_parent)
-    R, p = compose(model.model, E @ R_local, o + jnp.einsum("kij,kj->ki", E, p_local - rho))
-    return R, p, (S_local, S_dot_local, q_parent, psi, phi, rho, parent, has_parent)
+    E, o, shapes = attachment(model, q_parent)
+    R, p = compose(model.model, E @ R_local, o + jnp.einsum("kij,kj->ki", E, p_local - shapes[0]))
+    return R, p, (S_local, S_dot_local, q_parent, shapes, parent, has_parent)
 
 
 def _markers(model: FlexibleModel, R: Array, p: Array, qf: Array):
@@ -96,13 +124,22 @@ def _markers(model: FlexibleModel, R: Array, p: Array, qf: Array):
     body = np.array([b for b, _ in model.markers])
     h = np.array([max(n, 0) for _, n in model.markers])
     on_node = np.array([n >= 0 for _, n in model.markers])
-    b = model.bodies
-    rho = jnp.where(on_node[:, None], b.node_position[body, h], 0.0)
-    phi = jnp.where(on_node[:, None, None], b.node_phi[body, h], 0.0)
-    psi = jnp.where(on_node[:, None, None], b.node_psi[body, h], 0.0)
-    E = jax.vmap(exp)(jnp.einsum("kis,ks->ki", psi, qf[body]))
-    o = rho + jnp.einsum("kis,ks->ki", phi, qf[body])
-    return R[body] @ E, p[body] + jnp.einsum("kij,kj->ki", R[body], o)
+    r, o = jax.vmap(grid_point)(*_grid_shapes(model, body, h, on_node), qf[body])
+    return R[body] @ jax.vmap(exp)(r), p[body] + jnp.einsum("kij,kj->ki", R[body], o)
+
+
+def marker_forces(model: FlexibleModel, q: Array, f: Array) -> Array:
+    """The generalized forces (nv,) of world-frame wrenches f (markers, 6) (torque about each
+    marker's origin; force applied there): the gradient in v of their power n . omega + f . p_dot,
+    with the markers' motion from their poses, grid points' second-order part included (so a
+    load at a grid point stiffens its body, `grid_point`)."""
+    def power(v):
+        (R, p), (R_dot, p_dot) = jax.jvp(lambda q_: frame_poses(model, q_)[2:], (q,),
+                                         (model.q_dot(q, v),))
+        omega = jax.vmap(vee)(R_dot @ jnp.swapaxes(R, -1, -2))        # world components
+        return jnp.sum(f[:, :3] * omega) + jnp.sum(f[:, 3:] * p_dot)
+
+    return jax.grad(power)(jnp.zeros(model.nv, q.dtype))
 
 
 def inverse_motion(X: Array) -> Array:
@@ -129,7 +166,7 @@ def motion_transform(R: Array, p: Array) -> Array:
 
 def flex_kinematics(model: FlexibleModel, q: Array, v: Array) -> FlexKinematics:
     """Poses, subspaces, attachments, velocities and remainder accelerations of every body."""
-    R, p, (S_local, S_dot_local, q_parent, psi, phi, rho, parent, has_parent) = _poses(model, q, v)
+    R, p, (S_local, S_dot_local, q_parent, shapes, parent, has_parent) = _poses(model, q, v)
     _, qf = model.split(q)
     vj, uf = model.split(v)
     vb = model.model.body_v(vj)
@@ -138,9 +175,9 @@ def flex_kinematics(model: FlexibleModel, q: Array, v: Array) -> FlexKinematics:
     eye = jnp.eye(6, dtype=q.dtype)
     X_parent = jnp.where(has_parent[:, None, None], X[parent], eye)
     _, c_body = jax.vmap(
-        lambda ps, ph, rh, qp, up: jax.jvp(lambda q_: _partial_velocities(ps, ph, rh, q_) @ up,
-                                           (qp,), (up,)))(psi, phi, rho, q_parent, u_parent)
-    G = X_parent @ jax.vmap(_partial_velocities)(psi, phi, rho, q_parent)
+        lambda sh, qp, up: jax.jvp(lambda q_: _partial_velocities(sh, q_) @ up, (qp,), (up,)))(
+            shapes, q_parent, u_parent)
+    G = X_parent @ jax.vmap(_partial_velocities)(shapes, q_parent)
     S = to_ground(R, p, S_local)
     joint_velocity = jnp.einsum("kij,kj->ki", S, vb)
     attach_velocity = jnp.einsum("kij,kj->ki", G, u_parent)
@@ -149,8 +186,4 @@ def flex_kinematics(model: FlexibleModel, q: Array, v: Array) -> FlexKinematics:
     V_parent = jnp.where(has_parent[:, None], V[parent], 0.0)
     c = (cross_motion(V, joint_velocity) + jnp.einsum("kij,kj->ki", to_ground(R, p, S_dot_local), vb)
          + cross_motion(V_parent, attach_velocity) + jnp.einsum("kij,kj->ki", X_parent, c_body))
-    R_parent = jnp.where(has_parent[:, None, None], R[parent], jnp.eye(3, dtype=q.dtype))
-    p_parent = jnp.where(has_parent[:, None], p[parent], 0.0)
-    _, o, _, _, _ = attachment(model, q_parent)
-    x_node = p_parent + jnp.einsum("kij,kj->ki", R_parent, o)
-    return FlexKinematics(R, p, X, S, G, V, c, vb, qf, uf, q_parent, x_node)
+    return FlexKinematics(R, p, X, S, G, V, c, vb, qf, uf, q_parent)

@@ -102,16 +102,23 @@ def external_forces(model: FlexibleModel, q: Array, f_ext: Array) -> Array:
 
 
 def dense_forward_dynamics(model: FlexibleModel, q: Array, v: Array, tau: Array,
-                           f_ext: Array | None = None) -> Array:
+                           f_ext: Array | None = None, loads: Array | None = None):
     """v_dot from Lagrange's equations (the residual's Jacobian in v_dot solved densely), under
-    generalized forces tau and external wrenches f_ext (as `external_forces`).
+    generalized forces tau and external wrenches f_ext (as `external_forces`); with `loads`
+    (m, nv), also the accelerations each row alone produces, (v_dot, responses (m, nv)), as
+    `mbjax.flex.aba.flexible_aba_responses` (closed loops on this route).
 
-    Distal-load stiffening (the reactions of child bodies, eq 33's second sum) is not in this
-    route: it needs the joint reactions, which the recursion has and the energies do not."""
+    Distal-load stiffening (the reactions of child bodies, eq 33's second sum) needs no joint
+    reactions here: the child's energies see its joint move with the grid point's second-order
+    displacement (`mbjax.flex.kinematics.grid_point`), and Lagrange's equations turn that into
+    K_G(F) q."""
     _check(model)
     if f_ext is not None:
         tau = tau + external_forces(model, q, f_ext)
     zero = jnp.zeros_like(v)
     r0 = residual(model, q, v, zero, tau)
     M = jax.jacfwd(lambda a: residual(model, q, v, a, tau))(zero)
-    return jnp.linalg.solve(M, -r0)
+    if loads is None:
+        return jnp.linalg.solve(M, -r0)
+    x = jnp.linalg.solve(M, jnp.concatenate([-r0[:, None], loads.T], 1))
+    return x[:, 0], x[:, 1:].T

@@ -14,10 +14,10 @@ import jax.numpy as jnp
 from jax import Array
 
 from mbjax.control import AbstractControl, as_control
-from mbjax.control.applied import check_actuation, check_control, check_points
+from mbjax.control.applied import about_origins, check_actuation, check_control, check_points
 from mbjax.flex.aba import flexible_aba_responses
 from mbjax.flex.body import kinetic_energy as body_kinetic_energy
-from mbjax.flex.kinematics import body_velocities, frame_poses
+from mbjax.flex.kinematics import body_velocities, frame_poses, marker_forces
 from mbjax.flex.lagrange import dense_forward_dynamics, potential_energy
 from mbjax.flex.model import FlexibleModel
 from mbjax.integrate.tree_system import AbstractTreeSystem
@@ -27,12 +27,20 @@ METHODS = ("recursive", "dense")
 
 class FlexibleSystem(AbstractTreeSystem):
     """u = v; v_dot from the flexible tree's forward dynamics under gravity, elasticity, the
-    control and the external wrenches (as `mbjax.rigid.TreeSystem`; a wrench acts on a body's
-    reference frame, the joint grid where its modes are clamped, and external_point is a point
-    fixed in that frame). The control drives joint and modal coordinates alike (`actuation`
-    picks some). Geometric stiffening adds acceleration-dependent loads, so the equations are
-    not M v_dot + bias = 0 with a symmetric M (`symmetric_dynamics` is False): closed loops go
-    through `mbjax.loops.Stabilized`."""
+    control and the external wrenches. The control drives joint and modal coordinates alike
+    (`actuation` picks some).
+
+    `external` (t, q, v) returns world-frame wrenches (torque; force): one per body, shape
+    (n, 6), acting on the body's reference frame (the joint grid where its modes are clamped, or
+    `external_point`, a point fixed in that frame), as in `mbjax.rigid.TreeSystem`; or one per
+    frame, shape (n + markers, 6), the rows past n acting at the model's markers (torque about
+    the marker's origin, the force applied there). A load at a marker on a grid point bends the
+    body and stiffens it (seed 002 eq 33, `mbjax.flex.kinematics.grid_point`), as a cut joint's
+    constraint load there does.
+
+    Geometric stiffening adds acceleration-dependent loads, so the equations are not
+    M v_dot + bias = 0 with a symmetric M (`symmetric_dynamics` is False): closed loops go
+    through `mbjax.loops.Stabilized`, on either route."""
 
     model: FlexibleModel
     control: AbstractControl | None
@@ -79,11 +87,34 @@ class FlexibleSystem(AbstractTreeSystem):
         zero = jnp.zeros(self.nv, q.dtype)
         return jax.jacfwd(jax.grad(self.kinetic_energy, argnums=1), argnums=1)(q, zero)
 
+    def wrenches(self, t, q, v):
+        """The bodies' external wrenches (n, 6), world frame, torque about each body's origin;
+        or None (marker rows, if any, are in `applied`'s generalized forces)."""
+        f = self._external(t, q, v)
+        if f is None:
+            return None
+        return about_origins(f[:self.n], self.frames(q)[0][:self.n], self.external_point)
+
+    def applied(self, t, q, v):
+        """The control's generalized forces, plus those of the wrenches at markers."""
+        tau = super().applied(t, q, v)
+        f = self._external(t, q, v)
+        if f is None or f.shape[0] == self.n:
+            return tau
+        return tau + marker_forces(self.model, q, f[self.n:])
+
+    def _external(self, t, q, v):
+        if self.external is None:
+            return None
+        f = jnp.asarray(self.external(t, q, v), v.dtype)
+        if f.shape not in ((self.n, 6), (self.n_frames, 6)):
+            raise ValueError(f"external returned shape {f.shape}; it must return one world-frame "
+                             f"wrench (torque; force) per body, shape ({self.n}, 6), or per body "
+                             f"and marker, shape ({self.n_frames}, 6)")
+        return f
+
     def responses(self, t, q, v, loads):
         tau, f = self.applied(t, q, v), self.wrenches(t, q, v)
         if self.method == "dense":
-            if loads.shape[0]:
-                raise ValueError("the dense flexible route gives no load responses: use the "
-                                 "recursion (method='recursive') in closed loops")
-            return dense_forward_dynamics(self.model, q, v, tau, f), loads
+            return dense_forward_dynamics(self.model, q, v, tau, f, loads)
         return flexible_aba_responses(self.model, q, v, tau, loads, f)
