@@ -121,6 +121,80 @@ def exudyn_spin_up_beam(n_elements: int, dt: float, ts, *, length=10.0, E=7.0e10
     return np.interp(ts, t, deflection)
 
 
+def exudyn_slider_crank(n_elements: int, dt: float, ts, *, crank=6 * 0.0254, rod=12 * 0.0254,
+                        diameter=0.25 * 0.0254, E=3.0e7 * 4.4482216152605 / 0.0254**2,
+                        mass=0.1667 * 0.45359237, Omega=125.6, spectral_radius=0.8):
+    """Seed 002's flexible slider-crank (as `mbjax.flex.references.slider_crank_reference`) in
+    exudyn: the rod as n `ObjectANCFCable2D` elements from P to Q, P's coordinates prescribed on
+    the crank circle (two `CoordinateConstraint`s with offset user functions), Q's y held at 0
+    (the massless slider), both slopes and Q's x free; started straight and unstrained with the
+    rigid mechanism's velocities (at t = 0 a pure translation, P's velocity (-crank Omega, 0));
+    implicit generalized-alpha at fixed step dt. Returns the midpoint deflection from the chord
+    PQ [in], positive away from O at t = 0, at the times ts (multiples of ts[1] - ts[0])."""
+    import exudyn as exu
+    from exudyn.itemInterface import (CoordinateConstraint, MarkerNodeCoordinate,
+                                      MarkerNodePosition, NodePoint2DSlope1, NodePointGround,
+                                      ObjectANCFCable2D, SensorMarker, SensorNode)
+
+    inch = 0.0254
+    area, inertia = np.pi * diameter**2 / 4, np.pi * diameter**4 / 64
+    p0 = np.array([0.0, crank])
+    q0 = np.array([np.sqrt(rod**2 - crank**2), 0.0])
+    u = (q0 - p0) / rod
+    le = rod / n_elements
+    v0 = np.array([-crank * Omega, 0.0])
+    sc = exu.SystemContainer()
+    mbs = sc.AddSystem()
+    nodes = [mbs.AddNode(NodePoint2DSlope1(referenceCoordinates=[*(p0 + i * le * u), *u],
+                                           initialVelocities=[*v0, 0.0, 0.0]))
+             for i in range(n_elements + 1)]
+    cables = [mbs.AddObject(ObjectANCFCable2D(length=le, massPerLength=mass / rod,
+                                              bendingStiffness=E * inertia, axialStiffness=E * area,
+                                              nodeNumbers=[nodes[i], nodes[i + 1]]))
+              for i in range(n_elements)]
+    ground = mbs.AddMarker(MarkerNodeCoordinate(nodeNumber=mbs.AddNode(NodePointGround()),
+                                                coordinate=0))
+
+    def prescribe(node, coordinate, displacement):
+        marker = mbs.AddMarker(MarkerNodeCoordinate(nodeNumber=nodes[node], coordinate=coordinate))
+        mbs.AddObject(CoordinateConstraint(
+            markerNumbers=[ground, marker],
+            offsetUserFunction=lambda mbs, t, item, offset: displacement(t)))
+
+    prescribe(0, 0, lambda t: crank * np.cos(np.pi / 2 + Omega * t) - p0[0])
+    prescribe(0, 1, lambda t: crank * np.sin(np.pi / 2 + Omega * t) - p0[1])
+    prescribe(n_elements, 1, lambda t: 0.0)
+    at = [mbs.AddMarker(MarkerNodePosition(nodeNumber=nodes[i])) for i in (0, n_elements)]
+    sensors = [mbs.AddSensor(SensorMarker(markerNumber=m, storeInternal=True,
+                                          outputVariableType=exu.OutputVariableType.Position))
+               for m in at]
+    mid = n_elements // 2 if n_elements % 2 == 0 else None
+    if mid is None:
+        raise ValueError("exudyn_slider_crank: n_elements must be even (the midpoint is a node)")
+    sensors.append(mbs.AddSensor(SensorNode(nodeNumber=nodes[mid], storeInternal=True,
+                                            outputVariableType=exu.OutputVariableType.Position)))
+    mbs.Assemble()
+
+    ts = np.asarray(ts, float)
+    settings = exu.SimulationSettings()
+    settings.timeIntegration.endTime = float(ts[-1])
+    settings.timeIntegration.numberOfSteps = int(round(ts[-1] / dt))
+    settings.timeIntegration.generalizedAlpha.spectralRadius = spectral_radius
+    settings.timeIntegration.adaptiveStep = False
+    settings.timeIntegration.newton.absoluteTolerance = 1e-8
+    settings.timeIntegration.verboseMode = 0
+    settings.solution.file.write = False
+    settings.solution.sensors.writePeriod = float(ts[1] - ts[0])
+    mbs.SolveDynamic(settings)
+
+    P, Q, M = (mbs.GetSensorStoredData(s) for s in sensors)
+    t = P[:, 0]
+    chord = Q[:, 1:3] - P[:, 1:3]
+    chord /= np.linalg.norm(chord, axis=1, keepdims=True)
+    d = np.sum((M[:, 1:3] - P[:, 1:3]) * np.stack([-chord[:, 1], chord[:, 0]], 1), axis=1)
+    return np.interp(ts, t, d / inch)
+
+
 def crocoddyl_working() -> str | None:
     """None when Crocoddyl imports and its forward dynamics agree with Pinocchio's `aba` (to
     1e-9 relative on a random 7-dof state), else why not: crocoddyl 3.2.1 with pin 4.1.0

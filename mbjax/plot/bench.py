@@ -97,51 +97,76 @@ CEILING = 3.0   # m: errors above are drawn here (marked ^) with their value
 
 
 def flexible_bench_figure(records: list[dict]) -> Figure:
-    """`mbjax bench flexible`: max tip-deflection error against run time on Kane's spin-up beam.
-    One line per bending-mode count (stiffened modal model, the two steps), open markers without
-    geometric stiffening, squares for mbjax's ANCF beams (the reference drawn as a vertical line:
-    its error is zero by definition), crosses for exudyn's ANCF cable."""
-    fig = Figure(figsize=(7.5, 5.2), layout="constrained")
-    ax = fig.subplots()
+    """`mbjax bench flexible`: the history's largest error against run time, (a) Kane's spin-up
+    beam (tip deflection [m]), (b) the flexible slider-crank (midpoint deflection [in]). Modal
+    models: one line per bending-mode or element count with RK4 (circles), the simplified implicit
+    midpoint (diamonds), open markers without geometric stiffening; squares mbjax's ANCF beams (the
+    reference a vertical line: its error is zero by definition); crosses exudyn's ANCF cable. The
+    dashed horizontal line is the scene's tolerance; each point is labelled with its step."""
+    fig = Figure(figsize=(13, 5.2), layout="constrained")
+    axes = fig.subplots(1, 2)
+    palette = ("#1f77b4", "#ff7f0e", "#2ca02c", "#d62728", "#9467bd", "#8c564b")
 
     def pos(v):
         return v is not None and np.isfinite(v) and v > 0
 
-    modal = [r for r in records if r["kind"] == "modal"]
-    colors = dict(zip(sorted({r["n_bending"] for r in modal}),
-                      ("#1f77b4", "#ff7f0e", "#2ca02c", "#d62728", "#9467bd", "#8c564b")))
-    for nb, color in colors.items():
-        rows = sorted((r for r in modal if r["n_bending"] == nb and r["stiffening"]),
+    def label_steps(ax, rows, color):
+        for r in rows:
+            ax.annotate(f"{r['dt']:.2g}", (r["run_s"], r["error"]), textcoords="offset points",
+                        xytext=(4, 3), fontsize=6, color=color)
+
+    for ax, (scene, unit, what, tolerance) in zip(axes, (
+            ("spin-up", "m", "tip deflection", 1e-3),
+            ("slider-crank", "in", "midpoint deflection", 0.01))):
+        rows = [r for r in records if r.get("scene", "spin-up") == scene]
+        if not rows:
+            ax.set_visible(False)
+            continue
+        modal = [r for r in rows if r["kind"] == "modal"]
+        key = "n_bending" if scene == "spin-up" else "n_elements"
+        colors = dict(zip(sorted({r[key] for r in modal}), palette))
+        for value, color in colors.items():
+            for integrator, marker in (("rk4", "o-"), ("implicit", "D-")):
+                line = sorted((r for r in modal if r[key] == value and r["stiffening"]
+                               and r.get("integrator", "rk4").startswith(integrator)
+                               and pos(r["error"])), key=lambda r: r["run_s"])
+                if line:
+                    name = (f"{value} bending + 1 axial" if scene == "spin-up" else f"{value} el")
+                    ax.loglog([r["run_s"] for r in line], [r["error"] for r in line], marker,
+                              color=color, ms=5,
+                              label=f"modal, {name}, {'RK4' if integrator == 'rk4' else 'implicit midpoint'}")
+                    label_steps(ax, line, color)
+            for r in (r for r in modal if r[key] == value and not r["stiffening"]):
+                if pos(r["error"]):   # diverged runs (errors up to 1e20 m) drawn at the ceiling
+                    ax.loglog(r["run_s"], min(r["error"], CEILING), "^" if r["error"] > CEILING else "o",
+                              mfc="none", ms=10, color=color,
+                              label=f"modal, {value} bending + 1 axial, no stiffening")
+                    ax.annotate(f"{r['error']:.2g} {unit}", (r["run_s"], min(r["error"], CEILING)),
+                                textcoords="offset points", xytext=(8, -4), fontsize=7, color=color)
+        for r in (r for r in rows if r["kind"] == "ancf"):
+            if r.get("reference"):
+                ax.axvline(r["run_s"], color="k", ls=":",
+                           label=f"ANCF {r['n_elements']} el (reference), {r['run_s']:.3g} s")
+            elif pos(r.get("error")):
+                ax.loglog(r["run_s"], r["error"], "ks", label=f"ANCF {r['n_elements']} el (mbjax)")
+        peer = sorted((r for r in rows if r["kind"] == "peer" and pos(r.get("error"))),
                       key=lambda r: r["run_s"])
-        rows = [r for r in rows if pos(r["error"])]
-        if rows:
-            ax.loglog([r["run_s"] for r in rows], [r["error"] for r in rows], "o-", color=color,
-                      label=f"modal, {nb} bending + 1 axial")
-        for r in (r for r in modal if r["n_bending"] == nb and not r["stiffening"]):
-            if pos(r["error"]):   # diverged runs (errors up to 1e20 m) drawn at the 3 m ceiling
-                ax.loglog(r["run_s"], min(r["error"], CEILING), "^" if r["error"] > CEILING else "o",
-                          mfc="none", ms=10, color=color,
-                          label=f"modal, {nb} bending + 1 axial, no stiffening")
-                ax.annotate(f"{r['error']:.2g} m", (r["run_s"], min(r["error"], CEILING)),
-                            textcoords="offset points", xytext=(8, -4), fontsize=7, color=color)
-    for r in (r for r in records if r["kind"] == "ancf"):
-        if r.get("reference"):
-            ax.axvline(r["run_s"], color="k", ls=":",
-                       label=f"ANCF {r['n_elements']} el (reference), {r['run_s']:.3g} s")
-        elif pos(r["error"]):
-            ax.loglog(r["run_s"], r["error"], "ks", label=f"ANCF {r['n_elements']} el (mbjax)")
-    peer = sorted((r for r in records if r["kind"] == "peer" and pos(r.get("error"))),
-                  key=lambda r: r["run_s"])
-    if peer:
-        ax.loglog([r["run_s"] for r in peer], [r["error"] for r in peer], "x--", color="0.4",
-                  label=f"exudyn ANCF cable {peer[0]['n_elements']} el")
-    duration = records[0]["duration"]
-    ax.set(xlabel=f"run time for {duration:g} s [s]", ylabel="max |tip deflection - reference| [m]",
-           title=f"spin-up beam, 0-{duration:g} s: speed against accuracy")
-    ax.set_ylim(top=2 * CEILING)
-    ax.xaxis.set_minor_formatter(NullFormatter())
-    ax.grid(True, which="both", alpha=0.3)
-    ax.legend(fontsize=7)
+        if peer:
+            ax.loglog([r["run_s"] for r in peer], [r["error"] for r in peer], "x--", color="0.35",
+                      ms=8, label=f"exudyn ANCF cable {peer[0]['n_elements']} el, generalized-alpha")
+            label_steps(ax, peer, "0.35")
+        ax.axhline(tolerance, color="0.6", ls="--", lw=0.8, label=f"tolerance {tolerance:g} {unit}")
+        duration = rows[0]["duration"]
+        ax.set(xlabel=f"run time for {duration:g} s, compilation apart [s]",
+               ylabel=f"max |{what} - reference| over the history [{unit}]",
+               title=f"{scene}, 0-{duration:g} s: speed against accuracy")
+        if scene == "spin-up":
+            ax.set_ylim(top=2 * CEILING)
+        ax.xaxis.set_minor_formatter(NullFormatter())
+        ax.grid(True, which="both", alpha=0.3)
+        ax.legend(fontsize=6.5)
+    fig.text(0.01, 0.005, "run times are medians of a few calls on a shared machine: "
+             "differences under about 20 % are noise", fontsize=7, color="0.4")
     return fig
 
 

@@ -78,28 +78,39 @@ SLIDER_COLORS = {"1": "#ff7f0e", "2": "#2ca02c", "3": "#1f77b4"}
 
 def slider_crank_figure(data: dict) -> Figure:
     """(a) the rod's midpoint deflection against time for 1, 2, 3 beam elements and the ANCF rod
-    (seed 002 Fig. 5); (b) the peak |deflection| against the number of elements."""
-    fig = Figure(figsize=(12, 4.6), layout="constrained")
-    ax_d, ax_p = fig.subplots(1, 2, width_ratios=(2.2, 1))
+    (seed 002 Fig. 5); (b) each model's difference from the ANCF rod over the history, with the
+    tolerance; (c) the peak |deflection| against the number of elements."""
+    fig = Figure(figsize=(15, 4.6), layout="constrained")
+    ax_d, ax_e, ax_p = fig.subplots(1, 3, width_ratios=(2.2, 1.6, 1))
     ts = 1e3 * np.asarray(data["t"])
     ref = data["reference"]
+    ref_d = _array(ref["midpoint_deflection_in"])
     for n, values in data["by_elements"].items():
         ax_d.plot(ts, _array(values), color=SLIDER_COLORS.get(n), lw=1.5,
                   label=f"modal, {n} element{'s' * (n != '1')}")
-    ax_d.plot(1e3 * np.asarray(ref["t"]), _array(ref["midpoint_deflection_in"]),
+        ax_e.plot(ts, _array(values) - ref_d, color=SLIDER_COLORS.get(n), lw=1.2,
+                  label=f"{n} element{'s' * (n != '1')}: max {data['max_abs_differences'][n]:.3g} in")
+    ax_d.plot(1e3 * np.asarray(ref["t"]), ref_d,
               label=f"ANCF, {ref['n_elements']} elements (reference)", **REFERENCE_STYLE)
     ax_d.axhline(0.0, color="gray", lw=0.5)
     ax_d.set(xlabel="t [ms]", ylabel="midpoint deflection [in]",
              title="(a) flexible slider-crank, 125.6 rad/s (seed 002 Fig. 5)")
     ax_d.legend(fontsize=8)
+    tolerance = data.get("history_tolerance_in")
+    if tolerance:
+        for sign in (1, -1):
+            ax_e.axhline(sign * tolerance, color="0.5", ls="--", lw=0.8,
+                         label=f"tolerance {tolerance:g} in" if sign == 1 else None)
+    ax_e.set(xlabel="t [ms]", ylabel="modal - ANCF [in]", title="(b) the history's error")
+    ax_e.legend(fontsize=7)
     ns = [int(n) for n in data["peaks"]]
     ax_p.plot(ns, list(data["peaks"].values()), "o-", color="#1f77b4", label="modal")
     ax_p.axhline(data["reference_peak"], label="ANCF reference", **REFERENCE_STYLE)
     ax_p.set_xticks(ns)
     ax_p.set(xlabel="beam elements", ylabel="peak |midpoint deflection| [in]",
-             title="(b) convergence with elements")
+             title="(c) convergence with elements")
     ax_p.legend(fontsize=8)
-    for ax in (ax_d, ax_p):
+    for ax in (ax_d, ax_e, ax_p):
         ax.grid(alpha=0.3)
     return fig
 

@@ -76,9 +76,10 @@ def midpoint_deflection(system, midpoint, qs):
 
 
 def run(n_elements: int = 2, stiffening: bool = True, dt: float = 1e-5, t1: float = DURATION,
-        every: float = 5e-4):
-    """(ts, midpoint deflection [in], solution) of one RK4 run."""
+        every: float = 5e-4, integrator=None, **tolerance):
+    """(ts, midpoint deflection [in], solution) of one run (RK4 unless `integrator` is given;
+    `tolerance`: simulate's rtol and atol)."""
     system, q0, v0, midpoint = build(n_elements, stiffening)
     saveat = np.round(np.arange(0.0, t1 + every / 2, every), 12)
-    sol = simulate(system, RK4(), q0, v0, dt=dt, t1=t1, saveat=saveat)
+    sol = simulate(system, integrator or RK4(), q0, v0, dt=dt, t1=t1, saveat=saveat, **tolerance)
     return sol.ts, midpoint_deflection(system, midpoint, sol.qs) / INCH, sol

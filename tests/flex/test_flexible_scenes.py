@@ -25,11 +25,13 @@ def test_spin_up_beam_matches_the_nonlinear_reference_and_diverges_without_stiff
 
 @pytest.mark.slow
 def test_flexible_slider_crank_matches_the_nonlinear_reference():
-    """Seed 002 §3.1: the rod's midpoint deflection with 2 and 3 elements against the ANCF rod
-    (4 elements) over 0.15 s: the peaks agree within 5 % (the ANCF mesh itself moves 2 % from 2 to
-    4 elements), and the slider stays on its guide."""
-    ts, d, sol = flexible_slider_crank.run(n_elements=2)
-    assert sol.ok
-    reference = slider_crank_reference(n_elements=4, ts=np.asarray(ts))
-    peak, ref_peak = np.max(np.abs(np.asarray(d))), np.max(np.abs(np.asarray(reference.midpoint_deflection)))
-    assert abs(peak - ref_peak) < 0.05 * ref_peak
+    """Seed 002 §3.1: the rod's midpoint deflection with 2 and 3 elements stays within 0.01 in of
+    the ANCF rod (4 elements) over the whole 0.15 s (measured 0.0088 and 0.0078 in; before the
+    slider's load stiffened the rod, 0.078 and 0.087 in), the status success."""
+    reference = None
+    for n in (2, 3):
+        ts, d, sol = flexible_slider_crank.run(n_elements=n)
+        assert sol.ok
+        if reference is None:
+            reference = np.asarray(slider_crank_reference(n_elements=4, ts=np.asarray(ts)).midpoint_deflection)
+        assert np.max(np.abs(np.asarray(d) - reference)) < 0.01

@@ -114,3 +114,38 @@ def test_inertial_stiffening_structure():
     for q, N in ((0, -m * (1.0 - (x1 + x2) / 2)), (11, m * (1.0 - (x1**2 + x1 * x2 + x2**2) / 3) / 2)):
         ref = basis.shapes.T @ geometric_stiffness(b, jnp.asarray(N)) @ basis.shapes
         np.testing.assert_allclose(Ki[q], ref, atol=1e-10 * np.abs(ref).max())
+
+
+def test_a_grid_points_second_order_displacement_is_the_beams_foreshortening():
+    """The distal unit-load stiffness is the Hessian of the grid point's axial displacement
+    (`mbjax.flex.kinematics.grid_point`): bent by a static tip load, a cantilever's tip moves in by
+    (1/2) int w'^2 dx = (3/5) delta^2 / L for tip deflection delta (the cubic w = delta (3 x^2 L -
+    x^3) / (2 L^3), which cubic elements hold exactly), at the tip and, (1/2) int_0^a w'^2 dx, at
+    an inner node a; and a load along the beam at the point does work through it that is the
+    geometric stiffness K_G(F) q of eq 33."""
+    import jax
+
+    from mbjax.flex import beam_body
+    from mbjax.flex.kinematics import grid_point
+    from mbjax.flex.points import node_shapes
+
+    n, L = 4, 1.0
+    b = Beam(L, 2.1e11, 8e10, 7800.0, 1e-4, 1e-8, 1e-8, 2e-8, n)
+    basis = craig_bampton(b, n_modes=3 * n, planar="xy")
+    body = beam_body(b, basis, nodes=(n, n // 2))
+    _, Kr = reduced(b, basis)
+    _, phi_tip = node_shapes(basis, n)
+    q = jnp.linalg.solve(Kr, phi_tip[1] * 50.0)                 # 50 N across the tip
+    delta = float(phi_tip[1] @ q)
+    for h, a in ((0, L), (1, L / 2)):
+        args = (body.node_position[h], body.node_phi[h], body.node_psi[h], body.distal_stiffening[h])
+        _, o = grid_point(*args, q)
+        axial_static = float((body.node_phi[h] @ q)[0])          # the (linear) axial stretch
+        slope2 = (9 * delta**2 / (4 * L**6)) * (4 * L**2 * a**3 / 3 - L * a**4 + a**5 / 5)
+        np.testing.assert_allclose(float(o[0]) - a - axial_static, -0.5 * slope2, rtol=1e-10)
+        F = 3.0                                                   # N along the beam, at the point
+        work = jax.grad(lambda q_: F * grid_point(*args, q_)[1][0])(q)
+        np.testing.assert_allclose(work, F * body.node_phi[h][0] - F * body.distal_stiffening[h, 0] @ q,
+                                   rtol=1e-12, atol=1e-12 * float(jnp.max(jnp.abs(work))))
+        if a == L:                                                # the tip: (3/5) delta^2 / L
+            np.testing.assert_allclose(0.5 * slope2, 0.6 * delta**2 / L, rtol=1e-12)
