@@ -148,10 +148,10 @@ def exudyn_slider_crank(n_elements: int, dt: float, ts, *, crank=6 * 0.0254, rod
     nodes = [mbs.AddNode(NodePoint2DSlope1(referenceCoordinates=[*(p0 + i * le * u), *u],
                                            initialVelocities=[*v0, 0.0, 0.0]))
              for i in range(n_elements + 1)]
-    cables = [mbs.AddObject(ObjectANCFCable2D(length=le, massPerLength=mass / rod,
-                                              bendingStiffness=E * inertia, axialStiffness=E * area,
-                                              nodeNumbers=[nodes[i], nodes[i + 1]]))
-              for i in range(n_elements)]
+    for i in range(n_elements):
+        mbs.AddObject(ObjectANCFCable2D(length=le, massPerLength=mass / rod,
+                                        bendingStiffness=E * inertia, axialStiffness=E * area,
+                                        nodeNumbers=[nodes[i], nodes[i + 1]]))
     ground = mbs.AddMarker(MarkerNodeCoordinate(nodeNumber=mbs.AddNode(NodePointGround()),
                                                 coordinate=0))
 

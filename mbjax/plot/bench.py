@@ -102,7 +102,8 @@ def flexible_bench_figure(records: list[dict]) -> Figure:
     models: one line per bending-mode or element count with RK4 (circles), the simplified implicit
     midpoint (diamonds), open markers without geometric stiffening; squares mbjax's ANCF beams (the
     reference a vertical line: its error is zero by definition); crosses exudyn's ANCF cable. The
-    dashed horizontal line is the scene's tolerance; each point is labelled with its step."""
+    dashed horizontal line is the scene's tolerance; each point is labelled with its step (and its
+    status where it is not success)."""
     fig = Figure(figsize=(13, 5.2), layout="constrained")
     axes = fig.subplots(1, 2)
     palette = ("#1f77b4", "#ff7f0e", "#2ca02c", "#d62728", "#9467bd", "#8c564b")
@@ -112,8 +113,9 @@ def flexible_bench_figure(records: list[dict]) -> Figure:
 
     def label_steps(ax, rows, color):
         for r in rows:
-            ax.annotate(f"{r['dt']:.2g}", (r["run_s"], r["error"]), textcoords="offset points",
-                        xytext=(4, 3), fontsize=6, color=color)
+            status = "" if r.get("status", "success") == "success" else f" ({r['status']})"
+            ax.annotate(f"{r['dt']:.2g}{status}", (r["run_s"], r["error"]),
+                        textcoords="offset points", xytext=(4, 3), fontsize=6, color=color)
 
     for ax, (scene, unit, what, tolerance) in zip(axes, (
             ("spin-up", "m", "tip deflection", 1e-3),
@@ -144,7 +146,7 @@ def flexible_bench_figure(records: list[dict]) -> Figure:
                     ax.annotate(f"{r['error']:.2g} {unit}", (r["run_s"], min(r["error"], CEILING)),
                                 textcoords="offset points", xytext=(8, -4), fontsize=7, color=color)
         for r in (r for r in rows if r["kind"] == "ancf"):
-            if r.get("reference"):
+            if r.get("reference") and r["run_s"] > 0:
                 ax.axvline(r["run_s"], color="k", ls=":",
                            label=f"ANCF {r['n_elements']} el (reference), {r['run_s']:.3g} s")
             elif pos(r.get("error")):

@@ -117,15 +117,20 @@ def slider_crank_figure(data: dict) -> Figure:
 
 def flexible_tour_figure(runs: list[dict], histories: dict, reference: tuple, title: str) -> Figure:
     """(a) the largest tip-deflection difference from the ANCF reference against run time, one
-    point per modal model (bending modes, stiffening); (b) the tip histories."""
+    point per modal model (bending modes, stiffening; diamonds: the simplified implicit midpoint,
+    "integrator" "implicit"); (b) the tip histories."""
     fig = Figure(figsize=(12, 4.6), layout="constrained")
     ax_w, ax_h = fig.subplots(1, 2)
-    for stiffening, marker, color in ((True, "o-", "#1f77b4"), (False, "s--", "#d62728")):
-        rows = [r for r in runs if r["stiffening"] == stiffening]
+    for stiffening, implicit, marker, color, label in (
+            (True, False, "o-", "#1f77b4", "stiffened, RK4"),
+            (False, False, "s--", "#d62728", "no stiffening, RK4"),
+            (True, True, "D", "#2ca02c", "stiffened, implicit midpoint")):
+        rows = [r for r in runs if r["stiffening"] == stiffening
+                and (r.get("integrator") == "implicit") == implicit]
         if not rows:
             continue
         ax_w.loglog([r["seconds"] for r in rows], [r["error"] for r in rows], marker, color=color,
-                    label="stiffened" if stiffening else "no stiffening")
+                    label=label)
         for r in rows:
             ax_w.annotate(f"{r['n_bending']} mode{'s' * (r['n_bending'] != 1)}",
                           (r["seconds"], r["error"]), fontsize=7, textcoords="offset points",
