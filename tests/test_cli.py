@@ -171,6 +171,9 @@ def _check_time_elements(scenes):
     # ... and the summary says so next to the integration's own status
     assert flex["2 modes, stiffened"]["against_reference"] == "agrees"
     assert flex["2 modes, no stiffening"]["against_reference"] == "departs"
+    # the simplified implicit midpoint steps over the axial mode (50 ms, 14 times RK4's limit)
+    implicit = flex["2 modes, stiffened, implicit midpoint 50 ms"]
+    assert implicit["status"] == "success" and implicit["max_error_m"] < 2e-3
     # controls: the push moves the flange by millimetres and the servo catches it; a sampled
     # torque history gives MuJoCo's trajectory; jax.grad of the reach loss is the central difference
     controls = scenes["controls"]

@@ -62,6 +62,23 @@ def mujoco_rollout(model, data, quat0, Omega0, nstep: int):
     return final[:, 1:1 + model.nq], final[:, 1 + model.nq:1 + model.nq + model.nv]
 
 
+def _exudyn_solve(mbs, ts, dt: float, spectral_radius: float, absolute_tolerance: float) -> None:
+    """exudyn's implicit generalized-alpha over [0, ts[-1]] at the fixed step dt, sensors kept
+    every ts[1] - ts[0], Newton's absolute tolerance as given, nothing written to disk."""
+    import exudyn as exu
+
+    settings = exu.SimulationSettings()
+    settings.timeIntegration.endTime = float(ts[-1])
+    settings.timeIntegration.numberOfSteps = int(round(ts[-1] / dt))
+    settings.timeIntegration.generalizedAlpha.spectralRadius = spectral_radius
+    settings.timeIntegration.adaptiveStep = False
+    settings.timeIntegration.newton.absoluteTolerance = absolute_tolerance
+    settings.timeIntegration.verboseMode = 0
+    settings.solution.file.write = False
+    settings.solution.sensors.writePeriod = float(ts[1] - ts[0])
+    mbs.SolveDynamic(settings)
+
+
 def exudyn_spin_up_beam(n_elements: int, dt: float, ts, *, length=10.0, E=7.0e10, A=4.0e-4,
                         I=2.0e-7, mass=12.0, T_s=15.0, omega_s=6.0,  # noqa: E741 (the paper's I)
                         spectral_radius=0.8):
@@ -103,16 +120,7 @@ def exudyn_spin_up_beam(n_elements: int, dt: float, ts, *, length=10.0, E=7.0e10
                                       outputVariableType=exu.OutputVariableType.Coordinates))
     mbs.Assemble()
 
-    settings = exu.SimulationSettings()
-    settings.timeIntegration.endTime = float(ts[-1])
-    settings.timeIntegration.numberOfSteps = int(round(ts[-1] / dt))
-    settings.timeIntegration.generalizedAlpha.spectralRadius = spectral_radius
-    settings.timeIntegration.adaptiveStep = False
-    settings.timeIntegration.newton.absoluteTolerance = 1e-6
-    settings.timeIntegration.verboseMode = 0
-    settings.solution.file.write = False
-    settings.solution.sensors.writePeriod = float(ts[1] - ts[0])
-    mbs.SolveDynamic(settings)
+    _exudyn_solve(mbs, ts, dt, spectral_radius, absolute_tolerance=1e-6)
 
     data = mbs.GetSensorStoredData(sensor)        # t, displacements (x, y, x', y') of the tip
     t = data[:, 0]
@@ -176,16 +184,7 @@ def exudyn_slider_crank(n_elements: int, dt: float, ts, *, crank=6 * 0.0254, rod
     mbs.Assemble()
 
     ts = np.asarray(ts, float)
-    settings = exu.SimulationSettings()
-    settings.timeIntegration.endTime = float(ts[-1])
-    settings.timeIntegration.numberOfSteps = int(round(ts[-1] / dt))
-    settings.timeIntegration.generalizedAlpha.spectralRadius = spectral_radius
-    settings.timeIntegration.adaptiveStep = False
-    settings.timeIntegration.newton.absoluteTolerance = 1e-8
-    settings.timeIntegration.verboseMode = 0
-    settings.solution.file.write = False
-    settings.solution.sensors.writePeriod = float(ts[1] - ts[0])
-    mbs.SolveDynamic(settings)
+    _exudyn_solve(mbs, ts, dt, spectral_radius, absolute_tolerance=1e-8)
 
     P, Q, M = (mbs.GetSensorStoredData(s) for s in sensors)
     t = P[:, 0]

@@ -7,8 +7,9 @@ spatial acceleration A and its modal accelerations u_dot.
      `ModalBody` in its frame, moved to ground components: I = X^-T M X^-1), its elastic force
      K q + D u and the geometric stiffening K_G q = G_s A + g_s (eqs 32-33, 46-47), plus what its
      children sent (their reactions stiffen the body through the attachment's second-order
-     displacement, `mbjax.flex.kinematics.grid_point`, i.e. inside G). The modal accelerations are eliminated first (eq 53's inverse of the modal
-     mass M^{B^k}, now including the children's articulated inertia):
+     displacement, `mbjax.flex.kinematics.grid_point`, i.e. inside G). The modal accelerations
+     are eliminated first (eq 53's inverse of the modal mass M^{B^k}, now including the
+     children's articulated inertia):
 
          u_dot = -Y_A A - Y_p,   [Y_A, Y_p] = IA_ff^-1 [IA_fA, pA_f - Q_f]
          I6 = IA_AA - IA_Af Y_A, p6 = pA_A - IA_Af Y_p

@@ -90,31 +90,28 @@ class FlexibleSystem(AbstractTreeSystem):
     def wrenches(self, t, q, v):
         """The bodies' external wrenches (n, 6), world frame, torque about each body's origin;
         or None (marker rows, if any, are in `applied`'s generalized forces)."""
-        f = self._external(t, q, v)
-        if f is None:
-            return None
-        return about_origins(f[:self.n], self.frames(q)[0][:self.n], self.external_point)
+        return self._loads(t, q, v)[1]
 
     def applied(self, t, q, v):
         """The control's generalized forces, plus those of the wrenches at markers."""
-        tau = super().applied(t, q, v)
-        f = self._external(t, q, v)
-        if f is None or f.shape[0] == self.n:
-            return tau
-        return tau + marker_forces(self.model, q, f[self.n:])
+        return self._loads(t, q, v)[0]
 
-    def _external(self, t, q, v):
+    def _loads(self, t, q, v):
+        """(generalized forces, body wrenches or None), `external` called once."""
+        tau = super().applied(t, q, v)
         if self.external is None:
-            return None
+            return tau, None
         f = jnp.asarray(self.external(t, q, v), v.dtype)
         if f.shape not in ((self.n, 6), (self.n_frames, 6)):
             raise ValueError(f"external returned shape {f.shape}; it must return one world-frame "
                              f"wrench (torque; force) per body, shape ({self.n}, 6), or per body "
                              f"and marker, shape ({self.n_frames}, 6)")
-        return f
+        if f.shape[0] > self.n:
+            tau = tau + marker_forces(self.model, q, f[self.n:])
+        return tau, about_origins(f[:self.n], self.frames(q)[0][:self.n], self.external_point)
 
     def responses(self, t, q, v, loads):
-        tau, f = self.applied(t, q, v), self.wrenches(t, q, v)
+        tau, f = self._loads(t, q, v)
         if self.method == "dense":
             return dense_forward_dynamics(self.model, q, v, tau, f, loads)
         return flexible_aba_responses(self.model, q, v, tau, loads, f)

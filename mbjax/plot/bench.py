@@ -167,8 +167,8 @@ def flexible_bench_figure(records: list[dict]) -> Figure:
         ax.xaxis.set_minor_formatter(NullFormatter())
         ax.grid(True, which="both", alpha=0.3)
         ax.legend(fontsize=6.5)
-    fig.text(0.01, 0.005, "run times are medians of a few calls on a shared machine: "
-             "differences under about 20 % are noise", fontsize=7, color="0.4")
+    fig.suptitle("run times are medians of a few calls on a shared machine: differences under "
+                 "about 20 % are noise", fontsize=8, color="0.4")
     return fig
 
 

@@ -101,7 +101,9 @@ def slider_crank_figure(data: dict) -> Figure:
         for sign in (1, -1):
             ax_e.axhline(sign * tolerance, color="0.5", ls="--", lw=0.8,
                          label=f"tolerance {tolerance:g} in" if sign == 1 else None)
-    ax_e.set(xlabel="t [ms]", ylabel="modal - ANCF [in]", title="(b) the history's error")
+        ax_e.set_ylim(-3 * tolerance, 3 * tolerance)     # a coarser model may leave the panel
+    ax_e.set(xlabel="t [ms]", ylabel="modal - ANCF [in]",
+             title="(b) the history's error (largest in the legend)")
     ax_e.legend(fontsize=7)
     ns = [int(n) for n in data["peaks"]]
     ax_p.plot(ns, list(data["peaks"].values()), "o-", color="#1f77b4", label="modal")
