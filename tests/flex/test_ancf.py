@@ -167,12 +167,16 @@ def test_slider_crank_stays_on_its_constraints():
 
 @pytest.mark.slow
 def test_slider_crank_periodic_and_mesh_converged():
+    """The rod's response repeats per crank revolution, and the mesh converges fast: the largest
+    difference over 0.15 s falls from 0.029 in (2 against 4 elements) to 0.0016 in (4 against 8,
+    1.1 % of the 0.142 in peak), so the 4-element rod the reproductions use is converged to about
+    0.002 in, a fifth of the modal models' 0.01 in tolerance."""
     ts = np.linspace(0.0, 0.15, 151)
-    d2 = np.asarray(slider_crank_reference(2, ts).midpoint_deflection)
-    d4 = np.asarray(slider_crank_reference(4, ts).midpoint_deflection)
+    d2, d4, d8 = (np.asarray(slider_crank_reference(n, ts).midpoint_deflection) for n in (2, 4, 8))
     peaks = np.abs(d4[1:]).reshape(3, 50).max(1)                     # per crank revolution
     assert peaks.max() < 1.5 * peaks.min()
-    assert np.max(np.abs(d4 - d2)) < 0.05 * np.max(np.abs(d4))
+    coarse, fine = np.max(np.abs(d4 - d2)), np.max(np.abs(d8 - d4))
+    assert fine < 0.02 * np.max(np.abs(d8)) and fine < coarse / 8   # measured 1.1 %, ratio 18
 
 
 @pytest.mark.slow
