@@ -61,7 +61,7 @@ CRANK_RK4_STEP = {2: 2e-5, 3: 1e-5}
 CRANK_IMPLICIT_STEPS, QUICK_CRANK_IMPLICIT_STEPS = (1e-4, 5e-5), (1e-4,)
 EXUDYN_CRANK_STEPS, QUICK_EXUDYN_CRANK_STEPS = (1e-4, 5e-5, 2e-5), (1e-4,)
 TOLERANCE = {"spin-up": 1e-3, "slider-crank": 0.01}     # m, in
-IMPLICIT = {"name": "implicit_midpoint (simplified Newton, 4 iterations)"}
+IMPLICIT_NAME = "implicit_midpoint (simplified Newton, 4 iterations)"
 
 
 def largest_step(frequencies) -> float:
@@ -100,7 +100,7 @@ def spin_up_modal(n_bending: int, stiffening: bool, dt: float, t1: float, ref, r
     tip = np.asarray(tip)
     k = int(np.nanargmin(np.where(np.isfinite(tip), tip, np.nan))) if np.any(np.isfinite(tip)) else 0
     return {**common, "scene": "spin-up", "kind": "modal", "engine": "mbjax", "model": "modal",
-            "integrator": "rk4" if integrator is None else IMPLICIT["name"],
+            "integrator": "rk4" if integrator is None else IMPLICIT_NAME,
             "n_bending": n_bending, "n_axial": 1, "n_elements": N_ELEMENTS, "stiffening": stiffening,
             "dt": dt, "duration": t1, "compile_s": timing.compile_s, "run_s": timing.run_s,
             "error": err, "nonfinite_samples": nonfinite,
@@ -136,7 +136,7 @@ def spin_up_ancf(n_elements: int, ts, common) -> tuple[dict, object]:
             ref)
 
 
-def _exudyn(scene, solve, reference, steps, repeats, base) -> list[dict]:
+def _exudyn(solve, reference, steps, repeats, base) -> list[dict]:
     if not peers.available("exudyn"):
         return [{**base, "status": "unavailable: exudyn is not installed"}]
     import exudyn
@@ -181,7 +181,7 @@ def spin_up(common, quick: bool) -> list[dict]:
 
     base = {**common, "scene": "spin-up", "kind": "peer", "engine": "exudyn",
             "model": "ObjectANCFCable2D", "n_elements": n_ref, "duration": t1}
-    records += _exudyn("spin-up", lambda dt: peers.exudyn_spin_up_beam(n_ref, dt, ts),
+    records += _exudyn(lambda dt: peers.exudyn_spin_up_beam(n_ref, dt, ts),
                        ref.tip_deflection, QUICK_EXUDYN_STEPS if quick else EXUDYN_STEPS,
                        repeats, base)
     for r in records:
@@ -216,13 +216,13 @@ def slider_crank(common, quick: bool) -> list[dict]:
             d = scene.midpoint_deflection(system, midpoint, sol.qs) / scene.INCH
             err, nonfinite = _error(d, ref)
             records.append({**base, "kind": "modal", "engine": "mbjax", "model": "modal",
-                            "integrator": "rk4" if integrator is None else IMPLICIT["name"],
+                            "integrator": "rk4" if integrator is None else IMPLICIT_NAME,
                             "n_elements": n, "stiffening": True, "dt": dt,
                             "compile_s": timing.compile_s, "run_s": timing.run_s, "error": err,
                             "nonfinite_samples": nonfinite, "status": sol.messages()[0]})
     peer = {**base, "kind": "peer", "engine": "exudyn", "model": "ObjectANCFCable2D",
             "n_elements": 4}
-    records += _exudyn("slider-crank", lambda dt: peers.exudyn_slider_crank(4, dt, ts), ref,
+    records += _exudyn(lambda dt: peers.exudyn_slider_crank(4, dt, ts), ref,
                        QUICK_EXUDYN_CRANK_STEPS if quick else EXUDYN_CRANK_STEPS, repeats, peer)
     for r in records:
         r["reference_n_elements"] = 4
