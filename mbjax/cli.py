@@ -1,8 +1,12 @@
 """The `mbjax` command: the tour of every scene, paper reproductions and benchmark suites.
 
-    mbjax tour [--out DIR] [--quick] [--scene NAME ...] [--jobs N]
+    mbjax tour [--out DIR] [--quick] [--scene NAME ...] [--jobs N]    |    mbjax tour --list
     mbjax reproduce NAME [--out DIR] [--quick]    |    mbjax reproduce --list
-    mbjax bench SUITE [--out DIR] [--quick]
+    mbjax bench SUITE [--out DIR] [--quick]       |    mbjax bench --list
+    mbjax --version
+
+Every long command shows a running clock on stderr and ends by naming the files it wrote and the
+peers it skipped (and why).
 
 Compiled programs are kept on disk between runs (`mbjax.cache`; `mbjax --no-cache ...` or
 MBJAX_NO_CACHE=1 turns that off), except by `mbjax bench`, which times the compiles. Unknown
@@ -10,7 +14,9 @@ names and bad options exit with status 2 and list the valid choices.
 """
 
 import argparse
+import inspect
 import json
+import re
 import sys
 from functools import partial
 from pathlib import Path
@@ -18,6 +24,7 @@ from pathlib import Path
 
 def _parser(reproductions, suites, scenes) -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(prog="mbjax", description=__doc__.split("\n\n")[0])
+    parser.add_argument("--version", action="version", version=_version())
     parser.add_argument("--no-cache", action="store_true",
                         help="do not keep compiled programs on disk (mbjax.cache)")
     commands = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
@@ -30,20 +37,76 @@ def _parser(reproductions, suites, scenes) -> argparse.ArgumentParser:
     tour.add_argument("--jobs", type=_positive_int, default=None, metavar="N",
                       help="scenes run at once, each in a process of its own (default: one per "
                            "core; 1: one after another in this process, for quiet timings)")
+    tour.add_argument("--list", action="store_true", help="list the scenes, one line each")
 
     rep = commands.add_parser("reproduce", help="reproduce a paper figure or table")
     rep.add_argument("name", nargs="?", choices=sorted(reproductions), metavar="NAME",
                      help=f"one of: {', '.join(sorted(reproductions))}")
-    rep.add_argument("--list", action="store_true", help="list the reproductions")
+    rep.add_argument("--list", action="store_true", help="list the reproductions, one line each")
     rep.add_argument("--out", type=Path, default=Path("mbjax-out"), help="output folder")
     rep.add_argument("--quick", action="store_true", help="fewer sample points")
 
     bench = commands.add_parser("bench", help="run a benchmark suite")
-    bench.add_argument("suite", choices=sorted(suites), metavar="SUITE",
+    bench.add_argument("suite", nargs="?", choices=sorted(suites), metavar="SUITE",
                        help=f"one of: {', '.join(sorted(suites))}")
+    bench.add_argument("--list", action="store_true", help="list the suites, one line each")
     bench.add_argument("--out", type=Path, default=Path("mbjax-out/bench"), help="output folder")
     bench.add_argument("--quick", action="store_true", help="fewer configurations")
     return parser
+
+
+def _version() -> str:
+    import platform
+
+    import jax
+
+    from mbjax import __version__
+    return f"mbjax {__version__} (jax {jax.__version__}, Python {platform.python_version()})"
+
+
+def describe(obj) -> str:
+    """The first sentence of a module's or function's docstring, without its "`mbjax ...`:"
+    prefix, on one line of at most 100 characters."""
+    doc = inspect.getdoc(sys.modules.get(obj.__module__) if inspect.isfunction(obj)
+                         and obj.__name__ in ("run", "reproduce") else obj) or ""
+    text = re.sub(r"^`mbjax [^`]*`:\s*", "", " ".join(doc.split("\n\n")[0].split()))
+    sentence = re.split(r"(?<=\.)\s(?=[A-Z(])", text)[0]
+    if len(sentence) <= 100:
+        return sentence
+    return sentence[:97].rsplit(" ", 1)[0].rstrip(",;:") + "..."
+
+
+def _listing(entries: dict) -> str:
+    width = max(len(name) for name in entries) + 2
+    return "\n".join(f"{name:{width}s}{describe(fn)}" for name, fn in sorted(entries.items()))
+
+
+def _skipped(records) -> list[str]:
+    """The peers a command skipped and why: every record (or JSON value) whose status says
+    "unavailable", "failed" or "skipped", as "engine: status"."""
+    found = []
+
+    def walk(value, where):
+        if isinstance(value, dict):
+            status = value.get("status")
+            if isinstance(status, str) and status.startswith(("unavailable", "failed", "skipped")):
+                found.append(f"{value.get('engine', value.get('peer', where))}: {status}")
+            for key, item in value.items():
+                if key != "status":
+                    walk(item, key)
+        elif isinstance(value, list):
+            for item in value:
+                walk(item, where)
+
+    walk(records, "")
+    return sorted(set(found))
+
+
+def _report(written: list[Path], records) -> None:
+    """The files a command wrote and the peers it skipped."""
+    print("wrote " + ", ".join(str(p) for p in written if p.exists()))
+    skipped = _skipped(records)
+    print("peers skipped: " + ("; ".join(skipped) if skipped else "none"))
 
 
 def _positive_int(text: str) -> int:
@@ -115,18 +178,31 @@ def main(argv=None) -> int:
         use_compilation_cache()
     if args.command == "bench" and args.suite == "throughput":
         _one_device_per_core()
+    from mbjax.progress import progress
+
     if args.command == "tour":
+        if args.list:
+            print(_listing(TOUR))
+            return 0
         _tour(args.out, args.quick, args.scene, args.jobs)
     elif args.command == "reproduce":
         if args.list:
-            print("\n".join(sorted(REPRODUCTIONS)))
+            print(_listing(REPRODUCTIONS))
             return 0
         if args.name is None:
             parser.error(f"reproduce needs a NAME, one of: {', '.join(sorted(REPRODUCTIONS))}")
-        REPRODUCTIONS[args.name](args.out, quick=args.quick)
-        print(f"wrote {args.out / (args.name + '.json')} and {args.out / (args.name + '.png')}")
+        for name in progress([args.name], 1, "mbjax reproduce"):     # a running clock
+            data = REPRODUCTIONS[name](args.out, quick=args.quick)
+        _report([args.out / f"{args.name}.json", args.out / f"{args.name}.png"], data)
     elif args.command == "bench":
-        SUITES[args.suite](args.out, quick=args.quick)
+        if args.list:
+            print(_listing(SUITES))
+            return 0
+        if args.suite is None:
+            parser.error(f"bench needs a SUITE, one of: {', '.join(sorted(SUITES))}")
+        for name in progress([args.suite], 1, "mbjax bench"):
+            records = SUITES[name](args.out, quick=args.quick)
+        _report([args.out / f"{args.suite}.jsonl", args.out / f"{args.suite}.png"], records)
     return 0
 
 

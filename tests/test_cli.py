@@ -20,7 +20,7 @@ def test_console_script_is_installed():
 
 
 @pytest.mark.parametrize("argv", [["reproduce", "nope"], ["bench", "nope"], ["frobnicate"],
-                                  ["tour", "--bogus"], ["reproduce"]])
+                                  ["tour", "--bogus"], ["reproduce"], ["bench"]])
 def test_bad_names_and_options_exit_2_with_choices(argv, capsys):
     with pytest.raises(SystemExit) as exc:
         main(argv)
@@ -36,6 +36,49 @@ def test_bad_names_and_options_exit_2_with_choices(argv, capsys):
 def test_reproduce_list(capsys):
     assert main(["reproduce", "--list"]) == 0
     assert "integrators" in capsys.readouterr().out.split()
+
+
+def test_version(capsys):
+    import jax
+
+    import mbjax
+
+    with pytest.raises(SystemExit) as exc:
+        main(["--version"])
+    assert exc.value.code == 0
+    out = capsys.readouterr().out
+    assert f"mbjax {mbjax.__version__}" in out and f"jax {jax.__version__}" in out
+
+
+@pytest.mark.parametrize("command", ["reproduce", "bench", "tour"])
+def test_list_gives_one_line_per_name_saying_what_it_does(command, capsys):
+    from mbjax.bench import SUITES
+    from mbjax.reproduce import REPRODUCTIONS
+    from mbjax.tour import TOUR
+
+    names = {"reproduce": REPRODUCTIONS, "bench": SUITES, "tour": TOUR}[command]
+    assert main([command, "--list"]) == 0
+    lines = capsys.readouterr().out.strip().splitlines()
+    assert [line.split()[0] for line in lines] == sorted(names)
+    for line in lines:
+        _, description = line.split(maxsplit=1)
+        assert 10 < len(description) <= 100 and not description.startswith("`mbjax")
+
+
+def test_a_command_names_the_files_it_wrote_and_the_peers_it_skipped(tmp_path, capsys):
+    from mbjax.cli import _report
+
+    (tmp_path / "suite.jsonl").write_text("{}")
+    records = [{"engine": "mbjax", "status": "success"},
+               {"engine": "exudyn", "status": "unavailable: exudyn is not installed"},
+               {"cells": [{"engine": "mujoco", "status": "failed: SolverError"}]}]
+    _report([tmp_path / "suite.jsonl", tmp_path / "suite.png"], records)
+    out = capsys.readouterr().out.splitlines()
+    assert out[0] == f"wrote {tmp_path / 'suite.jsonl'}"          # only what exists
+    assert out[1] == ("peers skipped: exudyn: unavailable: exudyn is not installed; "
+                      "mujoco: failed: SolverError")
+    _report([tmp_path / "suite.jsonl"], [{"engine": "mbjax", "status": "success"}])
+    assert capsys.readouterr().out.splitlines()[1] == "peers skipped: none"
 
 
 @pytest.mark.slow

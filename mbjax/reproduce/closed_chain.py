@@ -1,4 +1,5 @@
-"""`mbjax reproduce closed-chain`: seed 002 §3.3, Fig. 8, and where unstabilized integration fails.
+"""`mbjax reproduce closed-chain`: a chain with both ends fixed, its loop held by each stabilization and
+where unstabilized integration fails (seed 002 §3.3, Fig. 8).
 
 The (n/2)-body chain with both ends fixed (`mbjax.scenes.closed_chain`), simulated (RK4, 1 ms;
 1 s for n <= 44, 0.1 s above, the time then scaled to 1 s) by seed 002's O(n + m^3) route (`Stabilized()`: the O(n) recursion, m + 1

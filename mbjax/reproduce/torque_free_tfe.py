@@ -1,4 +1,5 @@
-"""`mbjax reproduce torque-free-tfe`: seed 000 §8.1, Fig. 1 a-e.
+"""`mbjax reproduce torque-free-tfe`: time finite elements on the torque-free body against its closed
+form (seed 000 §8.1, Fig. 1 a-e).
 
 The torque-free symmetric body (`mbjax.scenes.torque_free_body`: J_t / J_a = 1.875, 15 rad/s
 about the symmetry axis and 10 rad/s about a transverse one, 6 s, about 100 rad of rotation)

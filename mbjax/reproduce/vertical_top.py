@@ -1,4 +1,5 @@
-"""`mbjax reproduce vertical-top`: seed 000 Tables 1-2 and the stability boundaries of eq 7.10.
+"""`mbjax reproduce vertical-top`: the time elements' stability on a vertical top at its critical speed
+(seed 000 Tables 1-2, the boundaries of eq 7.10).
 
 The vertical top (`mbjax.scenes.vertical_top`, omega = 5/3) spins at its critical speed; each
 element's transition matrix about that steady motion (eqs 6.8, 6.12, from jacfwd of the full
