@@ -64,16 +64,18 @@ def _version() -> str:
     return f"mbjax {__version__} (jax {jax.__version__}, Python {platform.python_version()})"
 
 
-def describe(obj) -> str:
+def describe(obj, limit: int | None = 100) -> str:
     """The first sentence of a module's or function's docstring, without its "`mbjax ...`:"
-    prefix, on one line of at most 100 characters."""
+    prefix, on one line of at most `limit` characters; limit None: the whole first paragraph."""
     doc = inspect.getdoc(sys.modules.get(obj.__module__) if inspect.isfunction(obj)
                          and obj.__name__ in ("run", "reproduce") else obj) or ""
     text = re.sub(r"^`mbjax [^`]*`:\s*", "", " ".join(doc.split("\n\n")[0].split()))
+    if limit is None:
+        return text
     sentence = re.split(r"(?<=\.)\s(?=[A-Z(])", text)[0]
-    if len(sentence) <= 100:
+    if len(sentence) <= limit:
         return sentence
-    return sentence[:97].rsplit(" ", 1)[0].rstrip(",;:") + "..."
+    return sentence[:limit - 3].rsplit(" ", 1)[0].rstrip(",;:") + "..."
 
 
 def _listing(entries: dict) -> str:
@@ -132,20 +134,87 @@ def _tour(out: Path, quick: bool, scenes=None, jobs=None) -> None:
           f"{', '.join(s['figure'] for s in summary['scenes'].values())}")
 
 
+# headers in words, units in brackets (`_header`); other keys: underscores to spaces, a unit suffix
+# (_m, _rad, _s, _in, _seconds) to a bracket
+HEADERS = {
+    "seconds": "run time [s]", "compile_seconds": "compile time [s]", "dt": "step [s]",
+    "duration": "duration [s]", "status": "status", "error_estimate": "error estimate",
+    "invariant_drift": "invariant drift (relative)", "energy_drift": "energy drift (relative)",
+    "energy_error": "energy error (relative)", "peak_relative_error": "peak error (relative)",
+    "against_reference": "against the reference", "relative_difference": "relative difference",
+    "seconds_per_step": "time per step [s]", "grad_seconds": "gradient time [s]",
+    "grad_compile_seconds": "gradient compile time [s]", "n_bending": "bending modes",
+    "max_abs_diff_mujoco_rad": "max difference from MuJoCo [rad]",
+}
+UNITS = {"m": "m", "rad": "rad", "s": "s", "in": "in", "seconds": "s", "mm": "mm"}
+
+STATUS_NOTE = ("*status* is the run's own verdict: success, or inaccurate where its error estimate "
+               "or invariant drift exceeds the scene's tolerance (rtol 1e-3, atol 1e-4), or what "
+               "went wrong (non-finite, not converged, constraint violated). Whether a model "
+               "follows a reference is a column of its own. Run times are single runs on a shared "
+               "machine: differences under about 20 % are noise.")
+
+
+def _header(key: str) -> str:
+    if key in HEADERS:
+        return HEADERS[key]
+    words = key.split("_")
+    if len(words) > 1 and words[-1] in UNITS:
+        return " ".join(words[:-1]) + f" [{UNITS[words[-1]]}]"
+    return " ".join(words)
+
+
+def _cell(value) -> str:
+    if isinstance(value, bool) or value is None:
+        return "—" if value is None else ("yes" if value else "no")
+    if isinstance(value, float):
+        return f"{value:.3g}"
+    if isinstance(value, (list, tuple)):
+        return ", ".join(_cell(v) for v in value)
+    return str(value)
+
+
+def _tables(scene: dict) -> tuple[list[str], list[str]]:
+    """(tables, facts): every dict of dicts as a table of its own (one experiment each), every
+    scalar as a fact."""
+    tables, facts = [], []
+    for key, value in scene.items():
+        if key in ("figure", "wall_seconds"):
+            continue
+        if isinstance(value, dict) and value and all(isinstance(v, dict) for v in value.values()):
+            columns = list(dict.fromkeys(k for row in value.values() for k in row
+                                         if not isinstance(row[k], dict)))
+            tables += [f"**{_header(key)}**", "",
+                       "| | " + " | ".join(_header(c) for c in columns) + " |",
+                       "|---" * (len(columns) + 1) + "|"]
+            tables += [f"| {name} | " + " | ".join(_cell(row.get(c)) for c in columns) + " |"
+                       for name, row in value.items()]
+            tables.append("")
+        elif isinstance(value, dict):
+            facts += [f"{_header(key)}, {_header(k)}: {_cell(v)}" for k, v in value.items()
+                      if not isinstance(v, dict)]
+        else:
+            facts.append(f"{_header(key)}: {_cell(value)}")
+    return tables, facts
+
+
 def _summary_markdown(summary: dict) -> str:
-    lines = ["# mbjax tour" + (" (quick)" if summary["quick"] else ""), ""]
+    """`summary.md` for people: per scene, what it shows and what to look at (the scene's own
+    description, `mbjax.tour.LOOK_AT`), its figure, one table per experiment with headers in
+    words and units, its settings and results, and its wall time."""
+    from mbjax.tour import LOOK_AT, TOUR
+
+    lines = ["# mbjax tour" + (" (quick)" if summary["quick"] else ""), "", STATUS_NOTE, ""]
     for name, scene in summary["scenes"].items():
-        lines += [f"## {name}", "", f"![{name}]({scene['figure']})", ""]
-        for table, header in (("integrators", "integrator"), ("runs", "run")):
-            rows = scene.get(table, {})
-            if not rows:
-                continue
-            keys = list(next(iter(rows.values())))
-            lines += [f"| {header} | " + " | ".join(keys) + " |", "|---" * (len(keys) + 1) + "|"]
-            for name, row in rows.items():
-                cells = [f"{v:.3g}" if isinstance(v, float) else str(v) for v in row.values()]
-                lines.append(f"| {name} | " + " | ".join(cells) + " |")
-        lines += ["", f"wall time {scene['wall_seconds']:.1f} s", ""]
+        lines += [f"## {name}", "", describe(TOUR[name], limit=None) if name in TOUR else "", ""]
+        if name in LOOK_AT:
+            lines += [f"*What to look at:* {LOOK_AT[name]}", ""]
+        lines += [f"![{name}]({scene['figure']})", ""]
+        tables, facts = _tables(scene)
+        lines += tables
+        if facts:
+            lines += [f"- {fact}" for fact in facts] + [""]
+        lines += [f"wall time {scene['wall_seconds']:.1f} s (compiling, running and drawing)", ""]
     return "\n".join(lines)
 
 

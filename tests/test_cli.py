@@ -174,6 +174,9 @@ def test_tour_quick(tmp_path, group):
         assert (tmp_path / scene["figure"]).stat().st_size > 10_000
     markdown = (tmp_path / "summary.md").read_text()
     assert all(f"## {scene}" in markdown for scene in scenes)
+    # written for people: a sentence per scene on what to look at, headers in words with units
+    assert markdown.count("*What to look at:*") == len(scenes)
+    assert "_rad |" not in markdown and "seconds |" not in markdown and "run time [s]" in markdown
     TOUR_CHECKS[group](summary["scenes"])
 
 
