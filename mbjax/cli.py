@@ -130,8 +130,8 @@ def _tour(out: Path, quick: bool, scenes=None, jobs=None) -> None:
     summary = {"quick": quick, "scenes": {name: results[name] for name in names}}
     (out / "summary.json").write_text(json.dumps(summary, indent=1))
     (out / "summary.md").write_text(_summary_markdown(summary))
-    print(f"tour written to {out}/: summary.json, summary.md and "
-          f"{', '.join(s['figure'] for s in summary['scenes'].values())}")
+    files = [f for s in summary["scenes"].values() for f in (s["figure"], s.get("animation")) if f]
+    _report([out / "summary.json", out / "summary.md", *(out / f for f in files)], summary)
 
 
 # headers in words, units in brackets (`_header`); other keys: underscores to spaces, a unit suffix
@@ -179,7 +179,7 @@ def _tables(scene: dict) -> tuple[list[str], list[str]]:
     scalar as a fact."""
     tables, facts = [], []
     for key, value in scene.items():
-        if key in ("figure", "wall_seconds"):
+        if key in ("figure", "animation", "wall_seconds"):
             continue
         if isinstance(value, dict) and value and all(isinstance(v, dict) for v in value.values()):
             columns = list(dict.fromkeys(k for row in value.values() for k in row
@@ -210,6 +210,8 @@ def _summary_markdown(summary: dict) -> str:
         if name in LOOK_AT:
             lines += [f"*What to look at:* {LOOK_AT[name]}", ""]
         lines += [f"![{name}]({scene['figure']})", ""]
+        if "animation" in scene:
+            lines += [f"![{name}, the motion]({scene['animation']})", ""]
         tables, facts = _tables(scene)
         lines += tables
         if facts:

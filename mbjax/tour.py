@@ -119,7 +119,12 @@ def rigid_chain_tour(out: Path, quick: bool) -> dict:
     fig = rigid_chain_figure(snapshots, runs, f"{rc.N_LINKS}-link chain falling under gravity, "
                              f"{duration:g} s, forward dynamics \"{choose_method(model)}\"")
     fig.savefig(out / "rigid-chain.png", dpi=110)
-    return {"figure": "rigid-chain.png", "duration": duration, "method": choose_method(model),
+    frames = np.round(np.arange(0.0, duration + 1e-9, 0.02), 10)
+    motion = simulate(system, INTEGRATORS["rk4"](), q0, v0, dt=5e-3, t1=duration, saveat=frames)
+    animation = _animate(out, "rigid-chain", system, frames, motion.qs,
+                         f"{rc.N_LINKS}-link chain falling", quick)
+    return {"figure": "rigid-chain.png", "animation": animation, "duration": duration,
+            "method": choose_method(model),
             "reference_status": int(ref.status), "integrators": rows}
 
 
@@ -342,7 +347,9 @@ def controls_tour(out: Path, quick: bool) -> dict:
                           f"{scene.DT * 1e3:g} ms" + (f"; sampled control vs mujoco.rollout: "
                                                        f"{mujoco_diff:.1e} rad" if mujoco_diff is not None else ""))
     fig.savefig(out / "controls.png", dpi=110)
-    return {"figure": "controls.png", "duration": duration,
+    animation = _animate(out, "controls", TreeSystem(arm), ts, pushed.qs,
+                         "arm under a PD servo, pushed at its flange", quick)
+    return {"figure": "controls.png", "animation": animation, "duration": duration,
             "runs": {"pushed": {"peak_flange_displacement_m": float(np.abs(displacement).max()),
                                 "seconds": timing.run_s, "status": pushed.messages()[0]},
                      "sampled": {"max_abs_diff_mujoco_rad": mujoco_diff,
@@ -402,7 +409,9 @@ def models_tour(out: Path, quick: bool) -> dict:
                         np.asarray(arm.upper), np.asarray(flange), peers,
                         f"{len(arm.frame_names)} named frames; status: {fall.messages()[0]}")
     fig.savefig(out / "models.png", dpi=110)
-    return {"figure": "models.png", "frames": list(arm.frame_names),
+    animation = _animate(out, "models", TreeSystem(arm), ts, fall.qs,
+                         "the URDF arm falling unpowered", quick)
+    return {"figure": "models.png", "animation": animation, "frames": list(arm.frame_names),
             "flange_at_start_m": np.asarray(flange[0]).tolist(),
             "flange_manipulability": manipulability, "status": fall.messages()[0],
             "first_limit_exceeded_s": float(ts[first]) if np.asarray(beyond).any() else None,
@@ -430,7 +439,9 @@ def trajectory_optimisation_tour(out: Path, quick: bool) -> dict:
                        f"arm reach by iLQR: {iterations} iterations in {timing.run_s:.2f} s, "
                        f"final error {error:.1e} m ({result.messages()[0]})")
     fig.savefig(out / "trajectory-optimisation.png", dpi=110)
-    return {"figure": "trajectory-optimisation.png",
+    animation = _animate(out, "trajectory-optimisation", problem.system, ts, result.qs,
+                         "arm reach by iLQR", quick)
+    return {"figure": "trajectory-optimisation.png", "animation": animation,
             "runs": {"ilqr": {"iterations": iterations, "seconds": timing.run_s,
                               "compile_seconds": timing.compile_s, "final_error_m": error,
                               "cost": float(result.cost), "status": result.messages()[0]}}}
@@ -505,6 +516,17 @@ TOUR = {   # in the order the summary tells them
 COST = {"time-elements": 9.1, "carpal-wrist": 9.0, "closed-loops": 8.6, "flexible-bodies": 7.7,
         "controls": 6.4, "rigid-chain": 4.8, "trajectory-optimisation": 4.5, "models": 2.6,
         "torque-free-body": 2.3, "heavy-top": 1.6}
+
+
+def _animate(out: Path, name: str, system, ts, qs, title: str, quick: bool, trace=None) -> str:
+    """Write the scene's animation, `name`.gif (`mbjax.plot.animate`), of a tree system moving
+    through the saved states qs at times ts; returns the file name."""
+    from mbjax.plot.animate import frames_along, stick_animation
+
+    R, p = frames_along(system, qs)
+    stick_animation(out / f"{name}.gif", ts, R, p, system.model.topology.parents, title=title,
+                    trace=trace, frames=30 if quick else 60)
+    return f"{name}.gif"
 
 
 def run_scene(name: str, out: Path, quick: bool) -> dict:

@@ -172,6 +172,10 @@ def test_tour_quick(tmp_path, group):
     assert set(summary["scenes"]) == set(scenes)
     for scene in summary["scenes"].values():
         assert (tmp_path / scene["figure"]).stat().st_size > 10_000
+        if "animation" in scene:               # the mechanism moving, frame by frame
+            from PIL import Image
+            with Image.open(tmp_path / scene["animation"]) as gif:
+                assert gif.format == "GIF" and gif.n_frames >= 20
     markdown = (tmp_path / "summary.md").read_text()
     assert all(f"## {scene}" in markdown for scene in scenes)
     # written for people: a sentence per scene on what to look at, headers in words with units
