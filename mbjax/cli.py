@@ -60,8 +60,8 @@ def _version() -> str:
 
     import jax
 
-    from mbjax import __version__
-    return f"mbjax {__version__} (jax {jax.__version__}, Python {platform.python_version()})"
+    import mbjax
+    return f"mbjax {mbjax.__version__} (jax {jax.__version__}, Python {platform.python_version()})"
 
 
 def describe(obj, limit: int | None = 100) -> str:
