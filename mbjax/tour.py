@@ -33,18 +33,21 @@ def torque_free_body_tour(out: Path, quick: bool) -> dict:
     dt = 0.01 if quick else 0.005
     body, q0, u0 = tfb.build()
     saveat = np.linspace(0.0, tfb.DURATION, 121)
-    histories, rows = {}, {}
+    histories, rows, motions = {}, {}, {}
     for name, cls in INTEGRATORS.items():
         sol, timing = measure(partial(simulate, body, cls(), q0, u0, dt=dt, t1=tfb.DURATION,
                                       saveat=saveat, **TOLERANCE), repeats=3)
         err = np.asarray(tfb.rotation_errors(body, sol.qs, sol.ts))
         histories[name] = (np.asarray(sol.ts), err)
+        motions[name] = sol.qs
         rows[name] = {"final_error_rad": float(err[-1]), "error_estimate": float(sol.error),
                       "invariant_drift": float(sol.drift), "seconds": timing.run_s, "status": sol.messages()[0]}
     fig = error_history_figure(histories, f"torque-free body (seed 000 §8.1), dt = {dt} s: "
                                "rotation error against the closed form")
     fig.savefig(out / "torque-free-body.png", dpi=110)
-    return {"figure": "torque-free-body.png", "dt": dt, "integrators": rows}
+    animation = _animate_body(out, "torque-free-body", body, saveat, motions["rk4"],
+                              "torque-free body (RK4)", quick)
+    return {"figure": "torque-free-body.png", "animation": animation, "dt": dt, "integrators": rows}
 
 
 def heavy_top_tour(out: Path, quick: bool) -> dict:
@@ -55,7 +58,7 @@ def heavy_top_tour(out: Path, quick: bool) -> dict:
     duration = 5.0 if quick else top.DURATION
     body, q0, u0 = top.build()
     saveat = np.linspace(0.0, duration, 501)
-    runs, rows = {}, {}
+    runs, rows, motions = {}, {}, {}
     symmetry_axis = jax.jit(jax.vmap(lambda q: body.rotation_matrix(q)[:, 2]))
     for name, cls in INTEGRATORS.items():
         sol, timing = measure(partial(simulate, body, cls(), q0, u0, dt=dt, t1=duration,
@@ -63,13 +66,17 @@ def heavy_top_tour(out: Path, quick: bool) -> dict:
         rel = np.asarray(body.relative_energy_error(sol.qs, sol.us))
         axis = np.asarray(symmetry_axis(sol.qs))
         runs[name] = (np.asarray(sol.ts), axis, rel)
+        motions[name] = sol.qs
         rows[name] = {"energy_drift": float(np.max(np.abs(rel))),
                       "error_estimate": float(sol.error), "invariant_drift": float(sol.drift),
                       "seconds": timing.run_s,
                       "status": sol.messages()[0]}
     fig = heavy_top_figure(runs, f"heavy top (Simo-Wong), dt = {dt * 1e3:g} ms, {duration:g} s")
     fig.savefig(out / "heavy-top.png", dpi=110)
-    return {"figure": "heavy-top.png", "dt": dt, "duration": duration, "integrators": rows}
+    animation = _animate_body(out, "heavy-top", body, saveat, motions["rkmk4"], "heavy top (RKMK4)",
+                              quick)
+    return {"figure": "heavy-top.png", "animation": animation, "dt": dt, "duration": duration,
+            "integrators": rows}
 
 
 # Steps of the rigid chain per integrator: from visible error down to about 1e-8 rad for RK4.
@@ -195,7 +202,9 @@ def closed_loops_tour(out: Path, quick: bool) -> dict:
         drift[name] = (saveat, phi)
     fig = closed_loops_tour_figure(runs, drift, f"closed chain, 12 dof, {duration:g} s, RK4")
     fig.savefig(out / "closed-loops.png", dpi=110)
-    return {"figure": "closed-loops.png", "duration": duration,
+    animation = _animate(out, "closed-loops", chain.tree, saveat, ref.qs,
+                         "closed chain (reference solution)", quick)
+    return {"figure": "closed-loops.png", "animation": animation, "duration": duration,
             "reference_status": int(ref.status), "integrators": rows}
 
 
@@ -526,6 +535,18 @@ def _animate(out: Path, name: str, system, ts, qs, title: str, quick: bool, trac
     R, p = frames_along(system, qs)
     stick_animation(out / f"{name}.gif", ts, R, p, system.model.topology.parents, title=title,
                     trace=trace, frames=30 if quick else 60)
+    return f"{name}.gif"
+
+
+def _animate_body(out: Path, name: str, body, ts, qs, title: str, quick: bool) -> str:
+    """Write `name`.gif of a single rigid body turning: its frame's triad at the fixed point and a
+    stick along its symmetry axis (body z), whose tip leaves its path (nutation and precession)."""
+    from mbjax.plot.animate import stick_animation
+
+    R = np.asarray(jax.jit(jax.vmap(body.rotation_matrix))(qs))
+    p = np.stack([np.zeros((len(R), 3)), R[:, :, 2]], axis=1)
+    stick_animation(out / f"{name}.gif", ts, np.stack([R, R], axis=1), p, [-1, 0], title=title,
+                    trace=1, axis_length=0.4, frames=30 if quick else 60)
     return f"{name}.gif"
 
 
