@@ -212,6 +212,7 @@ FLEX_MODES, QUICK_FLEX_MODES = (1, 2, 4), (2,)
 FLEX_DURATION, QUICK_FLEX_DURATION = 10.0, 8.0
 FLEX_DT, FLEX_REFERENCE_ELEMENTS = 2e-3, 4
 FLEX_IMPLICIT_DT = 0.05
+BEAM_MAGNIFICATION = 5
 
 
 # a modal run agrees with the ANCF reference when its tip stays within this fraction of the
@@ -246,6 +247,8 @@ def flexible_bodies_tour(out: Path, quick: bool) -> dict:
             name = f"{n_bending} mode{'s' * (n_bending != 1)}, " + ("stiffened" if stiffening
                                                                     else "no stiffening")
             histories[name] = (np.asarray(ts), np.asarray(tip))
+            if stiffening:
+                motion = (n_bending, np.asarray(ts), sol.qs)
             runs.append({"n_bending": n_bending, "stiffening": stiffening, "seconds": timing.run_s})
             rows[name] = {"seconds": timing.run_s, "compile_seconds": timing.compile_s,
                           "status": sol.messages()[0]}
@@ -283,7 +286,9 @@ def flexible_bodies_tour(out: Path, quick: bool) -> dict:
                                f"Kane's spin-up beam, {duration:g} s, RK4 {FLEX_DT * 1e3:g} ms: "
                                f"modal model against the ANCF beam ({ref_seconds:.0f} s)")
     fig.savefig(out / "flexible-bodies.png", dpi=110)
-    return {"figure": "flexible-bodies.png", "duration": duration, "dt": FLEX_DT,
+    animation = _animate_beam(out, *motion, quick)
+    return {"figure": "flexible-bodies.png", "animation": animation, "duration": duration,
+            "dt": FLEX_DT,
             "reference": {"n_elements": FLEX_REFERENCE_ELEMENTS, "peak_m": ref_peak,
                           "seconds": ref_seconds},
             "runs": rows}
@@ -536,6 +541,27 @@ def _animate(out: Path, name: str, system, ts, qs, title: str, quick: bool, trac
     stick_animation(out / f"{name}.gif", ts, R, p, system.model.topology.parents, title=title,
                     trace=trace, frames=30 if quick else 60)
     return f"{name}.gif"
+
+
+def _animate_beam(out: Path, n_bending: int, ts, qs, quick: bool) -> str:
+    """Write flexible-bodies.gif: the spun beam's centreline in the hub's rotating frame seen from
+    above (21 points along it, the deformation magnified `BEAM_MAGNIFICATION` times, as the title
+    says), q = (hub angle, modal coordinates)."""
+    from mbjax.flex import shape_at
+    from mbjax.plot.animate import stick_animation
+    from mbjax.scenes import spin_up_beam as sub
+
+    structure = sub.beam(20)
+    basis = sub.modes(structure, n_bending, 1)
+    phi = np.stack([np.asarray(shape_at(structure, basis, s)[0])
+                    for s in np.linspace(0.0, sub.LENGTH, 21)])            # (21, 3, mu)
+    points = np.linspace(0.0, sub.LENGTH, 21)[:, None] * np.array([1.0, 0.0, 0.0])
+    p = points[None] + BEAM_MAGNIFICATION * np.einsum("kis,ts->tki", phi, np.asarray(qs)[:, 1:])
+    R = np.broadcast_to(np.eye(3), (*p.shape[:2], 3, 3))
+    stick_animation(out / "flexible-bodies.gif", ts, R, p, [-1, *range(20)],
+                    title=f"spin-up beam seen in the hub frame, deflection x{BEAM_MAGNIFICATION}",
+                    triads=False, frames=30 if quick else 60, view=(90, -90))
+    return "flexible-bodies.gif"
 
 
 def _animate_body(out: Path, name: str, body, ts, qs, title: str, quick: bool) -> str:

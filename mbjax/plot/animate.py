@@ -34,14 +34,17 @@ def _limits(points: np.ndarray):
 
 
 def stick_animation(path: Path, ts, R, p, parents, *, title: str = "", trace: int | None = None,
-                    axis_length: float | None = None, frames: int = 60, fps: int = 15) -> Path:
+                    axis_length: float | None = None, frames: int = 60, fps: int = 15,
+                    triads: bool = True, view: tuple[float, float] | None = None) -> Path:
     """Write a GIF of the mechanism moving.
 
     ts (T,): save times; R (T, m, 3, 3), p (T, m, 3): world poses of the m frames at each time
     (the first len(parents) are bodies; any further ones, markers or named frames, are drawn as
     triads only); parents: each body's parent (-1: the ground); trace: the frame whose origin
     leaves a path (default: the last body); axis_length: the triads' length (default: a tenth of
-    the motion's extent). At most `frames` of the saved states are drawn, evenly spaced."""
+    the motion's extent); triads=False draws the sticks alone (a beam's centreline as a chain of
+    points, say); view: the camera's (elevation, azimuth) in degrees, (90, -90) looking down on
+    the x-y plane. At most `frames` of the saved states are drawn, evenly spaced."""
     ts, R, p = np.asarray(ts), np.asarray(R), np.asarray(p)
     parents = np.asarray(parents, dtype=int)
     n = len(parents)
@@ -55,9 +58,11 @@ def stick_animation(path: Path, ts, R, p, parents, *, title: str = "", trace: in
     ax.set(xlim=limits[0], ylim=limits[1], zlim=limits[2], xlabel="x [m]", ylabel="y [m]",
            zlabel="z [m]")
     ax.set_box_aspect((1, 1, 1))
+    if view is not None:
+        ax.view_init(*view)
     sticks = [ax.plot([], [], [], "-o", color="0.25", lw=2.5, ms=3)[0] for _ in range(n)]
     triads = [[ax.plot([], [], [], color=c, lw=1.2)[0] for c in AXIS_COLORS]
-              for _ in range(p.shape[1])]
+              for _ in range(p.shape[1] if triads else 0)]
     path_line = ax.plot([], [], [], color="#9467bd", lw=1, alpha=0.7)[0]
     label = ax.set_title("")
 
