@@ -86,23 +86,24 @@ def _listing(entries: dict) -> str:
 
 
 def _skipped(records) -> list[str]:
-    """The peers a command skipped and why: every record (or JSON value) whose status says
-    "unavailable", "failed" or "skipped", as "engine: status"."""
+    """The peers a command skipped and why: every record (or JSON object) that names an engine
+    or peer other than mbjax and whose status says "unavailable", "failed" or "skipped", as
+    "engine: status"."""
     found = []
 
-    def walk(value, where):
+    def walk(value):
         if isinstance(value, dict):
-            status = value.get("status")
-            if isinstance(status, str) and status.startswith(("unavailable", "failed", "skipped")):
-                found.append(f"{value.get('engine', value.get('peer', where))}: {status}")
-            for key, item in value.items():
-                if key != "status":
-                    walk(item, key)
+            engine, status = value.get("engine", value.get("peer")), value.get("status")
+            if (isinstance(engine, str) and engine != "mbjax" and isinstance(status, str)
+                    and status.startswith(("unavailable", "failed", "skipped"))):
+                found.append(f"{engine}: {status}")
+            for item in value.values():
+                walk(item)
         elif isinstance(value, list):
             for item in value:
-                walk(item, where)
+                walk(item)
 
-    walk(records, "")
+    walk(records)
     return sorted(set(found))
 
 

@@ -532,14 +532,14 @@ COST = {"time-elements": 9.1, "carpal-wrist": 9.0, "closed-loops": 8.6, "flexibl
         "torque-free-body": 2.3, "heavy-top": 1.6}
 
 
-def _animate(out: Path, name: str, system, ts, qs, title: str, quick: bool, trace=None) -> str:
+def _animate(out: Path, name: str, system, ts, qs, title: str, quick: bool) -> str:
     """Write the scene's animation, `name`.gif (`mbjax.plot.animate`), of a tree system moving
     through the saved states qs at times ts; returns the file name."""
     from mbjax.plot.animate import frames_along, stick_animation
 
     R, p = frames_along(system, qs)
     stick_animation(out / f"{name}.gif", ts, R, p, system.model.topology.parents, title=title,
-                    trace=trace, frames=30 if quick else 60)
+                    frames=30 if quick else 60)
     return f"{name}.gif"
 
 
@@ -551,7 +551,7 @@ def _animate_beam(out: Path, n_bending: int, ts, qs, quick: bool) -> str:
     from mbjax.plot.animate import stick_animation
     from mbjax.scenes import spin_up_beam as sub
 
-    structure = sub.beam(20)
+    structure = sub.beam(sub.N_ELEMENTS)                # the mesh behind `sub.run`'s modes
     basis = sub.modes(structure, n_bending, 1)
     phi = np.stack([np.asarray(shape_at(structure, basis, s)[0])
                     for s in np.linspace(0.0, sub.LENGTH, 21)])            # (21, 3, mu)

@@ -27,6 +27,7 @@ from mbjax.model import Model
 
 LENGTH, AREA, INERTIA, E, G, MASS = 10.0, 4e-4, 2e-7, 7e10, 3e10, 12.0
 T_S, OMEGA_S, DURATION = 15.0, 6.0, 20.0
+N_ELEMENTS = 20             # the basis mesh (see `build`)
 
 
 def omega(t):
@@ -60,7 +61,7 @@ def modes(structure: Beam, n_bending: int, n_axial: int = 1) -> ModalBasis:
     return ModalBasis(full.shapes[:, cols], full.frequencies[cols], tuple(full.kinds[c] for c in cols))
 
 
-def build(n_bending: int = 4, n_axial: int = 1, n_elements: int = 20, stiffening: bool = True,
+def build(n_bending: int = 4, n_axial: int = 1, n_elements: int = N_ELEMENTS, stiffening: bool = True,
           projection: bool = False):
     """(system, q0, v0): the spun beam as a `ClosedSystem` (seed 002's route), at rest and undeformed.
     q = (hub angle, modal coordinates). The basis mesh sets the geometric stiffness's accuracy
@@ -90,7 +91,7 @@ def tip(system, qs):
     return d[:, 1], d[:, 0]
 
 
-def run(n_bending: int = 4, n_axial: int = 1, n_elements: int = 20, stiffening: bool = True,
+def run(n_bending: int = 4, n_axial: int = 1, n_elements: int = N_ELEMENTS, stiffening: bool = True,
         dt: float = 1e-3, t1: float = DURATION, every: float = 0.1, integrator=None):
     """(ts, tip transverse, tip axial, solution) of one run with RK4, or with `integrator`
     (projected onto the prescribed angle, see `build`), e.g.
