@@ -553,9 +553,9 @@ def _animate_beam(out: Path, n_bending: int, ts, qs, quick: bool) -> str:
 
     structure = sub.beam(sub.N_ELEMENTS)                # the mesh behind `sub.run`'s modes
     basis = sub.modes(structure, n_bending, 1)
-    phi = np.stack([np.asarray(shape_at(structure, basis, s)[0])
-                    for s in np.linspace(0.0, sub.LENGTH, 21)])            # (21, 3, mu)
-    points = np.linspace(0.0, sub.LENGTH, 21)[:, None] * np.array([1.0, 0.0, 0.0])
+    arc = np.linspace(0.0, sub.LENGTH, 21)
+    phi = np.asarray(jax.vmap(lambda s: shape_at(structure, basis, s)[0])(arc))   # (21, 3, mu)
+    points = arc[:, None] * np.array([1.0, 0.0, 0.0])
     p = points[None] + BEAM_MAGNIFICATION * np.einsum("kis,ts->tki", phi, np.asarray(qs)[:, 1:])
     R = np.broadcast_to(np.eye(3), (*p.shape[:2], 3, 3))
     stick_animation(out / "flexible-bodies.gif", ts, R, p, [-1, *range(20)],
