@@ -1,4 +1,4 @@
-"""Forward dynamics of rigid chains (n = 1 ... 1000): seed 002's O(n) recursion against seed 001's
+"""Forward dynamics of rigid chains (n = 1 ... 1000): Anderson 1993's O(n) recursion against Jerkovsky 1978's
 dense form, Pinocchio and MuJoCo, batched, compile time and the gradient of a rollout, in one
 process.
 

@@ -3,7 +3,7 @@
 A LAPACK solve (`jnp.linalg.solve`, `jax.scipy.linalg.cho_solve`) is a library call, which keeps
 XLA from compiling the loop around it as one function of straight-line code (`mbjax.runtime`):
 the loop then runs kernel by kernel. The blocks mbjax solves inside its loops are small (a joint's
-D of seed 002 eq 48, at most 6 x 6; the Carpal Wrist's 3 x 3 A of seed 003 eq 6.21), and for
+D of Anderson 1993 eq 48, at most 6 x 6; the Carpal Wrist's 3 x 3 A of Canfield 1997 eq 6.21), and for
 those Cholesky written out over the columns is a few dozen scalar operations that XLA fuses.
 (The flexible recursion's joint blocks are not symmetric where geometric stiffening couples the
 accelerations, so `mbjax.flex.aba` keeps a general solve.)

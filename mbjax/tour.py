@@ -27,7 +27,7 @@ def _max_abs(x) -> float:
 
 
 def torque_free_body_tour(out: Path, quick: bool) -> dict:
-    """Every integrator against the closed form of seed 000 §8.1, one step size."""
+    """Every integrator against the closed form of Borri 1990 §8.1, one step size."""
     from mbjax.plot.scenes import error_history_figure
 
     dt = 0.01 if quick else 0.005
@@ -42,7 +42,7 @@ def torque_free_body_tour(out: Path, quick: bool) -> dict:
         motions[name] = sol.qs
         rows[name] = {"final_error_rad": float(err[-1]), "error_estimate": float(sol.error),
                       "invariant_drift": float(sol.drift), "seconds": timing.run_s, "status": sol.messages()[0]}
-    fig = error_history_figure(histories, f"torque-free body (seed 000 §8.1), dt = {dt} s: "
+    fig = error_history_figure(histories, f"torque-free body (Borri 1990 §8.1), dt = {dt} s: "
                                "rotation error against the closed form")
     fig.savefig(out / "torque-free-body.png", dpi=110)
     animation = _animate_body(out, "torque-free-body", body, saveat, motions["rk4"],
@@ -136,7 +136,7 @@ def rigid_chain_tour(out: Path, quick: bool) -> dict:
 
 
 def time_elements_tour(out: Path, quick: bool) -> dict:
-    """Seed 000's time elements on a sleeping top (`mbjax reproduce top-long-run`, shortened): the
+    """Borri 1990's time elements on a sleeping top (`mbjax reproduce top-long-run`, shortened): the
     primal form of eq 4.1 grows at the rate its transition matrix predicts, the mixed form of eq
     4.9 keeps the physical tilt."""
     from mbjax.plot.tfe import top_long_run_figure
@@ -146,7 +146,7 @@ def time_elements_tour(out: Path, quick: bool) -> dict:
     runs = [tlr.run(name, form, quadrature, "steady", duration, repeats=1)
             for name, form, quadrature in tlr.FORMS if name in ("primal", "mixed")]
     data = {"scene": f"time elements: vertical top at {tlr.SPIN_RATIO:g} Omega_c, {tlr.NODES}-node "
-                     f"elements {tlr.DT:g} s between nodes, {duration:g} s (seed 000 §6-7)",
+                     f"elements {tlr.DT:g} s between nodes, {duration:g} s (Borri 1990 §6-7)",
             "physical": tlr.physical(duration), "runs": runs}
     top_long_run_figure(data).savefig(out / "time-elements.png", dpi=110)
     return {"figure": "time-elements.png", "duration": duration,
@@ -161,9 +161,9 @@ QUICK_LOOP_SYSTEMS = ("coupled, none", "coupled, projection", "O(n + m^3), none"
 
 
 def closed_loops_tour(out: Path, quick: bool) -> dict:
-    """Seed 002's closed chain (12 dof, 4 closure equations, `mbjax reproduce closed-chain` in
-    small): speed against accuracy of the coupled multipliers (seed 001) with no stabilization,
-    with Baumgarte's and with projection after every step, and of seed 002's O(n + m^3) route, the
+    """Anderson 1993's closed chain (12 dof, 4 closure equations, `mbjax reproduce closed-chain` in
+    small): speed against accuracy of the coupled multipliers (Jerkovsky 1978) with no stabilization,
+    with Baumgarte's and with projection after every step, and of Anderson 1993's O(n + m^3) route, the
     error being the largest joint-angle error after 1 s against an adaptive Dopri8 reference
     (rtol 1e-12), with the constraint residual |Phi| reached."""
     from mbjax.integrate import RK4
@@ -221,8 +221,8 @@ FLEX_AGREEMENT = 0.1
 
 
 def flexible_bodies_tour(out: Path, quick: bool) -> dict:
-    """Kane's spin-up beam (seed 002 §3.2, `mbjax reproduce spin-up-beam` in small): the modal
-    model (RK4, 2 ms, seed 002's O(n + m^3) route) with 1, 2, 4 bending modes (quick: 2), each with
+    """Kane's spin-up beam (Anderson 1993 §3.2, `mbjax reproduce spin-up-beam` in small): the modal
+    model (RK4, 2 ms, Anderson 1993's O(n + m^3) route) with 1, 2, 4 bending modes (quick: 2), each with
     and without geometric stiffening, against the geometrically nonlinear ANCF beam (4 elements):
     speed against accuracy, the error being the largest tip-deflection difference over the run.
     The window (10 s, quick 8 s) holds the peak lag (0.57 m at 6.8 s) and the unstiffened run's
@@ -295,7 +295,7 @@ def flexible_bodies_tour(out: Path, quick: bool) -> dict:
 
 
 def carpal_wrist_tour(out: Path, quick: bool) -> dict:
-    """The Carpal Wrist (seed 003 §6.4): the chapter's explicit Euler (eq 6.45) and the foundation's
+    """The Carpal Wrist (Canfield 1997 §6.4): the chapter's explicit Euler (eq 6.45) and the foundation's
     integrators (quick: RK4 only) on the torque-free tool (error against RK4 at 0.1 ms, energy drift) and on the
     servoed wrist under gravity (stable or not), against the step; the run time of each method is
     per step of the free-motion runs (all steps vmapped in one call)."""

@@ -309,7 +309,7 @@ def test_bench_rigid_quick(tmp_path):
 
 @pytest.mark.slow     # tests/tfe/test_stability checks the tables; notebook 03 prints them
 def test_reproduce_vertical_top(tmp_path):
-    """Seed 000 Tables 1-2 (the quick run's rows) to the issue's tolerances, and eq 7.10."""
+    """Borri 1990 Tables 1-2 (the quick run's rows) to the issue's tolerances, and eq 7.10."""
     assert main(["reproduce", "vertical-top", "--quick", "--out", str(tmp_path)]) == 0
     data = json.loads((tmp_path / "vertical-top.json").read_text())
     assert set(data) >= {"exact", "reduced", "stability_boundary"}
@@ -338,7 +338,7 @@ def test_reproduce_vertical_top(tmp_path):
 
 @pytest.mark.slow
 def test_reproduce_torque_free_tfe(tmp_path):
-    """Seed 000 Fig. 1 over the quick run's 2 s: the issue's keys, every case converged, errors
+    """Borri 1990 Fig. 1 over the quick run's 2 s: the issue's keys, every case converged, errors
     well below 0.2 rad, and the mixed 4-node element ahead of the primal one at every spacing;
     the accuracy status (rtol 1e-3, atol 1e-4) is inaccurate exactly where the error against
     the closed form is past 1e-3 rad, and the estimate within a factor 10 of that error."""
@@ -424,7 +424,7 @@ def test_reproduce_closed_chain(tmp_path):
     final = {name: rows[-1][1] for name, rows in data["drift"].items()}
     assert final["projection"] < 1e-10 < final["none"]
     assert final["baumgarte"] < final["none"]
-    # seed 002's epsilon-dynamics: the position feedback bounds the drift the paper's form leaves
+    # Anderson 1993's epsilon-dynamics: the position feedback bounds the drift the paper's form leaves
     assert final["epsilon=0.2,kappa=10"] < final["epsilon=0.2"] / 5
     # each run's status says what its residual shows (the closed system's tolerance is 1e-6)
     for name, check in data["drift_status"].items():
@@ -472,7 +472,7 @@ def test_reproduce_spin_up_beam(tmp_path):
 
 @pytest.mark.slow
 def test_reproduce_flexible_slider_crank(tmp_path):
-    """Seed 002 Fig. 5, quick (one crank revolution, 1 and 2 elements): the issue's keys; the
+    """Anderson 1993 Fig. 5, quick (one crank revolution, 1 and 2 elements): the issue's keys; the
     2-element rod's peak midpoint deflection within 8 % of the ANCF rod's, closer than 1
     element's, and the deflection first bows away from O (positive) as the rod is pulled."""
     assert main(["reproduce", "flexible-slider-crank", "--quick", "--out", str(tmp_path)]) == 0
@@ -485,7 +485,7 @@ def test_reproduce_flexible_slider_crank(tmp_path):
     assert all(v is not None and math.isfinite(v) for v in d)
     ref = data["reference"]["midpoint_deflection_in"]
     peak, ref_peak = max(map(abs, d)), max(map(abs, ref))
-    assert 0.05 < ref_peak < 0.3                      # inches: seed 002 Fig. 5's scale
+    assert 0.05 < ref_peak < 0.3                      # inches: Anderson 1993 Fig. 5's scale
     assert abs(peak - ref_peak) < 0.08 * ref_peak
     one = max(map(abs, data["by_elements"]["1"]))
     assert abs(peak - ref_peak) < abs(one - ref_peak)

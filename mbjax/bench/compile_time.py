@@ -1,4 +1,4 @@
-"""`mbjax bench compile`: what compiling costs a user (issue 21, target 4).
+"""`mbjax bench compile`: what compiling costs a user (its targets: a cold quick tour in 60 s, warm in 15 s, a scene in 3 s).
 
 - the tour: `mbjax tour --quick` in a fresh process with an empty persistent cache (cold), then
   again with the cache it filled (warm), and the process's wall time from start to exit; once as
@@ -24,7 +24,7 @@ from pathlib import Path
 from mbjax.timing import write_jsonl
 
 NAME = "compile"
-# issue 21's targets: seconds
+# targets, seconds
 TARGET_TOUR_COLD, TARGET_TOUR_WARM, TARGET_SCENE = 60.0, 15.0, 3.0
 
 _TOUR = """
@@ -112,7 +112,7 @@ def _tours(records: list[dict], one_at_a_time: bool) -> dict:
 
 
 def summarize(records: list[dict]) -> dict:
-    """Issue 21's compile-time targets, each met or missed: the tours as a user runs them, each
+    """The compile-time targets, each met or missed: the tours as a user runs them, each
     scene alone (one at a time, from a cold cache)."""
     tours, alone = _tours(records, False), _tours(records, True)
     targets = [{"target": "tour --quick, cold cache", "value": tours["cold"]["wall_s"],

@@ -1,11 +1,11 @@
-"""`mbjax bench flexible`: work against precision on seed 002's two flexible scenes, mbjax's modal
+"""`mbjax bench flexible`: work against precision on Anderson 1993's two flexible scenes, mbjax's modal
 bodies against geometrically nonlinear ANCF beams (mbjax's own and exudyn's), one run.
 
 Kane's spin-up beam (`mbjax.scenes.spin_up_beam`, 0-20 s; --quick 0-8 s), records with
 "scene": "spin-up":
 - mbjax's modal model: Craig-Bampton modes of a `N_ELEMENTS`-element beam (1, 4, 8 in-plane
   bending + 1 axial mode; the basis mesh sets the stiffening's accuracy, O(h^2): 10 elements
-  leave 1.2e-3 m, 20 leave 4e-4 m), geometric stiffening, the hub angle prescribed, seed 002's
+  leave 1.2e-3 m, 20 leave 4e-4 m), geometric stiffening, the hub angle prescribed, Anderson 1993's
   O(n + m^3) route. RK4 at the largest stable step (RK4's limit 2.8 / omega_max, omega_max the
   axial mode's 759 rad/s, rounded down to a whole number of steps per 0.1 s) and half of it;
   `ImplicitMidpoint(simplified=True)` (projected onto the prescribed angle) at steps far past the

@@ -1,16 +1,16 @@
 """`mbjax bench loops`: the closed-loop routes, speed against accuracy and scaling in n.
 
-- Work-precision on seed 002's closed chain (12 dof, 4 closure equations, 1 s, RK4): seed 001's
+- Work-precision on Anderson 1993's closed chain (12 dof, 4 closure equations, 1 s, RK4): Jerkovsky 1978's
   coupled multipliers (velocity form with no stabilization, with Baumgarte's (10, 10), with
-  projection after every step; the momentum form) and seed 002's O(n + m^3) route, at the steps
+  projection after every step; the momentum form) and Anderson 1993's O(n + m^3) route, at the steps
   STEPS; error = largest joint-angle error over the run against an adaptive Dopri8 reference
   (rtol 1e-12), residual = largest |Phi|.
-- Scaling (seed 002 Fig. 8): run time of 1 s of simulation (1 ms steps; above n = 44 timed over
+- Scaling (Anderson 1993 Fig. 8): run time of 1 s of simulation (1 ms steps; above n = 44 timed over
   0.1 s and scaled) for the O(n + m^3) and the dense O(n^3) routes, n = NS.
 
 Compile and run times are separate (median after warm-up). No peer engine is measured here:
 MuJoCo's equality constraints are soft (regularized), a different problem from the exact
-closures of seeds 001-002. JSON lines + PNG.
+closures of Jerkovsky 1978 and Anderson 1993. JSON lines + PNG.
 """
 
 import platform

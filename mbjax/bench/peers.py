@@ -132,7 +132,7 @@ def exudyn_spin_up_beam(n_elements: int, dt: float, ts, *, length=10.0, E=7.0e10
 def exudyn_slider_crank(n_elements: int, dt: float, ts, *, crank=6 * 0.0254, rod=12 * 0.0254,
                         diameter=0.25 * 0.0254, E=3.0e7 * 4.4482216152605 / 0.0254**2,
                         mass=0.1667 * 0.45359237, Omega=125.6, spectral_radius=0.8):
-    """Seed 002's flexible slider-crank (as `mbjax.flex.references.slider_crank_reference`) in
+    """Anderson 1993's flexible slider-crank (as `mbjax.flex.references.slider_crank_reference`) in
     exudyn: the rod as n `ObjectANCFCable2D` elements from P to Q, P's coordinates prescribed on
     the crank circle (two `CoordinateConstraint`s with offset user functions), Q's y held at 0
     (the massless slider), both slopes and Q's x free; started straight and unstrained with the

@@ -2,8 +2,8 @@
 
 One run measures, for regular n-link revolute chains (`mbjax.model.chain(n)`, float64, CPU):
 
-1. One state per call: `jit(forward_dynamics)` with method "recursive" (seed 002's O(n)
-   recursion) and "dense" (seed 001's transformation operator + Cholesky, O(n^3)), the model
+1. One state per call: `jit(forward_dynamics)` with method "recursive" (Anderson 1993's O(n)
+   recursion) and "dense" (Jerkovsky 1978's transformation operator + Cholesky, O(n^3)), the model
    passed as an argument; run time, compile time as the first call minus a typical call and,
    for the targets, as the time to lower and compile ahead of time (`lower_compile_time`).
    Extra sizes between 2 and 70 resolve the crossover where the recursion overtakes the dense
@@ -261,7 +261,7 @@ def crossover(rows: list[dict], key: str = "run_s", group: str | None = None,
 
 
 def summarize(records: list[dict], ns, common: dict) -> dict:
-    """Crossovers, scaling fits and the issue's targets. Scaling is judged on the looped times
+    """Crossovers, scaling fits and the speed targets. Scaling is judged on the looped times
     (per evaluation, no dispatch overhead); compile time on the single-call jit."""
     single = [r for r in records if r["kind"] == "forward" and r["engine"] == "mbjax"
               and r["batch"] == 0 and "run_s" in r]

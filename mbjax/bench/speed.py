@@ -1,6 +1,6 @@
 """`mbjax bench speed`: the cost users feel (one call, one trajectory, its gradient, a vmapped
 batch, compile time) on chains and real robots, mbjax against Pinocchio, jaxsim and adam in one
-run (issue 21).
+run.
 
 Robots: the regular 7- and 30-link chains (`mbjax.model.chain`, written with `to_urdf`), and from
 example-robot-data the Panda arm (7 dof, fixed base) and the Unitree G1 humanoid (floating base,
@@ -24,7 +24,7 @@ mbjax and Pinocchio only). Every library reads the same URDF; float64, CPU. Per 
 Pinocchio: `aba` per call (the C++ estimate: Python loop time minus an empty loop's) and
 `abaInParallel` per state at B = BATCH on one thread per core. `kernels` reads the compiled HLO of
 `jit(forward_dynamics)`: the kernels XLA launches per call outside the tree passes and per body
-step inside them. The summary record holds issue 21's targets met or missed.
+step inside them. The summary record holds the speed targets met or missed.
 """
 
 import re
@@ -51,7 +51,7 @@ STEPS, QUICK_STEPS = 1000, 100
 BATCH, QUICK_BATCH = 4096, 256
 MEMORY_STEPS = (256, 1024, 4096)            # horizons of `grad_memory` (powers of 2: sqrt exact)
 DT = 1e-3
-# issue 21's targets
+# targets
 TARGET_EVAL_RATIO, TARGET_CALL_S, TARGET_GRAD_RATIO = 2.0, 10e-6, 3.0
 # instructions that launch no kernel of their own
 _FREE = {"parameter", "get-tuple-element", "tuple", "constant", "bitcast"}
@@ -266,7 +266,7 @@ def run(out: Path, quick: bool = False) -> list[dict]:
 
 
 def summarize(records: list[dict], common: dict) -> dict:
-    """Issue 21's targets, each met or missed with its measured ratio."""
+    """The speed targets, each met or missed with its measured ratio."""
     rows = {(r["robot"], r["library"]): r for r in records
             if "library" in r and "skipped" not in r}
     targets = []

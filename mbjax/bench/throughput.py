@@ -1,5 +1,5 @@
 """`mbjax bench throughput`: batched forward dynamics, rollouts and rollout gradients of revolute
-chains, mbjax against Pinocchio, MuJoCo and MJX in one run (issue 8).
+chains, mbjax against Pinocchio, MuJoCo and MJX in one run.
 
 For regular n-link chains (`mbjax.model.chain(n)`, n = 7, 30, 100; float64 unless said, CPU):
 
@@ -24,7 +24,7 @@ With more than one CPU device (`mbjax bench throughput` starts one per core, `cl
 and a "vmap sharded" series (`jit(vmap(forward_dynamics))` with its batch split by
 `jax.shard_map`) split the batch over them, as the peers use one thread per core.
 
-JSON lines + PNG; the last record (kind "summary") holds the targets of issue 8, each met or
+JSON lines + PNG; the last record (kind "summary") holds the throughput targets, each met or
 missed with its ratio.
 """
 
@@ -59,7 +59,7 @@ GRAD_N, GRAD_STEPS = 7, 1000
 MEMORY_STEPS = (250, 1000, 4000)
 PEER_STATES = 256
 THREADS = os.cpu_count() or 1
-# issue 8's targets
+# targets
 TARGET_MJX_RATIO, TARGET_GRAD_RATIO, TARGET_GPU_EVALS = 10.0, 4.0, 1e8
 
 
@@ -416,7 +416,7 @@ def run(out: Path, quick: bool = False) -> list[dict]:
 
 def report(records: list[dict]) -> str:
     summary = records[-1]
-    lines = ["throughput targets (issue 8):"]
+    lines = ["throughput targets:"]
     for name, t in summary["targets"].items():
         state = {True: "met", False: "MISSED", None: "not run"}[t.get("met")]
         value = t.get("value")

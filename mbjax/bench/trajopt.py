@@ -28,7 +28,7 @@ Many targets: `N_TARGETS` flange targets 0.4 m from the start in a 30-degree con
 single problem's direction (seeded), solved by mbjax as one `jax.vmap`ped solve (every problem
 iterates until the slowest is done), by mbjax one jitted solve at a time, and by Crocoddyl in a
 Python loop (its targets changed in place). JSON lines + PNG; the last record (kind "summary")
-holds the issue's targets: the better problem's `seconds_to_tolerance` within 2x Crocoddyl's, and
+holds the targets: the better problem's `seconds_to_tolerance` within 2x Crocoddyl's, and
 the 64 targets ahead of Crocoddyl's loop.
 """
 
@@ -245,7 +245,7 @@ def many(n: int, repeats: int, common: dict, loop: bool = True) -> list[dict]:
 
 
 def summarize(records: list[dict], common: dict) -> dict:
-    """The issue's targets from the records."""
+    """The targets, met or missed, from the records."""
     out = {**common, "kind": "summary"}
     singles = {(r["problem"], r["engine"]): r for r in records
                if r["kind"] == "single" and "skipped" not in r}

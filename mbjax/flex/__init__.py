@@ -1,4 +1,4 @@
-"""Flexible bodies (seed 002): beam finite elements and Craig-Bampton modal reduction, the modal
+"""Flexible bodies (Anderson 1993): beam finite elements and Craig-Bampton modal reduction, the modal
 body's time-invariant coefficients and geometric stiffening, flexible bodies in the O(n)
 recursion, and a geometrically nonlinear ANCF beam as the independent reference."""
 

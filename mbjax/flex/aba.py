@@ -1,4 +1,4 @@
-"""O(n) forward dynamics of rigid and modal flexible bodies: seed 002 §2.3(ii)-(iii), eqs 48-86.
+"""O(n) forward dynamics of rigid and modal flexible bodies: Anderson 1993 §2.3(ii)-(iii), eqs 48-86.
 
 The three passes of `mbjax.rigid.aba`, with each body a (6 + mu)-block: its rigid frame's
 spatial acceleration A and its modal accelerations u_dot.
@@ -26,7 +26,7 @@ spatial acceleration A and its modal accelerations u_dot.
      A = A' + S q_ddot, u_dot = -Y_A A - Y_p.
 
 Like `mbjax.rigid.aba.aba_responses`, one triangularization serves any number of extra load
-columns (seed 002's unit constraint loads, eqs 101-107), which the stabilized loop route uses.
+columns (Anderson 1993's unit constraint loads, eqs 101-107), which the stabilized loop route uses.
 """
 
 import jax
@@ -128,5 +128,5 @@ def flexible_aba_responses(model: FlexibleModel, q: Array, v: Array, tau: Array,
 def flexible_aba(model: FlexibleModel, q: Array, v: Array, tau: Array,
                  f_ext: Array | None = None) -> Array:
     """v_dot (nv,) of the flexible tree at (q, v) under generalized forces tau (joint forces, then
-    modal forces), gravity and external wrenches f_ext: seed 002's O(n) recursion."""
+    modal forces), gravity and external wrenches f_ext: Anderson 1993's O(n) recursion."""
     return flexible_aba_responses(model, q, v, tau, jnp.zeros((0, model.nv), q.dtype), f_ext)[0]

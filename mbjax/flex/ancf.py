@@ -1,5 +1,5 @@
 """Planar absolute-nodal-coordinate (ANCF) beam: an independent, geometrically exact reference for
-the modal flexible bodies of seed 002 (§3.1 slider-crank, §3.2 spin-up beam, geometric stiffening
+the modal flexible bodies of Anderson 1993 (§3.1 slider-crank, §3.2 spin-up beam, geometric stiffening
 eqs 32-33).
 
 The element is the planar gradient-deficient beam of Berzeri & Shabana (J. Sound Vib. 235, 2000)
@@ -14,7 +14,7 @@ with the "elastic line" strain measures of Gerstmayr & Irschik (J. Sound Vib. 31
   kappa -> v'', so small-strain frequencies are Euler-Bernoulli's; the axial law is linear in
   the stretch (Green strain would add an artificial hardening at large stretch). |r'| - 1 couples
   transverse slopes into the axial strain (eps ~ u' + v'^2 / 2), which is the geometric
-  stiffening that seed 002 adds to modal models by eqs 32-33.
+  stiffening that Anderson 1993 adds to modal models by eqs 32-33.
 - Gauss-Legendre quadrature with `n_gauss` points per element (default 5: exact for the mass
   matrix (degree 6), and for eps and kappa, which are not polynomials, converged: the stiffness
   at the straight state is a degree-4 polynomial, exact from 3 points on).

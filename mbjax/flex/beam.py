@@ -1,4 +1,4 @@
-"""Straight 3-D beam finite elements: the structural model M x_dd + K x = 0 of seed 002 eq (9).
+"""Straight 3-D beam finite elements: the structural model M x_dd + K x = 0 of Anderson 1993 eq (9).
 
 Conventions (used by `modal`, `points` and `stiffening` too):
 
@@ -137,7 +137,7 @@ class Beam(eqx.Module):
         return 6 * np.arange(self.n_elements)[:, None] + np.arange(12)[None, :]
 
     def matrices(self):
-        """Assembled consistent mass and stiffness (M, K), each (6N, 6N), seed 002 eq (9)."""
+        """Assembled consistent mass and stiffness (M, K), each (6N, 6N), Anderson 1993 eq (9)."""
         return _matrices(self)
 
 
@@ -240,7 +240,7 @@ def element_stiffness(beam: Beam):
 def geometric_stiffness(beam: Beam, axial_force, torsion=True):
     """Assembled geometric stiffness (6N, 6N) for per-element axial forces N_e (tension positive).
 
-    Seed 002 eq (32) (Banerjee and Dickens) with only the axial prestress sigma_xx0 = N_e / A: the
+    Anderson 1993 eq (32) (Banerjee and Dickens) with only the axial prestress sigma_xx0 = N_e / A: the
     bending and shear stresses of eq (32) are dropped, the usual beam approximation, so transverse
     loads and moments do not stiffen a straight beam. Integrated over the section (centroidal axes),
     eq (32) gives N_e times the integral of uy'^2 + uz'^2 (+ (Iy + Iz)/A rx'^2 with `torsion`) over
@@ -252,7 +252,7 @@ def geometric_stiffness(beam: Beam, axial_force, torsion=True):
 
 
 def _unit_geometric_stiffness(beam: Beam, torsion=True):
-    """Element geometric stiffness (12, 12) per unit axial force, seed 002 eq (32) (see above)."""
+    """Element geometric stiffness (12, 12) per unit axial force, Anderson 1993 eq (32) (see above)."""
     xi, w = _gauss(4)
     dNt = jax.vmap(jax.jacfwd(lambda x: interpolation(beam, x)[0]))(xi) / beam.Le
     dNr = jax.vmap(jax.jacfwd(lambda x: interpolation(beam, x)[1]))(xi) / beam.Le
@@ -322,7 +322,7 @@ def _eigh_generalized(M, K):
 
 
 def eigenmodes(M, K, free, groups=None):
-    """Generalized symmetric eigenproblem of seed 002 eq (9) on the free dofs.
+    """Generalized symmetric eigenproblem of Anderson 1993 eq (9) on the free dofs.
 
     Cholesky M_ff = L L^T, then `jnp.linalg.eigh` of L^-1 K_ff L^-T. `groups` (static index arrays
     partitioning `free`, e.g. `dof_groups(free)`) splits uncoupled blocks into separate eigenproblems

@@ -1,7 +1,7 @@
-"""A modal flexible body: the time-invariant coefficients of seed 002's Appendix, and the body's
+"""A modal flexible body: the time-invariant coefficients of Anderson 1993's Appendix, and the body's
 equations of motion in its own frame.
 
-Seed 002 lumps the body's mass and rotary inertia at points P (eqs 36-42): a point at undeformed
+Anderson 1993 lumps the body's mass and rotary inertia at points P (eqs 36-42): a point at undeformed
 position rho_p (from the joint grid J, the body frame's origin) moves to
 xi_p = rho_p + phi_p q (eq 5) and turns by psi_p q (eq 8), q the modal coordinates. With
 A_p = [rho_p, phi_p] (3 x (1 + mu)) and q_bar = (1, q), every mass integral the equations need is
@@ -154,7 +154,7 @@ class ModalBody(eqx.Module):
 
     def without_stiffening(self) -> "ModalBody":
         """The same body with geometric stiffening switched off (the prematurely linearized model
-        that seed 002's introduction warns about)."""
+        that Anderson 1993's introduction warns about)."""
         return eqx.tree_at(lambda b: (b.inertial_stiffening, b.distal_stiffening), self,
                            (jnp.zeros_like(self.inertial_stiffening),
                             jnp.zeros_like(self.distal_stiffening)))

@@ -1,4 +1,4 @@
-"""From a beam finite-element model to a `ModalBody` (seed 002 §2.2 and the Appendix).
+"""From a beam finite-element model to a `ModalBody` (Anderson 1993 §2.2 and the Appendix).
 
 `beam_body` chains the structural side (`mbjax.flex.beam`, `modal`, `points`, `stiffening`):
 the reduced stiffness phi^T K phi, the mass-point cloud of the modal shapes, the 21 inertial and

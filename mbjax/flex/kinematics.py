@@ -1,4 +1,4 @@
-"""Outward kinematics of a tree of rigid and flexible bodies (seed 002 §2.3(i), eqs 5-8, 20-31).
+"""Outward kinematics of a tree of rigid and flexible bodies (Anderson 1993 §2.3(i), eqs 5-8, 20-31).
 
 As for rigid trees (`mbjax.rigid.kinematics`), spatial vectors are in ground components at the
 ground origin, so the recursions carry no frame shifts. A body attached at grid point h of a
@@ -56,7 +56,7 @@ def _parents(model: FlexibleModel) -> tuple[np.ndarray, np.ndarray]:
 
 def grid_point(rho: Array, phi: Array, psi: Array, K: Array, q: Array) -> tuple[Array, Array]:
     """(rotation vector r, origin o) of a grid point in its body's frame at modal coordinates q:
-    seed 002 eqs 5-8 (o = rho + phi q, r = psi q) plus the second-order part whose Hessian is the
+    Anderson 1993 eqs 5-8 (o = rho + phi q, r = psi q) plus the second-order part whose Hessian is the
     point's unit-load geometric stiffness K (6, mu, mu) (eq 33's K_distal: force x, y, z, then
     moment x, y, z):
 
@@ -152,7 +152,7 @@ def inverse_motion(X: Array) -> Array:
 
 def body_velocities(model: FlexibleModel, q: Array, v: Array) -> Array:
     """(n, 6 + mu): per body its frame's (omega; v) in body components and its modal rates, the
-    w of seed 002 eq 34, from the recursion's velocities (any joint type)."""
+    w of Anderson 1993 eq 34, from the recursion's velocities (any joint type)."""
     kin = flex_kinematics(model, q, v)
     Vb = jnp.einsum("kij,kj->ki", jax.vmap(inverse_motion)(kin.X), kin.V)
     return jnp.concatenate([Vb, kin.u], -1)

@@ -5,7 +5,7 @@ velocities or remainder terms: only the frame poses (`frame_poses`) and each bod
 mass (`mbjax.flex.body.mass_matrix`). The body-frame velocities come from differentiating the
 poses, omega~ = R^T R_dot, v = R^T p_dot, so
 
-    T(q, v) = sum_k w_k^T M_k(q_k) w_k / 2,  w_k = (omega_k, v_k, u_k)          (seed 002 eq 34)
+    T(q, v) = sum_k w_k^T M_k(q_k) w_k / 2,  w_k = (omega_k, v_k, u_k)          (Anderson 1993 eq 34)
     V(q)    = -g . sum_k (m_k p_k + R_k S_k q_bar_k) + sum_k q_k^T K_k q_k / 2
 
 and the residual of Lagrange's equations, d/dt dT/dv - dT/dq + dV/dq + D u + K_G q - tau, is

@@ -1,7 +1,7 @@
-"""Craig-Bampton component-mode reduction of a beam, seed 002 sec. 2.2, eqs (9)-(10): x = phi q.
+"""Craig-Bampton component-mode reduction of a beam, Anderson 1993 sec. 2.2, eqs (9)-(10): x = phi q.
 
 The body frame is clamped at the joint grid J^k (`clamped_node`), so rigid motion stays in the joint
-coordinates and the modal basis holds deformation only (seed 002 eqs (5)-(7) measure phi relative
+coordinates and the modal basis holds deformation only (Anderson 1993 eqs (5)-(7) measure phi relative
 to J^k; here phi is zero at J^k by construction). The basis columns are, in this order:
 
 - fixed-interface normal modes (J^k and all interface-node dofs held), the lowest `n_modes` or those
@@ -9,7 +9,7 @@ to J^k; here phi is zero at J^k by construction). The basis columns are, in this
 - constraint modes: static shape for a unit displacement of each free dof of each interface node,
   the other interface dofs held (Craig and Bampton 1968);
 - static-correction modes: static shape for a unit load at each free dof of each
-  `static_load_nodes` node, interface held (seed 002 sec. 2.2).
+  `static_load_nodes` node, interface held (Anderson 1993 sec. 2.2).
 
 With `orthonormalize=True` (default) the assembled basis is rotated by the eigenvectors of the
 reduced problem (phi^T K phi, phi^T M phi), so M_r = I and K_r = diag(frequencies^2), sorted
@@ -31,7 +31,7 @@ __all__ = ["ModalBasis", "craig_bampton", "reduced"]
 
 
 class ModalBasis(eqx.Module):
-    """Modal shapes phi (6N, mu) in full beam dofs (zero on held dofs), seed 002 eq (10).
+    """Modal shapes phi (6N, mu) in full beam dofs (zero on held dofs), Anderson 1993 eq (10).
 
     `frequencies` (mu,) in rad/s; `kinds` (static) is "normal", "constraint", "static" or "reduced"
     per column (see the module docstring)."""
@@ -60,7 +60,7 @@ def _nodes(name, nodes, beam, exclude=()):
 
 def craig_bampton(beam: Beam, *, clamped_node=0, interface_nodes=(), n_modes=None, cutoff=None,
                   static_load_nodes=(), planar=None, orthonormalize=True) -> ModalBasis:
-    """Craig-Bampton basis of `beam` clamped at `clamped_node` (seed 002 sec. 2.2, eq (10)).
+    """Craig-Bampton basis of `beam` clamped at `clamped_node` (Anderson 1993 sec. 2.2, eq (10)).
 
     Exactly one of `n_modes` (count of fixed-interface normal modes, 0 allowed) or `cutoff` (keep
     modes with omega <= cutoff, rad/s; needs concrete beam parameters, so use `n_modes` under
@@ -81,7 +81,7 @@ def craig_bampton(beam: Beam, *, clamped_node=0, interface_nodes=(), n_modes=Non
     if len(i) == 0:
         raise ValueError("craig_bampton: no interior dofs left for normal modes")
 
-    # fixed-interface normal modes, seed 002 eq (9) on the interior dofs
+    # fixed-interface normal modes, Anderson 1993 eq (9) on the interior dofs
     w, X = eigenmodes(M, K, i, dof_groups(i))
     if n_modes is not None:
         if isinstance(n_modes, bool) or int(n_modes) != n_modes or not 0 <= n_modes <= len(i):

@@ -1,4 +1,4 @@
-"""`FlexibleModel`: a tree of rigid and modal flexible bodies (seed 002 §2.1, Figs. 1-2).
+"""`FlexibleModel`: a tree of rigid and modal flexible bodies (Anderson 1993 §2.1, Figs. 1-2).
 
 The tree, its joints and placements and the rigid bodies' inertia are a `mbjax.model.Model`;
 the flexible bodies are `ModalBody`s that replace the inertia of theirs. A flexible body's frame is

@@ -1,8 +1,8 @@
-"""Mass-point cloud of a modal beam: the grid points P^{k,i} of seed 002 eqs (5)-(8), (36)-(42).
+"""Mass-point cloud of a modal beam: the grid points P^{k,i} of Anderson 1993 eqs (5)-(8), (36)-(42).
 
 Mass and section rotary inertia are lumped at the Gauss points of each element (the quadrature
 that defines the consistent mass matrix, `beam.element_mass`), so the time-invariant modal
-coefficients of seed 002 (e.g. eq (58): sum_i Phi^T I_1 Phi) are sums over points, and with
+coefficients of Anderson 1993 (e.g. eq (58): sum_i Phi^T I_1 Phi) are sums over points, and with
 n_gauss = 4 they reproduce phi^T M phi exactly (cubic interpolation, degree-6 integrands).
 Translational shapes phi use the element interpolation (Hermite cubic transverse, linear axial);
 rotational shapes psi are torsion (linear) and the bending section rotations (rz = duy/dx,

@@ -1,5 +1,5 @@
-"""Geometrically nonlinear ANCF references for seed 002's flexible examples (§3.1, §3.2), to
-validate the modal model with geometric stiffening (seed 002 eqs 32-33). Parameterised: nothing
+"""Geometrically nonlinear ANCF references for Anderson 1993's flexible examples (§3.1, §3.2), to
+validate the modal model with geometric stiffening (Anderson 1993 eqs 32-33). Parameterised: nothing
 here is a stored result.
 """
 
@@ -15,7 +15,7 @@ INCH = 0.0254
 
 
 def spin_up_theta(t, T_s=15.0, omega_s=6.0):
-    """Base angle of Kane's spin-up (seed 002 eq 109, here for any T_s, omega_s): the integral of
+    """Base angle of Kane's spin-up (Anderson 1993 eq 109, here for any T_s, omega_s): the integral of
     omega(t) = (omega_s / T_s) (t - (T_s / 2 pi) sin(2 pi t / T_s)) for t < T_s, omega_s after."""
     c = T_s / (2 * np.pi)
     def ramp(t):
@@ -33,7 +33,7 @@ class SpinUpResult(NamedTuple):
 def spin_up_beam_reference(n_elements=8, ts=None, *, dt=None, safety=0.5, length=10.0, E=7.0e10,
                            A=4.0e-4, I=2.0e-7, mass=12.0, T_s=15.0, omega_s=6.0,  # noqa: E741
                            free_root_stretch=True, throw: bool = False) -> SpinUpResult:
-    """Kane's spin-up beam (seed 002 §3.2, eq 109; Kane, Ryan & Banerjee 1987) as an ANCF beam in
+    """Kane's spin-up beam (Anderson 1993 §3.2, eq 109; Kane, Ryan & Banerjee 1987) as an ANCF beam in
     the x-y plane: node 0 clamped on the axis (position 0, slope (cos theta, sin theta)
     prescribed), starting straight along x at rest. ts defaults to 0 ... 20 s every 0.1 s.
     `free_root_stretch` (default): the clamp prescribes the root slope's direction only, r'(0) =
@@ -80,7 +80,7 @@ def slider_crank_reference(n_elements=4, ts=None, *, dt=None, safety=0.5, crank=
                            rod=12 * INCH, diameter=0.25 * INCH, E=3.0e7 * 4.4482216152605 / INCH**2,
                            mass=0.1667 * 0.45359237, Omega=125.6,
                            throw: bool = False) -> SliderCrankResult:
-    """Seed 002 §3.1 flexible slider-crank (SI inside, deflection reported in inches): rigid crank
+    """Anderson 1993 §3.1 flexible slider-crank (SI inside, deflection reported in inches): rigid crank
     O-P at constant Omega counter-clockwise from P(0) = (0, crank); elastic rod P-Q as an ANCF
     beam with P's position prescribed and Q's y prescribed 0 (massless slider on the x axis), both
     slopes and Q's x free. Initial state: the rigid mechanism's rod, straight and unstrained, with

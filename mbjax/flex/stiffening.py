@@ -1,4 +1,4 @@
-"""Geometric stiffening of a modal beam, seed 002 eqs (32)-(33) and Table 1 (Banerjee and Dickens).
+"""Geometric stiffening of a modal beam, Anderson 1993 eqs (32)-(33) and Table 1 (Banerjee and Dickens).
 
 The body geometric stiffness is linear in 21 temporal scalars s_q of the body's own motion and in
 the 6 load components F_h applied by each distal body (eq (33)):
@@ -28,7 +28,7 @@ _N_GAUSS = 4  # exact consistent loads for the (linear) inertial load fields on 
 
 
 def inertial_scalars(a, alpha, omega):
-    """The 21 temporal scalars s of seed 002 Table 1 from the body-frame classical acceleration a of
+    """The 21 temporal scalars s of Anderson 1993 Table 1 from the body-frame classical acceleration a of
     J^k, angular acceleration alpha and angular velocity omega:
     s = (a, alpha, w1^2, w1 w2, w1 w3, w2^2, w2 w3, w3^2, alpha, w1^2, w1 w2, w1 w3, w2^2, w2 w3, w3^2)."""
     w1, w2, w3 = omega[0], omega[1], omega[2]
@@ -48,7 +48,7 @@ def _acceleration_basis(rho):
     return jnp.stack(cols, axis=1)
 
 
-def _moment_basis(I):  # noqa: E741 (seed 002 eq 37)
+def _moment_basis(I):  # noqa: E741 (Anderson 1993 eq 37)
     """H (3, 9) with I alpha + omega x I omega = H @ s[12:21], Table 1 rows 13-21."""
     e = jnp.eye(3)
     pairs = [(0, 0), (0, 1), (0, 2), (1, 1), (1, 2), (2, 2)]
@@ -75,7 +75,7 @@ def _project(beam: Beam, basis: ModalBasis, N, torsion):
 
 @eqx.filter_jit
 def inertial_stiffening(beam: Beam, basis: ModalBasis, clamped_node=0, torsion=True):
-    """K_inertial (21, mu, mu): the inertial part of seed 002 eq (33), K_G = sum_q s_q K_inertial[q].
+    """K_inertial (21, mu, mu): the inertial part of Anderson 1993 eq (33), K_G = sum_q s_q K_inertial[q].
 
     In the body frame with origin at the clamped grid J (node `clamped_node`), a is the classical
     acceleration of J, alpha the angular acceleration and omega the angular velocity; the scalars s
@@ -106,7 +106,7 @@ def inertial_stiffening(beam: Beam, basis: ModalBasis, clamped_node=0, torsion=T
 
 
 def distal_stiffening(beam: Beam, basis: ModalBasis, nodes, clamped_node=0, torsion=True):
-    """K_distal (len(nodes), 6, mu, mu): the distal-body part of seed 002 eq (33), K_G per unit load
+    """K_distal (len(nodes), 6, mu, mu): the distal-body part of Anderson 1993 eq (33), K_G per unit load
     applied at grid node h by a distal body, components (force x, y, z, moment x, y, z) in the body
     frame, reacted at J (`clamped_node`); a load F (6,) at node h adds sum_j F_j K_distal[h, j].
     Only force x (along the beam) is nonzero in the axial-prestress approximation of eq (32)."""

@@ -1,6 +1,6 @@
 """Flexible trees as systems for `mbjax.simulate` and `mbjax.loops.ClosedSystem`.
 
-`FlexibleSystem` integrates (q, v) = (joint and modal coordinates, their rates) with seed 002's
+`FlexibleSystem` integrates (q, v) = (joint and modal coordinates, their rates) with Anderson 1993's
 O(n) recursion ("recursive", `mbjax.flex.aba`) or the dense Lagrangian route ("dense",
 `mbjax.flex.lagrange`). Closed loops and prescribed motions wrap it in
 `mbjax.loops.ClosedSystem(..., method=Stabilized())`, with cut joints at the model's markers.
@@ -35,7 +35,7 @@ class FlexibleSystem(AbstractTreeSystem):
     `external_point`, a point fixed in that frame), as in `mbjax.rigid.TreeSystem`; or one per
     frame, shape (n + markers, 6), the rows past n acting at the model's markers (torque about
     the marker's origin, the force applied there). A load at a marker on a grid point bends the
-    body and stiffens it (seed 002 eq 33, `mbjax.flex.kinematics.grid_point`), as a cut joint's
+    body and stiffens it (Anderson 1993 eq 33, `mbjax.flex.kinematics.grid_point`), as a cut joint's
     constraint load there does.
 
     Geometric stiffening adds acceleration-dependent loads, so the equations are not
@@ -69,7 +69,7 @@ class FlexibleSystem(AbstractTreeSystem):
         return jnp.concatenate([R, R_markers]), jnp.concatenate([p, p_markers])
 
     def kinetic_energy(self, q, v):
-        """T = sum_k w_k^T M_k(q_k) w_k / 2 (seed 002 eq 34), w from the recursion's velocities."""
+        """T = sum_k w_k^T M_k(q_k) w_k / 2 (Anderson 1993 eq 34), w from the recursion's velocities."""
         w = body_velocities(self.model, q, v)
         qf = self.model.split(q)[1]
         return jnp.sum(jax.vmap(body_kinetic_energy)(self.model.bodies, qf, w))

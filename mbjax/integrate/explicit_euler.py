@@ -1,4 +1,4 @@
-"""Explicit (forward) Euler, the Carpal Wrist chapter's time stepping (seed 003 eq 6.45)."""
+"""Explicit (forward) Euler, the Carpal Wrist chapter's time stepping (Canfield 1997 eq 6.45)."""
 
 import jax.numpy as jnp
 

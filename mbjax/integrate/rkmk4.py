@@ -2,8 +2,8 @@
 
 Each step integrates the local coordinate xi about the configuration q0 at the start of the step,
 xi_dot = local_rate(q0, xi, u) = dexp^-1_xi(velocity), from xi = 0, and maps back with
-q1 = retract(q0, xi1). For rotations dexp^-1 is Gamma^-T (seed 000 eqs 2.8, A.21), so this is
-RK4 on the incremental rotation vector of seed 000 §2: the configuration stays exactly on the
+q1 = retract(q0, xi1). For rotations dexp^-1 is Gamma^-T (Borri 1990 eqs 2.8, A.21), so this is
+RK4 on the incremental rotation vector of Borri 1990 §2: the configuration stays exactly on the
 rotation group and the chart never approaches the singularity of Gamma at |xi| = 2 pi.
 """
 

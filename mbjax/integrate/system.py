@@ -6,7 +6,7 @@ A system has configuration coordinates q and velocities u with
 
 q may live on a manifold (a quaternion, a rotation vector), so a system also gives a local chart
 about any configuration q0: q = retract(q0, xi) with xi in R^dim(u), xi = 0 at q0, and the rate
-xi_dot = local_rate(q0, xi, u). For rotations this is seed 000's incremental rotation vector about a
+xi_dot = local_rate(q0, xi, u). For rotations this is Borri 1990's incremental rotation vector about a
 reference configuration (§2): R = R0 exp(xi), xi_dot = Gamma(xi)^-T Omega. Euclidean systems keep the
 defaults (retract(q0, xi) = q0 + xi).
 """

@@ -4,7 +4,7 @@ An `AbstractTreeSystem` integrates (q, v): configuration coordinates q (nq) and 
 coordinates v (nv), with q_dot = q_dot(q, v) and a chart (`retract`, `local_rate`) about any q
 for quaternion joints. It gives the poses of its frames (bodies, then markers), its energy, its
 mass matrix M(q) = d^2 T / dv^2, and the O(n) response of the recursion to m unit generalized
-loads at once (seed 002 eqs 101-107: one triangularization, m + 1 force passes): what the
+loads at once (Anderson 1993 eqs 101-107: one triangularization, m + 1 force passes): what the
 O(n + m^3) loop route needs. Trees whose equations of motion are M(q) v_dot + bias(t, q, v) = 0
 with that symmetric M (`symmetric_dynamics`; rigid trees, not flexible ones, whose geometric
 stiffening adds acceleration-dependent loads) also serve the dense loop routes.
@@ -118,7 +118,7 @@ class AbstractTreeSystem(AbstractSystem):
         """(v_dot (nv,), responses (m, nv)): the accelerations under every force (gravity,
         velocity terms, elasticity, control, external wrenches), and those each row of `loads`
         (m, nv) alone produces (no gravity, velocity or applied force): the unit constraint-load
-        responses of seed 002 eqs 101-107, from one triangularization."""
+        responses of Anderson 1993 eqs 101-107, from one triangularization."""
 
     def bias(self, t: Array, q: Array, v: Array) -> Array:
         """The equations of motion as M(q) v_dot + bias(t, q, v) = 0 (`symmetric_dynamics`

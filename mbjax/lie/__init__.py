@@ -1,4 +1,4 @@
-"""Rotations: the rotation vector, its tangent map Gamma (seed 000 App. A) and quaternions.
+"""Rotations: the rotation vector, its tangent map Gamma (Borri 1990 App. A) and quaternions.
 
 Every function is exact and differentiable (to any order) at and near zero rotation.
 """

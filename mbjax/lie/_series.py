@@ -1,6 +1,6 @@
 """Even functions of the rotation angle that are exact, and exactly differentiable, at phi = 0.
 
-The coefficients of exp, Gamma and Gamma^-1 (seed 000 eqs A.3, A.17, A.21, A.23) are ratios such
+The coefficients of exp, Gamma and Gamma^-1 (Borri 1990 eqs A.3, A.17, A.21, A.23) are ratios such
 as (phi - sin phi) / phi^3 that lose all precision by cancellation near phi = 0 and are 0/0 at it.
 Each is an even function of phi, so it is evaluated as a function of phi2 = r . r: the closed form
 away from zero, its power series in phi2 below a cut-off. The closed form is fed a harmless phi2

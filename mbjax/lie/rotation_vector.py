@@ -1,4 +1,4 @@
-"""The rotation vector and its tangent map (seed 000, Appendix A).
+"""The rotation vector and its tangent map (Borri 1990, Appendix A).
 
 A rotation vector r = phi e (angle phi, unit axis e) parametrizes R = exp(r x I) (eq A.6). The
 angular velocity is spatial, omega x I = R_dot R^T (eq A.11), and is related to r_dot by
@@ -56,7 +56,7 @@ def _coefficients(r: Array):
 
 @jax.jit
 def exp(r: Array) -> Array:
-    """Rotation matrix R = exp(r x I) = I + a_o (r x I) + a_1 (r x I)^2 (seed 000 eqs A.3, A.6)."""
+    """Rotation matrix R = exp(r x I) = I + a_o (r x I) + a_1 (r x I)^2 (Borri 1990 eqs A.3, A.6)."""
     r = _inputs.rotation_vector(r, "exp")
     a_o, a_1, _ = _coefficients(r)
     K = hat(r)
@@ -74,7 +74,7 @@ def gamma(r: Array) -> Array:
 
 @jax.jit
 def gamma_inv(r: Array) -> Array:
-    """Gamma^-1 = I - (r x I)/2 + (1 - a_o / (2 a_1)) / phi^2 (r x I)^2 (seed 000 eq A.21).
+    """Gamma^-1 = I - (r x I)/2 + (1 - a_o / (2 a_1)) / phi^2 (r x I)^2 (Borri 1990 eq A.21).
 
     The paper prints a_o / (2 b_1); the consistent coefficient, which its eq A.57 uses as
     a_o / (2 b_o) with b_o = a_1, is a_o / (2 a_1) = (phi/2) cot(phi/2). Singular at
@@ -94,14 +94,14 @@ def gamma_inv(r: Array) -> Array:
 
 @jax.jit
 def det_gamma(r: Array) -> Array:
-    """det Gamma(r) = 2 (1 - cos phi) / phi^2 (seed 000 eq A.28); zero at phi = 2 pi n, n >= 1."""
+    """det Gamma(r) = 2 (1 - cos phi) / phi^2 (Borri 1990 eq A.28); zero at phi = 2 pi n, n >= 1."""
     r = _inputs.rotation_vector(r, "det_gamma")
     return 2.0 * _coefficients(r)[1]
 
 
 @jax.jit
 def rescale(r: Array) -> Array:
-    """The rescaled rotation vector r_p = r - 2 pi n e of seed 000 eq A.29.
+    """The rescaled rotation vector r_p = r - 2 pi n e of Borri 1990 eq A.29.
 
     Both describe the same rotation and Gamma(r_p) dr_p = Gamma(r) dr (eq A.36). The paper takes
     n = int(phi / 2 pi); here n is the nearest integer, which gives the principal vector

@@ -1,10 +1,10 @@
-"""Closed loops (seed 001 §VI, seed 002 §2.4): any tree closed by cut joints and prescribed
+"""Closed loops (Jerkovsky 1978 §VI, Anderson 1993 §2.4): any tree closed by cut joints and prescribed
 motions (`CutJoint`, `Coupling`, `Prescribed`), as a system for `simulate`:
 
     ClosedSystem(tree, closures, method=..., projection=False)
 
-with the loop method a strategy passed in: seed 001's coupled Lagrange multipliers with Baumgarte
-stabilization (`Coupled`), its momentum form (`Momentum`), or seed 002's O(n + m^3) route from one
+with the loop method a strategy passed in: Jerkovsky 1978's coupled Lagrange multipliers with Baumgarte
+stabilization (`Coupled`), its momentum form (`Momentum`), or Anderson 1993's O(n + m^3) route from one
 triangularization with its epsilon-dynamics (`Stabilized`). Projection onto the constraints
 after every step (differentiable, by the implicit function theorem) and of initial conditions
 (`consistent_state`), and the status flags of a run (`Status.CONSTRAINT_VIOLATED`,

@@ -1,5 +1,5 @@
 """Loop closures: cut joints and prescribed motions as holonomic constraints Phi(q, t) = 0
-(seed 001 eq 85, seed 002 eq 87).
+(Jerkovsky 1978 eq 85, Anderson 1993 eq 87).
 
 A closed chain is modelled as a spanning tree (`mbjax.model.Model`) plus cut joints. A cut joint
 ties a frame A fixed in body `body_a` to a frame B fixed in body `body_b` (or in the ground,

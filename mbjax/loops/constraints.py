@@ -1,10 +1,10 @@
-"""The constraints of a closed mechanism at position, velocity and acceleration level (seed 002
-eqs 87-88, seed 001 eq 85), all by autodiff of the holonomic residual Phi(q, t):
+"""The constraints of a closed mechanism at position, velocity and acceleration level (Anderson 1993
+eqs 87-88, Jerkovsky 1978 eq 85), all by autodiff of the holonomic residual Phi(q, t):
 
     Phi(q, t) = 0,    A(q, t) v + B(q, t) = 0,    A(q, t) v_dot + b(q, v, t) = 0,
 
 with A = dPhi/dq . dq/dv (the velocity constraint operator, (m, nv)), B = dPhi/dt and
-b = d/dt (A v + B) at fixed v, the "A_dot u + B_dot" of seed 002 eq 92. Derivatives follow q along
+b = d/dt (A v + B) at fixed v, the "A_dot u + B_dot" of Anderson 1993 eq 92. Derivatives follow q along
 q_dot = tree.q_dot(q, v), so quaternion joints need no special case.
 """
 

@@ -1,4 +1,4 @@
-"""Coupled free and constrained motion by Lagrange multipliers (seed 001 §VI, eqs 85-93, the
+"""Coupled free and constrained motion by Lagrange multipliers (Jerkovsky 1978 §VI, eqs 85-93, the
 velocity form), with optional Baumgarte stabilization.
 
 With nu = mu^-1 the inverse mass matrix, the unconstrained acceleration a_free = nu (K^a - Y)
@@ -7,7 +7,7 @@ With nu = mu^-1 the inverse mass matrix, the unconstrained acceleration a_free =
 (A nu A^t) K_c = -(A a_free + b) and eq 93 the motion v_dot = a_free + nu A^t K_c. Baumgarte's
 stabilization adds 2 alpha (A v + B) + beta^2 Phi to b, so the constraint errors obey
 e_ddot + 2 alpha e_dot + beta^2 e = 0 instead of drifting. The mass matrix is dense here
-(O(n^3)); `mbjax.loops.stabilized` is seed 002's O(n + m^3) route.
+(O(n^3)); `mbjax.loops.stabilized` is Anderson 1993's O(n + m^3) route.
 """
 
 import equinox as eqx
@@ -21,7 +21,7 @@ from mbjax.loops.multipliers import multipliers
 
 def coupled_acceleration(loops: Loops, q: Array, v: Array, t=0.0,
                          baumgarte=(0.0, 0.0)) -> tuple[Array, Array, Array]:
-    """(v_dot, K_c, rank) of seed 001 eqs 89-93 under the tree's forces; K_c are the multipliers
+    """(v_dot, K_c, rank) of Jerkovsky 1978 eqs 89-93 under the tree's forces; K_c are the multipliers
     of the rows of A, so A^t K_c is the generalized constraint force. The Baumgarte gains are
     Python floats."""
     tree = loops.tree
@@ -38,7 +38,7 @@ def coupled_acceleration(loops: Loops, q: Array, v: Array, t=0.0,
 
 
 class Coupled(AbstractLoopMethod):
-    """u = v; v_dot from the coupled Lagrange-multiplier equations (seed 001 eqs 89-93), with
+    """u = v; v_dot from the coupled Lagrange-multiplier equations (Jerkovsky 1978 eqs 89-93), with
     Baumgarte gains (alpha, beta) ((0, 0): none). Needs a tree with a symmetric mass matrix."""
 
     baumgarte: tuple = eqx.field(static=True, default=(0.0, 0.0),
@@ -55,5 +55,5 @@ class Coupled(AbstractLoopMethod):
         return coupled_acceleration(loops, q, u, t, self.baumgarte)[0]
 
     def loads(self, loops, t, q, u):
-        """The multipliers K_c (seed 001 eq 92): A^t K_c is the generalized constraint force."""
+        """The multipliers K_c (Jerkovsky 1978 eq 92): A^t K_c is the generalized constraint force."""
         return coupled_acceleration(loops, q, u, t, self.baumgarte)[1]

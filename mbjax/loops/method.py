@@ -41,6 +41,6 @@ class AbstractLoopMethod(eqx.Module):
 def require_symmetric(method: str, tree) -> None:
     """The dense routes need M(q) v_dot + bias = 0 with a symmetric M."""
     if not tree.symmetric_dynamics:
-        raise TypeError(f"{method} solves seed 001's multipliers with the symmetric mass matrix of "
+        raise TypeError(f"{method} solves Jerkovsky 1978's multipliers with the symmetric mass matrix of "
                         f"M v_dot + bias = 0; {type(tree).__name__} has none (geometric stiffening "
                         "adds acceleration-dependent loads): close its loops with Stabilized()")

@@ -1,4 +1,4 @@
-"""Seed 001's momentum formulation of a closed mechanism (eqs 95-98).
+"""Jerkovsky 1978's momentum formulation of a closed mechanism (eqs 95-98).
 
 The state is the generalized momentum G = mu v: G_dot = K^a - X + A^t K_c (eq 87), with
 X = Y - mu_dot v (eq 99), so K^a - X = -bias + mu_dot v, and the multipliers of eq 98,
@@ -15,7 +15,7 @@ from mbjax.loops.multipliers import multipliers
 
 
 def momentum_rate(loops: Loops, q: Array, G: Array, t=0.0) -> tuple[Array, Array, Array]:
-    """(G_dot, K_c, rank) of the momentum formulation, seed 001 eqs 95-98, for momenta G = mu v,
+    """(G_dot, K_c, rank) of the momentum formulation, Jerkovsky 1978 eqs 95-98, for momenta G = mu v,
     under the tree's forces."""
     tree = loops.tree
     factor = jax.scipy.linalg.cho_factor(tree.mass_matrix(q))
@@ -32,7 +32,7 @@ def momentum_rate(loops: Loops, q: Array, G: Array, t=0.0) -> tuple[Array, Array
 
 class Momentum(AbstractLoopMethod):
     """u = G = mu v, the generalized momenta; G_dot = K^a - X + A^t K_c with the multipliers of
-    seed 001 eq 98. Needs a tree with a symmetric mass matrix."""
+    Jerkovsky 1978 eq 98. Needs a tree with a symmetric mass matrix."""
 
     def validate(self, tree):
         require_symmetric("Momentum", tree)

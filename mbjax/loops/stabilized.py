@@ -1,4 +1,4 @@
-"""Seed 002's constraint stabilization on top of the O(n) recursion (§2.4, eqs 89-108).
+"""Anderson 1993's constraint stabilization on top of the O(n) recursion (§2.4, eqs 89-108).
 
 The unconstrained recursion gives eta, the accelerations with every constraint load removed
 (eq 101); the same recursion driven by unit generalized constraint loads, the rows of A, with no
@@ -11,7 +11,7 @@ flexible). The constraint loads f_c follow from A u_dot + b = 0:
 
 - epsilon = 0: (A Gamma) f_c = A eta + b, an m x m solve, O(m^3) (regularized and rank-checked
   as in `mbjax.loops.multipliers`);
-- epsilon > 0, seed 002's epsilon-dynamics (eqs 89-93): f_c is a state with
+- epsilon > 0, Anderson 1993's epsilon-dynamics (eqs 89-93): f_c is a state with
   epsilon f_c_dot + A Gamma f_c = A eta + b, which relaxes onto the algebraic value on the time
   scale epsilon / eig(A Gamma); its integral keeps A u + B - epsilon f_c constant (zero when
   f_c starts from eq 89). The velocity error is then epsilon f_c: the paper's constraints are
@@ -24,7 +24,7 @@ flexible). The constraint loads f_c follow from A u_dot + b = 0:
   and gains a slow one, 1 / kappa.
 
 Total cost O(n m + m^3) = O(n + m^3) for a fixed number of loops. Here f_c = -K_c of
-`mbjax.loops.coupled` (seed 002 counts the loads with the opposite sign).
+`mbjax.loops.coupled` (Anderson 1993 counts the loads with the opposite sign).
 """
 
 import equinox as eqx
@@ -62,7 +62,7 @@ def stabilized_acceleration(loops: Loops, q: Array, v: Array, t=0.0, f_c=None, e
 
 
 class Stabilized(AbstractLoopMethod):
-    """Seed 002's O(n + m^3) route, for rigid and flexible trees. epsilon = 0: u = v and
+    """Anderson 1993's O(n + m^3) route, for rigid and flexible trees. epsilon = 0: u = v and
     algebraic loads; epsilon > 0: u = (v, f_c), the loads integrated by eq 93, so that
     A v + B - epsilon f_c keeps its initial value all along: the velocity constraint holds to
     O(epsilon |f_c|), at the price of a stiff load equation (time constant epsilon /

@@ -1,7 +1,7 @@
 """Joint models: what each joint type contributes to the tree recursions.
 
-For joint k between its proximal body and body k, `joint_calc` gives (Featherstone's jcalc; seed
-002 eqs 21, 23, 25, 27, 29, 31 for one subjoint each):
+For joint k between its proximal body and body k, `joint_calc` gives (Featherstone's jcalc; Anderson
+1993 eqs 21, 23, 25, 27, 29, 31 for one subjoint each):
 
     R_J, p_J   orientation and origin of body k's frame in the joint frame (x_joint = R_J x_k + p_J),
     S          the motion subspace, 6 x width in body-k coordinates: V_rel = S v_k,
@@ -12,10 +12,10 @@ and `joint_rate` maps (q_k, v_k) to q_dot_k. The joint frame sits in the proxima
 placement (R_T, p_T); a revolute or prismatic axis is a unit vector in the joint frame.
 
 Types, with (nq, nv):
-    revolute   (1, 1)  rotation q about `axis` (seed 002's revolute subjoint, lambda = axis);
+    revolute   (1, 1)  rotation q about `axis` (Anderson 1993's revolute subjoint, lambda = axis);
     prismatic  (1, 1)  translation q along `axis` (the prismatic subjoint);
     universal  (2, 2)  a Hooke joint: two revolute subjoints, about `axis` then about `axis2`
-                       (seed 002 §2.3(i): a multi-DOF joint as a sequence of 1-DOF subjoints);
+                       (Anderson 1993 §2.3(i): a multi-DOF joint as a sequence of 1-DOF subjoints);
     spherical  (4, 3)  manifold coordinates: a unit quaternion (w, x, y, z); v = body angular
                        velocity;
     free       (7, 6)  floating base: origin position (3) then a unit quaternion (4);
@@ -112,7 +112,7 @@ def joint_rate(kind: str, q: Array, v: Array) -> Array:
 
 def joint_retract(kind: str, q0: Array, xi: Array) -> Array:
     """The configuration at chart point xi (in R^nv) about q0: q0 + xi for Euclidean joints; a
-    body-frame rotation increment quat0 * exp(xi) (seed 000 §2) for quaternions, and for a free
+    body-frame rotation increment quat0 * exp(xi) (Borri 1990 §2) for quaternions, and for a free
     joint also the origin moved by xi's ground-frame part."""
     if kind == "spherical":
         return quat_multiply(_unit(q0[:4]), quat_from_rotvec(xi[:3]))
@@ -124,7 +124,7 @@ def joint_retract(kind: str, q0: Array, xi: Array) -> Array:
 
 
 def joint_local_rate(kind: str, q0: Array, xi: Array, v: Array) -> Array:
-    """xi_dot for velocity v: Gamma(xi)^-T omega for the rotation increment (seed 000 eq 2.8) and
+    """xi_dot for velocity v: Gamma(xi)^-T omega for the rotation increment (Borri 1990 eq 2.8) and
     R v_origin for a free joint's origin; v itself for Euclidean joints."""
     if kind == "spherical":
         return gamma_inv(xi[:3]).T @ v[:3]

@@ -86,7 +86,7 @@ def loops_bench_figure(records: list[dict]) -> Figure:
         ax_s.loglog([r["n"] for r in rows], [r["run_s_per_simulated_s"] for r in rows], "o-",
                     label=route)
     ax_s.set(xlabel="n (tree degrees of freedom)", ylabel="run time per simulated second [s]",
-             title="(b) scaling (seed 002 Fig. 8)")
+             title="(b) scaling (Anderson 1993 Fig. 8)")
     for ax in (ax_w, ax_s):
         ax.grid(alpha=0.3, which="both")
         ax.legend(fontsize=8)

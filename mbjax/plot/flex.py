@@ -1,4 +1,4 @@
-"""Figures of the flexible bodies (seed 002 §3.1-3.2): `mbjax reproduce spin-up-beam`,
+"""Figures of the flexible bodies (Anderson 1993 §3.1-3.2): `mbjax reproduce spin-up-beam`,
 `mbjax reproduce flexible-slider-crank` and the tour's flexible-bodies scene."""
 
 import numpy as np
@@ -78,7 +78,7 @@ SLIDER_COLORS = {"1": "#ff7f0e", "2": "#2ca02c", "3": "#1f77b4"}
 
 def slider_crank_figure(data: dict) -> Figure:
     """(a) the rod's midpoint deflection against time for 1, 2, 3 beam elements and the ANCF rod
-    (seed 002 Fig. 5); (b) each model's difference from the ANCF rod over the history, with the
+    (Anderson 1993 Fig. 5); (b) each model's difference from the ANCF rod over the history, with the
     tolerance; (c) the peak |deflection| against the number of elements."""
     fig = Figure(figsize=(15, 4.6), layout="constrained")
     ax_d, ax_e, ax_p = fig.subplots(1, 3, width_ratios=(2.2, 1.6, 1))
@@ -94,7 +94,7 @@ def slider_crank_figure(data: dict) -> Figure:
               label=f"ANCF, {ref['n_elements']} elements (reference)", **REFERENCE_STYLE)
     ax_d.axhline(0.0, color="gray", lw=0.5)
     ax_d.set(xlabel="t [ms]", ylabel="midpoint deflection [in]",
-             title="(a) flexible slider-crank, 125.6 rad/s (seed 002 Fig. 5)")
+             title="(a) flexible slider-crank, 125.6 rad/s (Anderson 1993 Fig. 5)")
     ax_d.legend(fontsize=8)
     tolerance = data.get("history_tolerance_in")
     if tolerance:

@@ -1,18 +1,18 @@
-"""Figures of the closed loops (seeds 001 §VI, 002 §2.4): `mbjax reproduce closed-chain`."""
+"""Figures of the closed loops (Jerkovsky 1978 §VI, Anderson 1993 §2.4): `mbjax reproduce closed-chain`."""
 
 import numpy as np
 from matplotlib.figure import Figure
 
 
 def closed_chain_figure(data: dict) -> Figure:
-    """(a) CPU time of 1 s of simulation against n, O(n + m^3) against O(n^3) (seed 002 Fig. 8);
+    """(a) CPU time of 1 s of simulation against n, O(n + m^3) against O(n^3) (Anderson 1993 Fig. 8);
     (b) constraint drift |Phi| against time for each stabilization."""
     fig = Figure(figsize=(12, 4.6), layout="constrained")
     ax_t, ax_d = fig.subplots(1, 2)
-    ax_t.loglog(data["n"], data["recursive_s"], "o-", label="O(n + m^3): seed 002 recursion")
+    ax_t.loglog(data["n"], data["recursive_s"], "o-", label="O(n + m^3): Anderson 1993 recursion")
     ax_t.loglog(data["n"], data["dense_s"], "s--", label="O(n^3): coupled multipliers, dense mass")
     ax_t.set(xlabel="n (tree degrees of freedom)", ylabel="run time for 1 s [s]",
-             title="(a) closed chain, seed 002 Fig. 8")
+             title="(a) closed chain, Anderson 1993 Fig. 8")
     for name, rows in data["drift"].items():
         rows = np.asarray(rows)
         ax_d.semilogy(rows[1:, 0], np.maximum(rows[1:, 1], 1e-17), label=name)

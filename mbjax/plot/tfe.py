@@ -1,4 +1,4 @@
-"""Figures of the time finite elements (seed 000): `mbjax reproduce vertical-top`,
+"""Figures of the time finite elements (Borri 1990): `mbjax reproduce vertical-top`,
 `torque-free-tfe` and `top-long-run`."""
 
 import numpy as np
@@ -47,7 +47,7 @@ def vertical_top_figure(data: dict) -> Figure:
 
 
 def torque_free_figure(data: dict) -> Figure:
-    """Seed 000 Fig. 1 a-e: rotation error against time, primal and mixed, one panel per
+    """Borri 1990 Fig. 1 a-e: rotation error against time, primal and mixed, one panel per
     (nodes, spacing)."""
     panels = sorted({(c["nodes"], c["spacing"]) for c in data["cases"]}, key=lambda k: (k[1], k[0]))
     fig = Figure(figsize=(4.2 * len(panels), 4), layout="constrained")

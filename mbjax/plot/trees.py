@@ -109,12 +109,12 @@ def rigid_bench_figure(records: list[dict]) -> Figure:
 
 def tree_scaling_figure(data: dict) -> Figure:
     """CPU time of one forward-dynamics evaluation against n, log-log, with slope-1 and slope-3
-    guides (seed 002 Fig. 8)."""
+    guides (Anderson 1993 Fig. 8)."""
     fig = Figure(figsize=(7, 5.5), layout="constrained")
     ax = fig.subplots()
     ns = np.asarray(data["n"], dtype=float)
-    series = (("recursive_s", "recursive", "mbjax recursive, O(n) (seed 002)"),
-              ("dense_s", "dense", "mbjax dense, O(n^3) (seed 001 + Cholesky)"),
+    series = (("recursive_s", "recursive", "mbjax recursive, O(n) (Anderson 1993)"),
+              ("dense_s", "dense", "mbjax dense, O(n^3) (Jerkovsky 1978 + Cholesky)"),
               ("pinocchio_aba_s", "pinocchio", "Pinocchio aba (from Python)"))
     for key, color, text in series:
         if key in data:
@@ -123,7 +123,7 @@ def tree_scaling_figure(data: dict) -> Figure:
     _guide(ax, ns, ns[-1], data["dense_s"][-1], 3, color="grey", label="slope 3")
     ax.set(xlabel="degrees of freedom n (n-link revolute chain)",
            ylabel="CPU time of one evaluation [s]",
-           title="forward dynamics against n (cf. seed 002 Fig. 8)",
+           title="forward dynamics against n (cf. Anderson 1993 Fig. 8)",
            ylim=(0.3 * min(min(data[k]) for k, _, _ in series if k in data), None))
     ax.grid(True, which="both", alpha=0.3)
     ax.legend(fontsize=8)

@@ -3,7 +3,7 @@
 The seven-body mechanism of Hairer & Wanner II §VII.7 (test set problem `andrews`), built from
 mbjax bodies, revolute joints, three `point_on_line` cut joints, a spring and a motor torque
 (`mbjax.scenes.andrews_squeezer`), integrated by RK4 with the coupled Lagrange multipliers
-(`ClosedSystem` with `Coupled()`, seed 001 eqs 89-93) from the test set's initial values to t = 0.03 s, and compared
+(`ClosedSystem` with `Coupled()`, Jerkovsky 1978 eqs 89-93) from the test set's initial values to t = 0.03 s, and compared
 with the test set's reference solution (its `SOLN`, PSIDE at tolerance 1e-14).
 
 Convergence: the error against the reference for several steps dt, and the difference from the
@@ -14,7 +14,7 @@ same end state to about 1e-11, which differs from the published reference by 1.4
 Theta (1e-10 relative), the floor of the published values.
 
 Full run: dt = DT (5 us) and the study STEPS, plus the same run by projection after every step
-(`projection=True`) and by seed 002's O(n + m^3) route (`Stabilized()`);
+(`projection=True`) and by Anderson 1993's O(n + m^3) route (`Stabilized()`);
 quick: dt = QUICK_DT (10 us) and QUICK_STEPS, no second routes.
 
 JSON: {"t", "q" (beta, Theta, gamma, Phi, delta, Omega, epsilon at t), "reference", "max_abs_error",

@@ -1,4 +1,4 @@
-"""`mbjax reproduce carpal-wrist`: seed 003's time response, its stated purpose (trajectory
+"""`mbjax reproduce carpal-wrist`: Canfield 1997's time response, its stated purpose (trajectory
 synthesis), and the Newton-Euler check, on the scene `mbjax.scenes.carpal_wrist`.
 
 1. Integrators (§6.4). The chapter's scheme (eq 6.45, explicit Euler) and the foundation's

@@ -1,15 +1,15 @@
 """`mbjax reproduce closed-chain`: a chain with both ends fixed, its loop held by each stabilization and
-where unstabilized integration fails (seed 002 §3.3, Fig. 8).
+where unstabilized integration fails (Anderson 1993 §3.3, Fig. 8).
 
 The (n/2)-body chain with both ends fixed (`mbjax.scenes.closed_chain`), simulated (RK4, 1 ms;
-1 s for n <= 44, 0.1 s above, the time then scaled to 1 s) by seed 002's O(n + m^3) route (`Stabilized()`: the O(n) recursion, m + 1
+1 s for n <= 44, 0.1 s above, the time then scaled to 1 s) by Anderson 1993's O(n + m^3) route (`Stabilized()`: the O(n) recursion, m + 1
 passes) and by the coupled Lagrange multipliers with the dense mass matrix, O(n^3)
-(`Coupled()`, seed 001 eqs 89-93); run time of each after compilation (median of 3 calls), and
+(`Coupled()`, Jerkovsky 1978 eqs 89-93); run time of each after compilation (median of 3 calls), and
 the largest difference between their joint angles over the run.
 
 Then the constraint drift |Phi(q(t))| over 10 s of the 12-dof chain (1 ms steps) for no
 stabilization, Baumgarte's (alpha = beta = 10 / s), projection onto Phi = 0 and A v + B = 0
-after every step (all RK4) and seed 002's epsilon-dynamics (`EPSILONS`): the paper's form
+after every step (all RK4) and Anderson 1993's epsilon-dynamics (`EPSILONS`): the paper's form
 (loads started by eq 89), whose velocity error epsilon f_c makes Phi grow under gravity, and the
 position feedback kappa, which bounds Phi by epsilon |f_c - f_c(0)| / kappa. The load equation
 is stiff (explicit RK4 needs dt < 2.8 epsilon / max eig(A Gamma), and max eig(A Gamma) =
@@ -41,7 +41,7 @@ QUICK_NS = (4, 12, 28, 44)
 DRIFT_N = 12
 DRIFT_DURATION = 10.0
 DRIFT_DT = 1e-3
-# Seed 002's epsilon-dynamics: (epsilon, kappa, integrator). RK4 needs dt < 2.8 epsilon /
+# Anderson 1993's epsilon-dynamics: (epsilon, kappa, integrator). RK4 needs dt < 2.8 epsilon /
 # max eig(A Gamma), 267 / s here; smaller epsilon takes the A-stable implicit midpoint rule.
 EPSILONS = ((1.0, 0.0, "rk4"), (0.2, 0.0, "rk4"), (0.2, 10.0, "rk4"))
 STIFF_EPSILONS = ((0.01, 10.0, "implicit_midpoint"),)       # full run only (about 5 min)

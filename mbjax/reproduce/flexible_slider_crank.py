@@ -1,13 +1,13 @@
 """`mbjax reproduce flexible-slider-crank`: a slider-crank's flexible rod, its midpoint deflection
-against a nonlinear ANCF rod over three crank turns (seed 002 §3.1, Figs. 4-5).
+against a nonlinear ANCF rod over three crank turns (Anderson 1993 §3.1, Figs. 4-5).
 
 The slider-crank with a flexible connecting rod (`mbjax.scenes.flexible_slider_crank`: 6 in rigid
 crank at 125.6 rad/s, 12 in steel rod of 0.25 in diameter, massless slider), the rod modelled by
-1, 2 and 3 beam elements with all their in-plane modes and geometric stiffening, solved by seed
-002's O(n + m^3) route with projection, RK4; the rod's midpoint deflection from the chord PQ in
+1, 2 and 3 beam elements with all their in-plane modes and geometric stiffening, solved by Anderson
+1993's O(n + m^3) route with projection, RK4; the rod's midpoint deflection from the chord PQ in
 inches, positive away from O at t = 0, over three crank revolutions (0.15 s).
 
-The slider's constraint load stiffens the rod as a child's reaction would (seed 002 eq 33, through
+The slider's constraint load stiffens the rod as a child's reaction would (Anderson 1993 eq 33, through
 the grid point's second-order displacement, `mbjax.flex.kinematics.grid_point`): without it the
 3-element rod departed from the reference after the first revolution (0.087 in over 0.15 s against
 a 0.145 in amplitude); with it the whole history stays within `HISTORY_TOLERANCE`.

@@ -146,7 +146,7 @@ def closed(method, projection: bool):
 
 def closed_flexible(projection: bool):
     """The flexible slider-crank (driven crank, the slider at a marker of the rod, one element)
-    closed by seed 002's route, a torque on the rod's joint."""
+    closed by Anderson 1993's route, a torque on the rod's joint."""
     def loss(p, integrator):
         system0, q0, v0, _ = _slider_crank()
         model = system0.tree.model

@@ -1,6 +1,6 @@
 """`mbjax reproduce integrators`: speed against accuracy of every integrator on the single body.
 
-1. Torque-free symmetric body of seed 000 §8.1 (6 s, about 100 rad of rotation): error of the
+1. Torque-free symmetric body of Borri 1990 §8.1 (6 s, about 100 rad of rotation): error of the
    final rotation against the closed form (eqs 8.7-8.8) and run time, for each integrator over
    a range of steps: a work-precision chart and the fitted convergence orders.
 2. Heavy top of Simo and Wong (10 s): relative energy drift against the step, where explicit
@@ -139,7 +139,7 @@ def reproduce(out: Path, quick: bool = False) -> dict:
               for name in INTEGRATORS}
     top_records = heavy_top_sweep(QUICK_TOP_STEPS if quick else TOP_STEPS)
     data = {
-        "scene": "torque-free symmetric body, seed 000 §8.1: J_t/J_a = 1.875, "
+        "scene": "torque-free symmetric body, Borri 1990 §8.1: J_t/J_a = 1.875, "
                  "Omega0 = (10, 0, 15) rad/s, 6 s; error = angle of R_num R_exact^T at 6 s",
         "results": results,
         "orders": orders,

@@ -1,10 +1,10 @@
 """`mbjax reproduce spin-up-beam`: Kane's spin-up beam, the modal tip with and without geometric
-stiffening against a nonlinear ANCF beam (seed 002 §3.2, eq 109).
+stiffening against a nonlinear ANCF beam (Anderson 1993 §3.2, eq 109).
 
 The hub-clamped cantilever (L = 10 m, `mbjax.scenes.spin_up_beam`) spun up in its own plane, omega
 rising from 0 to 6 rad/s over 15 s and held; omega passes the first bending frequency (3.8 rad/s)
 at t = 8.5 s. The modal model (20 beam elements, the lowest `N_BENDING` in-plane bending modes and
-one axial mode, Craig-Bampton, clamped at the hub) is solved by seed 002's O(n + m^3) route with
+one axial mode, Craig-Bampton, clamped at the hub) is solved by Anderson 1993's O(n + m^3) route with
 RK4 (`DT`), with geometric stiffening (eqs 32-33) and without it. Without stiffening
 K - omega^2 M_yy softens and turns indefinite, and the tip runs away (about 70 m at 10 s and
 1e20 m at 20 s); with stiffening the tip lags by at most 0.57 m and settles once omega is steady.

@@ -1,4 +1,4 @@
-"""`mbjax reproduce top-long-run`: where the primal form fails and the mixed form does not (seed 000
+"""`mbjax reproduce top-long-run`: where the primal form fails and the mixed form does not (Borri 1990
 §6-8), as long runs of the vertical top.
 
 The top (`mbjax.scenes.vertical_top`) spins at Omega = 1.01 Omega_c: a sleeping top, physically

@@ -1,5 +1,5 @@
 """`mbjax reproduce torque-free-tfe`: time finite elements on the torque-free body against its closed
-form (seed 000 §8.1, Fig. 1 a-e).
+form (Borri 1990 §8.1, Fig. 1 a-e).
 
 The torque-free symmetric body (`mbjax.scenes.torque_free_body`: J_t / J_a = 1.875, 15 rad/s
 about the symmetry axis and 10 rad/s about a transverse one, 6 s, about 100 rad of rotation)
@@ -63,7 +63,7 @@ def reproduce(out: Path, quick: bool = False) -> dict:
     duration = 2.0 if quick else tfb.DURATION
     cases = [run_case(form, nodes, spacing, repeats=1 if quick else 3, duration=duration)
              for nodes, spacing in PANELS for form in FORMS]
-    data = {"scene": f"torque-free body, seed 000 §8.1, {duration:g} s; primal = eq 4.1, "
+    data = {"scene": f"torque-free body, Borri 1990 §8.1, {duration:g} s; primal = eq 4.1, "
                      f"mixed = eq 4.9, exact quadrature, {REFERENCE} reference",
             "cases": cases}
     out.mkdir(parents=True, exist_ok=True)

@@ -1,17 +1,17 @@
 """`mbjax reproduce tree-scaling`: CPU time against n for the O(n) and O(n^3) formulations.
 
-In the spirit of seed 002 Fig. 8 (§3.3), where the O(n) recursion and a conventional O(n^3)
+In the spirit of Anderson 1993 Fig. 8 (§3.3), where the O(n) recursion and a conventional O(n^3)
 Kane formulation simulate the same chain for 1 s and the CPU time is plotted against the number
 of degrees of freedom n (n = 4 ... 44, a closed (n/2)-body chain of Hooke's joints). Here: an
-open n-link revolute chain (`mbjax.model.chain(n)`, n degrees of freedom; closed loops are a later
-issue), the CPU time of one forward-dynamics evaluation, and n up to 384 so that both asymptotic
+open n-link revolute chain (`mbjax.model.chain(n)`, n degrees of freedom; closed loops are in
+`mbjax reproduce closed-chain`), the CPU time of one forward-dynamics evaluation, and n up to 384 so that both asymptotic
 slopes show. An mbjax time is that of one evaluation among many in a jitted loop
 (`mbjax.bench.rigid.looped_fn`; the median of timed loops after a compiling warm-up, over the
 evaluations per loop), as a simulation meets it, free of the per-call dispatch of a lone jitted
 call (tens of microseconds on CPU, which would hide the small-n end of the chart):
 
-- recursive_s: `forward_dynamics(..., method="recursive")`, seed 002 §2.3, O(n);
-- dense_s: `method="dense"`, seed 001's transformation operator and a Cholesky solve, O(n^3);
+- recursive_s: `forward_dynamics(..., method="recursive")`, Anderson 1993 §2.3, O(n);
+- dense_s: `method="dense"`, Jerkovsky 1978's transformation operator and a Cholesky solve, O(n^3);
 - pinocchio_aba_s (when Pinocchio is installed): `pin.aba` on the same chain loaded from
   `to_urdf`, the median of single calls from Python (so it includes under 1 us of binding).
 

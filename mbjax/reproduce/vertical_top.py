@@ -1,5 +1,5 @@
 """`mbjax reproduce vertical-top`: the time elements' stability on a vertical top at its critical speed
-(seed 000 Tables 1-2, the boundaries of eq 7.10).
+(Borri 1990 Tables 1-2, the boundaries of eq 7.10).
 
 The vertical top (`mbjax.scenes.vertical_top`, omega = 5/3) spins at its critical speed; each
 element's transition matrix about that steady motion (eqs 6.8, 6.12, from jacfwd of the full
@@ -33,7 +33,7 @@ from mbjax.tfe import Element, Mixed, PrimalUnsymmetric, make_reference, stabili
 NAME = "vertical-top"
 DTS = tuple(round(0.02 * k, 2) for k in range(1, 11))
 NODES = (2, 3, 4)
-# Tables 1 and 2 of seed 000 as printed: (real, imaginary) per node count, rows dt = 0.02 ... 0.20.
+# Tables 1 and 2 of Borri 1990 as printed: (real, imaginary) per node count, rows dt = 0.02 ... 0.20.
 PAPER = {
     "exact": {
         "2": [(1.6031e-02, 1.6663), (3.2027e-02, 1.6654), (4.7952e-02, 1.6638), (6.3772e-02, 1.6617),

@@ -1,5 +1,5 @@
-"""Rigid-body dynamics: the single rigid body, and trees by seed 002's O(n) recursion, the RNEA
-and seed 001's transformation operator (velocity and momentum forms, constraint forces)."""
+"""Rigid-body dynamics: the single rigid body, and trees by Anderson 1993's O(n) recursion, the RNEA
+and Jerkovsky 1978's transformation operator (velocity and momentum forms, constraint forces)."""
 
 from mbjax.rigid.aba import aba
 from mbjax.rigid.batched import batch_aba, batched_forward_dynamics

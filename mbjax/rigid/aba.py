@@ -1,16 +1,16 @@
-"""O(n) forward dynamics: seed 002 §2.3, rigid bodies (the articulated-body recursion).
+"""O(n) forward dynamics: Anderson 1993 §2.3, rigid bodies (the articulated-body recursion).
 
 Three tree passes, each a `lax.scan` (compile time flat in n), in ground coordinates at the ground
 origin (see `kinematics`), so no quantity changes frame on its way along the tree:
 
-(i)   outward kinematics: motion subspaces S (seed 002's partial velocities P, eq 41), velocities
+(i)   outward kinematics: motion subspaces S (Anderson 1993's partial velocities P, eq 41), velocities
       V and remainder accelerations c (eqs 20-31);
 (ii)  inward triangularization (eqs 48-50, 80-81): each body starts from its own inertia I_1 and
       remainder force F_1 = -(V x* I V) (eq 43 with no applied load); it adds its children's
       articulated inertia I_3 and force F_3 (I_2, F_2) and eliminates its own joint accelerations:
           U = I_2 P,   D = P^T U,   u = tau - P^T F_2
           I_3 = I_2 - U D^-1 U^T,   F_3 = F_2 + I_3 c + U D^-1 u
-      which its parent receives as they are (seed 002's shift S of eq 45 is the identity here);
+      which its parent receives as they are (Anderson 1993's shift S of eq 45 is the identity here);
 (iii) outward back-substitution (eqs 82-84): a' = a_parent + c, u_dot = D^-1 (u - U^T a'),
       a = a' + P u_dot. The ground's acceleration is -g, which puts gravity in every body.
 
@@ -42,7 +42,7 @@ class Factor(NamedTuple):
     """The articulated-body factorization of the mass matrix at q, step (ii)'s elimination: per
     body the motion subspace S (n, 6, w), U = I_2 S (n, 6, w) and D = S^T U (n, w, w), and for a
     floating base eliminated on its own (see `_wide_root`) its S, U, D (6 x 6, else None). It is
-    a sparse L D L^T factorization of M(q) (the triangularization of seed 002 eqs 48-50), so
+    a sparse L D L^T factorization of M(q) (the triangularization of Anderson 1993 eqs 48-50), so
     `solve` applies M(q)^-1 in two vector passes."""
 
     S: Array
@@ -130,11 +130,11 @@ def aba_responses(model: Model, q: Array, v: Array, tau: Array, loads: Array,
     """(u_dot, Gamma^T): the accelerations (nv,) under tau, gravity and the external wrenches
     f_ext (n, 6) (world frame, (torque about body k's origin; force), or None), and the
     accelerations (m, nv) that each row of `loads` (m, nv) alone produces (no gravity, no
-    velocity), the unit constraint-load responses of seed 002 eqs 101-107. An external wrench
-    enters body k's own force F_1 of step (ii) (seed 002 eq 43's applied load).
+    velocity), the unit constraint-load responses of Anderson 1993 eqs 101-107. An external wrench
+    enters body k's own force F_1 of step (ii) (Anderson 1993 eq 43's applied load).
 
     The articulated inertias (I_3, U, D) depend on q only, so one triangularization serves every
-    load: the force recursion and the back-substitution run on 1 + m columns at once (seed 002's
+    load: the force recursion and the back-substitution run on 1 + m columns at once (Anderson 1993's
     O(n + m n) for the loads)."""
     return _recursion(model, q, v, tau, loads, f_ext)[0]
 

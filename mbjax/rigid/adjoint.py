@@ -1,13 +1,13 @@
 """Derivatives of the forward dynamics through the equations of motion, not through the recursion.
 
-The accelerations u_dot = M^-1 (tau - h) of seed 002's recursion (`aba`) are the root of the
-inverse dynamics, RNEA(model, q, v, u_dot) = tau (`rnea`; seed 001 eq 55's mu_hat u_dot + h).
+The accelerations u_dot = M^-1 (tau - h) of Anderson 1993's recursion (`aba`) are the root of the
+inverse dynamics, RNEA(model, q, v, u_dot) = tau (`rnea`; Jerkovsky 1978 eq 55's mu_hat u_dot + h).
 Differentiating that identity at the solved u_dot gives every derivative of the forward dynamics:
 
     M du_dot = dtau - d_RNEA/d(model, q, v, f_ext) . (dmodel, dq, dv, df_ext)
 
 one JVP of the O(n) RNEA and one solve with the mass matrix. The solve reuses the recursion's own
-elimination: step (ii)'s articulated inertias are a sparse L D L^T factorization of M (seed 002
+elimination: step (ii)'s articulated inertias are a sparse L D L^T factorization of M (Anderson 1993
 eqs 48-50; `aba.Factor`), so M^-1 b is two vector passes (`aba.solve`), a twentieth of a
 recursion. Reverse mode transposes the rule: the adjoint lambda = M^-1 u_dot_bar (M is symmetric,
 so the solve is its own transpose), then tau_bar = lambda and

@@ -1,4 +1,4 @@
-"""Forward dynamics of many states at once: seed 002's O(n) recursion (§2.3) laid out for throughput.
+"""Forward dynamics of many states at once: Anderson 1993's O(n) recursion (§2.3) laid out for throughput.
 
 `aba` (mbjax.rigid.aba) is written for one state, in ground coordinates, with general motion
 subspaces and 6x6 blocks; `jax.vmap` of it puts the batch first and leaves XLA many tiny matrix
@@ -14,7 +14,7 @@ CPU's vector units and XLA's fusion:
   1-DOF joint's motion subspace is then a constant unit vector s, (a; 0) for a revolute joint about
   a, (0; a) for a prismatic one (joint-axis sparsity), so U = I_2 s, D = s.U and S u_dot are
   products with constants, and the remainder acceleration of eqs 29-31 is c = V x (s v);
-- the articulated inertia handed to the parent (X^T I_3 X, seed 002 eqs 45-50) in 3x3 blocks: a
+- the articulated inertia handed to the parent (X^T I_3 X, Anderson 1993 eqs 45-50) in 3x3 blocks: a
   rotation, then a shift of origin by cross products;
 - `mbjax.tree`'s passes (a carry-only scan for a chain, a scan over bodies or depth levels for a
   tree), so compile time stays flat in n;
@@ -28,7 +28,7 @@ Together the last two took `jit(vmap(forward_dynamics))` of the 7-link chain at 
 uniform in [-pi, pi)) from 1.63 to 0.60 us per state, against 0.70 for Pinocchio's
 `abaInParallel` on two threads (one A/B script, `mbjax bench throughput`'s forward records).
 
-The passes, per body k with parent p (seed 002 eqs 20-31, 48-50, 80-84):
+The passes, per body k with parent p (Anderson 1993 eqs 20-31, 48-50, 80-84):
 
     (i)   V_k = X_k V_p + s_k v_k,      c_k = V_k x (s_k v_k),      F_1 = V_k x* (I_k V_k)
     (ii)  U = I_2 s,  D = s.U,  u = tau - s.F_2,  I_3 = I_2 - U U^T / D,  F_3 = F_2 + I_3 c + U u / D;

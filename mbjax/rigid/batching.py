@@ -2,7 +2,7 @@
 
 A user batches with `jax.vmap(mbjax.forward_dynamics)`. Left to itself, vmap puts the batch axis
 in front of every 6x6 block of `aba` (mbjax.rigid.aba), many small batched matrix products per
-body; `batch_aba` (mbjax.rigid.batched) runs the same recursion of seed 002 §2.3 with the batch
+body; `batch_aba` (mbjax.rigid.batched) runs the same recursion of Anderson 1993 §2.3 with the batch
 last, as straight-line elementwise code: 7.2 -> 1.4 us per state for the 7-link chain at
 B = 4096, 0.65 since its vectorized sines and symmetric blocks (`mbjax bench speed`,
 benchmarks/README.md). `aba_vmappable` is `aba` whose vmap rule

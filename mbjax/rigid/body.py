@@ -6,7 +6,7 @@ velocity of the centre of mass. A body about a fixed point (a heavy top, or a to
 turning about its centre of mass) has no translational part.
 
 Rotation coordinates are either unit quaternions (w, x, y, z), q_dot = q * (0, Omega) / 2, or
-rotation vectors r with r_dot = Gamma(r)^-T Omega (seed 000 eqs 2.8, A.21: omega = R Omega =
+rotation vectors r with r_dot = Gamma(r)^-T Omega (Borri 1990 eqs 2.8, A.21: omega = R Omega =
 Gamma r_dot and Gamma^-1 R = Gamma^-T by eq A.24), rescaled to |r| <= pi after each step
 (eq A.29).
 """
@@ -143,7 +143,7 @@ class RigidBody(AbstractSystem):
         return rot if self.fixed_point else jnp.concatenate([rot, q0[self.n_rot:] + xi[3:]])
 
     def local_rate(self, q0, xi, u):
-        """xi_dot = Gamma(xi)^-T Omega, the body-frame dexp^-1 (seed 000 eq 2.8)."""
+        """xi_dot = Gamma(xi)^-T Omega, the body-frame dexp^-1 (Borri 1990 eq 2.8)."""
         xi_dot = lie.gamma_inv(xi[:3]).T @ u[:3]
         return xi_dot if self.fixed_point else jnp.concatenate([xi_dot, u[3:]])
 

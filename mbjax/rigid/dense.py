@@ -1,4 +1,4 @@
-"""Forward dynamics in seed 001's velocity formulation, dense: eq 74 solved by Cholesky.
+"""Forward dynamics in Jerkovsky 1978's velocity formulation, dense: eq 74 solved by Cholesky.
 
     mu_hat_ff sigma_hat_f_dot + Y_hat_f = K_hat_f                       (eq 74, sigma_hat_c = 0)
     Y_hat_f = A_hat_f^T A^T (Y + mu (A_dot sigma_bar + A A_hat_f_dot sigma_hat_f))   (eq 63)

@@ -1,7 +1,7 @@
 """The public dynamics of a tree: `forward_dynamics`, `inverse_dynamics`, `mass_matrix`.
 
-`forward_dynamics(..., method=...)` runs either seed 002's O(n) recursion ("recursive") or seed
-001's transformation operator with a Cholesky solve ("dense", O(n^3)); "auto" picks the cheaper
+`forward_dynamics(..., method=...)` runs either Anderson 1993's O(n) recursion ("recursive") or Jerkovsky
+1978's transformation operator with a Cholesky solve ("dense", O(n^3)); "auto" picks the cheaper
 for the model's size from the crossover measured by `mbjax bench rigid` (below it the dense form's
 few array operations match the recursion's n sequential steps; above it O(n) wins, by 70x at
 n = 300 in a loop).
@@ -80,7 +80,7 @@ def _primal(model: Model, q: Array, v: Array, tau: Array, f_ext: Array | None) -
     return aba(model, q, v, tau, f_ext)
 
 
-# seed 002's recursion, differentiated through the equations of motion (mbjax.rigid.adjoint):
+# Anderson 1993's recursion, differentiated through the equations of motion (mbjax.rigid.adjoint):
 # jax.grad of a 1000-step rollout of the 7-link chain costs 3x the rollout instead of 6x
 recursive_forward_dynamics = with_adjoint(_primal)
 
@@ -96,6 +96,6 @@ def inverse_dynamics(model: Model, q: Array, q_dot: Array, q_ddot: Array,
 
 @jax.jit
 def mass_matrix(model: Model, q: Array) -> Array:
-    """The generalized mass matrix mu_hat_ff (seed 001 eq 55), nv x nv."""
+    """The generalized mass matrix mu_hat_ff (Jerkovsky 1978 eq 55), nv x nv."""
     _check(model, q=q)
     return _mass_matrix(model, q)

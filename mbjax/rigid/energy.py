@@ -1,6 +1,6 @@
 """Kinetic and potential energy and the momentum of a tree.
 
-T = 1/2 sigma^T mu sigma (seed 001 eq 10), summed body by body from the recursive velocities
+T = 1/2 sigma^T mu sigma (Jerkovsky 1978 eq 10), summed body by body from the recursive velocities
 (O(n)); V = -sum_k M_k g . c_k; the momentum is the sum of the bodies' (angular about the
 ground origin; linear) momenta, ground frame.
 """

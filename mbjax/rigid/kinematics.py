@@ -1,6 +1,6 @@
-"""Outward kinematics of a tree (seed 002 §2.3 step (i), eqs 20-31 for rigid bodies).
+"""Outward kinematics of a tree (Anderson 1993 §2.3 step (i), eqs 20-31 for rigid bodies).
 
-Seed 002 writes its recursions with vectors and dyadics, free of any frame; mbjax evaluates them in
+Anderson 1993 writes its recursions with vectors and dyadics, free of any frame; mbjax evaluates them in
 ground-frame components, with 6-D spatial vectors (angular; linear) taken at the ground origin.
 Then the recursions need no frame changes at all:
 
@@ -47,7 +47,7 @@ def forward_kinematics(model: Model, q: Array) -> tuple[Array, Array]:
     Its derivative in q is written out (for the joints `fixed_in_body` accepts): moving the
     coordinates along dq moves body k rigidly by the twist xi_k, the sum of the joints' twists
     S_j e_j over k's path from the ground (ground frame at the ground origin; e_j the joint's
-    increments along its columns, dq_j itself for a hinge), xi = pi (S e) with seed 001's path
+    increments along its columns, dq_j itself for a hinge), xi = pi (S e) with Jerkovsky 1978's path
     matrix pi (eq 1); then dR_k = xi_k,w x R_k and dp_k = xi_k,w x p_k + xi_k,v. One product of
     6-vectors per direction instead of the derivative of the products of rotations: the 7-dof
     arm's flange Jacobian at 100 poses under `jax.jacfwd` 0.25 against 0.66 ms. The derivative
@@ -73,7 +73,7 @@ def _poses_jvp(primals, tangents):
     dR, dp = jnp.zeros_like(R), jnp.zeros_like(p)
     if not is_zero(dq):
         S = to_ground(R, p, S_local)
-        path = jnp.asarray(model.topology.path_matrix(), q.dtype)      # seed 001 eq 1
+        path = jnp.asarray(model.topology.path_matrix(), q.dtype)      # Jerkovsky 1978 eq 1
         twist = path @ columns(S, joint_increments(model, q, still, dq))
         w = twist[:, :3]
         dR, dp = skew(w) @ R, jnp.cross(w, p) + twist[:, 3:]

@@ -1,4 +1,4 @@
-"""Seed 001's momentum formulation (eqs 72-73, 75) for a tree.
+"""Jerkovsky 1978's momentum formulation (eqs 72-73, 75) for a tree.
 
 The state is (q, G_hat_f) with the free momenta G_hat_f = mu_hat_ff sigma_hat_f (eq 73,
 sigma_hat_c = 0): p = alpha_f^T mu sigma = M(q) v. They obey eq 72,
@@ -8,7 +8,7 @@ sigma_hat_c = 0): p = alpha_f^T mu sigma = M(q) v. They obey eq 72,
 where G = mu sigma is the primitive momentum (eq 8) and X = 0 for the primitive equations, so
 X_hat_f = A_hat_f^T X_bar - A_hat_f_dot^T G_bar (eqs 27, 61) = -(A A_hat_f)_dot^T G. Integrating
 p rather than v is what makes this form attractive: p_dot needs no mass-matrix solve, only
-v = mu_hat_ff^-1 p does (one Cholesky per evaluation, as seed 001 notes after eq 73).
+v = mu_hat_ff^-1 p does (one Cholesky per evaluation, as Jerkovsky 1978 notes after eq 73).
 
 The constraint forces follow from eq 75, K_hat_c = G_hat_c_dot + X_hat_c, with
 G_hat = A_hat^T A^T G the momentum of each outward system j-bar about its hinge (eq 19-20); its

@@ -1,4 +1,4 @@
-"""The transformation-operator formulation of seed 001 (§§III-V), dense, for rigid trees.
+"""The transformation-operator formulation of Jerkovsky 1978 (§§III-V), dense, for rigid trees.
 
 Primitive variables (§III): per body the angular velocity omega and the velocity of the centre of
 mass v_c, sigma = (omega; v_c) (eq 6, stored body by body rather than all omegas first); the
@@ -70,7 +70,7 @@ def _rotate(R: Array, m: Array) -> Array:
 
 
 def path_operator(model: Model) -> Array:
-    """The path matrix pi (seed 001 eq 1) as a float array, the sparsity of A (eq 14)."""
+    """The path matrix pi (Jerkovsky 1978 eq 1) as a float array, the sparsity of A (eq 14)."""
     return jnp.asarray(model.topology.path_matrix(), dtype=model.mass.dtype)
 
 
@@ -90,7 +90,7 @@ def transformation_operator(model: Model, q: Array) -> tuple[Array, Array]:
 
 
 def inverse_operator(model: Model, q: Array) -> Array:
-    """B = A^-1 (seed 001 eqs 15, 17) from the reference matrix rho, explicit 6n x 6n, body-major:
+    """B = A^-1 (Jerkovsky 1978 eqs 15, 17) from the reference matrix rho, explicit 6n x 6n, body-major:
     Omega^i = sum_j rho_ij omega^j and U^i = sum_j rho_ij (R~_{c_j h_i} omega^j + v_cj), so the
     (i, j) block is rho_ij [[1, 0], [R~_{c_j h_i}, 1]]. Only 2n - 1 blocks are non-zero: rho is
     sparser than pi, as the paper notes after eq 26."""
@@ -102,7 +102,7 @@ def inverse_operator(model: Model, q: Array) -> Array:
 
 
 def primitive_inverse_mass(terms: OperatorTerms) -> Array:
-    """nu = diag(J_c, W 1) = mu^-1 body by body (seed 001 eq 7b), (n, 6, 6), by 3x3 solves."""
+    """nu = diag(J_c, W 1) = mu^-1 body by body (Jerkovsky 1978 eq 7b), (n, 6, 6), by 3x3 solves."""
     I_c, M = terms.mu[:, :3, :3], terms.mu[:, 3, 3]
     eye = jnp.broadcast_to(jnp.eye(3, dtype=I_c.dtype), I_c.shape)
     J_c = jnp.linalg.solve(I_c, eye)
@@ -171,5 +171,5 @@ def generalized_mass(terms: OperatorTerms) -> Array:
 
 
 def mass_matrix(model: Model, q: Array) -> Array:
-    """The generalized mass matrix mu_hat_ff (nv x nv) of seed 001 eq 55."""
+    """The generalized mass matrix mu_hat_ff (nv x nv) of Jerkovsky 1978 eq 55."""
     return generalized_mass(operator_terms(model, q, jnp.zeros(model.nv, q.dtype)))

@@ -1,9 +1,9 @@
 """Inverse dynamics by the recursive Newton-Euler algorithm (Featherstone, RBDA §5.3).
 
-An outward pass gives body accelerations a[k] = a[parent] + S[k] q_ddot[k] + c[k] (seed 002
+An outward pass gives body accelerations a[k] = a[parent] + S[k] q_ddot[k] + c[k] (Anderson 1993
 eqs 25, 27 with the remainder terms of eqs 29, 31; gravity enters as the ground acceleration -g);
-each body needs the wrench f[k] = I[k] a[k] + V[k] x* I[k] V[k] (seed 001 eq 9's
-mu sigma_dot + Y, per body). An inward pass sums the wrenches of each body's outward set (seed 001
+each body needs the wrench f[k] = I[k] a[k] + V[k] x* I[k] V[k] (Jerkovsky 1978 eq 9's
+mu sigma_dot + Y, per body). An inward pass sums the wrenches of each body's outward set (Jerkovsky 1978
 eq 20: the system j-bar) and projects them on the joint axes: tau[k] = S[k]^T f_bar[k]. All in
 ground coordinates at the ground origin (see `kinematics`), so the passes are plain sums.
 """
@@ -36,7 +36,7 @@ def rnea_passes(model: Model, q: Array, v: Array, a: Array,
 def joint_wrenches(model: Model, q: Array, v: Array, a: Array, f_ext: Array | None = None) -> Array:
     """The wrench each joint transmits to its outward system (n, 6) for joint accelerations a
     (nv,): (torque about the joint origin; force) in body coordinates. Its projection on the joint
-    axes is tau; the rest are the constraint forces K_c of seed 001 eq 76."""
+    axes is tau; the rest are the constraint forces K_c of Jerkovsky 1978 eq 76."""
     f_bar, kin, _ = rnea_passes(model, q, v, a, f_ext)
     Rt = jnp.swapaxes(kin.R, -1, -2)
     torque = f_bar[:, :3] - jnp.cross(kin.p, f_bar[:, 3:])         # about the hinge

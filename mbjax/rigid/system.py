@@ -1,7 +1,7 @@
 """Trees as systems for `mbjax.simulate`, every integrator and `mbjax.loops.ClosedSystem`.
 
-`TreeSystem` integrates (q, v) with the velocity form (seed 002's recursion or seed 001 eq 74);
-`MomentumSystem` integrates (q, p) with seed 001's momentum form (eqs 72-73); `BatchTreeSystem`
+`TreeSystem` integrates (q, v) with the velocity form (Anderson 1993's recursion or Jerkovsky 1978 eq 74);
+`MomentumSystem` integrates (q, p) with Jerkovsky 1978's momentum form (eqs 72-73); `BatchTreeSystem`
 B copies at once in the throughput layout.
 
 Systems are equinox modules (their model and controls are array leaves), so compile their bound
@@ -52,7 +52,7 @@ def _model(model) -> Model:
 
 class TreeSystem(AbstractTreeSystem):
     """A rigid tree: u = v, v_dot = forward dynamics under gravity, the control and the external
-    wrenches, by seed 002's O(n) recursion or seed 001 eq 74 (`method`, as in
+    wrenches, by Anderson 1993's O(n) recursion or Jerkovsky 1978 eq 74 (`method`, as in
     `mbjax.forward_dynamics`).
 
     control: a callable (t, q, v) -> forces on the actuated coordinates (a `mbjax.control`
@@ -149,7 +149,7 @@ class BatchTreeSystem(AbstractSystem):
 
 
 class MomentumSystem(AbstractSystem):
-    """u = p = M(q) v, the free momenta (seed 001 eq 73); u_dot from eq 72. Controls and
+    """u = p = M(q) v, the free momenta (Jerkovsky 1978 eq 73); u_dot from eq 72. Controls and
     external wrenches as for `TreeSystem`."""
 
     model: Model

@@ -1,4 +1,4 @@
-"""Closed-form motion of a torque-free rigid body with an axis of symmetry (seed 000 §8.1)."""
+"""Closed-form motion of a torque-free rigid body with an axis of symmetry (Borri 1990 §8.1)."""
 
 import jax
 import jax.numpy as jnp

@@ -36,7 +36,7 @@ so Theta, Phi and Omega are relative angles (of the rod to the crank, of body Ph
 of body Omega to body epsilon), and beta, gamma, delta, epsilon absolute ones.
 
 The tree (`Model`): every joint a revolute joint about z, its angle one of the test set's. mbjax
-numbers a body after its parent (seed 002 §2.1 rule (i)), and Phi's body hangs from delta's,
+numbers a body after its parent (Anderson 1993 §2.1 rule (i)), and Phi's body hangs from delta's,
 Omega's from epsilon's, so the tree's order is (beta, Theta, gamma, delta, Phi, epsilon, Omega):
 
     body 0  beta     ground, at O                 m1, centre (ra, 0),         i1

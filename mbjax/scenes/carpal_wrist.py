@@ -1,4 +1,4 @@
-"""A Carpal Wrist carrying a tool: the robot of seed 003 at the scale of a surgical or small
+"""A Carpal Wrist carrying a tool: the robot of Canfield 1997 at the scale of a surgical or small
 industrial wrist, with the scenarios the tests, the tour, the reproduction and the notebooks use.
 
 The tool's centre of mass sits off the axis (TOOL_COM) and its inertia is not axisymmetric, so the

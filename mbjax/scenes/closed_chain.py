@@ -1,4 +1,4 @@
-"""The (n/2)-body chain with both ends fixed (seed 002 §3.3, Fig. 7A).
+"""The (n/2)-body chain with both ends fixed (Anderson 1993 §3.3, Fig. 7A).
 
 n/2 slender links, 0.3 m and 1 kg each, hang between two ground points at the same height, a
 horizontal SPAN fraction of the chain's length apart; every joint is a two-dof Hooke (universal)

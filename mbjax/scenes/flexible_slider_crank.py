@@ -1,4 +1,4 @@
-"""Seed 002 §3.1 (Figs. 4-5): a slider-crank with a flexible connecting rod.
+"""Anderson 1993 §3.1 (Figs. 4-5): a slider-crank with a flexible connecting rod.
 
 Crank O-P, 6 in, rigid, turning at a constant 125.6 rad/s counter-clockwise from P(0) = (0, 6 in);
 rod P-Q, 12 in, round, 0.25 in diameter, E = 3.0e7 psi, 0.1667 lbm (steel); a massless slider at Q
@@ -8,10 +8,10 @@ inside; the deflection is reported in inches.
 
 mbjax's model: the crank a rigid body on a revolute joint whose angle is prescribed (pi/2 + Omega t,
 a rheonomic `Prescribed` constraint); the rod a flexible body on a revolute joint at P, beam
-elements clamped at P (its joint grid J), all of its in-plane modes (seed 002: "all available
+elements clamped at P (its joint grid J), all of its in-plane modes (Anderson 1993: "all available
 modes ... associated with motion of B in the x-y plane": 3 per element, so the basis spans what a
 Craig-Bampton basis with Q as interface would); the massless slider a cut joint putting Q's grid point on the plane y = 0
-(`point_on_plane`, one equation). Seed 002's route (`ClosedSystem(..., method=Stabilized())`) solves the loads;
+(`point_on_plane`, one equation). Anderson 1993's route (`ClosedSystem(..., method=Stabilized())`) solves the loads;
 (q, v) are projected back onto the constraints after every step.
 The midpoint deflection is the signed distance of the rod's material midpoint from the chord PQ,
 positive away from O at t = 0 (the rod frame's +y).

@@ -8,7 +8,7 @@ along its body x axis from its joint.
 The cut joint is, by default, a planar pin: a `point_on_line` cut joint (the coupler's tip on the
 rocker's z line through its tip), 2 equations of full rank. `closure="revolute"` uses the spatial
 revolute cut joint instead, 5 equations of which only 2 are independent in a planar loop: the
-redundancy that `Status.REDUNDANT` reports (seed 001 §VI's multipliers then come from the
+redundancy that `Status.REDUNDANT` reports (Jerkovsky 1978 §VI's multipliers then come from the
 least-squares solve of `mbjax.loops.multipliers`).
 
 `joint_angles(theta)` is the closed-form position analysis (two circles' intersection, elbow-up

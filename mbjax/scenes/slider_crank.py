@@ -1,5 +1,5 @@
 """A slider-crank in a vertical plane: steel crank and connecting rod, a steel slider on a
-horizontal guide through the crank's pivot, gravity -y: the rigid counterpart of seed 002 §3.1's
+horizontal guide through the crank's pivot, gravity -y: the rigid counterpart of Anderson 1993 §3.1's
 slider-crank (there a flexible rod, 6 in crank, 12 in rod, 125.6 rad/s).
 
 Tree (joint axes z for the pins, x for the guide):
@@ -10,7 +10,7 @@ The loop is cut at the rod-slider pin: a `point_on_line` cut joint (the rod's ti
 slider's z line), 2 equations of full rank (planar pin; R < L, so no configuration is singular).
 
 With `driven=True` the crank turns at constant speed, q_0 = theta0 + rate t, a `Prescribed`
-motion (rheonomic constraint, seed 001 eq 85 with B = dPhi/dt): the mechanism has no degree of
+motion (rheonomic constraint, Jerkovsky 1978 eq 85 with B = dPhi/dt): the mechanism has no degree of
 freedom left, and the multiplier of the prescribed row is the motor torque on the crank (about
 +z; `ClosedSystem.loads(...)[-1]`, since that row of A is e_0, A^t K_c puts it on the crank
 coordinate). With `driven=False` the crank is free and `rate` is its initial speed.

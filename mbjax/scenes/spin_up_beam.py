@@ -1,4 +1,4 @@
-"""Kane's spin-up beam (seed 002 §3.2, eq 109; Kane, Ryan & Banerjee 1987): a uniform cantilever
+"""Kane's spin-up beam (Anderson 1993 §3.2, eq 109; Kane, Ryan & Banerjee 1987): a uniform cantilever
 clamped on a vertical axis and spun up in its own plane,
 
     omega(t) = (6 / 15) (t - (15 / (2 pi)) sin(2 pi t / 15))   for t < 15 s,   6 rad/s after,
@@ -10,8 +10,8 @@ and the tip diverges; with stiffening the deflection stays small and bounded.
 
 mbjax's model: one flexible body (beam elements, `mbjax.flex.beam`, Craig-Bampton modes clamped at
 the hub, the lowest `n_bending` in-plane bending and `n_axial` axial modes) on a revolute joint
-about z, whose angle is the prescribed motion theta(t) (a rheonomic `Prescribed` constraint, seed
-002 eq 87) solved by seed 002's route (`ClosedSystem(..., method=Stabilized())`, eqs 101-108). The tip deflection is
+about z, whose angle is the prescribed motion theta(t) (a rheonomic `Prescribed` constraint, Anderson
+1993 eq 87) solved by Anderson 1993's route (`ClosedSystem(..., method=Stabilized())`, eqs 101-108). The tip deflection is
 read in the rotating body frame: y (transverse, negative when the tip lags) and x (axial).
 """
 
@@ -63,7 +63,7 @@ def modes(structure: Beam, n_bending: int, n_axial: int = 1) -> ModalBasis:
 
 def build(n_bending: int = 4, n_axial: int = 1, n_elements: int = N_ELEMENTS, stiffening: bool = True,
           projection: bool = False):
-    """(system, q0, v0): the spun beam as a `ClosedSystem` (seed 002's route), at rest and undeformed.
+    """(system, q0, v0): the spun beam as a `ClosedSystem` (Anderson 1993's route), at rest and undeformed.
     q = (hub angle, modal coordinates). The basis mesh sets the geometric stiffness's accuracy
     (element-constant axial forces, O(h^2)): against the converged ANCF beam, 4 bending modes of 10
     elements leave 1.2e-3 m over 20 s, of 20 elements 4.4e-4 m. `projection`: the state is

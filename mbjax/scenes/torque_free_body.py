@@ -1,8 +1,8 @@
-"""The torque-free symmetric body of seed 000 §8.1.
+"""The torque-free symmetric body of Borri 1990 §8.1.
 
 Transverse to axial inertia 1.875, 15 rad/s about the symmetry axis and 10 rad/s about a
 transverse axis, 6 s (about 100 rad of total rotation). Only the rotation is modelled: with the
-reference point at the centre of mass, translation decouples (seed 000 §8.1).
+reference point at the centre of mass, translation decouples (Borri 1990 §8.1).
 """
 
 import jax
@@ -27,12 +27,12 @@ def build(rotation: str = "quaternion"):
 
 
 def exact_rotation(t):
-    """R(t) in closed form (seed 000 eqs 8.7-8.8)."""
+    """R(t) in closed form (Borri 1990 eqs 8.7-8.8)."""
     return torque_free_motion(J_AXIAL, J_TRANSVERSE, jnp.eye(3), jnp.array(OMEGA0), t)[0]
 
 
 def rotation_error_matrix(R, t):
-    """Angle in radians between a computed rotation R and the exact one (seed 000 Fig. 1's
+    """Angle in radians between a computed rotation R and the exact one (Borri 1990 Fig. 1's
     error)."""
     return jnp.linalg.norm(lie.log(R @ exact_rotation(t).T, check=False))
 

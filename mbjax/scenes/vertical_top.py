@@ -1,4 +1,4 @@
-"""The vertical spinning top of seed 000 §7-8 (Tables 1-2).
+"""The vertical spinning top of Borri 1990 §7-8 (Tables 1-2).
 
 A symmetric top on a fixed suspension point, spinning steadily about the upward vertical e_3 at
 the rate Omega, is linearized about that steady motion. Its transverse motion has the exact

@@ -1,8 +1,8 @@
 """Spatial vectors, Plucker transforms, cross products and rigid-body inertia (angular; linear).
 
-The cross products are seed 002's recursive kinematics (eqs 20-31) written once in 6-D: the
+The cross products are Anderson 1993's recursive kinematics (eqs 20-31) written once in 6-D: the
 velocity-product acceleration of a joint is V x (S u) and the Euler-coupling force of a body is
-V x* (I V) (seed 001 eq 6: omega x H).
+V x* (I V) (Jerkovsky 1978 eq 6: omega x H).
 """
 
 import jax
@@ -12,7 +12,7 @@ from jax import Array
 
 
 def skew(v: Array) -> Array:
-    """The 3x3 matrix with skew(v) @ w = v x w (seed 001's tilde dyadic)."""
+    """The 3x3 matrix with skew(v) @ w = v x w (Jerkovsky 1978's tilde dyadic)."""
     x, y, z = v[..., 0], v[..., 1], v[..., 2]
     zero = jnp.zeros_like(x)
     return jnp.stack([jnp.stack([zero, -z, y], -1),

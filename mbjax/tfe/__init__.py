@@ -1,4 +1,4 @@
-"""Time finite elements for rigid-body dynamics (seed 000).
+"""Time finite elements for rigid-body dynamics (Borri 1990).
 
 Elements and quadrature (`Element`), the body and its reference motion (`Body`, `Reference`),
 the weak forms as residuals (`PrimalUnsymmetric`, `PrimalSymmetric`, `Mixed`, `MixedUnsymmetric`, `ThreeField`),

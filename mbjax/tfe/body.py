@@ -1,4 +1,4 @@
-"""The rigid body as the weak forms see it (seed 000 §3).
+"""The rigid body as the weak forms see it (Borri 1990 §3).
 
 Quantities are referred to a body point O' and ordered (angular; linear) as everywhere in mbjax,
 so the paper's q = (x, r), p_hat = (l, h), f_hat = (b, m) are stored here as (r, x), (h, l),

@@ -1,4 +1,4 @@
-"""Lagrange time elements and Gauss-Legendre quadrature (seed 000 §5).
+"""Lagrange time elements and Gauss-Legendre quadrature (Borri 1990 §5).
 
 An n-node element spans [t_1, t_1 + (n - 1) dt] with its nodes dt apart (dt is "the time between
 nodes" of Tables 1-2). On the unit parameter tau = (t - t_1) / ((n - 1) dt) in [0, 1] the shape

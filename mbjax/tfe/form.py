@@ -1,4 +1,4 @@
-"""What every weak form provides on one time element (seed 000 §5).
+"""What every weak form provides on one time element (Borri 1990 §5).
 
 A form turns the element's weak form into a square nonlinear system in its unknowns U, given the
 state at the element's start z_1 = (p_1, q_1):

@@ -1,4 +1,4 @@
-"""The mixed (two-field) forms of Hamilton's law on an n-node element (seed 000 eqs 3.28, 3.30,
+"""The mixed (two-field) forms of Hamilton's law on an n-node element (Borri 1990 eqs 3.28, 3.30,
 4.9, B.20, §5.2, §6).
 
 Momentum and coordinates z = (p, q) are independent fields:

@@ -1,5 +1,5 @@
 """Newton's method for one element's equations, differentiable by the implicit function theorem
-(seed 000 §5: "in order to take advantage of the quadratic convergence property of the Newton
+(Borri 1990 §5: "in order to take advantage of the quadratic convergence property of the Newton
 method, consistent linearized expressions ... are required" - here the tangent is jacfwd of the
 residual, so it is consistent by construction).
 """

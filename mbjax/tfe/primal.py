@@ -1,4 +1,4 @@
-"""Primal (kinematic) forms of Hamilton's law on an n-node element (seed 000 §3, §4, §5.1).
+"""Primal (kinematic) forms of Hamilton's law on an n-node element (Borri 1990 §3, §4, §5.1).
 
 The trial q and the test function are both Lagrange-interpolated from nodal values (eq 5.1).
 Each form supplies a pointwise pair (P1, P2) multiplying (d/dt test, test) (eqs 4.3, 4.7), and

@@ -1,4 +1,4 @@
-"""Reference configurations and incremental coordinates (seed 000 §2).
+"""Reference configurations and incremental coordinates (Borri 1990 §2).
 
 Over an element starting at t_1 the motion is written about a prescribed reference (x_o(t),
 R_o(t)) as x = x_o + x_* and R = R_* R_o with R_* = exp(r_* x I); the unknowns are the incremental

@@ -1,4 +1,4 @@
-"""Time marching element by element: `solve_tfe` (seed 000 §5).
+"""Time marching element by element: `solve_tfe` (Borri 1990 §5).
 
 Each element starts from the converged end state of the previous one. Its reference (§2) is built
 from that state and the incremental coordinates start at zero; or one prescribed reference motion

@@ -1,4 +1,4 @@
-"""Linearized stability of time elements by transition matrices (seed 000 §6-7).
+"""Linearized stability of time elements by transition matrices (Borri 1990 §6-7).
 
 About a known motion (here a reference that solves the equations exactly, such as the steadily
 spinning top of §7), the element maps a perturbation of its initial state to one of its final

@@ -1,4 +1,4 @@
-"""Tangent matrices by autodiff, and the one hand formula they are checked against (seed 000
+"""Tangent matrices by autodiff, and the one hand formula they are checked against (Borri 1990
 §4, App. A-B).
 
 The paper derives the tangents of every weak form by hand over Appendix B; here each is one

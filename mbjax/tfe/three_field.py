@@ -1,4 +1,4 @@
-"""The three-field form of Hamilton's law (seed 000 eqs 3.34, B.42-B.45): coordinates q,
+"""The three-field form of Hamilton's law (Borri 1990 eqs 3.34, B.42-B.45): coordinates q,
 velocity w and momentum p_hat all independent (the Hu-Washizu form of rigid-body dynamics).
 
     int [ dq_hat . (f_hat - S_1(w) M6 w) + d*w . (M6 w - p_hat) - d*p . X^-1 (w - w_n)

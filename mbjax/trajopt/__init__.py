@@ -1,5 +1,5 @@
 """Trajectory optimisation for any system (`Problem`, `solve` with a solver strategy such as
-`ILQR`, `MultipleShooting`, `Shooting`; `optimal_cost` for co-design), and the Carpal Wrist's synthesis, baseline, controller and sweeps (seed 003 §6)."""
+`ILQR`, `MultipleShooting`, `Shooting`; `optimal_cost` for co-design), and the Carpal Wrist's synthesis, baseline, controller and sweeps (Canfield 1997 §6)."""
 
 from mbjax.trajopt.codesign import optimal_cost
 from mbjax.trajopt.ilqr import ILQR

@@ -1,5 +1,5 @@
 """The inverse-dynamics feed-forward baseline for trajectory synthesis: a smooth tool-space path
-through `inverse_kinematics` and `inverse_dynamics` (seed 003 eq 6.16 used as the chapter
+through `inverse_kinematics` and `inverse_dynamics` (Canfield 1997 eq 6.16 used as the chapter
 intends, 'when the manipulator path is known, the required moment for each motor can be
 determined').
 

@@ -1,4 +1,4 @@
-"""A neural controller for the Carpal Wrist trained through the differentiable simulator (seed 003
+"""A neural controller for the Carpal Wrist trained through the differentiable simulator (Canfield 1997
 §6.1: 'the simulation environment can be used to train a neural network control system').
 
 The controller is a joint PD servo with gravity feed-forward C(theta*) (eq 6.16) plus a small

@@ -84,7 +84,7 @@ def sweep(fn, params, *, devices=None, trim: bool = True):
 
 def peak_torque(wrist: CarpalWrist, path: ToolPath, samples: int = 64):
     """The largest |motor torque| (inverse dynamics) along a tool path, and where (time index):
-    the actuator-sizing number of seed 003 eq 6.16."""
+    the actuator-sizing number of Canfield 1997 eq 6.16."""
     ts = jnp.linspace(0.0, path.duration, samples)
     q, q_dot, q_ddot, _ = jax.vmap(lambda t: path.joint_motion(wrist, t))(ts)
     tau = jax.vmap(wrist.inverse_dynamics)(q, q_dot, q_ddot)

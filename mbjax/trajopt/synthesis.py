@@ -1,4 +1,4 @@
-"""Gradient-based trajectory synthesis for the Carpal Wrist (seed 003's stated purpose, §6.1:
+"""Gradient-based trajectory synthesis for the Carpal Wrist (Canfield 1997's stated purpose, §6.1:
 'use the simulation environment as part of an optimization routine solving trajectory synthesis
 problems').
 

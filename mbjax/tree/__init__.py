@@ -1,4 +1,4 @@
-"""Tree topology (seed 001 §II, seed 002 §2.1) and the tree passes every algorithm runs on."""
+"""Tree topology (Jerkovsky 1978 §II, Anderson 1993 §2.1) and the tree passes every algorithm runs on."""
 
 from mbjax.tree.passes import backward_pass, forward_pass
 from mbjax.tree.topology import Topology

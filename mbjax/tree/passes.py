@@ -11,7 +11,7 @@ of 1000 (compile time flat in n). The kind of scan follows the tree's shape
   are dropped, so padding never computes on made-up data (no NaN to leak into gradients).
 
 Per-body arrays carry one spare row, row n, for the ground (the parent of every base body).
-Seed 002 §2.3 runs exactly these passes: (i) outward kinematics, (ii) inward triangularization,
+Anderson 1993 §2.3 runs exactly these passes: (i) outward kinematics, (ii) inward triangularization,
 (iii) outward back-substitution.
 """
 

@@ -1,8 +1,8 @@
-"""Topology of a tree of n bodies from its proximal-body array (seed 002 eq 1).
+"""Topology of a tree of n bodies from its proximal-body array (Anderson 1993 eq 1).
 
-Bodies are numbered 0..n-1 with every body numbered higher than its proximal body (seed 002 §2.1,
-rule (i)); the parent of a base body is -1 (seed 002 writes 0 with 1-based labels). From that array
-follow the ancestor, distal and descendant sets of seed 002 eqs 2-4, seed 001's path matrix pi
+Bodies are numbered 0..n-1 with every body numbered higher than its proximal body (Anderson 1993 §2.1,
+rule (i)); the parent of a base body is -1 (Anderson 1993 writes 0 with 1-based labels). From that array
+follow the ancestor, distal and descendant sets of Anderson 1993 eqs 2-4, Jerkovsky 1978's path matrix pi
 (eq 1) and reference matrix rho (eq 2), with rho pi = I (eq 3), and the depth levels the tree passes
 are scheduled on.
 """
@@ -34,7 +34,7 @@ class Topology:
                 raise ValueError(f"parents[{k}] = {k}: a body cannot be its own parent (a cycle)")
             if p > k:
                 raise ValueError(f"parents[{k}] = {p}: every body must be numbered higher than its "
-                                 "parent (seed 002 §2.1 rule (i)); renumber the bodies depth-first, "
+                                 "parent (Anderson 1993 §2.1 rule (i)); renumber the bodies depth-first, "
                                  "which also rules out cycles")
         self.parents = parents
 
@@ -51,7 +51,7 @@ class Topology:
     def n(self) -> int:
         return len(self.parents)
 
-    # -- the sets of seed 002 eqs 2-4 ---------------------------------------------------------
+    # -- the sets of Anderson 1993 eqs 2-4 ---------------------------------------------------------
 
     def ancestors(self, k: int) -> tuple[int, ...]:
         """An[k] (eq 2): the bodies between body k and the ground, nearest first, k excluded."""
@@ -69,10 +69,10 @@ class Topology:
         """Des[k] (eq 4): every body outboard of k, k excluded, in increasing order."""
         return tuple(int(j) for j in np.flatnonzero(self.path_matrix()[:, k]) if j != k)
 
-    # -- seed 001 eqs 1-3 ----------------------------------------------------------------------
+    # -- Jerkovsky 1978 eqs 1-3 ----------------------------------------------------------------------
 
     def path_matrix(self) -> np.ndarray:
-        """pi (seed 001 eq 1): pi[i, j] = 1 if body j lies on the path from the ground to body i
+        """pi (Jerkovsky 1978 eq 1): pi[i, j] = 1 if body j lies on the path from the ground to body i
         (j = i included). Row i is the inward set i^, column j the outward set j-bar."""
         pi = np.zeros((self.n, self.n), dtype=np.int64)
         for i, p in enumerate(self.parents):
@@ -82,7 +82,7 @@ class Topology:
         return pi
 
     def reference_matrix(self) -> np.ndarray:
-        """rho (seed 001 eq 2): 1 on the diagonal and -1 at (i, parent of i); rho @ pi = I (eq 3)."""
+        """rho (Jerkovsky 1978 eq 2): 1 on the diagonal and -1 at (i, parent of i); rho @ pi = I (eq 3)."""
         rho = np.eye(self.n, dtype=np.int64)
         for i, p in enumerate(self.parents):
             if p >= 0:

@@ -1,4 +1,4 @@
-"""The Carpal Wrist parallel robot (seed 003): closed-form kinematics, forward and inverse
+"""The Carpal Wrist parallel robot (Canfield 1997): closed-form kinematics, forward and inverse
 dynamics from an autodiff Lagrangian, an independent Newton-Euler route, and a `simulate`-ready
 system."""
 

@@ -1,4 +1,4 @@
-"""Carpal Wrist dynamics from its Lagrangian by autodiff (seed 003 §6.3).
+"""Carpal Wrist dynamics from its Lagrangian by autodiff (Canfield 1997 §6.3).
 
 L(theta, theta_dot) = T - V (eq 6.7) is written once, in the input angles theta (the chapter's
 generalized coordinates), from the closed-form kinematics:

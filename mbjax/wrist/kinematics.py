@@ -1,4 +1,4 @@
-"""Closed-form kinematics of the Carpal Wrist (`../shared/carpal-wrist-model.md`, seed 003 §6.2).
+"""Closed-form kinematics of the Carpal Wrist (`docs/carpal-wrist-model.md`, Canfield 1997 §6.2).
 
 The three knees define the midplane; the distal plate is the base plate mirrored in it. The
 midplane is written in the nonsingular slope chart z = p + gx x + gy y (p: the plunge, g: the
@@ -105,7 +105,7 @@ def rotation_from_slope(g: Array, variant: str = "physical") -> Array:
 
     "physical": the mirror image of the base in the midplane, R = (I - 2 N N^T) diag(1, 1, -1)
     = Rz(alpha) Ry(beta) Rz(-alpha), smooth in g (the constant-velocity, zero-twist plate).
-    "chapter": seed 003's printed R = Rz(alpha) Ry(beta) (eq 6.2's omega); the same tool axis but
+    "chapter": Canfield 1997's printed R = Rz(alpha) Ry(beta) (eq 6.2's omega); the same tool axis but
     twisted by alpha about it, and discontinuous at beta = 0 where alpha is undefined.
     """
     if variant == "physical":
@@ -140,7 +140,7 @@ def com_and_rotation(wrist, theta: Array) -> tuple[Array, Array]:
 
 
 def forward_kinematics(wrist, theta: Array) -> Pose:
-    """The tool pose for input angles theta (closed form; `carpal-wrist-model.md`)."""
+    """The tool pose for input angles theta (closed form; `docs/carpal-wrist-model.md`)."""
     theta = jnp.asarray(theta)
     p, g = midplane(wrist, theta)
     return pose_from_chart(wrist, p, g)
@@ -206,7 +206,7 @@ def _normal_plunge(wrist, theta: Array) -> Array:
 
 
 def jacobian(wrist, theta: Array) -> Array:
-    """J of seed 003 eq 6.34, (N_x, N_y, p)_dot = J theta_dot, by forward-mode autodiff."""
+    """J of Canfield 1997 eq 6.34, (N_x, N_y, p)_dot = J theta_dot, by forward-mode autodiff."""
     return jax.jacfwd(_normal_plunge, argnums=1)(wrist, jnp.asarray(theta))
 
 

@@ -1,4 +1,4 @@
-"""The Carpal Wrist as a parameter module (seed 003; geometry in `carpal-wrist-model.md`)."""
+"""The Carpal Wrist as a parameter module (Canfield 1997; geometry in `docs/carpal-wrist-model.md`)."""
 
 import equinox as eqx
 import jax.numpy as jnp
@@ -40,7 +40,7 @@ class CarpalWrist(eqx.Module):
     from the distal-plate centre (in D), gravity `gravity` along -e3.
 
     Every parameter is an array leaf, so wrists can be differentiated, vmapped and swept
-    (`mbjax.trajopt.sweeps`). `rotation_model="chapter"` switches to seed 003's printed
+    (`mbjax.trajopt.sweeps`). `rotation_model="chapter"` switches to Canfield 1997's printed
     R = Rz(alpha) Ry(beta) (eq 6.2) instead of the physical mirror plate Rz(alpha) Ry(beta)
     Rz(-alpha): for reproducing the chapter's equations only, see `kinematics.rotation_from_slope`.
     """

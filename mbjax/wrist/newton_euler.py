@@ -3,7 +3,7 @@ principle of virtual power through the wrist Jacobian (the legs are massless).
 
 The tool's velocities come from the closed-form Jacobian (`chart_jacobian`, K^-1 D), not from the
 Lagrangian: (p, g)_dot = J theta_dot, N_dot from N = (-g, 1) / s, omega = 2 N x N_dot (the
-mirror plate's angular velocity, `carpal-wrist-model.md`), c_D = 2 p N_z N and v_G = c_D_dot +
+mirror plate's angular velocity, `docs/carpal-wrist-model.md`), c_D = 2 p N_z N and v_G = c_D_dot +
 omega x R G. Then the wrench the distal plate exerts on the tool, about G,
 
     F = m (a_G + g e3),      n = I_B omega_dot + omega x I_B omega,   I_B = R I_G R^T,

@@ -1,4 +1,4 @@
-"""The Carpal Wrist as a system for `simulate` (seed 003 §6.4)."""
+"""The Carpal Wrist as a system for `simulate` (Canfield 1997 §6.4)."""
 
 import equinox as eqx
 import jax.numpy as jnp

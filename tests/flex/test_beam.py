@@ -1,4 +1,4 @@
-"""Beam finite elements (seed 002 eq (9)): element matrices, frequencies, statics, gradients."""
+"""Beam finite elements (Anderson 1993 eq (9)): element matrices, frequencies, statics, gradients."""
 
 import jax
 import jax.numpy as jnp

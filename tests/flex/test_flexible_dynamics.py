@@ -1,4 +1,4 @@
-"""Flexible bodies in the tree dynamics (seed 002 eqs 20-86): the modal body's coefficients
+"""Flexible bodies in the tree dynamics (Anderson 1993 eqs 20-86): the modal body's coefficients
 against direct sums over its mass points, the O(n) recursion against the dense Lagrangian route
 (an independent derivation from the energies), energy conservation, gradients through a rollout
 against finite differences, and the bad-input errors."""
@@ -86,7 +86,7 @@ def test_modal_mass_matrix_is_the_sum_over_mass_points():
 
 @pytest.mark.parametrize("stiffening", [True, pytest.param(False, marks=pytest.mark.slow)])
 def test_recursion_matches_the_lagrangian_route(stiffening):
-    """Seed 002's O(n) recursion with modal blocks, attachments and Table 1 stiffening (inertial,
+    """Anderson 1993's O(n) recursion with modal blocks, attachments and Table 1 stiffening (inertial,
     and distal: the children's reactions at the grid points) against Lagrange's equations from
     the energies (no shared partial velocities), at a random state."""
     model = random_tree(stiffening)
@@ -229,7 +229,7 @@ def test_bad_input_is_a_clear_error():
 
 
 def test_closed_loop_routes_agree_with_the_constraint_load_stiffening():
-    """The flexible slider-crank (seed 002 §3.1, one element) at a deformed, moving state: the
+    """The flexible slider-crank (Anderson 1993 §3.1, one element) at a deformed, moving state: the
     stabilized route's accelerations from the O(n) recursion and from the dense Lagrangian route
     (its load responses solved from the mass matrix) agree, the slider's constraint load included;
     and that load stiffens the rod: without the grid point's second-order displacement the modal

@@ -1,4 +1,4 @@
-"""Seed 002's flexible examples against the geometrically nonlinear ANCF references
+"""Anderson 1993's flexible examples against the geometrically nonlinear ANCF references
 (`mbjax.flex.references`, an independent model: absolute nodal coordinates, exact strains)."""
 
 import numpy as np
@@ -25,7 +25,7 @@ def test_spin_up_beam_matches_the_nonlinear_reference_and_diverges_without_stiff
 
 @pytest.mark.slow
 def test_flexible_slider_crank_matches_the_nonlinear_reference():
-    """Seed 002 §3.1: the rod's midpoint deflection with 2 and 3 elements stays within 0.01 in of
+    """Anderson 1993 §3.1: the rod's midpoint deflection with 2 and 3 elements stays within 0.01 in of
     the ANCF rod (4 elements) over the whole 0.15 s (measured 0.0088 and 0.0078 in; before the
     slider's load stiffened the rod, 0.078 and 0.087 in), the status success."""
     reference = None

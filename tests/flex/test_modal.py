@@ -1,4 +1,4 @@
-"""Craig-Bampton reduction (seed 002 sec. 2.2, eq (10)) and the mass-point cloud (eqs (36)-(42))."""
+"""Craig-Bampton reduction (Anderson 1993 sec. 2.2, eq (10)) and the mass-point cloud (eqs (36)-(42))."""
 
 import jax
 import jax.numpy as jnp

@@ -1,4 +1,4 @@
-"""Geometric stiffening (seed 002 eqs (32)-(33), Table 1): Southwell, Euler buckling, the load basis.
+"""Geometric stiffening (Anderson 1993 eqs (32)-(33), Table 1): Southwell, Euler buckling, the load basis.
 
 Tolerances: the axial force is constant per element (the element average of the exact N(x), as the
 linear axial elements deliver it), so the stiffening coefficient converges as O(h^2). Measured

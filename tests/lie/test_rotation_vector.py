@@ -1,4 +1,4 @@
-"""mbjax.lie against seed 000 App. A identities, scipy and finite differences."""
+"""mbjax.lie against Borri 1990 App. A identities, scipy and finite differences."""
 
 import jax
 import jax.numpy as jnp

@@ -219,7 +219,7 @@ def test_agrees_with_the_test_sets_equations_integrated_by_dop853(quick_run):
 
 @pytest.mark.slow
 def test_projection_and_order_n_routes_agree(squeezer, quick_run):
-    """Seed 002's O(n + m^3) route gives the coupled multipliers' motion to round-off; projection
+    """Anderson 1993's O(n + m^3) route gives the coupled multipliers' motion to round-off; projection
     after every step moves each state by its O(dt^5) constraint error, so it differs by RK4's
     truncation error (4e-9 at 10 us), and both meet the reference as closely."""
     for system, atol in ((squeezer.system(Stabilized()), 1e-11),

@@ -1,5 +1,5 @@
-"""The (n/2)-body chain with both ends fixed (seed 002 §3.3): projection onto the constraints,
-and seed 002's O(n + m^3) route against seed 001's coupled multipliers."""
+"""The (n/2)-body chain with both ends fixed (Anderson 1993 §3.3): projection onto the constraints,
+and Anderson 1993's O(n + m^3) route against Jerkovsky 1978's coupled multipliers."""
 
 import jax
 import jax.numpy as jnp
@@ -31,7 +31,7 @@ def test_projection_lands_on_the_constraints():
 
 
 def test_order_n_route_agrees_with_the_coupled_one_on_the_closed_chain():
-    """Seed 002 reports its O(n) and O(n^3) codes "effectively identical"; here to round-off."""
+    """Anderson 1993 reports its O(n) and O(n^3) codes "effectively identical"; here to round-off."""
     dense_system, q0, v0 = closed_chain.build(12)
     loops = dense_system.loops
     ts = np.linspace(0.0, 0.2, 5)

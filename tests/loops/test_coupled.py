@@ -1,4 +1,4 @@
-"""Loop closures and the coupled Lagrange-multiplier solution (seed 001 eqs 85-93) on a planar
+"""Loop closures and the coupled Lagrange-multiplier solution (Jerkovsky 1978 eqs 85-93) on a planar
 four-bar, against an independent minimal-coordinate solution (closed-form loop, one-dof
 Lagrangian, scipy's DOP853)."""
 
@@ -103,7 +103,7 @@ def test_ill_posed_closures_get_clear_errors():
 
 @pytest.mark.slow     # the closed chain's test covers the same agreement by default
 def test_order_n_stabilization_agrees_with_the_coupled_solution():
-    """Seed 002's eta - Gamma f_c (m + 1 passes of the O(n) recursion) against seed 001's dense
+    """Anderson 1993's eta - Gamma f_c (m + 1 passes of the O(n) recursion) against Jerkovsky 1978's dense
     Lagrange multipliers, the same RK4 steps: the two trajectories agree to round-off."""
     ts = np.linspace(0.0, 0.5, 6)
     coupled = simulate(SYSTEM, RK4(), Q0, V0, dt=1e-3, t1=0.5, saveat=ts)

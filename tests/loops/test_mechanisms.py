@@ -1,5 +1,5 @@
 """The mechanism scenes (planar four-bar, slider-crank, Bricard's mechanism) closed by cut joints
-and solved with seed 001's coupled Lagrange multipliers (`Coupled`), each against an
+and solved with Jerkovsky 1978's coupled Lagrange multipliers (`Coupled`), each against an
 independent minimal-coordinate reference: the scene's closed-form position analysis, the one-dof
 Lagrangian L(theta, omega) = T - V in that coordinate (differentiated by jax) and scipy's DOP853;
 for the driven slider-crank, the same Lagrangian's inverse dynamics gives the motor torque."""

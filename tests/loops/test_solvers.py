@@ -1,5 +1,5 @@
-"""The solvers of mbjax.loops beyond the velocity form: seed 001's momentum form (eqs 95-98),
-seed 002's loads from one triangularization (eqs 101-107), projection after every step, the
+"""The solvers of mbjax.loops beyond the velocity form: Jerkovsky 1978's momentum form (eqs 95-98),
+Anderson 1993's loads from one triangularization (eqs 101-107), projection after every step, the
 status flags, consistent initial conditions and the epsilon-dynamics with position feedback."""
 
 import equinox as eqx
@@ -53,7 +53,7 @@ def test_momentum_form_follows_the_same_motion():
 
 
 def test_one_triangularization_gives_the_unit_load_responses():
-    """eta and the columns of Gamma (seed 002 eqs 101-107) against the dense forward dynamics,
+    """eta and the columns of Gamma (Anderson 1993 eqs 101-107) against the dense forward dynamics,
     Gamma under the rows of A with no gravity and no velocity."""
     @jax.jit
     def loads_and_dense(q, v):

@@ -1,4 +1,4 @@
-"""Seed 001's operators: A from the path matrix, B = A^-1 from the reference matrix (eq 17)."""
+"""Jerkovsky 1978's operators: A from the path matrix, B = A^-1 from the reference matrix (eq 17)."""
 
 import functools
 

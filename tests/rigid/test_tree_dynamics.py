@@ -1,5 +1,5 @@
-"""Dynamics of rigid trees: identities between the O(n) recursion (seed 002), the RNEA and seed
-001's transformation operator; Pinocchio and MuJoCo on the same URDF; invariants of simulated
+"""Dynamics of rigid trees: identities between the O(n) recursion (Anderson 1993), the RNEA and Jerkovsky
+1978's transformation operator; Pinocchio and MuJoCo on the same URDF; invariants of simulated
 motion; gradients, vmap and input checks.
 
 Everything traced is jitted once per model (a compile per topology), so the file stays fast.
@@ -105,7 +105,7 @@ def _dynamics(model: Model, q, v, tau, a):
     out["M_rnea"] = jax.jit(jax.vmap(lambda e: rigid.inverse_dynamics(no_gravity, q, zero, e)))(
         jnp.eye(model.nv)).T
 
-    # Momentum form (seed 001 eqs 72-73): d/dt (M v) along the motion under tau.
+    # Momentum form (Jerkovsky 1978 eqs 72-73): d/dt (M v) along the motion under tau.
     q_dot = model.q_dot(q, v)
     p, p_dot = jax.jvp(lambda q_, v_: rigid.momentum(model, q_, v_), (q, v),
                        (q_dot, out["fd_recursive"]))
@@ -193,7 +193,7 @@ def test_mass_matrix_is_rnea_of_unit_accelerations(case):
 
 
 def test_momentum_rate_is_time_derivative_of_momentum(case):
-    """Seed 001 eq 72 against d/dt (M v) along the motion (forward-mode autodiff); eq 73."""
+    """Jerkovsky 1978 eq 72 against d/dt (M v) along the motion (forward-mode autodiff); eq 73."""
     _, _, _, out = case
     assert_close(out["p"], out["Mv"])
     assert_close(out["momentum_rate"], out["p_dot"])
@@ -224,7 +224,7 @@ def test_wrench_projections_give_tau_and_constraint_forces(case):
 
 
 def test_transformation_operator_gives_primitive_velocities(case):
-    """sigma = A A_hat_f v (seed 001 eqs 14, 49): per body (omega; v_c) in ground axes, against
+    """sigma = A A_hat_f v (Jerkovsky 1978 eqs 14, 49): per body (omega; v_c) in ground axes, against
     forward kinematics differentiated by autodiff and by central differences."""
     _, _, _, out = case
     assert_close(out["sigma_operator"], out["sigma_jvp"])
@@ -385,7 +385,7 @@ def test_energy_conservation_converges_at_fourth_order(gravity):
 
 
 def test_momentum_and_velocity_forms_agree():
-    """MomentumSystem (seed 001 eqs 72-73) and TreeSystem integrate the same motion: they differ
+    """MomentumSystem (Jerkovsky 1978 eqs 72-73) and TreeSystem integrate the same motion: they differ
     by RK4's error only (falling about 2^4 when dt halves), and both keep the energy."""
     differences = []
     for dt in STEPS:

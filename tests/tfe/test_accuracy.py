@@ -1,7 +1,7 @@
 """The accuracy status of time elements (issue 23): `solve_tfe(..., rtol=, atol=)` estimates
 the final state's error by step doubling and the drift of the body's invariants, and flags
-INACCURATE past the tolerance. Checked against the closed form of the torque-free body (seed
-000 §8.1) and on the top whose primal element is unstable (§7)."""
+INACCURATE past the tolerance. Checked against the closed form of the torque-free body (Borri
+1990 §8.1) and on the top whose primal element is unstable (§7)."""
 
 import jax
 import jax.numpy as jnp

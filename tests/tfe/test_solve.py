@@ -1,4 +1,4 @@
-"""Newton per element and time marching (seed 000 §5): convergence orders against the closed
+"""Newton per element and time marching (Borri 1990 §5): convergence orders against the closed
 form (eq 8.8), a free 6-dof body against its closed form, quadratic Newton convergence, status
 on failure, gradients by the implicit function theorem against finite differences."""
 

@@ -1,4 +1,4 @@
-"""Transition matrices (seed 000 §6-7): Tables 1-2, eq 7.10's boundaries, eqs 7.8-7.9, the
+"""Transition matrices (Borri 1990 §6-7): Tables 1-2, eq 7.10's boundaries, eqs 7.8-7.9, the
 paper's eq 6.8 / 6.12 constructions against the implicit-function-theorem Jacobian, and long
 marches against the one-element maps."""
 

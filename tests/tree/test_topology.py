@@ -1,4 +1,4 @@
-"""Tree topology (seed 001 eqs 1-3, seed 002 eqs 2-4) and the forward/backward tree passes.
+"""Tree topology (Jerkovsky 1978 eqs 1-3, Anderson 1993 eqs 2-4) and the forward/backward tree passes.
 
 Expected sets and matrices are written by hand from the definitions; the passes are checked
 against plain-Python recursions over the parent array.
@@ -44,7 +44,7 @@ def test_topology_is_static_and_hashable():
 # A small branched tree, by hand
 # --------------------------------------------------------------------------------------------
 #
-#   ground - 0 -+- 1 -+- 2          (seed 001 labels: 1 is the central body, here 0)
+#   ground - 0 -+- 1 -+- 2          (Jerkovsky 1978 labels: 1 is the central body, here 0)
 #               |     +- 3
 #               +- 4 --- 5
 #
@@ -53,14 +53,14 @@ FIVE = Topology(FIVE_PARENTS)
 
 
 def test_sets_of_branched_tree():
-    """An[k] (seed 002 eq 2, nearest first), Dist[k] (eq 3), Des[k] (eq 4)."""
+    """An[k] (Anderson 1993 eq 2, nearest first), Dist[k] (eq 3), Des[k] (eq 4)."""
     assert [FIVE.ancestors(k) for k in range(6)] == [(), (0,), (1, 0), (1, 0), (0,), (4, 0)]
     assert [FIVE.distal(k) for k in range(6)] == [(1, 4), (2, 3), (), (), (5,), ()]
     assert [FIVE.descendants(k) for k in range(6)] == [(1, 2, 3, 4, 5), (2, 3), (), (), (5,), ()]
 
 
 def test_path_and_reference_matrices_of_branched_tree():
-    """pi (seed 001 eq 1): row i is the inward set i^, column j the outward set j-bar;
+    """pi (Jerkovsky 1978 eq 1): row i is the inward set i^, column j the outward set j-bar;
     rho (eq 2): I on the diagonal and -I where body i is referenced to body j; eq 3."""
     pi = np.array([[1, 0, 0, 0, 0, 0],
                    [1, 1, 0, 0, 0, 0],
@@ -144,7 +144,7 @@ def test_random_tree_matrices_and_sets(parents):
     top = Topology(parents)
     n = len(parents)
     pi, rho = top.path_matrix(), top.reference_matrix()
-    np.testing.assert_array_equal(rho @ pi, np.eye(n))          # seed 001 eq 3
+    np.testing.assert_array_equal(rho @ pi, np.eye(n))          # Jerkovsky 1978 eq 3
     np.testing.assert_array_equal(pi @ rho, np.eye(n))
     assert np.array_equal(pi, np.tril(pi)) and np.array_equal(rho, np.tril(rho))
     for k in range(n):

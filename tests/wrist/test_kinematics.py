@@ -1,4 +1,4 @@
-"""Carpal Wrist kinematics against `carpal-wrist-model.md`: its check values, FK(IK(x)) == x over
+"""Carpal Wrist kinematics against `docs/carpal-wrist-model.md`: its check values, FK(IK(x)) == x over
 the workspace, the Jacobian three ways, the singularity measures on both singularities, and
 unreachable poses."""
 

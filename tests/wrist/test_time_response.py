@@ -1,4 +1,4 @@
-"""The Carpal Wrist's time response (seed 003 §6.4): the chapter's scheme, energy conservation,
+"""The Carpal Wrist's time response (Canfield 1997 §6.4): the chapter's scheme, energy conservation,
 convergence order, and stability exactly where each method's linearization says it fails."""
 
 import jax
