@@ -19,6 +19,7 @@ from collections.abc import Callable, Hashable, Sequence
 from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
 from concurrent.futures.process import BrokenProcessPool
 
+from mbjax import progress as _progress
 from mbjax.progress import Board, progress
 
 # JAX settings a worker takes from the parent
@@ -54,8 +55,12 @@ def _start_worker(settings: dict, events) -> None:
 
 def _run(task: Callable, key: Hashable) -> tuple[float, object]:
     start = time.perf_counter()
-    _events.put((key, start))
-    return start, task(key)
+    _events.put((key, start, None))
+    _progress._sink = lambda what: _events.put((key, None, what))   # the task's steps
+    try:
+        return start, task(key)
+    finally:
+        _progress._sink = None
 
 
 def run(task: Callable, keys: Sequence[Hashable], jobs: int | None = None,
@@ -83,9 +88,13 @@ def run(task: Callable, keys: Sequence[Hashable], jobs: int | None = None,
             while pending:
                 done, _ = wait(pending, timeout=0.5, return_when=FIRST_COMPLETED)
                 while not events.empty():
-                    key, start = events.get()
-                    if key not in results:          # a notice may come after its result
+                    key, start, what = events.get()
+                    if key in results:              # a notice may come after its result
+                        continue
+                    if start is not None:
                         board.started(key, start)
+                    elif key in board.running:
+                        board.step(key, what)
                 for future in done:
                     key = pending.pop(future)
                     start, results[key] = future.result()

@@ -5,6 +5,7 @@ only run. Run time is the median of `repeats` calls after that warm-up, each end
 `jax.block_until_ready` on the output so that JAX's asynchronous dispatch is not mistaken for speed.
 """
 
+import functools
 import json
 import statistics
 import time
@@ -13,6 +14,8 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import jax
+
+from mbjax.progress import step
 
 
 @dataclass(frozen=True)
@@ -23,7 +26,9 @@ class Timing:
 
 
 def measure(fn: Callable, *args, repeats: int = 10) -> tuple[object, Timing]:
-    """Call fn(*args) once to compile, then `repeats` times; return (output, Timing)."""
+    """Call fn(*args) once to compile, then `repeats` times; return (output, Timing). Each call
+    of `measure` is a step on the progress display (`mbjax.progress.step`), named after `fn`."""
+    step(_name(fn))
     start = time.perf_counter()
     out = jax.block_until_ready(fn(*args))
     first = time.perf_counter() - start
@@ -34,6 +39,12 @@ def measure(fn: Callable, *args, repeats: int = 10) -> tuple[object, Timing]:
         samples.append(time.perf_counter() - start)
     run = statistics.median(samples)
     return out, Timing(compile_s=max(first - run, 0.0), run_s=run, runs=repeats)
+
+
+def _name(fn: Callable) -> str:
+    while isinstance(fn, functools.partial):
+        fn = fn.func
+    return getattr(fn, "__name__", type(fn).__name__)
 
 
 def write_jsonl(path: Path, records: Iterable[dict]) -> None:

@@ -6,11 +6,13 @@ import os
 import jax
 import pytest
 
-from mbjax import parallel
+from mbjax import parallel, progress
 
 
 def _worker_facts(key):
-    """What a task sees: its process, the precision arrays get, the compilation cache."""
+    """What a task sees: its process, the precision arrays get, the compilation cache. It reports
+    a step, as `mbjax.timing.measure` does."""
+    progress.step(f"looking at {key}")
     return {"key": key, "pid": os.getpid(), "dtype": jax.numpy.ones(1).dtype.name,
             "cache": jax.config.jax_compilation_cache_dir}
 
@@ -21,7 +23,8 @@ def _fails_on_two(key):
     return key
 
 
-def test_workers_get_the_parents_settings(capsys):
+def test_workers_get_the_parents_settings(capsys, monkeypatch):
+    monkeypatch.setattr(progress.Board, "log_every", 0.0)      # every step on its own line
     facts = parallel.run(_worker_facts, ["a", "b", "c"], jobs=2, desc="facts")
     assert sorted(facts) == ["a", "b", "c"]
     assert all(f["key"] == key for key, f in facts.items())
@@ -30,13 +33,16 @@ def test_workers_get_the_parents_settings(capsys):
     assert all(f["cache"] == jax.config.jax_compilation_cache_dir for f in facts.values())
     err = capsys.readouterr().err                   # not a terminal: a line per event
     assert all(f"{key} started" in err and f"{key} done in" in err for key in "abc")
+    assert all(f"{key} step 1: looking at {key}" in err for key in "abc")   # a worker's steps
     assert "facts [########################] 3/3 done in" in err
 
 
-def test_one_job_runs_here_in_order(capsys):
+def test_one_job_runs_here_in_order(capsys, monkeypatch):
+    monkeypatch.setattr(progress.Board, "log_every", 0.0)
     facts = parallel.run(_worker_facts, [3, 1, 2], jobs=1)
     assert list(facts) == [3, 1, 2] and {f["pid"] for f in facts.values()} == {os.getpid()}
-    assert "3/3 done in" in capsys.readouterr().err
+    err = capsys.readouterr().err
+    assert "3/3 done in" in err and "2 step 1: looking at 2" in err
 
 
 @pytest.mark.parametrize("jobs", [1, 2])

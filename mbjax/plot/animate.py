@@ -15,6 +15,8 @@ import numpy as np
 from matplotlib.animation import FuncAnimation, PillowWriter
 from matplotlib.figure import Figure
 
+from mbjax.progress import step
+
 __all__ = ["frames_along", "stick_animation"]
 
 AXIS_COLORS = ("#d62728", "#2ca02c", "#1f77b4")     # x, y, z
@@ -45,6 +47,7 @@ def stick_animation(path: Path, ts, R, p, parents, *, title: str = "", trace: in
     the motion's extent); triads=False draws the sticks alone (a beam's centreline as a chain of
     points, say); view: the camera's (elevation, azimuth) in degrees, (90, -90) looking down on
     the x-y plane. At most `frames` of the saved states are drawn, evenly spaced."""
+    step(f"animation {Path(path).name}")
     ts, R, p = np.asarray(ts), np.asarray(R), np.asarray(p)
     parents = np.asarray(parents, dtype=int)
     n = len(parents)

@@ -39,6 +39,7 @@ from pathlib import Path
 import numpy as np
 
 from mbjax.flex.references import slider_crank_reference
+from mbjax.progress import step
 from mbjax.reproduce.spin_up_beam import history_status
 from mbjax.scenes import flexible_slider_crank as scene
 
@@ -69,6 +70,7 @@ def reproduce(out: Path, quick: bool = False) -> dict:
     elements = QUICK_ELEMENTS if quick else ELEMENTS
     runs = {}
     for n in elements:
+        step(f"{n} elements")
         start = time.perf_counter()
         ts, d, sol = scene.run(n_elements=n, dt=dt, t1=duration, every=EVERY)
         d = np.asarray(d)

@@ -35,6 +35,7 @@ from mbjax.flex import Beam, FlexibleModel, FlexibleSystem, beam_body, craig_bam
 from mbjax.integrate import INTEGRATORS, simulate
 from mbjax.loops import ClosedSystem, Coupled, Momentum, Stabilized
 from mbjax.model import Model, chain
+from mbjax.progress import step
 from mbjax.rigid import RigidBody, TreeSystem
 from mbjax.scenes import carpal_wrist as cw
 from mbjax.scenes import flexible_slider_crank as fsc
@@ -221,10 +222,12 @@ def check(cell: Cell, step: float = STEP) -> dict:
 def reproduce(out: Path, quick: bool = False) -> dict:
     """Every cell (quick: `QUICK_CELLS`); writes NAME.json and NAME.png."""
     from mbjax.plot.gradients import gradient_matrix_figure
-    from mbjax.progress import progress
 
     names = QUICK_CELLS if quick else tuple(CELLS)
-    cells = [check(CELLS[name]) for name in progress(names, len(names), NAME)]
+    cells = []
+    for name in names:
+        step(name)
+        cells.append(check(CELLS[name]))
     data = {"step": STEP, "tolerance": TOLERANCE, "cells": cells}
     out.mkdir(parents=True, exist_ok=True)
     (out / f"{NAME}.json").write_text(json.dumps(data, indent=1))

@@ -41,6 +41,7 @@ from mbjax.model import Model
 from mbjax.model.checks import ModelWarning
 from mbjax.model.mjcf import from_mujoco, object_name, site_frame_name
 from mbjax.model.states import state_from_mujoco, state_to_mujoco
+from mbjax.progress import step
 from mbjax.rigid import forward_dynamics, frame_placement
 from mbjax.rigid.kinematics import forward_kinematics
 
@@ -157,6 +158,7 @@ def survey(paths=None) -> tuple[list[dict], list[dict]]:
     found, skipped = [], []
     for path in corpus_paths() if paths is None else [Path(p) for p in paths]:
         name = short_name(path)
+        step(name)
         try:
             mjmodel = mujoco.MjModel.from_xml_path(str(path))
         except ValueError as err:

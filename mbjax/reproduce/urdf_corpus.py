@@ -25,9 +25,9 @@ import numpy as np
 
 from mbjax.model.states import state_to_pinocchio
 from mbjax.model.urdf import load_urdf
+from mbjax.progress import step
 from mbjax.rigid import aba, forward_kinematics, inverse_dynamics, mass_matrix
 from mbjax.rigid.frames import frame_jacobian, frame_poses
-
 
 # Above this condition number of the mass matrix, forward dynamics are compared by their backward
 # error: cond(M) eps exceeds 1e-10 there, so neither engine's accelerations are accurate to it.
@@ -165,6 +165,7 @@ def rows(paths=None) -> list[dict]:
     out = []
     for path in paths or corpus_paths():
         for floating in (False, True):
+            step(f"{name(path)}{', floating' if floating else ''}")
             start = time.perf_counter()
             row = compare(path, floating)
             row["seconds"] = time.perf_counter() - start

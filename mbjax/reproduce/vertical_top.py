@@ -27,6 +27,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
+from mbjax.progress import step
 from mbjax.scenes import vertical_top as vt
 from mbjax.tfe import Element, Mixed, PrimalUnsymmetric, make_reference, stability
 
@@ -85,6 +86,7 @@ def transverse_exponent(T, h) -> complex:
 def eigenvalue_table(form, quadrature: str, dts) -> dict:
     table = {}
     for nodes in NODES:
+        step(f"{type(form).__name__}, {quadrature} quadrature, {nodes} nodes")
         element = Element(nodes, quadrature)
         rows = []
         for dt in dts:
