@@ -143,13 +143,14 @@ def time_elements_tour(out: Path, quick: bool) -> dict:
     from mbjax.reproduce import top_long_run as tlr
 
     duration = 20.0 if quick else 40.0
-    runs = [tlr.run(name, form, quadrature, "steady", duration, repeats=1)
+    runs = [tlr.run(name, form, quadrature, "steady", duration, repeats=1, rotations=True)
             for name, form, quadrature in tlr.FORMS if name in ("primal", "mixed")]
+    animation = _animate_tops(out, runs, quick)
     data = {"scene": f"time elements: vertical top at {tlr.SPIN_RATIO:g} Omega_c, {tlr.NODES}-node "
                      f"elements {tlr.DT:g} s between nodes, {duration:g} s (Borri 1990 §6-7)",
             "physical": tlr.physical(duration), "runs": runs}
     top_long_run_figure(data).savefig(out / "time-elements.png", dpi=110)
-    return {"figure": "time-elements.png", "duration": duration,
+    return {"figure": "time-elements.png", "animation": animation, "duration": duration,
             "runs": {r["form"]: {k: r[k] for k in ("predicted_growth", "measured_growth", "max_tilt",
                                                    "seconds", "status")} for r in runs},
             "physical_max_tilt": float(np.max(data["physical"]["tilt"]))}
@@ -300,17 +301,25 @@ def carpal_wrist_tour(out: Path, quick: bool) -> dict:
     servoed wrist under gravity (stable or not), against the step; the run time of each method is
     per step of the free-motion runs (all steps vmapped in one call)."""
     from mbjax.plot.wrist import integrator_figure
+    from mbjax.plot.animate import wrist_animation
     from mbjax.reproduce import carpal_wrist as cwr
+    from mbjax.scenes import carpal_wrist as cws
 
     seconds = {}
     # quick: the chapter's explicit Euler against RK4 only (each method compiles two wrist rollouts)
     methods = ("explicit_euler", "rk4") if quick else cwr.METHODS
-    rows, critical = cwr.integrator_study(cwr.QUICK_STEPS if quick else cwr.STEPS, seconds, methods)
+    motion = {}
+    rows, critical = cwr.integrator_study(cwr.QUICK_STEPS if quick else cwr.STEPS, seconds, methods,
+                                          motion)
     fig = integrator_figure(rows, critical, seconds)
     fig.savefig(out / "carpal-wrist.png", dpi=110)
+    wrist_animation(out / "carpal-wrist.gif", cws.wrist(), motion["ts"], motion["qs"],
+                    title="Carpal Wrist, torque-free tool", frames=30 if quick else 40)
+    animation = "carpal-wrist.gif"
     table = {f"{r['name']} dt={r['dt'] * 1e3:g} ms": {k: r[k] for k in ("error", "energy_drift", "stable")}
              for r in rows}
-    return {"figure": "carpal-wrist.png", "integrators": table, "critical_dt": critical,
+    return {"figure": "carpal-wrist.png", "animation": animation, "integrators": table,
+            "critical_dt": critical,
             "seconds_per_step": seconds}
 
 
@@ -574,6 +583,28 @@ def _animate_body(out: Path, name: str, body, ts, qs, title: str, quick: bool) -
     stick_animation(out / f"{name}.gif", ts, np.stack([R, R], axis=1), p, [-1, 0], title=title,
                     trace=1, axis_length=0.4, frames=30 if quick else 60)
     return f"{name}.gif"
+
+
+def _animate_tops(out: Path, runs: list[dict], quick: bool) -> str:
+    """Write time-elements.gif: the tops of the primal (left) and mixed (right) runs side by side,
+    each a stick from its pivot along its symmetry axis, whose tip leaves its path; the tilt is
+    magnified (as the title says) so that the primal form's growth shows, not the mixed form's."""
+    from mbjax.plot.animate import stick_animation
+
+    R = np.stack([run.pop("R") for run in runs], axis=1)                # (T, 2, 3, 3)
+    axis = R[..., :, 2]
+    tilt = np.arccos(np.clip(axis[..., 2], -1.0, 1.0))
+    magnification = max(1, int(1.0 / max(float(tilt.max()), 1e-3)))    # the largest tilt ~ 1 rad
+    azimuth = np.arctan2(axis[..., 1], axis[..., 0])
+    shown = magnification * tilt
+    tips = np.stack([np.sin(shown) * np.cos(azimuth), np.sin(shown) * np.sin(azimuth),
+                     np.cos(shown)], axis=-1)
+    pivots = np.array([[-0.8, 0.0, 0.0], [0.8, 0.0, 0.0]])
+    ts = np.asarray(runs[0]["t"])
+    stick_animation(out / "time-elements.gif", ts, R, pivots + tips, [-1, -1],
+                    title=f"primal (left), mixed (right), tilt x{magnification}", trace=[0, 1],
+                    triads=False, anchors=pivots, frames=30 if quick else 60)
+    return "time-elements.gif"
 
 
 def run_scene(name: str, out: Path, quick: bool) -> dict:

@@ -172,10 +172,9 @@ def test_tour_quick(tmp_path, group):
     assert set(summary["scenes"]) == set(scenes)
     for scene in summary["scenes"].values():
         assert (tmp_path / scene["figure"]).stat().st_size > 10_000
-        if "animation" in scene:               # the mechanism moving, frame by frame
-            from PIL import Image
-            with Image.open(tmp_path / scene["animation"]) as gif:
-                assert gif.format == "GIF" and gif.n_frames >= 20
+        from PIL import Image              # every scene animates its mechanism, frame by frame
+        with Image.open(tmp_path / scene["animation"]) as gif:
+            assert gif.format == "GIF" and gif.n_frames >= 20
     markdown = (tmp_path / "summary.md").read_text()
     assert all(f"## {scene}" in markdown for scene in scenes)
     # written for people: a sentence per scene on what to look at, headers in words with units
@@ -680,3 +679,8 @@ def test_reproduce_trajopt(tmp_path):
     # synthesis reached 4.9e-3); iLQR's tail, the effort among clamped torques, is slow
     assert rows["carpal-wrist", "ilqr"]["final_error"] < 1e-4
     assert (tmp_path / "trajopt.png").stat().st_size > 10_000
+    from PIL import Image                      # each problem's iLQR solution moving
+    assert set(data["animations"]) == {p for p, _ in rows}
+    for gif_name in data["animations"].values():
+        with Image.open(tmp_path / gif_name) as gif:
+            assert gif.format == "GIF" and gif.n_frames >= 15

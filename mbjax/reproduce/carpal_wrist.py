@@ -115,14 +115,18 @@ def linear_critical_steps(system, q_eq, u_eq) -> dict:
     return out
 
 
-def integrator_study(steps, seconds: dict | None = None, methods=METHODS) -> tuple[list[dict], dict]:
+def integrator_study(steps, seconds: dict | None = None, methods=METHODS,
+                     motion: dict | None = None) -> tuple[list[dict], dict]:
     """The rows of the JSON's "integrators" for `methods` and the predicted critical steps; with a
     `seconds` dict, each method's run time per step of the vmapped free-motion runs is stored in
-    it."""
+    it; with a `motion` dict, the reference free motion ("ts", "qs": 41 saved states)."""
     free, q0, u0 = scene.free_motion()
     servo, s0, v0 = scene.servo()
-    ref = simulate(free, RK4(), q0, u0, dt=REFERENCE_DT, t1=scene.FREE_DURATION,
-                   saveat=np.array([scene.FREE_DURATION])).qs[-1]
+    reference = simulate(free, RK4(), q0, u0, dt=REFERENCE_DT, t1=scene.FREE_DURATION,
+                         saveat=np.linspace(0.0, scene.FREE_DURATION, 41))
+    ref = reference.qs[-1]
+    if motion is not None:
+        motion.update(ts=np.asarray(reference.ts), qs=np.asarray(reference.qs))
     E0 = jax.jit(lambda q, u: free.wrist.energy(q, u))(q0, u0)
     law = servo.control
 

@@ -118,7 +118,10 @@ def tilt_of(R) -> np.ndarray:
     return np.arccos(np.clip(np.asarray(R)[..., 2, 2], -1.0, 1.0))
 
 
-def run(form_name: str, form, quadrature: str, march: str, duration: float, repeats: int) -> dict:
+def run(form_name: str, form, quadrature: str, march: str, duration: float, repeats: int,
+        rotations: bool = False) -> dict:
+    """One march of the top: its tilt, invariants, growth rates, time and status; with
+    `rotations`, also "R", the body's rotation at every node (an array, for an animation)."""
     body = vt.build()
     spin = SPIN_RATIO * vt.CRITICAL_SPIN
     element = Element(NODES, quadrature)
@@ -145,7 +148,8 @@ def run(form_name: str, form, quadrature: str, march: str, duration: float, repe
             "predicted_growth": growth_rate(T, element.length(DT)),
             "measured_growth": measured_growth(t, tilt), "max_tilt": float(np.max(tilt)),
             "seconds": timing.run_s, "error_estimate": float(checked.error),
-            "invariant_drift": float(checked.drift), "status": checked.messages()[0]}
+            "invariant_drift": float(checked.drift), "status": checked.messages()[0],
+            **({"R": np.asarray(sol.R)} if rotations else {})}
 
 
 def physical(duration: float) -> dict:

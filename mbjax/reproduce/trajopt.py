@@ -6,7 +6,8 @@ Lagrangian of the defects), single shooting with L-BFGS (`Shooting("lbfgs")`) an
 (`Shooting("adam")`, the first-order baseline). Each solve is one compiled program, timed after
 compiling (`mbjax.timing.measure`); the cost after each iteration is plotted against the time it
 was reached, taken as the iteration's share of the solve's run time (iterations of one solver
-cost about the same). Per problem and solver the JSON gives
+cost about the same). Each problem's iLQR solution is animated, NAME-PROBLEM.gif (JSON
+"animations"). Per problem and solver the JSON gives
 {"name", "solver", "iterations", "seconds", "compile_seconds", "final_error", "cost", "status"}:
 final_error is the problem's own task error at the end (the flange's distance to its target
 [m] for the arm).
@@ -130,10 +131,30 @@ SHOOTING = ("arm-reach", "acrobot-swingup", "four-bar", "slewing-beam")
 QUICK_SHOOTING = ("arm-reach", "acrobot-swingup")
 
 
+def _animate(out: Path, name: str, problem, result, quick: bool) -> str:
+    """Write NAME-PROBLEM.gif, the iLQR solution moving (`mbjax.plot.animate`); the slewing beam
+    as its centreline seen from above, the deflection magnified 10 times."""
+    from mbjax.plot.animate import animate, stick_animation
+
+    path = out / f"{NAME}-{name}.gif"
+    ts = np.arange(problem.horizon + 1) * problem.dt
+    title, frames = f"{name} by iLQR", 20 if quick else 50
+    if name == "slewing-beam":
+        from mbjax.scenes import slewing_beam as sb
+
+        p = sb.centreline(problem.system.model, result.qs, magnification=10.0)
+        R = np.broadcast_to(np.eye(3), (*p.shape[:2], 3, 3))
+        stick_animation(path, ts, R, p, [-1, *range(p.shape[1] - 1)], triads=False,
+                        title=f"{title}, deflection x10", frames=frames, view=(90, -90))
+    else:
+        animate(path, problem.system, ts, result.qs, title=title, frames=frames)
+    return path.name
+
+
 def reproduce(out: Path, quick: bool = False) -> dict:
     from mbjax.plot.trajopt import trajopt_figure
 
-    rows, histories = [], {}
+    rows, histories, animations = [], {}, {}
     for name, build in PROBLEMS.items():
         problem, guess, final_error = build()
         for solver_name, solver in (QUICK_SOLVERS if quick else SOLVERS).items():
@@ -145,10 +166,12 @@ def reproduce(out: Path, quick: bool = False) -> dict:
                          "seconds": timing.run_s, "compile_seconds": timing.compile_s,
                          "final_error": final_error(result), "cost": float(result.cost),
                          "status": result.messages()[0]})
+            if solver_name == "ilqr":
+                animations[name] = _animate(out, name, problem, result, quick)
             costs = np.asarray(result.costs)[:iterations + 1]
             histories[(name, solver_name)] = (np.arange(iterations + 1) * timing.run_s
                                               / max(iterations, 1), costs)
-    data = {"problems": rows,
+    data = {"problems": rows, "animations": animations,
             "histories": [{"name": n, "solver": s, "seconds": t.tolist(), "cost": c.tolist()}
                           for (n, s), (t, c) in histories.items()]}
     out.mkdir(parents=True, exist_ok=True)

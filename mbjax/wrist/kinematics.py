@@ -50,6 +50,19 @@ def knees(wrist, theta: Array) -> Array:
     return jnp.concatenate([rho[:, None] * c, (wrist.link_length * jnp.sin(theta))[:, None]], axis=1)
 
 
+def leg_points(wrist, theta: Array) -> Array:
+    """The joints of the three legs, shape (3, 3, 3): [0] the base revolutes b_i = rb r_i, [1] the
+    knees m_i, [2] the distal revolutes d_i, b_i mirrored in the midplane N . x = N . m_1 (the
+    mirror symmetry of `docs/carpal-wrist-model.md`); what a picture of the wrist draws."""
+    c = leg_directions(wrist)
+    base = jnp.concatenate([wrist.base_radius * c, jnp.zeros((3, 1), c.dtype)], axis=1)
+    m = knees(wrist, theta)
+    p, g = midplane(wrist, theta)
+    N = normal_from_slope(g)
+    distal = base - 2 * (_dot(base, N) - p * N[2])[:, None] * N
+    return jnp.stack([base, m, distal])
+
+
 def _knee_matrix(wrist, theta: Array) -> Array:
     """K with rows (1, rho_i c_i): the knees' plane equations in (p, gx, gy)."""
     rho = wrist.base_radius - wrist.link_length * jnp.cos(theta)

@@ -76,6 +76,10 @@ class CarpalWrist(eqx.Module):
         """The tool pose (alpha, beta, plunge, rotation, centre, com) for input angles theta."""
         return kinematics.forward_kinematics(self, theta)
 
+    def leg_points(self, theta) -> Array:
+        """Base revolutes, knees and distal revolutes of the three legs, (3, 3, 3)."""
+        return kinematics.leg_points(self, theta)
+
     def inverse_kinematics(self, alpha, beta, plunge) -> Array:
         """theta (knees-out) for the pose; an unreachable pose raises."""
         return kinematics.inverse_kinematics(self, alpha, beta, plunge)

@@ -42,6 +42,12 @@ def test_knees_lie_on_the_midplane_and_the_plate_is_their_mirror():
     Ry = np.array([[np.cos(b), 0, np.sin(b)], [0, 1, 0], [-np.sin(b), 0, np.cos(b)]])
     np.testing.assert_allclose(pose.rotation, Rz(a) @ Ry @ Rz(-a), atol=1e-15)
     np.testing.assert_allclose(np.linalg.det(np.asarray(pose.rotation)), 1.0, atol=1e-14)
+    # the legs' joints: the distal revolutes sit on the plate (d_i = c_D + R b_i), each link is l
+    b, m, d = np.asarray(w.leg_points(theta))
+    np.testing.assert_allclose(b[:, 2], 0.0, atol=1e-15)
+    np.testing.assert_allclose(d, pose.centre + b @ np.asarray(pose.rotation).T, atol=1e-14)
+    np.testing.assert_allclose(np.linalg.norm(m - b, axis=1), w.link_length, atol=1e-14)
+    np.testing.assert_allclose(np.linalg.norm(d - m, axis=1), w.link_length, atol=1e-14)
 
 
 def _workspace_samples(w, n=2000, seed=0):
