@@ -1,5 +1,5 @@
 """The documentation site (`mkdocs.yml`, docs/): the API reference generated from the docstrings,
-the papers, the conventions and the notebooks' index. It builds in strict mode, so a page naming
+the papers, the conventions and the notebooks with their outputs. It builds in strict mode, so a page naming
 an object that no longer exists, or a broken link, fails the suite."""
 
 import subprocess
@@ -21,6 +21,10 @@ def test_the_documentation_builds_strict(tmp_path):
     assert "FlexibleSystem" in flex and "craig_bampton" in flex
     assert "simplified" in (tmp_path / "site" / "api" / "integrate" / "index.html").read_text()
     assert "Canfield" in (tmp_path / "site" / "papers" / "index.html").read_text()
+    # every notebook is a page, rendered as committed: its figures included
+    for notebook in sorted((ROOT / "notebooks").glob("*.ipynb")):
+        page = (tmp_path / "site" / "notebooks" / notebook.stem / "index.html").read_text()
+        assert "data:image/png;base64" in page, notebook.name
 
 
 def test_a_reference_to_a_missing_object_fails_the_build(tmp_path):

@@ -5,7 +5,9 @@ from mbjax.model import checks, limits, states
 from mbjax.model.builders import chain, random_tree
 from mbjax.model.checks import ModelWarning
 from mbjax.model.joints import JOINT_TYPES
+from mbjax.model.mjcf import from_mujoco, load_mjcf
 from mbjax.model.model import Model
+from mbjax.model.urdf import load_urdf, to_urdf
 
-__all__ = ["JOINT_TYPES", "Model", "ModelWarning", "chain", "checks", "limits", "random_tree",
-           "states"]
+__all__ = ["JOINT_TYPES", "Model", "ModelWarning", "chain", "checks", "from_mujoco", "limits",
+           "load_mjcf", "load_urdf", "random_tree", "states", "to_urdf"]

@@ -1,10 +1,9 @@
 """Figures of the benchmark suites."""
 
 import numpy as np
-from matplotlib.figure import Figure
 from matplotlib.ticker import NullFormatter
 
-from mbjax.plot.style import COLORS, MARKERS
+from mbjax.plot.style import COLORS, MARKERS, Figure
 
 
 def integrators_bench_figure(records: list[dict]) -> Figure:

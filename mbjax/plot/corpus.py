@@ -1,7 +1,8 @@
 """The model corpus: each real model's largest relative difference from its format's engine."""
 
 import numpy as np
-from matplotlib.figure import Figure
+
+from mbjax.plot.style import Figure
 
 
 def corpus_figure(data: dict) -> Figure:

@@ -2,7 +2,8 @@
 `mbjax reproduce flexible-slider-crank` and the tour's flexible-bodies scene."""
 
 import numpy as np
-from matplotlib.figure import Figure
+
+from mbjax.plot.style import Figure
 
 FIRST_BENDING = 3.8          # rad/s, the spin-up beam's first bending frequency
 REFERENCE_STYLE = dict(color="black", ls="--", lw=1.2)

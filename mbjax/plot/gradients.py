@@ -1,7 +1,8 @@
 """The gradient matrix: relative error of jax.grad and jax.jacfwd against central differences."""
 
 import numpy as np
-from matplotlib.figure import Figure
+
+from mbjax.plot.style import Figure
 
 
 def gradient_matrix_figure(data: dict) -> Figure:

@@ -1,9 +1,8 @@
 """The figure of `mbjax reproduce integrators`."""
 
 import numpy as np
-from matplotlib.figure import Figure
 
-from mbjax.plot.style import COLORS, MARKERS, label
+from mbjax.plot.style import COLORS, MARKERS, Figure, label
 
 
 def integrators_figure(data: dict, energy_histories: dict, energy_dt: float) -> Figure:

@@ -1,7 +1,8 @@
 """Figures of the closed loops (Jerkovsky 1978 §VI, Anderson 1993 §2.4): `mbjax reproduce closed-chain`."""
 
 import numpy as np
-from matplotlib.figure import Figure
+
+from mbjax.plot.style import Figure
 
 
 def closed_chain_figure(data: dict) -> Figure:

@@ -1,9 +1,8 @@
 """Figures of closed mechanisms from the literature: `mbjax reproduce andrews-squeezer`."""
 
 import numpy as np
-from matplotlib.figure import Figure
 
-from mbjax.plot.style import COLORS, MARKERS
+from mbjax.plot.style import COLORS, MARKERS, Figure
 
 ANGLES = ("beta", "Theta", "gamma", "Phi", "delta", "Omega", "epsilon")
 

@@ -1,9 +1,8 @@
 """Figures of the tour's scenes."""
 
 import numpy as np
-from matplotlib.figure import Figure
 
-from mbjax.plot.style import COLORS, label
+from mbjax.plot.style import COLORS, Figure, label
 
 
 def error_history_figure(histories: dict, title: str) -> Figure:

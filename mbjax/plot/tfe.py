@@ -2,7 +2,8 @@
 `torque-free-tfe` and `top-long-run`."""
 
 import numpy as np
-from matplotlib.figure import Figure
+
+from mbjax.plot.style import Figure
 
 NODE_COLORS = {"2": "#1f77b4", "3": "#ff7f0e", "4": "#2ca02c"}
 FORM_STYLES = {"primal": "-", "mixed": "--"}

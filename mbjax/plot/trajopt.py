@@ -2,7 +2,8 @@
 and one solved reach (the tour)."""
 
 import numpy as np
-from matplotlib.figure import Figure
+
+from mbjax.plot.style import Figure
 
 STYLE = {"ilqr": ("#1f77b4", "o"), "multiple-shooting": ("#2ca02c", "D"),
          "lbfgs": ("#ff7f0e", "s"), "adam": ("#7f7f7f", "^")}

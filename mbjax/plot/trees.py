@@ -2,9 +2,8 @@
 tour's rigid chain."""
 
 import numpy as np
-from matplotlib.figure import Figure
 
-from mbjax.plot.style import COLORS, MARKERS, label
+from mbjax.plot.style import COLORS, MARKERS, Figure, label
 
 # One colour per formulation or peer, in every tree figure.
 TREE_COLORS = {"recursive": "#1f77b4", "dense": "#d62728", "pinocchio": "#2ca02c",

@@ -1,9 +1,8 @@
 """Figures of the Carpal Wrist: integrator accuracy and stability, synthesized torques, sweeps."""
 
 import numpy as np
-from matplotlib.figure import Figure
 
-from mbjax.plot.style import COLORS, MARKERS, label
+from mbjax.plot.style import COLORS, MARKERS, Figure, label
 
 
 def _integrator_panels(ax_err, ax_stab, rows: list, critical: dict, seconds: dict | None = None):
