@@ -37,7 +37,13 @@ def progress(items: Iterable, total: int, desc: str = "") -> Iterator:
         for item in items:
             start = time.perf_counter()
             board.started(item, start)
-            _sink = lambda what, item=item: (board.step(item, what), outer and outer(what))  # noqa: E731
+
+            def report(what: str, item=item) -> None:
+                board.step(item, what)
+                if outer is not None:
+                    outer(what)
+
+            _sink = report
             yield item
             _sink = outer
             board.finished(item, start)
