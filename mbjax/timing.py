@@ -44,7 +44,8 @@ def measure(fn: Callable, *args, repeats: int = 10) -> tuple[object, Timing]:
 def _name(fn: Callable) -> str:
     while isinstance(fn, functools.partial):
         fn = fn.func
-    return getattr(fn, "__name__", type(fn).__name__)
+    name = getattr(fn, "__name__", type(fn).__name__)
+    return "a timed run" if name == "<lambda>" else name
 
 
 def write_jsonl(path: Path, records: Iterable[dict]) -> None:
