@@ -26,8 +26,14 @@ def _run(path, tmp_path, monkeypatch, smoke: bool):
     # the kernel talks over Unix sockets in tmp_path, not TCP ports: two xdist workers starting
     # kernels at once raced for one port ("Address already in use"; the kernel died)
     km = KernelManager(kernel_name="python3", transport="ipc", ip=str(tmp_path / "kernel"))
-    NotebookClient(nb, km=km, timeout=600, kernel_name="python3",
-                   resources={"metadata": {"path": str(tmp_path)}}).execute()
+    try:
+        NotebookClient(nb, km=km, timeout=600, kernel_name="python3",
+                       resources={"metadata": {"path": str(tmp_path)}}).execute()
+    finally:
+        # a client given its kernel manager leaves the kernel running: 11 idle kernels held
+        # 0.5-1.3 GB each until the suite ended
+        if km.has_kernel:
+            km.shutdown_kernel(now=True)
     errors = [o for cell in nb.cells if cell.cell_type == "code"
               for o in cell.get("outputs", []) if o.get("output_type") == "error"]
     assert not errors
