@@ -1,6 +1,6 @@
 """What compiling costs a user: `mbjax tour --quick` from a cold and a warm compilation cache,
 scene by scene with the programs each compiles, and the first calls of the public functions
-outside `jax.jit` (issue 21, target 4).
+outside `jax.jit`.
 
     python benchmarks/bench_compile.py [--out DIR]
 

@@ -1,6 +1,6 @@
 """The cost users feel (one call, one evaluation in a rollout, a vmapped batch, the gradient of a
 rollout, compile time) on chains and real robots, mbjax against Pinocchio, jaxsim and adam in one
-process (issue 21).
+process.
 
     python benchmarks/bench_speed.py [--out DIR] [--quick]
 

@@ -1,5 +1,5 @@
 """Batched forward dynamics, rollouts and rollout gradients of revolute chains, mbjax against
-Pinocchio (aba per call, abaInParallel), mujoco.rollout and MJX, in one run (issue 8).
+Pinocchio (aba per call, abaInParallel), mujoco.rollout and MJX, in one run.
 
     python benchmarks/bench_throughput.py [--out DIR] [--quick]
 
