@@ -203,7 +203,7 @@ def closed_loops_tour(out: Path, quick: bool) -> dict:
         drift[name] = (saveat, phi)
     fig = closed_loops_tour_figure(runs, drift, f"closed chain, 12 dof, {duration:g} s, RK4")
     fig.savefig(out / "closed-loops.png", dpi=110)
-    animation = _animate(out, "closed-loops", chain.tree, saveat, ref.qs,
+    animation = _animate(out, "closed-loops", chain, saveat, ref.qs,
                          "closed chain (reference solution)", quick)
     return {"figure": "closed-loops.png", "animation": animation, "duration": duration,
             "reference_status": int(ref.status), "integrators": rows}
@@ -542,13 +542,11 @@ COST = {"time-elements": 9.1, "carpal-wrist": 9.0, "closed-loops": 8.6, "flexibl
 
 
 def _animate(out: Path, name: str, system, ts, qs, title: str, quick: bool) -> str:
-    """Write the scene's animation, `name`.gif (`mbjax.plot.animate`), of a tree system moving
-    through the saved states qs at times ts; returns the file name."""
-    from mbjax.plot.animate import frames_along, stick_animation
+    """Write the scene's animation, `name`.gif (`mbjax.plot.animate.animate`), of a system
+    moving through the saved states qs at times ts; returns the file name."""
+    from mbjax.plot.animate import animate
 
-    R, p = frames_along(system, qs)
-    stick_animation(out / f"{name}.gif", ts, R, p, system.model.topology.parents, title=title,
-                    frames=30 if quick else 60)
+    animate(out / f"{name}.gif", system, ts, qs, title=title, frames=30 if quick else 60)
     return f"{name}.gif"
 
 

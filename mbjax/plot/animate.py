@@ -111,14 +111,39 @@ def stick_animation(path: Path, ts, R, p, parents, *, title: str = "",
 
 def animate(path: Path, system, ts, qs, *, title: str = "", frames: int = 60) -> Path:
     """Write a GIF of any mbjax system moving through the saved configurations qs at times ts:
-    the Carpal Wrist's legs and plates (`wrist_animation`), a closed loop's spanning tree, or a
-    tree system's bodies (`stick_animation` of its `frames`)."""
+    the Carpal Wrist's legs and plates (`wrist_animation`), a closed loop's spanning tree with a
+    stick from each body of a cut joint to the joint's frame on it (so the loop is seen closed),
+    or a tree system's bodies (`stick_animation` of its `frames`)."""
     if hasattr(system, "wrist"):
         return wrist_animation(path, system.wrist, ts, qs, title=title, frames=frames)
     tree = getattr(system, "tree", system)          # a ClosedSystem draws its tree
     R, p = frames_along(tree, qs)
-    return stick_animation(path, ts, R, p, tree.model.topology.parents, title=title,
-                           frames=frames)
+    parents = list(tree.model.topology.parents)
+    n, m = len(parents), p.shape[1]                # bodies, then markers or named frames
+    anchors = np.zeros((n, 3))
+    extra = []                                      # (parent body or -1, points (T, 3), anchor)
+    for joint in getattr(system, "closures", ()):
+        if not hasattr(joint, "origin_a"):          # a prescribed motion: nothing to draw
+            continue
+        a, b = joint.body_a, joint.body_b
+        extra.append((a, p[:, a] + R[:, a] @ np.asarray(joint.origin_a), None))
+        if b >= 0:
+            extra.append((b, p[:, b] + R[:, b] @ np.asarray(joint.origin_b), None))
+        else:                                       # on the ground: a fixed dot
+            extra.append((-1, np.broadcast_to(np.asarray(joint.origin_b), p[:, 0].shape),
+                          np.asarray(joint.origin_b)))
+    if extra:
+        body_R, body_p = R[:, :n], p[:, :n]
+        points = np.stack([points for _, points, _ in extra], axis=1)
+        R = np.concatenate([body_R, np.broadcast_to(np.eye(3), (*points.shape[:2], 3, 3)),
+                            R[:, n:]], axis=1)
+        p = np.concatenate([body_p, points, p[:, n:]], axis=1)
+        anchors = np.concatenate([anchors, [np.zeros(3) if anchor is None else anchor
+                                            for _, _, anchor in extra]])
+        parents += [parent for parent, _, _ in extra]
+    triads = [*range(n), *range(n + len(extra), m + len(extra))]   # not the cut joints' points
+    return stick_animation(path, ts, R, p, parents, title=title, frames=frames,
+                           trace=n - 1, triads=triads, anchors=anchors)
 
 
 def wrist_animation(path: Path, wrist, ts, thetas, *, title: str = "", frames: int = 60) -> Path:
