@@ -8,7 +8,7 @@ from mbjax.trajopt.problem import Problem
 from mbjax.trajopt.result import AbstractSolver, Result
 from mbjax.trajopt.shooting import Shooting
 from mbjax.trajopt.solve import solve
-from mbjax.trajopt.sweeps import sweep
+from mbjax.trajopt.sweeps import grid, peak_torque, sweep
 
-__all__ = ["AbstractSolver", "ILQR", "MultipleShooting", "Problem", "Result", "Shooting",
-           "optimal_cost", "solve", "sweep"]
+__all__ = ["AbstractSolver", "ILQR", "MultipleShooting", "Problem", "Result", "Shooting", "grid",
+           "optimal_cost", "peak_torque", "solve", "sweep"]
