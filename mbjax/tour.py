@@ -554,16 +554,13 @@ def _animate_beam(out: Path, n_bending: int, ts, qs, quick: bool) -> str:
     """Write flexible-bodies.gif: the spun beam's centreline in the hub's rotating frame seen from
     above (21 points along it, the deformation magnified `BEAM_MAGNIFICATION` times, as the title
     says), q = (hub angle, modal coordinates)."""
-    from mbjax.flex import shape_at
+    from mbjax.flex import centreline
     from mbjax.plot.animate import stick_animation
     from mbjax.scenes import spin_up_beam as sub
 
     structure = sub.beam(sub.N_ELEMENTS)                # the mesh behind `sub.run`'s modes
     basis = sub.modes(structure, n_bending, 1)
-    arc = np.linspace(0.0, sub.LENGTH, 21)
-    phi = np.asarray(jax.vmap(lambda s: shape_at(structure, basis, s)[0])(arc))   # (21, 3, mu)
-    points = arc[:, None] * np.array([1.0, 0.0, 0.0])
-    p = points[None] + BEAM_MAGNIFICATION * np.einsum("kis,ts->tki", phi, np.asarray(qs)[:, 1:])
+    p = np.asarray(centreline(structure, basis, np.asarray(qs)[:, 1:], 21, BEAM_MAGNIFICATION))
     R = np.broadcast_to(np.eye(3), (*p.shape[:2], 3, 3))
     stick_animation(out / "flexible-bodies.gif", ts, R, p, [-1, *range(20)],
                     title=f"spin-up beam seen in the hub frame, deflection x{BEAM_MAGNIFICATION}",

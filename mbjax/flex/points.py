@@ -73,3 +73,13 @@ def shape_at(beam: Beam, basis: ModalBasis, s):
     Nt, Nr = interpolation(beam, s / beam.Le - e)
     Pe = basis.shapes[6 * e + np.arange(12)]
     return Nt @ Pe, Nr @ Pe
+
+
+def centreline(beam: Beam, basis: ModalBasis, q, points: int = 21, magnification: float = 1.0):
+    """Positions (..., points, 3) of `points` points evenly spaced on the beam's axis (x, from its
+    root) in the body frame, deformed by the modal coordinates q (..., mu), the deflection times
+    `magnification` (for a picture)."""
+    s = jnp.linspace(0.0, beam.L, points)
+    phi = jax.vmap(lambda si: shape_at(beam, basis, si)[0])(s)          # (points, 3, mu)
+    axis = s[:, None] * jnp.array([1.0, 0.0, 0.0])
+    return axis + magnification * jnp.einsum("kim,...m->...ki", phi, jnp.asarray(q))

@@ -22,7 +22,8 @@ import jax.numpy as jnp
 import numpy as np
 from jax import Array
 
-from mbjax.flex import Beam, FlexibleModel, FlexibleSystem, beam_body, shape_at
+from mbjax.flex import Beam, FlexibleModel, FlexibleSystem, beam_body
+from mbjax.flex import centreline as flex_centreline
 from mbjax.integrate import RK4
 from mbjax.model import Model
 from mbjax.scenes.spin_up_beam import modes
@@ -70,15 +71,12 @@ def tip(arm: FlexibleModel, q: Array) -> Array:
 
 def centreline(arm: FlexibleModel, qs, points: int = 11, magnification: float = 1.0) -> np.ndarray:
     """World positions (T, points, 3) along the beam's centreline at the configurations qs (T, nq):
-    the modal deflection (times `magnification`, for a picture) in the hub frame, turned by the
-    hub angle."""
+    the modal deflection (times `magnification`, for a picture) in the hub frame
+    (`mbjax.flex.centreline`), turned by the hub angle."""
     structure = beam()
     basis = modes(structure, arm.bodies.stiffness.shape[-1], 0)     # the basis `model` was built on
-    arc = np.linspace(0.0, LENGTH, points)
-    phi = np.asarray(jax.vmap(lambda s: shape_at(structure, basis, s)[0])(arc))  # (points, 3, modes)
     qs = np.asarray(qs)
-    local = arc[:, None] * np.array([1.0, 0.0, 0.0]) + magnification * np.einsum(
-        "kim,tm->tki", phi, qs[:, 1:])
+    local = np.asarray(flex_centreline(structure, basis, qs[:, 1:], points, magnification))
     c, s = np.cos(qs[:, 0])[:, None], np.sin(qs[:, 0])[:, None]
     return np.stack([c * local[..., 0] - s * local[..., 1], s * local[..., 0] + c * local[..., 1],
                      local[..., 2]], axis=-1)

@@ -7,7 +7,7 @@ import pytest
 
 from mbjax.flex.beam import Beam, dof_groups, eigenmodes, free_dofs
 from mbjax.flex.modal import craig_bampton, reduced
-from mbjax.flex.points import mass_points, node_shapes, shape_at
+from mbjax.flex.points import centreline, mass_points, node_shapes, shape_at
 
 N = 6  # elements: 7 nodes, 42 dofs
 
@@ -138,3 +138,9 @@ def test_node_and_point_shapes():
     _, psi_s = shape_at(b, basis, s)
     np.testing.assert_allclose(psi_s[2], dphi[1], atol=1e-6 * float(jnp.abs(dphi).max()))
     np.testing.assert_allclose(psi_s[1], -dphi[2], atol=1e-6 * float(jnp.abs(dphi).max()))
+    # the centreline (for pictures): the undeformed axis plus each grid node's shapes times q
+    q = jnp.asarray(np.random.default_rng(0).normal(size=(2, basis.shapes.shape[1])))
+    line = centreline(b, basis, q, points=N + 1, magnification=3.0)
+    nodes = np.stack([np.asarray(node_shapes(basis, k)[1]) for k in range(N + 1)])   # (N+1, 3, mu)
+    axis = np.linspace(0.0, float(b.L), N + 1)[:, None] * np.array([1.0, 0.0, 0.0])
+    np.testing.assert_allclose(line, axis + 3.0 * np.einsum("kim,tm->tki", nodes, q), atol=1e-12)
