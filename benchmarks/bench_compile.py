@@ -10,7 +10,7 @@ is `mbjax bench compile`; the suite itself is mbjax/bench/compile_time.py, so th
 
 import sys
 
-from mbjax.cli import main
+from mbjax_harness.cli import main
 
 if __name__ == "__main__":
     sys.exit(main(["bench", "compile", *sys.argv[1:]]))

@@ -8,7 +8,7 @@ installed `mbjax` command runs it too.
 
 import sys
 
-from mbjax.cli import main
+from mbjax_harness.cli import main
 
 if __name__ == "__main__":
     sys.exit(main(["bench", "integrators", *sys.argv[1:]]))

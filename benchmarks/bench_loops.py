@@ -8,7 +8,7 @@ command runs it too.
 
 import sys
 
-from mbjax.cli import main
+from mbjax_harness.cli import main
 
 if __name__ == "__main__":
     sys.exit(main(["bench", "loops", *sys.argv[1:]]))

@@ -9,7 +9,7 @@ GPU (jax[cuda]) the same command runs the mbjax side there.
 
 import sys
 
-from mbjax.cli import main
+from mbjax_harness.cli import main
 
 if __name__ == "__main__":
     sys.exit(main(["bench", "throughput", *sys.argv[1:]]))

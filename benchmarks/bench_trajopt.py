@@ -9,7 +9,7 @@ benchmarks/trajopt_gpu.py.
 
 import sys
 
-from mbjax.cli import main
+from mbjax_harness.cli import main
 
 if __name__ == "__main__":
     sys.exit(main(["bench", "trajopt", *sys.argv[1:]]))

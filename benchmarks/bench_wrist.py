@@ -9,7 +9,7 @@ is `mbjax bench wrist`; the suite itself is mbjax/bench/wrist.py.
 
 import sys
 
-from mbjax.cli import main
+from mbjax_harness.cli import main
 
 if __name__ == "__main__":
     sys.exit(main(["bench", "wrist", *sys.argv[1:]]))

@@ -13,7 +13,7 @@ import jax
 
 jax.config.update("jax_enable_x64", True)
 
-from mbjax.bench import trajopt  # noqa: E402
+from mbjax_harness.bench import trajopt  # noqa: E402
 
 
 def main(out: Path) -> None:

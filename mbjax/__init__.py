@@ -4,28 +4,39 @@ Kernels are pure functions of equinox modules and arrays, so `jax.jit`, `jax.vma
 compose over all of them. mbjax changes no JAX setting: enable float64 yourself for accuracy work
 (``jax.config.update("jax_enable_x64", True)``). Imported before JAX starts its backend, it sets
 XLA's and JAX's CPU runtime options for small programs: loops compiled as one kernel, no
-concurrency scheduling, the classic fusion emitter, synchronous dispatch (`mbjax.runtime`;
-MBJAX_XLA_DEFAULTS=0 turns them off).
+concurrency scheduling, the classic fusion emitter, synchronous dispatch (MBJAX_XLA_DEFAULTS=0
+turns them off).
+
+The names below are the everyday ones; each topic has its namespace: `mbjax.lie`, `mbjax.model`,
+`mbjax.control`, `mbjax.rigid`, `mbjax.flex`, `mbjax.loops`, `mbjax.tfe`, `mbjax.wrist`,
+`mbjax.integrate`, `mbjax.trajopt`, `mbjax.scenes`, `mbjax.data`.
 """
 
-from mbjax import runtime  # first: it sets XLA_FLAGS before anything can start JAX's backend
-from mbjax import control, data, integrate, lie, model, rigid, scenes, spatial, tree
-from mbjax.cache import use_compilation_cache
-from mbjax.integrate import simulate
-from mbjax.model import Model
-from mbjax.model.mjcf import from_mujoco, load_mjcf
-from mbjax.model.states import (
-    state_from_mujoco,
-    state_from_pinocchio,
-    state_to_mujoco,
-    state_to_pinocchio,
-)
-from mbjax.model.urdf import load_urdf
-from mbjax.rigid import forward_dynamics, frame_jacobian, frame_pose, inverse_dynamics, mass_matrix
+from mbjax._src import runtime as _runtime  # first: it sets XLA_FLAGS before JAX starts its backend
+
+from mbjax import (control, data, flex, integrate, lie, loops, model, rigid, scenes, tfe, trajopt,
+                   wrist)
+from mbjax._src.cache import use_compilation_cache as use_compilation_cache
+from mbjax._src.integrate.simulate import simulate as simulate
+from mbjax._src.model.mjcf import load_mjcf as load_mjcf
+from mbjax._src.model.model import Model as Model
+from mbjax._src.model.urdf import load_urdf as load_urdf
+from mbjax._src.rigid.dynamics import forward_dynamics as forward_dynamics
+from mbjax._src.rigid.dynamics import inverse_dynamics as inverse_dynamics
+from mbjax._src.rigid.dynamics import mass_matrix as mass_matrix
+from mbjax._src.system.dynamics import AbstractForwardDynamics as AbstractForwardDynamics
+from mbjax._src.system.dynamics import Auto as Auto
+from mbjax._src.system.dynamics import Dense as Dense
+from mbjax._src.system.dynamics import Recursive as Recursive
+from mbjax._src.system.status import Status as Status
+from mbjax._src.system.system import AbstractSystem as AbstractSystem
+from mbjax._src.system.tree_system import AbstractTreeSystem as AbstractTreeSystem
+
+del _runtime
 
 __version__ = "0.1.0"
-__all__ = ["Model", "control", "data", "forward_dynamics", "frame_jacobian", "frame_pose",
-           "from_mujoco", "integrate", "inverse_dynamics", "lie", "load_mjcf", "load_urdf",
-           "mass_matrix", "model", "rigid", "runtime", "scenes", "simulate", "spatial", "state_from_mujoco",
-           "state_from_pinocchio", "state_to_mujoco", "state_to_pinocchio", "tree",
-           "use_compilation_cache"]
+__all__ = [
+    "AbstractForwardDynamics", "AbstractSystem", "AbstractTreeSystem", "Auto", "Dense", "Model",
+    "Recursive", "Status", "forward_dynamics", "inverse_dynamics", "load_mjcf", "load_urdf",
+    "mass_matrix", "simulate", "use_compilation_cache",
+]

@@ -8,8 +8,8 @@ import subprocess
 import numpy as np
 import pytest
 
-from mbjax.bench import peers
-from mbjax.cli import main
+from mbjax_harness.bench import peers
+from mbjax_harness.cli import main
 
 
 def test_console_script_is_installed():
@@ -52,9 +52,9 @@ def test_version(capsys):
 
 @pytest.mark.parametrize("command", ["reproduce", "bench", "tour"])
 def test_list_gives_one_line_per_name_saying_what_it_does(command, capsys):
-    from mbjax.bench import SUITES
-    from mbjax.reproduce import REPRODUCTIONS
-    from mbjax.tour import TOUR
+    from mbjax_harness.bench import SUITES
+    from mbjax_harness.reproduce import REPRODUCTIONS
+    from mbjax_harness.tour import TOUR
 
     names = {"reproduce": REPRODUCTIONS, "bench": SUITES, "tour": TOUR}[command]
     assert main([command, "--list"]) == 0
@@ -66,7 +66,7 @@ def test_list_gives_one_line_per_name_saying_what_it_does(command, capsys):
 
 
 def test_a_command_names_the_files_it_wrote_and_the_peers_it_skipped(tmp_path, capsys):
-    from mbjax.cli import _report
+    from mbjax_harness.cli import _report
 
     (tmp_path / "suite.jsonl").write_text("{}")
     records = [{"engine": "mbjax", "status": "success"},
@@ -111,7 +111,7 @@ def test_reproduce_tree_scaling(tmp_path):
     for key in keys - {"n"}:
         assert all(math.isfinite(t) and t > 0 for t in data[key]), (key, data[key])
     assert (tmp_path / "tree-scaling.png").stat().st_size > 10_000
-    from mbjax.reproduce import tree_scaling
+    from mbjax_harness.reproduce import tree_scaling
 
     with pytest.raises(RuntimeError, match="at n = 3 the dense accelerations differ"):
         tree_scaling.check_agreement(3, {"recursive": np.ones(3),
@@ -131,7 +131,7 @@ TOUR_GROUPS_ALL = [scene for group in TOUR_GROUPS.values() for scene in group]
 
 
 def test_tour_groups_cover_every_scene():
-    from mbjax.tour import TOUR
+    from mbjax_harness.tour import TOUR
 
     assert sorted(s for group in TOUR_GROUPS.values() for s in group) == sorted(TOUR)
     assert set(TOUR) == {"torque-free-body", "heavy-top", "rigid-chain", "time-elements",
@@ -152,7 +152,7 @@ def test_tour_rejects_jobs_below_one(capsys):
 
 
 def test_tour_in_workers(tmp_path):
-    """Scenes side by side in worker processes (`mbjax.parallel`), the summary in the tour's
+    """Scenes side by side in worker processes (`mbjax_harness.parallel`), the summary in the tour's
     order whichever finishes first."""
     assert main(["tour", "--quick", "--out", str(tmp_path), "--jobs", "2",
                  "--scene", "heavy-top", "--scene", "torque-free-body"]) == 0
@@ -589,7 +589,7 @@ def test_compilation_cache_folder_and_switch(tmp_path, monkeypatch):
     rather than changed for the test process); MBJAX_NO_CACHE turns it off."""
     import jax
 
-    from mbjax.cache import cache_folder, use_compilation_cache
+    from mbjax._src.cache import cache_folder, use_compilation_cache
 
     updates = {}
     monkeypatch.setattr(jax.config, "update", lambda key, value: updates.__setitem__(key, value))
@@ -632,7 +632,7 @@ def test_bench_compile(tmp_path):
     cache every program the cold tour compiled, scene by scene (no timing is asserted), with a
     worker per core and one scene at a time; the first calls outside jit are recorded; each
     scene's target is there."""
-    from mbjax.parallel import cores
+    from mbjax_harness.parallel import cores
 
     assert main(["bench", "compile", "--out", str(tmp_path)]) == 0
     records = [json.loads(line) for line in (tmp_path / "compile.jsonl").read_text().splitlines()]

@@ -20,7 +20,8 @@ from jax import monitoring
 import mbjax
 from mbjax import lie
 from mbjax.model import chain
-from mbjax.rigid import energy, forward_kinematics, frame_jacobian
+from mbjax.rigid import forward_kinematics, frame_jacobian
+from mbjax._src.rigid import energy
 
 compiled = []
 monitoring.register_event_duration_secs_listener(

@@ -1,11 +1,11 @@
-"""mbjax.linalg.spd_solve against NumPy's solve, and free of library calls where it is written out."""
+"""mbjax._src.linalg.spd_solve against NumPy's solve, and free of library calls where it is written out."""
 
 import jax
 import jax.numpy as jnp
 import numpy as np
 import pytest
 
-from mbjax.linalg import UNROLL, spd_solve
+from mbjax._src.linalg import UNROLL, spd_solve
 
 
 @pytest.mark.parametrize("w", [1, 2, 3, 6, 8])

@@ -1,4 +1,4 @@
-"""`mbjax.parallel.run`: tasks in worker processes with the parent's JAX settings, results by
+"""`mbjax_harness.parallel.run`: tasks in worker processes with the parent's JAX settings, results by
 key, a worker's exception raised in the parent, and the progress it reports."""
 
 import os
@@ -6,12 +6,12 @@ import os
 import jax
 import pytest
 
-from mbjax import parallel, progress
+from mbjax_harness import parallel, progress
 
 
 def _worker_facts(key):
     """What a task sees: its process, the precision arrays get, the compilation cache. It reports
-    a step, as `mbjax.timing.measure` does."""
+    a step, as `mbjax_harness.timing.measure` does."""
     progress.step(f"looking at {key}")
     return {"key": key, "pid": os.getpid(), "dtype": jax.numpy.ones(1).dtype.name,
             "cache": jax.config.jax_compilation_cache_dir}

@@ -1,4 +1,4 @@
-"""`mbjax.runtime`: the XLA CPU options mbjax sets at import, and `mbjax bench speed`'s HLO reader."""
+"""`mbjax._src.runtime`: the XLA CPU options mbjax sets at import, and `mbjax bench speed`'s HLO reader."""
 
 import json
 import os
@@ -9,8 +9,8 @@ import jax
 import jax.numpy as jnp
 import pytest
 
-from mbjax import runtime
-from mbjax.bench.speed import kernel_counts
+from mbjax._src import runtime
+from mbjax_harness.bench.speed import kernel_counts
 
 # A float64 rollout of the 7-link chain, printed bit for bit, with what the process's XLA_FLAGS
 # became on `import mbjax`.
@@ -25,8 +25,8 @@ def step(s, _):
     v = v + 1e-3 * mbjax.forward_dynamics(m, q, v, 0 * v)
     return (q + 1e-3 * v, v), None
 q = jax.jit(lambda q: jax.lax.scan(step, (q, 0 * q), None, length=200)[0][0])(0.3 + 0 * m.neutral())
-print(json.dumps({"flags": os.environ.get("XLA_FLAGS"), "applied": mbjax.runtime.applied(),
-                  "synchronous": mbjax.runtime.synchronous(),
+print(json.dumps({"flags": os.environ.get("XLA_FLAGS"), "applied": mbjax._src.runtime.applied(),
+                  "synchronous": mbjax._src.runtime.synchronous(),
                   "q": [float(x).hex() for x in q]}))
 """
 

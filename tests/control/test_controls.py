@@ -14,7 +14,8 @@ from mbjax.integrate import RK4, simulate
 from mbjax.model import Model, chain
 from mbjax.rigid import RigidBody, TreeSystem, forward_dynamics, forward_kinematics
 from mbjax.scenes import carpal_wrist as cw
-from mbjax.wrist import WristSystem, newton_euler
+from mbjax.wrist import WristSystem
+from mbjax._src.wrist import newton_euler
 
 
 def test_zero_order_hold_takes_the_value_of_its_interval_and_holds_it_over_a_step():

@@ -16,7 +16,7 @@ import mbjax
 from mbjax.control import ZeroOrderHold
 from mbjax.integrate import RK4, simulate
 from mbjax.model import Model, chain, random_tree
-from mbjax.model.urdf import to_urdf
+from mbjax._src.model.urdf import to_urdf
 from mbjax.rigid import TreeSystem
 from tests.peers import pinocchio_maps, random_state
 

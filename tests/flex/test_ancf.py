@@ -1,4 +1,4 @@
-"""Planar ANCF beam (mbjax.flex.ancf) and the Anderson 1993 §3.1 / §3.2 references built on it."""
+"""Planar ANCF beam (mbjax._src.flex.ancf) and the Anderson 1993 §3.1 / §3.2 references built on it."""
 
 import jax
 import jax.numpy as jnp
@@ -6,8 +6,9 @@ import numpy as np
 import pytest
 import scipy.linalg
 
-from mbjax.flex import AncfBeam, simulate_ancf, slider_crank_reference, spin_up_beam_reference
-from mbjax.flex.references import INCH
+from mbjax.flex import AncfBeam, simulate_ancf
+from mbjax._src.flex import slider_crank_reference, spin_up_beam_reference
+from mbjax._src.flex.references import INCH
 
 L, EA, EI, RHOA = 10.0, 2.8e7, 1.4e4, 1.2   # the spin-up beam (Anderson 1993 §3.2)
 

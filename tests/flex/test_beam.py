@@ -5,7 +5,7 @@ import jax.numpy as jnp
 import numpy as np
 import pytest
 
-from mbjax.flex.beam import (Beam, axial_forces, dof_groups, eigenmodes, element_mass, element_stiffness,
+from mbjax._src.flex.beam import (Beam, axial_forces, dof_groups, eigenmodes, element_mass, element_stiffness,
                              free_dofs, geometric_stiffness, interpolation)
 
 BETA = np.array([1.875104069, 4.694091133, 7.854757438])  # clamped-free roots of cos b cosh b = -1

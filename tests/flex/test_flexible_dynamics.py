@@ -9,14 +9,14 @@ import jax.numpy as jnp
 import numpy as np
 import pytest
 
-from mbjax.flex import (Beam, FlexibleModel, FlexibleSystem, ModalBody, beam_body, craig_bampton,
-                        dense_forward_dynamics, energy, flexible_aba)
-from mbjax.flex.body import mass_matrix
+from mbjax.flex import Beam, FlexibleModel, FlexibleSystem, ModalBody, beam_body, craig_bampton, flexible_aba
+from mbjax._src.flex import dense_forward_dynamics, energy
+from mbjax._src.flex.body import mass_matrix
 from mbjax.integrate import RK4, simulate
 from mbjax.lie import exp
 from mbjax.loops import ClosedSystem, Coupled, Momentum, Prescribed, Stabilized
 from mbjax.model import Model
-from mbjax.spatial import skew
+from mbjax._src.spatial import skew
 
 
 class Points(eqx.Module):
@@ -165,7 +165,7 @@ def test_a_child_is_its_reaction_at_the_grid_point():
     q = model.neutral().at[0].set(0.4).at[1].set(-0.3).at[2:].set(jnp.asarray(rng.normal(size=2)) * 1e-3)
     v = jnp.asarray(rng.normal(size=model.nv))
     v_dot = jax.jit(flexible_aba)(model, q, v, jnp.zeros(model.nv))
-    from mbjax.flex.lagrange import _body_motion
+    from mbjax._src.flex.lagrange import _body_motion
     R, _, omega, _, alpha, a = jax.jit(_body_motion)(model, q, v, v_dot)
     child = model.model
     m, c, Ic = child.mass[1], child.com[1], child.inertia[1]

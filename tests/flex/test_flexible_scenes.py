@@ -1,10 +1,10 @@
 """Anderson 1993's flexible examples against the geometrically nonlinear ANCF references
-(`mbjax.flex.references`, an independent model: absolute nodal coordinates, exact strains)."""
+(`mbjax._src.flex.references`, an independent model: absolute nodal coordinates, exact strains)."""
 
 import numpy as np
 import pytest
 
-from mbjax.flex import slider_crank_reference, spin_up_beam_reference
+from mbjax._src.flex import slider_crank_reference, spin_up_beam_reference
 from mbjax.scenes import flexible_slider_crank, spin_up_beam
 
 

@@ -5,9 +5,9 @@ import jax.numpy as jnp
 import numpy as np
 import pytest
 
-from mbjax.flex.beam import Beam, dof_groups, eigenmodes, free_dofs
-from mbjax.flex.modal import craig_bampton, reduced
-from mbjax.flex.points import centreline, mass_points, node_shapes, shape_at
+from mbjax._src.flex.beam import Beam, dof_groups, eigenmodes, free_dofs
+from mbjax._src.flex.modal import craig_bampton, reduced
+from mbjax._src.flex.points import centreline, mass_points, node_shapes, shape_at
 
 N = 6  # elements: 7 nodes, 42 dofs
 

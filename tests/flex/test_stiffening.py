@@ -11,10 +11,10 @@ import jax.numpy as jnp
 import numpy as np
 import scipy.linalg
 
-from mbjax.flex.beam import Beam, geometric_stiffness
-from mbjax.flex.modal import craig_bampton, reduced
-from mbjax.flex.points import mass_points
-from mbjax.flex.stiffening import (_acceleration_basis, _moment_basis, distal_stiffening,
+from mbjax._src.flex.beam import Beam, geometric_stiffness
+from mbjax._src.flex.modal import craig_bampton, reduced
+from mbjax._src.flex.points import mass_points
+from mbjax._src.flex.stiffening import (_acceleration_basis, _moment_basis, distal_stiffening,
                                    inertial_scalars, inertial_stiffening)
 
 K1 = 1.1932  # Southwell coefficient of the first cantilever bending mode (Wright et al. 1982: 1.193)
@@ -118,7 +118,7 @@ def test_inertial_stiffening_structure():
 
 def test_a_grid_points_second_order_displacement_is_the_beams_foreshortening():
     """The distal unit-load stiffness is the Hessian of the grid point's axial displacement
-    (`mbjax.flex.kinematics.grid_point`): bent by a static tip load, a cantilever's tip moves in by
+    (`mbjax._src.flex.kinematics.grid_point`): bent by a static tip load, a cantilever's tip moves in by
     (1/2) int w'^2 dx = (3/5) delta^2 / L for tip deflection delta (the cubic w = delta (3 x^2 L -
     x^3) / (2 L^3), which cubic elements hold exactly), at the tip and, (1/2) int_0^a w'^2 dx, at
     an inner node a; and a load along the beam at the point does work through it that is the
@@ -126,8 +126,8 @@ def test_a_grid_points_second_order_displacement_is_the_beams_foreshortening():
     import jax
 
     from mbjax.flex import beam_body
-    from mbjax.flex.kinematics import grid_point
-    from mbjax.flex.points import node_shapes
+    from mbjax._src.flex.kinematics import grid_point
+    from mbjax._src.flex.points import node_shapes
 
     n, L = 4, 1.0
     b = Beam(L, 2.1e11, 8e10, 7800.0, 1e-4, 1e-8, 1e-8, 2e-8, n)

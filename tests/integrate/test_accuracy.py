@@ -8,8 +8,9 @@ import numpy as np
 import pytest
 
 from mbjax import simulate
-from mbjax.integrate import RK4, Status
-from mbjax.model.builders import chain
+from mbjax.integrate import RK4
+from mbjax._src.integrate import Status
+from mbjax._src.model.builders import chain
 from mbjax.rigid import TreeSystem
 
 SYSTEM = TreeSystem(chain(3))
@@ -132,7 +133,7 @@ def test_momentum_of_a_floating_tree_with_and_without_gravity():
     be seen (M g t = 29 N s at t = 1 s)."""
     import equinox as eqx
 
-    from mbjax.rigid.energy import free_momenta
+    from mbjax._src.rigid.energy import free_momenta
 
     model = chain(3, joint_types=("free", "revolute", "revolute"))
     q0 = model.neutral()

@@ -5,7 +5,7 @@ costs a few compilations of a gradient through a rollout); `-m slow` runs all of
 
 import pytest
 
-from mbjax.reproduce.gradient_matrix import CELLS, QUICK_CELLS, TOLERANCE, check
+from mbjax_harness.reproduce.gradient_matrix import CELLS, QUICK_CELLS, TOLERANCE, check
 
 PARAMS = [pytest.param(name, marks=() if name in QUICK_CELLS else pytest.mark.slow)
           for name in CELLS]

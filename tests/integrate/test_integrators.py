@@ -5,16 +5,8 @@ import jax.numpy as jnp
 import numpy as np
 import pytest
 
-from mbjax.integrate import (
-    INTEGRATORS,
-    RK4,
-    AbstractSystem,
-    ExplicitEuler,
-    ImplicitMidpoint,
-    Status,
-    simulate,
-    solve_reference,
-)
+from mbjax.integrate import RK4, ExplicitEuler, ImplicitMidpoint, simulate, solve_reference
+from mbjax._src.integrate import INTEGRATORS, AbstractSystem, Status
 from mbjax.scenes import heavy_top as top
 
 
@@ -127,7 +119,7 @@ def test_diffrax_reference_program_holds_no_host_callback():
     """The reference's compiled program can be kept in the persistent compilation cache: no
     host callback (diffrax checks times it saves at inside a solve by callbacks, so the
     reference saves at each interval's end instead)."""
-    from mbjax.integrate.reference import _solve
+    from mbjax._src.integrate.reference import _solve
 
     text = _solve.lower(OSC, Q0, U0, jnp.linspace(0.0, 3.0, 7), 1e-10, 1e-10, None,
                         1000).as_text()

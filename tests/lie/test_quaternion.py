@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 
-from mbjax import lie
+from mbjax._src import lie
 
 rng = np.random.default_rng(1)
 ROTATIONS = Rotation.random(20, random_state=3)

@@ -9,7 +9,7 @@ from hypothesis import strategies as st
 from jax.test_util import check_grads
 from scipy.spatial.transform import Rotation
 
-from mbjax import lie
+from mbjax._src import lie
 
 EPS = 1e-13
 rng = np.random.default_rng(0)

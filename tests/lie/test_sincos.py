@@ -1,4 +1,4 @@
-"""`mbjax.lie.sincos` against the C library's sin and cos (NumPy's, an independent
+"""`mbjax._src.lie.sincos` against the C library's sin and cos (NumPy's, an independent
 implementation): Cephes' reduction and polynomials to within 2 ulp below 2^30, the library itself
 beyond, exact derivatives, and the same answers under jit, vmap and inside loops."""
 
@@ -7,8 +7,8 @@ import jax.numpy as jnp
 import numpy as np
 import pytest
 
-from mbjax.lie import sincos
-from mbjax.lie.sincos import LIMIT
+from mbjax._src.lie import sincos
+from mbjax._src.lie.sincos import LIMIT
 
 
 @pytest.mark.parametrize("scale", [1e-8, 1.0, np.pi, 100.0, 1e6, 0.99 * LIMIT])

@@ -11,12 +11,13 @@ import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
 
-from mbjax.cli import main
-from mbjax.loops import Coupled, Loops, Stabilized, numerical_rank
-from mbjax.reproduce import andrews_squeezer as reproduction
-from mbjax.rigid.dynamics import mass_matrix
+from mbjax_harness.cli import main
+from mbjax.loops import Coupled, Loops, Stabilized
+from mbjax._src.loops import numerical_rank
+from mbjax_harness.reproduce import andrews_squeezer as reproduction
+from mbjax._src.rigid.dynamics import mass_matrix
 from mbjax.scenes import andrews_squeezer as S
-from mbjax.scenes.andrews_squeezer import (c0, d, da, e, ea, fa, i1, i2, i3, i4, i5, i6, i7, l0,
+from mbjax._src.scenes.andrews_squeezer import (c0, d, da, e, ea, fa, i1, i2, i3, i4, i5, i6, i7, l0,
                                            m1, m2, m3, m4, m5, m6, m7, mom, ra, rr, sa, sb, sc,
                                            sd, ss, ta, tb, u, ua, ub, xa, xb, xc, ya, yb, yc, zf,
                                            zt)

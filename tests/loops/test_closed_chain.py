@@ -7,7 +7,8 @@ import numpy as np
 import pytest
 
 from mbjax.integrate import RK4, simulate
-from mbjax.loops import ClosedSystem, Stabilized, numerical_rank, project_configuration, project_velocity
+from mbjax.loops import ClosedSystem, Stabilized, project_configuration, project_velocity
+from mbjax._src.loops import numerical_rank
 from mbjax.scenes import closed_chain
 
 

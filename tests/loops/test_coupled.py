@@ -9,10 +9,11 @@ import pytest
 from scipy.integrate import solve_ivp
 
 from mbjax.integrate import RK4, simulate
-from mbjax.loops import ClosedSystem, CutJoint, Loops, Prescribed, Stabilized, coupled_acceleration
+from mbjax.loops import ClosedSystem, CutJoint, Loops, Prescribed, Stabilized
+from mbjax._src.loops import coupled_acceleration
 from mbjax.rigid import kinetic_energy, potential_energy
 from mbjax.scenes import four_bar
-from mbjax.scenes.four_bar import OMEGA0, THETA0, joint_angles
+from mbjax._src.scenes.four_bar import OMEGA0, THETA0, joint_angles
 
 # the four-bar scene closed by the spatial revolute cut joint: 5 equations of rank 2
 SYSTEM, Q0, V0 = four_bar.build(closure="revolute")

@@ -15,7 +15,8 @@ from scipy.integrate import solve_ivp
 from scipy.linalg import expm
 
 from mbjax.integrate import RK4, simulate
-from mbjax.loops import ClosedSystem, Coupled, gauss_newton, numerical_rank, project_velocity
+from mbjax.loops import ClosedSystem, Coupled, project_velocity
+from mbjax._src.loops import gauss_newton, numerical_rank
 from mbjax.rigid import kinetic_energy, potential_energy
 from mbjax.scenes import bricard, four_bar, slider_crank
 

@@ -8,12 +8,12 @@ import jax.numpy as jnp
 import numpy as np
 import pytest
 
-from mbjax.integrate import RK4, Status, simulate
-from mbjax.loops import (GROUND, ClosedSystem, Coupled, CutJoint, Loops, Momentum, Prescribed,
-                         Stabilized, consistent_state, coupled_acceleration, eta_and_gamma,
-                         momentum_rate)
+from mbjax.integrate import RK4, simulate
+from mbjax._src.integrate import Status
+from mbjax.loops import GROUND, ClosedSystem, Coupled, CutJoint, Loops, Momentum, Prescribed, Stabilized, consistent_state
+from mbjax._src.loops import coupled_acceleration, eta_and_gamma, momentum_rate
 from mbjax.rigid import TreeSystem
-from mbjax.rigid.dynamics import forward_dynamics, mass_matrix
+from mbjax._src.rigid.dynamics import forward_dynamics, mass_matrix
 from mbjax.scenes import closed_chain
 
 CHAIN, Q0, V0 = closed_chain.build(6)           # 3 links, 6 dof, 4 closure equations: 2 dof

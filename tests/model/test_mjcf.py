@@ -2,7 +2,7 @@
 several joints per body, ball and free joints, inertias, joint data, connect and weld closures,
 the ignored-features warning, and the corpus of MJCF models shipped by the installed packages.
 
-Every dynamic comparison runs `mbjax.reproduce.mjcf_corpus.compare`: MuJoCo with contacts,
+Every dynamic comparison runs `mbjax_harness.reproduce.mjcf_corpus.compare`: MuJoCo with contacts,
 constraints, actuators and springs disabled (joint damping and armature kept) at a random state
 (qpos, qvel, qfrc_applied), mbjax's `forward_dynamics` mapped to MuJoCo's qacc by `jax.jvp` of
 `state_to_mujoco`, relative difference below 1e-8; poses are `mbjax.frame_pose` of every body
@@ -20,9 +20,9 @@ import pytest
 
 import mbjax
 from mbjax.loops import ClosedSystem, CutJoint, Loops
-from mbjax.model.checks import ModelWarning
-from mbjax.model.mjcf import object_name, site_frame_name
-from mbjax.reproduce.mjcf_corpus import (
+from mbjax._src.model.checks import ModelWarning
+from mbjax._src.model.mjcf import object_name, site_frame_name
+from mbjax_harness.reproduce.mjcf_corpus import (
     TOLERANCE,
     compare,
     quick_paths,
@@ -248,7 +248,7 @@ def test_fullinertia_diaginertia_and_welded_bodies():
     mjmodel, model = _load(xml)
     assert model.names == ("a", "c") and model.frame_parents[model.frame_names.index("b")] == 0
     assert model.mass[0] == pytest.approx(3.0)
-    R_b = mbjax.model.mjcf.quat_matrix(mjmodel.body_quat[2])
+    R_b = mbjax._src.model.mjcf.quat_matrix(mjmodel.body_quat[2])
     com_b = np.array([0.5, 0, 0]) + R_b @ [0.1, 0, 0]
     np.testing.assert_allclose(model.com[0], (2 * np.array([0.2, 0.1, 0]) + com_b) / 3
                                - [0.1, 0, 0], atol=1e-12)             # in the frame at the anchor

@@ -9,8 +9,8 @@ import pytest
 import mbjax
 from mbjax import rigid
 from mbjax.model import Model, chain, random_tree
-from mbjax.model.checks import ModelWarning
-from mbjax.model.urdf import to_urdf
+from mbjax._src.model.checks import ModelWarning
+from mbjax._src.model.urdf import to_urdf
 from tests.peers import pinocchio_maps, random_state
 
 I3 = 0.01 * np.eye(3)

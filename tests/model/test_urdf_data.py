@@ -8,9 +8,10 @@ import numpy as np
 import pytest
 
 import mbjax
-from mbjax.integrate import RK4, Status, simulate
+from mbjax.integrate import RK4, simulate
+from mbjax._src.integrate import Status
 from mbjax.loops import ClosedSystem, Coupled, Coupling
-from mbjax.model.checks import ModelWarning
+from mbjax._src.model.checks import ModelWarning
 from mbjax.rigid import TreeSystem
 from tests.model.test_model_urdf import LIMIT, _inertial, _joint, _link, _robot
 from tests.peers import random_state
@@ -149,7 +150,7 @@ def test_limits_flag_the_status():
                       jnp.zeros(2), dt=0.01, t1=0.1)
     assert int(strong.status) & Status.LIMIT_EXCEEDED
     assert "limit exceeded" in fast.messages()[0]
-    excess = mbjax.model.limits.excess(model, jnp.array([2.5, 9.0]), jnp.array([5.0, 0.0]))
+    excess = mbjax._src.model.limits.excess(model, jnp.array([2.5, 9.0]), jnp.array([5.0, 0.0]))
     np.testing.assert_allclose(excess, [0.5, 0.0, 1.0, 0.0, 0.0, 0.0])
 
 
@@ -256,7 +257,7 @@ QUICK_ROBOTS = ("romeo/romeo_small",)
 
 
 def _corpus():
-    from mbjax.reproduce import urdf_corpus
+    from mbjax_harness.reproduce import urdf_corpus
     try:
         return urdf_corpus, urdf_corpus.corpus_paths()
     except Exception as err:          # PackageNotFoundError

@@ -8,7 +8,7 @@ from hypothesis import strategies as st
 
 from mbjax import lie
 from mbjax.model import Model
-from mbjax.tree import Topology
+from mbjax._src.tree import Topology
 
 INERTIA = np.tile(np.eye(3) * 0.1, (2, 1, 1))
 

@@ -1,4 +1,4 @@
-"""The derivative rule of `mbjax.rigid.adjoint`: forward dynamics differentiated through the RNEA
+"""The derivative rule of `mbjax._src.rigid.adjoint`: forward dynamics differentiated through the RNEA
 and the articulated-body factor of M, against differentiating the recursion itself, the dense mass
 matrix, and central differences."""
 
@@ -10,10 +10,10 @@ import pytest
 
 from mbjax.model import random_tree
 from mbjax.rigid import forward_dynamics, mass_matrix
-from mbjax.rigid.aba import aba, aba_factored, solve
-from mbjax.rigid.dynamics import recursive_forward_dynamics
-from mbjax.rigid.rnea import inverse_dynamics
-from mbjax.rigid.rnea_derivatives import applies, rnea_jvp
+from mbjax._src.rigid.aba import aba, aba_factored, solve
+from mbjax._src.rigid.dynamics import recursive_forward_dynamics
+from mbjax._src.rigid.rnea import inverse_dynamics
+from mbjax._src.rigid.rnea_derivatives import applies, rnea_jvp
 
 
 def _with_joint_data(model):

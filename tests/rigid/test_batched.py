@@ -1,4 +1,4 @@
-"""The throughput layout (`mbjax.rigid.batched`) against the one-state recursion, Pinocchio and
+"""The throughput layout (`mbjax._src.rigid.batched`) against the one-state recursion, Pinocchio and
 finite differences; `BatchTreeSystem` rollouts against vmapped ones; checkpointed gradients."""
 
 import equinox as eqx
@@ -10,10 +10,11 @@ from jax.test_util import check_grads
 
 from mbjax.integrate import RK4, simulate
 from mbjax.model import Model, chain, random_tree
-from mbjax.model.urdf import to_urdf
-from mbjax.rigid import BatchTreeSystem, TreeSystem, batch_aba, batched_forward_dynamics, forward_dynamics
-from mbjax.rigid.aba import aba
-from mbjax.rigid.batched import CHUNK
+from mbjax._src.model.urdf import to_urdf
+from mbjax.rigid import BatchTreeSystem, TreeSystem, batched_forward_dynamics, forward_dynamics
+from mbjax._src.rigid import batch_aba
+from mbjax._src.rigid.aba import aba
+from mbjax._src.rigid.batched import CHUNK
 
 MODELS = {
     "regular chain": lambda: chain(7),

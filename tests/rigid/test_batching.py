@@ -1,4 +1,4 @@
-"""`jax.vmap(forward_dynamics)` runs `batch_aba` (mbjax.rigid.batching) and agrees with the
+"""`jax.vmap(forward_dynamics)` runs `batch_aba` (mbjax._src.rigid.batching) and agrees with the
 one-state recursion, in value and in every derivative, and falls back where it must."""
 
 from functools import partial
@@ -9,9 +9,10 @@ import jax.numpy as jnp
 import numpy as np
 
 from mbjax.model import random_tree
-from mbjax.rigid import batch_aba, forward_dynamics
-from mbjax.rigid.aba import aba
-from mbjax.rigid.batching import BATCH_CROSSOVER, batchable
+from mbjax.rigid import forward_dynamics
+from mbjax._src.rigid import batch_aba
+from mbjax._src.rigid.aba import aba
+from mbjax._src.rigid.batching import BATCH_CROSSOVER, batchable
 
 B = BATCH_CROSSOVER
 MODEL = random_tree(5, seed=4, joint_types=("revolute", "prismatic"))

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from mbjax import lie
-from mbjax.bench import peers
+from mbjax_harness.bench import peers
 from mbjax.integrate import RK4, RKMK4, ImplicitMidpoint, simulate, solve_reference
 from mbjax.rigid import RigidBody, torque_free_motion
 from mbjax.scenes import heavy_top as top

@@ -5,9 +5,9 @@ import importlib.util
 
 import pytest
 
-from mbjax.bench.jax_peers import check_against_pinocchio
+from mbjax_harness.bench.jax_peers import check_against_pinocchio
 from mbjax.model import chain
-from mbjax.model.urdf import to_urdf
+from mbjax._src.model.urdf import to_urdf
 
 needs = pytest.mark.skipif(not all(importlib.util.find_spec(m) for m in ("pinocchio", "jaxsim", "adam")),
                            reason="the bench extra's peers (pin, jaxsim, adam-robotics)")
@@ -26,7 +26,7 @@ def test_peers_agree_with_pinocchio_on_chains(tmp_path, seed):
 @pytest.mark.slow
 @needs
 def test_peers_agree_with_pinocchio_on_the_panda():
-    from mbjax.reproduce.urdf_corpus import corpus_paths
+    from mbjax_harness.reproduce.urdf_corpus import corpus_paths
     panda = next(p for p in corpus_paths() if p.stem == "panda")
     for floating in (False, True):
         errors = check_against_pinocchio(str(panda), floating=floating)

@@ -9,9 +9,9 @@ import pytest
 
 from mbjax.data import ARM7
 from mbjax.model import random_tree
-from mbjax.model.urdf import load_urdf
+from mbjax._src.model.urdf import load_urdf
 from mbjax.rigid import forward_kinematics
-from mbjax.rigid.kinematics import _poses, fixed_in_body
+from mbjax._src.rigid.kinematics import _poses, fixed_in_body
 
 MODELS = {
     "hinges": random_tree(6, seed=2),

@@ -8,12 +8,8 @@ import numpy as np
 import pytest
 
 from mbjax.model import chain, random_tree
-from mbjax.rigid import (
-    inverse_operator,
-    operator_terms,
-    primitive_inverse_mass,
-    transformation_operator,
-)
+from mbjax.rigid import transformation_operator
+from mbjax._src.rigid import inverse_operator, operator_terms, primitive_inverse_mass
 
 MODELS = {
     "chain": chain(6, seed=3),

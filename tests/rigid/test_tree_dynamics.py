@@ -15,11 +15,11 @@ import pytest
 from jax.test_util import check_grads
 
 import mbjax
-from mbjax import rigid
+from mbjax._src import rigid
 from mbjax.integrate import RK4, RKMK4, simulate
 from mbjax.model import Model, chain, random_tree
-from mbjax.model.urdf import to_urdf
-from mbjax.rigid.aba import _wide_root
+from mbjax._src.model.urdf import to_urdf
+from mbjax._src.rigid.aba import _wide_root
 
 RTOL = 1e-10          # float64 identities
 
@@ -155,7 +155,7 @@ def case(request):
 
 def test_a_floating_base_is_eliminated_on_its_own():
     """A free base under narrower joints is eliminated with its own 6 x 6 blocks and the tree
-    passes run at the other joints' width (mbjax.rigid.aba._wide_root): the identities below
+    passes run at the other joints' width (mbjax._src.rigid.aba._wide_root): the identities below
     check that route on "multi_dof" and "mixed", the URDF tests on real floating robots. Two
     free bodies, or a tree without a free base, keep one width."""
     assert _wide_root(_multi_dof()) == _wide_root(_mixed()) == (0, 3)     # spherical joints
@@ -467,7 +467,7 @@ def test_vmap_over_states_equals_loop():
     states = [random_state(model, seed=s)[:3] for s in range(4)]
     q, v, tau = (jnp.stack(x) for x in zip(*states, strict=True))
     batched = jax.jit(jax.vmap(f, (0, 0, 0, None)))(q, v, tau, model.mass)
-    # the batch runs as one compiled loop over the states (mbjax.rigid.batching), a single call
+    # the batch runs as one compiled loop over the states (mbjax._src.rigid.batching), a single call
     # kernel by kernel: the same arithmetic, rounded apart by at most about 1e-12
     for i in range(len(states)):
         assert_close(batched[i], f(q[i], v[i], tau[i], model.mass), rtol=1e-11)

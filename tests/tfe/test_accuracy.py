@@ -9,8 +9,8 @@ import numpy as np
 import pytest
 
 from mbjax import lie
-from mbjax.reproduce import top_long_run as tlr
-from mbjax.reproduce import torque_free_tfe as tft
+from mbjax_harness.reproduce import top_long_run as tlr
+from mbjax_harness.reproduce import torque_free_tfe as tft
 from mbjax.scenes import torque_free_body as tfb
 from mbjax.scenes import vertical_top as vt
 from mbjax.tfe import Element, Mixed, PrimalUnsymmetric, initial_state, solve_tfe

@@ -5,7 +5,8 @@ import jax.numpy as jnp
 import numpy as np
 import pytest
 
-from mbjax.tfe import Element, gauss_legendre, lagrange
+from mbjax.tfe import Element
+from mbjax._src.tfe import gauss_legendre, lagrange
 
 
 @pytest.mark.parametrize("points", [1, 2, 3, 4, 5])

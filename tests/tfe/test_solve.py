@@ -12,11 +12,11 @@ import numpy as np
 import pytest
 
 from mbjax import lie
-from mbjax.integrate import Status
+from mbjax._src.integrate import Status
 from mbjax.rigid import torque_free_motion
 from mbjax.scenes import torque_free_body as tfb
-from mbjax.tfe import (FORMS, REFERENCES, Body, Element, State, element_map, initial_state,
-                       make_reference, solve_tfe)
+from mbjax.tfe import Body, Element, initial_state, solve_tfe
+from mbjax._src.tfe import FORMS, REFERENCES, State, element_map, make_reference
 
 TORQUE_FREE = Body(1.0, jnp.diag(jnp.array([tfb.J_TRANSVERSE, tfb.J_TRANSVERSE, tfb.J_AXIAL])),
                    gravity=(0.0, 0.0, 0.0), fixed_point=True)

@@ -8,11 +8,11 @@ import numpy as np
 import pytest
 
 from mbjax import lie
-from mbjax.reproduce import top_long_run
-from mbjax.reproduce import vertical_top as rep
+from mbjax_harness.reproduce import top_long_run
+from mbjax_harness.reproduce import vertical_top as rep
 from mbjax.scenes import vertical_top as vt
-from mbjax.tfe import (FORMS, Element, element_map, initial_state, make_reference, solve_tfe,
-                       stability)
+from mbjax.tfe import Element, initial_state, solve_tfe, stability
+from mbjax._src.tfe import FORMS, element_map, make_reference
 
 
 # The 2-node rows by default; the 3- and 4-node elements (a compilation each) run with -m slow,

@@ -9,8 +9,9 @@ import pytest
 
 from mbjax import lie
 from mbjax.scenes import vertical_top as vt
-from mbjax.tfe import FORMS, Body, Element, PrimalSymmetric, PrimalUnsymmetric, make_reference
-from mbjax.tfe.tangents import H, element_tangent, pointwise_tangent
+from mbjax.tfe import Body, Element, PrimalSymmetric, PrimalUnsymmetric
+from mbjax._src.tfe import FORMS, make_reference
+from mbjax._src.tfe.tangents import H, element_tangent, pointwise_tangent
 
 RNG = np.random.default_rng(4)
 

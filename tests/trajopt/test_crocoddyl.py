@@ -1,16 +1,16 @@
 """iLQR against an independent optimal-control library: Crocoddyl's FDDP (analytic derivatives
 on Pinocchio) on the arm reach built from the same URDF, residuals, weights, semi-implicit Euler
-steps and first guess (`mbjax.bench.peers.crocoddyl_reach`). Skipped where Crocoddyl is not
+steps and first guess (`mbjax_harness.bench.peers.crocoddyl_reach`). Skipped where Crocoddyl is not
 installed or its pairing with Pinocchio is broken (`peers.crocoddyl_working` says which)."""
 
 import jax.numpy as jnp
 import numpy as np
 import pytest
 
-from mbjax.bench import peers
-from mbjax.bench.trajopt import _Crocoddyl, arm_reach
+from mbjax_harness.bench import peers
+from mbjax_harness.bench.trajopt import _Crocoddyl, arm_reach
 from mbjax.trajopt import ILQR, solve
-from mbjax.trajopt.ilqr import CROCODDYL_SCHEDULE
+from mbjax._src.trajopt.ilqr import CROCODDYL_SCHEDULE
 
 WHY = peers.crocoddyl_working()
 pytestmark = pytest.mark.skipif(WHY is not None, reason=str(WHY))

@@ -1,4 +1,4 @@
-"""`mbjax.trajopt.solve` with `ILQR`: the LQR optimum of a linear problem in closed form, the
+"""`mbjax._src.trajopt.solve` with `ILQR`: the LQR optimum of a linear problem in closed form, the
 box-constrained optimum against SciPy's bounded quasi-Newton, a 7-dof arm's reach (stationary
 under the single-shooting gradient), many targets in one vmapped solve, and clear errors."""
 

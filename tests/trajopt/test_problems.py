@@ -24,7 +24,7 @@ def test_four_bar_matches_its_minimal_coordinate_optimum():
     problem = fb.crank_problem()
     # the solver of `mbjax reproduce trajopt`: one program, compiled once for both (the
     # suite's persistent cache), whichever runs first
-    from mbjax.reproduce.trajopt import QUICK_SOLVERS
+    from mbjax_harness.reproduce.trajopt import QUICK_SOLVERS
 
     result = solve(problem, QUICK_SOLVERS["ilqr"])
     assert result.messages() == ["success"]

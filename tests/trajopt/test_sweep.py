@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 
 from mbjax.trajopt import sweep
-from mbjax.trajopt.sweeps import size
+from mbjax._src.trajopt.sweep import size
 
 SCRIPT = Path(__file__).parents[2] / "benchmarks" / "sweep_distributed.py"
 sys.path.insert(0, str(SCRIPT.parent))

@@ -1,4 +1,4 @@
-"""`mbjax.tree.take`: static-index gathers as slices, and the scatter-free programs they give."""
+"""`mbjax._src.tree.take`: static-index gathers as slices, and the scatter-free programs they give."""
 
 import jax
 import jax.numpy as jnp
@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from mbjax.model import chain, random_tree
-from mbjax.tree.take import MAX_RUNS, runs, take
+from mbjax._src.tree.take import MAX_RUNS, runs, take
 
 
 def _primitives(jaxpr, found=None):

@@ -11,7 +11,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from mbjax.tree import Topology, backward_pass, forward_pass, topology
+from mbjax._src.tree import Topology, backward_pass, forward_pass, topology
 
 # --------------------------------------------------------------------------------------------
 # Validation

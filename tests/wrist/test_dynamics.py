@@ -45,8 +45,8 @@ def test_eom_terms_reassemble_the_inverse_dynamics_and_invert_the_forward():
 
 def test_mass_matrix_is_the_jacobians_inertia():
     """A = m J_v^T J_v + J_w^T (R I R^T) J_w with the Newton-Euler route's Jacobians."""
-    from mbjax.wrist import newton_euler
-    from mbjax.wrist.kinematics import forward_kinematics
+    from mbjax._src.wrist import newton_euler
+    from mbjax._src.wrist.kinematics import forward_kinematics
     w = cw.wrist()
     theta = cw.home(w) + jnp.array([0.2, -0.1, 0.3])
     J_v, J_w = jax.jit(jax.jacfwd(lambda v: newton_euler.tool_velocity(w, theta, v)))(jnp.zeros(3))
@@ -108,7 +108,7 @@ def test_gradients_of_the_dynamics_in_parameters_are_finite_and_match_finite_dif
 def test_eom_terms_equal_the_derivatives_of_the_kinetic_energy():
     """eom_terms reads A, B and C from the pose's derivatives (T quadratic in theta_dot); here
     they are taken from T and V themselves, the Lagrangian form of eq 6.16, for both rotations."""
-    from mbjax.wrist import dynamics
+    from mbjax._src.wrist import dynamics
 
     def lagrange_terms(w, q, v):
         dT_dv = jax.jacfwd(dynamics.kinetic_energy, argnums=2)

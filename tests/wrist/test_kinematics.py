@@ -10,7 +10,7 @@ import pytest
 
 from mbjax.scenes import carpal_wrist as cw
 from mbjax.wrist import CarpalWrist
-from mbjax.wrist import kinematics as kin
+from mbjax._src.wrist import kinematics as kin
 
 
 def unit_wrist(**kw):

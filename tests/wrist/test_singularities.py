@@ -9,10 +9,11 @@ import numpy as np
 import pytest
 
 from mbjax import simulate
-from mbjax.integrate import RK4, Status
+from mbjax.integrate import RK4
+from mbjax._src.integrate import Status
 from mbjax.scenes import carpal_wrist as cw
-from mbjax.wrist import kinematics as kin
-from mbjax.wrist.system import WristSystem
+from mbjax._src.wrist import kinematics as kin
+from mbjax._src.wrist.system import WristSystem
 
 WRIST = cw.wrist()
 LEGS_UP = jnp.full(3, jnp.pi / 2)     # every knee at the top of its circle: all three tangent

@@ -6,8 +6,9 @@ import jax.numpy as jnp
 import numpy as np
 import pytest
 
-from mbjax.integrate import INTEGRATORS, RK4, ExplicitEuler, simulate
-from mbjax.reproduce.carpal_wrist import QUICK_STEPS, linear_critical_steps, masked_rollout
+from mbjax.integrate import RK4, ExplicitEuler, simulate
+from mbjax._src.integrate import INTEGRATORS
+from mbjax_harness.reproduce.carpal_wrist import QUICK_STEPS, linear_critical_steps, masked_rollout
 from mbjax.scenes import carpal_wrist as cw
 
 

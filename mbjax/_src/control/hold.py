@@ -1,0 +1,64 @@
+"""Sampled controls: a value per step, held over the step (MuJoCo's `ctrl`, a digital controller).
+
+`simulate` calls `hold` at the start of every step, so a sampled control gives every stage of the
+step (RK4's four, an implicit step's Newton iterations) the value of the step's start. A function
+of time alone cannot do this: a step's last stage falls on the next sample's time.
+"""
+
+import equinox as eqx
+import jax.numpy as jnp
+from jax import Array
+
+from mbjax._src.control.base import AbstractControl, Constant, as_control
+
+# Times within this fraction of a step of a sample time count as on it (the step grid t0 + k dt
+# is computed in floating point).
+_GRID_TOLERANCE = 1e-6
+
+
+class ZeroOrderHold(AbstractControl):
+    """values[k] on [t0 + k dt, t0 + (k + 1) dt): a control history on a step grid, (K, ...)
+    (values[0] before t0, values[-1] after the last interval). A history of wrenches for
+    `external=` is (K, n_bodies, 6)."""
+
+    values: Array
+    dt: float = eqx.field(static=True)
+    t0: float = eqx.field(static=True)
+
+    def __init__(self, values, dt: float, t0: float = 0.0):
+        values = jnp.asarray(values, dtype=float)
+        if values.ndim == 1:
+            values = values[:, None]
+        if values.shape[0] < 1:
+            raise ValueError(f"values must be (K, ...) samples, K >= 1, got shape {values.shape}")
+        if not float(dt) > 0:
+            raise ValueError(f"dt must be positive, got {dt}")
+        self.values = values
+        self.dt = float(dt)
+        self.t0 = float(t0)
+
+    def index(self, t: Array) -> Array:
+        k = jnp.floor((t - self.t0) / self.dt + _GRID_TOLERANCE)
+        return jnp.clip(k, 0, self.values.shape[0] - 1).astype(jnp.int32)
+
+    def __call__(self, t, q, v):
+        return self.values[self.index(t)]
+
+    def hold(self, t, q, v):
+        return Constant(self(t, q, v))
+
+
+class SampleAndHold(AbstractControl):
+    """Any control sampled at the start of each step of `simulate` and held over it (a feedback
+    law run at the simulation rate, as MuJoCo applies `ctrl`). Called directly, it is the law."""
+
+    control: AbstractControl
+
+    def __init__(self, control):
+        self.control = as_control(control)
+
+    def __call__(self, t, q, v):
+        return self.control(t, q, v)
+
+    def hold(self, t, q, v):
+        return Constant(self.control(t, q, v))

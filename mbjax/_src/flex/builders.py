@@ -1,0 +1,38 @@
+"""From a beam finite-element model to a `ModalBody` (Anderson 1993 §2.2 and the Appendix).
+
+`beam_body` chains the structural side (`mbjax._src.flex.beam`, `modal`, `points`, `stiffening`):
+the reduced stiffness phi^T K phi, the mass-point cloud of the modal shapes, the 21 inertial and
+the distal unit-load geometric stiffness matrices (eq 33, Table 1), and the shapes at the grid
+points where other bodies or cut joints attach.
+"""
+
+import equinox as eqx
+import jax.numpy as jnp
+import numpy as np
+
+from mbjax._src.flex.beam import Beam
+from mbjax._src.flex.body import ModalBody
+from mbjax._src.flex.modal import ModalBasis, reduced
+from mbjax._src.flex.points import mass_points, node_shapes
+from mbjax._src.flex.stiffening import distal_stiffening, inertial_stiffening
+
+
+@eqx.filter_jit
+def beam_body(beam: Beam, basis: ModalBasis, nodes=(), *, clamped_node: int = 0,
+              stiffening: bool = True, damping=None) -> ModalBody:
+    """The modal body of `beam` in `basis` (clamped at `clamped_node`, the joint grid J^k), with
+    attachment points at the grid nodes `nodes` (for child bodies, cut joints and markers: index
+    i of `nodes` is attachment point i). stiffening=False leaves the geometric stiffness out."""
+    nodes = tuple(int(h) for h in nodes)
+    _, K_r = reduced(beam, basis)
+    index = np.asarray(nodes, dtype=int)
+    node_position = jnp.zeros((len(nodes), 3)).at[:, 0].set(beam.node_x()[index])
+    shapes = [node_shapes(basis, h) for h in nodes]
+    node_psi = jnp.stack([psi for psi, _ in shapes]) if nodes else jnp.zeros((0, 3, basis.mu))
+    node_phi = jnp.stack([phi for _, phi in shapes]) if nodes else jnp.zeros((0, 3, basis.mu))
+    return ModalBody.from_points(
+        mass_points(beam, basis), K_r, damping=damping,
+        inertial_stiffening=inertial_stiffening(beam, basis, clamped_node) if stiffening else None,
+        nodes=(node_position, node_phi, node_psi),
+        distal_stiffening=(distal_stiffening(beam, basis, nodes, clamped_node)
+                           if stiffening and nodes else None))

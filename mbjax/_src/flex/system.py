@@ -1,0 +1,117 @@
+"""Flexible trees as systems for `mbjax.simulate` and `mbjax.loops.ClosedSystem`.
+
+`FlexibleSystem` integrates (q, v) = (joint and modal coordinates, their rates) with Anderson 1993's
+O(n) recursion ("recursive", `mbjax._src.flex.aba`) or the dense Lagrangian route ("dense",
+`mbjax._src.flex.lagrange`). Closed loops and prescribed motions wrap it in
+`mbjax.loops.ClosedSystem(..., method=Stabilized())`, with cut joints at the model's markers.
+"""
+
+from typing import ClassVar
+
+import equinox as eqx
+import jax
+import jax.numpy as jnp
+from jax import Array
+
+from mbjax._src.control import AbstractControl, as_control
+from mbjax._src.system.driven import about_origins, check_actuation, check_control, check_points
+from mbjax._src.flex.aba import flexible_aba_responses
+from mbjax._src.flex.body import kinetic_energy as body_kinetic_energy
+from mbjax._src.flex.kinematics import body_velocities, frame_poses, marker_forces
+from mbjax._src.flex.lagrange import dense_forward_dynamics, potential_energy
+from mbjax._src.flex.model import FlexibleModel
+from mbjax._src.system.tree_system import AbstractTreeSystem
+
+METHODS = ("recursive", "dense")
+
+
+class FlexibleSystem(AbstractTreeSystem):
+    """u = v; v_dot from the flexible tree's forward dynamics under gravity, elasticity, the
+    control and the external wrenches. The control drives joint and modal coordinates alike
+    (`actuation` picks some).
+
+    `external` (t, q, v) returns world-frame wrenches (torque; force): one per body, shape
+    (n, 6), acting on the body's reference frame (the joint grid where its modes are clamped, or
+    `external_point`, a point fixed in that frame), as in `mbjax.rigid.TreeSystem`; or one per
+    frame, shape (n + markers, 6), the rows past n acting at the model's markers (torque about
+    the marker's origin, the force applied there). A load at a marker on a grid point bends the
+    body and stiffens it (Anderson 1993 eq 33, `mbjax._src.flex.kinematics.grid_point`), as a cut joint's
+    constraint load there does.
+
+    Geometric stiffening adds acceleration-dependent loads, so the equations are not
+    M v_dot + bias = 0 with a symmetric M (`symmetric_dynamics` is False): closed loops go
+    through `mbjax.loops.Stabilized`, on either route."""
+
+    model: FlexibleModel
+    control: AbstractControl | None
+    external: AbstractControl | None
+    external_point: Array | None
+    actuation: tuple[int, ...] | None = eqx.field(static=True)
+    method: str = eqx.field(static=True)
+    symmetric_dynamics: ClassVar[bool] = False
+
+    def __init__(self, model: FlexibleModel, control=None, *, external=None, external_point=None,
+                 actuation=None, method: str = "recursive"):
+        if not isinstance(model, FlexibleModel):
+            raise TypeError(f"model must be a FlexibleModel, got {type(model).__name__}")
+        if method not in METHODS:
+            raise ValueError(f"method must be one of {METHODS}, got {method!r}")
+        self.model = model
+        self.actuation = check_actuation(actuation, model.nv)
+        self.control = check_control(control, self.actuation, model.nv)
+        self.external = as_control(external)
+        self.external_point = check_points(external_point, model.n)
+        self.method = method
+
+    def frames(self, q):
+        """Body frames (joint grids), then the markers at grid points, deformation included."""
+        R, p, R_markers, p_markers = frame_poses(self.model, q)
+        return jnp.concatenate([R, R_markers]), jnp.concatenate([p, p_markers])
+
+    def kinetic_energy(self, q, v):
+        """T = sum_k w_k^T M_k(q_k) w_k / 2 (Anderson 1993 eq 34), w from the recursion's velocities."""
+        w = body_velocities(self.model, q, v)
+        qf = self.model.split(q)[1]
+        return jnp.sum(jax.vmap(body_kinetic_energy)(self.model.bodies, qf, w))
+
+    def dissipative(self):
+        """Joint damping or modal damping."""
+        return jnp.any(self.model.model.damping != 0) | jnp.any(self.model.bodies.damping != 0)
+
+    def energy(self, q, v):
+        """Kinetic, gravitational and modal strain energy."""
+        return self.kinetic_energy(q, v) + potential_energy(self.model, q)
+
+    def mass_matrix(self, q):
+        """d^2 T / dv^2: symmetric; the equations of motion add stiffening to it."""
+        zero = jnp.zeros(self.nv, q.dtype)
+        return jax.jacfwd(jax.grad(self.kinetic_energy, argnums=1), argnums=1)(q, zero)
+
+    def wrenches(self, t, q, v):
+        """The bodies' external wrenches (n, 6), world frame, torque about each body's origin;
+        or None (marker rows, if any, are in `applied`'s generalized forces)."""
+        return self._loads(t, q, v)[1]
+
+    def applied(self, t, q, v):
+        """The control's generalized forces, plus those of the wrenches at markers."""
+        return self._loads(t, q, v)[0]
+
+    def _loads(self, t, q, v):
+        """(generalized forces, body wrenches or None), `external` called once."""
+        tau = super().applied(t, q, v)
+        if self.external is None:
+            return tau, None
+        f = jnp.asarray(self.external(t, q, v), v.dtype)
+        if f.shape not in ((self.n, 6), (self.n_frames, 6)):
+            raise ValueError(f"external returned shape {f.shape}; it must return one world-frame "
+                             f"wrench (torque; force) per body, shape ({self.n}, 6), or per body "
+                             f"and marker, shape ({self.n_frames}, 6)")
+        if f.shape[0] > self.n:
+            tau = tau + marker_forces(self.model, q, f[self.n:])
+        return tau, about_origins(f[:self.n], self.frames(q)[0][:self.n], self.external_point)
+
+    def responses(self, t, q, v, loads):
+        tau, f = self._loads(t, q, v)
+        if self.method == "dense":
+            return dense_forward_dynamics(self.model, q, v, tau, f, loads)
+        return flexible_aba_responses(self.model, q, v, tau, loads, f)

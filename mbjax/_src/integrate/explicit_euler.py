@@ -1,0 +1,18 @@
+"""Explicit (forward) Euler, the Carpal Wrist chapter's time stepping (Canfield 1997 eq 6.45)."""
+
+import jax.numpy as jnp
+
+from mbjax._src.integrate.base import AbstractIntegrator
+
+
+class ExplicitEuler(AbstractIntegrator):
+    """q1 = q0 + dt q_dot(q0, u0), u1 = u0 + dt u_dot(t0, q0, u0). Order 1; it adds energy to
+    every undamped oscillation and so is unconditionally unstable for conservative mechanics."""
+
+    order = 1
+    name = "explicit_euler"
+
+    def step(self, system, t, q, u, dt):
+        q1 = system.project(q + dt * system.kinematics(q, u))
+        u1 = u + dt * system.acceleration(t, q, u)
+        return q1, u1, jnp.array(True)

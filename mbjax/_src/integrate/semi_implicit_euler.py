@@ -1,0 +1,18 @@
+"""Semi-implicit (symplectic) Euler."""
+
+import jax.numpy as jnp
+
+from mbjax._src.integrate.base import AbstractIntegrator
+
+
+class SemiImplicitEuler(AbstractIntegrator):
+    """u1 = u0 + dt u_dot(t0, q0, u0), then q1 = q0 + dt q_dot(q0, u1). Order 1; symplectic for
+    separable Hamiltonians, so energy errors stay bounded instead of growing."""
+
+    order = 1
+    name = "semi_implicit_euler"
+
+    def step(self, system, t, q, u, dt):
+        u1 = u + dt * system.acceleration(t, q, u)
+        q1 = system.project(q + dt * system.kinematics(q, u1))
+        return q1, u1, jnp.array(True)

@@ -1,0 +1,82 @@
+"""The constraints of a closed mechanism at position, velocity and acceleration level (Anderson 1993
+eqs 87-88, Jerkovsky 1978 eq 85), all by autodiff of the holonomic residual Phi(q, t):
+
+    Phi(q, t) = 0,    A(q, t) v + B(q, t) = 0,    A(q, t) v_dot + b(q, v, t) = 0,
+
+with A = dPhi/dq . dq/dv (the velocity constraint operator, (m, nv)), B = dPhi/dt and
+b = d/dt (A v + B) at fixed v, the "A_dot u + B_dot" of Anderson 1993 eq 92. Derivatives follow q along
+q_dot = tree.q_dot(q, v), so quaternion joints need no special case.
+"""
+
+import equinox as eqx
+import jax
+import jax.numpy as jnp
+from jax import Array
+
+from mbjax._src.system.tree_system import AbstractTreeSystem
+from mbjax._src.model.closures import GROUND, Coupling, CutJoint, Prescribed
+
+
+class Loops(eqx.Module):
+    """A tree (any `AbstractTreeSystem`: rigid, or flexible with markers as frames n, n + 1, ...)
+    closed by cut joints and driven by prescribed motions."""
+
+    tree: AbstractTreeSystem
+    closures: tuple
+
+    def __init__(self, tree: AbstractTreeSystem, closures):
+        if not isinstance(tree, AbstractTreeSystem):
+            raise TypeError(f"tree must be a tree system (mbjax.rigid.TreeSystem, "
+                            f"mbjax.flex.FlexibleSystem), got {type(tree).__name__}"
+                            + ("; wrap the model: TreeSystem(model)"
+                               if type(tree).__name__ == "Model" else ""))
+        closures = tuple(closures)
+        if not closures:
+            raise ValueError("a closed system needs at least one cut joint or prescribed motion")
+        for c in closures:
+            if isinstance(c, CutJoint):
+                for body in (c.body_a, c.body_b):
+                    if body != GROUND and not 0 <= body < tree.n_frames:
+                        raise ValueError(f"cut joint {c.kind!r}: body {body} is not in the tree "
+                                         f"(0 ... {tree.n_frames - 1}, or -1 for the ground)")
+            elif isinstance(c, Prescribed):
+                if not c.dof < tree.nq or tree.nq != tree.nv:
+                    raise ValueError(f"prescribed motion of coordinate {c.dof}: the tree has "
+                                     f"{tree.nq} coordinates (and drives need nq == nv)")
+            elif isinstance(c, Coupling):
+                if not max(c.coordinate, c.reference) < tree.nq:
+                    raise ValueError(f"coupling of coordinates {c.coordinate} and {c.reference}: "
+                                     f"the tree has {tree.nq} coordinates")
+            else:
+                raise TypeError(f"closures must be CutJoint, Coupling or Prescribed, got "
+                                f"{type(c).__name__}")
+        self.tree = tree
+        self.closures = closures
+
+    @property
+    def m(self) -> int:
+        """Number of scalar constraint equations (redundant ones included)."""
+        return sum(c.size for c in self.closures)
+
+    def phi(self, q: Array, t=0.0) -> Array:
+        """Phi(q, t), (m,)."""
+        if any(isinstance(c, CutJoint) for c in self.closures):
+            R, p = self.tree.frames(q)
+        else:                         # prescribed motions only: no kinematics to trace
+            R = p = None
+        return jnp.concatenate([c.residual(R, p, q, t) for c in self.closures])
+
+    def rate(self, q: Array, v: Array, t=0.0) -> Array:
+        """A v + B = dPhi/dt along the motion."""
+        return jax.jvp(self.phi, (q, jnp.asarray(t, q.dtype)),
+                       (self.tree.q_dot(q, v), jnp.ones((), q.dtype)))[1]
+
+    def jacobian(self, q: Array, t=0.0) -> Array:
+        """A (m, nv): the rate is linear in v, A v + B. Reverse mode, one pass per constraint
+        row, so O(m n) rather than O(n^2) for long chains."""
+        return jax.jacrev(lambda v: self.rate(q, v, t))(jnp.zeros(self.tree.nv, q.dtype))
+
+    def acceleration_bias(self, q: Array, v: Array, t=0.0) -> Array:
+        """b = d/dt (A v + B) at fixed v, so that A v_dot + b is the second derivative of Phi."""
+        return jax.jvp(lambda q_, t_: self.rate(q_, v, t_), (q, jnp.asarray(t, q.dtype)),
+                       (self.tree.q_dot(q, v), jnp.ones((), q.dtype)))[1]

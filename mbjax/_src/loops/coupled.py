@@ -1,0 +1,59 @@
+"""Coupled free and constrained motion by Lagrange multipliers (Jerkovsky 1978 §VI, eqs 85-93, the
+velocity form), with optional Baumgarte stabilization.
+
+With nu = mu^-1 the inverse mass matrix, the unconstrained acceleration a_free = nu (K^a - Y)
+(= -nu bias, the tree's applied forces included) and the constraint rows A v_dot + b = 0
+(`mbjax._src.loops.constraints`), eqs 89-92 give the multipliers K_c from
+(A nu A^t) K_c = -(A a_free + b) and eq 93 the motion v_dot = a_free + nu A^t K_c. Baumgarte's
+stabilization adds 2 alpha (A v + B) + beta^2 Phi to b, so the constraint errors obey
+e_ddot + 2 alpha e_dot + beta^2 e = 0 instead of drifting. The mass matrix is dense here
+(O(n^3)); `mbjax._src.loops.stabilized` is Anderson 1993's O(n + m^3) route.
+"""
+
+import equinox as eqx
+import jax
+from jax import Array
+
+from mbjax._src.loops.constraints import Loops
+from mbjax._src.loops.method import AbstractLoopMethod, require_symmetric
+from mbjax._src.loops.multipliers import multipliers
+
+
+def coupled_acceleration(loops: Loops, q: Array, v: Array, t=0.0,
+                         baumgarte=(0.0, 0.0)) -> tuple[Array, Array, Array]:
+    """(v_dot, K_c, rank) of Jerkovsky 1978 eqs 89-93 under the tree's forces; K_c are the multipliers
+    of the rows of A, so A^t K_c is the generalized constraint force. The Baumgarte gains are
+    Python floats."""
+    tree = loops.tree
+    factor = jax.scipy.linalg.cho_factor(tree.mass_matrix(q))
+    a_free = jax.scipy.linalg.cho_solve(factor, -tree.bias(t, q, v))
+    A = loops.jacobian(q, t)
+    b = loops.acceleration_bias(q, v, t)
+    if tuple(baumgarte) != (0.0, 0.0):        # Python floats: no extra passes when unused
+        alpha, beta = baumgarte
+        b = b + 2.0 * alpha * loops.rate(q, v, t) + beta**2 * loops.phi(q, t)
+    nu_At = jax.scipy.linalg.cho_solve(factor, A.T)
+    K_c, rank = multipliers(A @ nu_At, -(A @ a_free + b))
+    return a_free + nu_At @ K_c, K_c, rank
+
+
+class Coupled(AbstractLoopMethod):
+    """u = v; v_dot from the coupled Lagrange-multiplier equations (Jerkovsky 1978 eqs 89-93), with
+    Baumgarte gains (alpha, beta) ((0, 0): none). Needs a tree with a symmetric mass matrix."""
+
+    baumgarte: tuple = eqx.field(static=True, default=(0.0, 0.0),
+                                 converter=lambda g: tuple(float(x) for x in g))
+
+    def __check_init__(self):
+        if len(self.baumgarte) != 2 or not min(self.baumgarte) >= 0:
+            raise ValueError(f"baumgarte must be two gains (alpha, beta) >= 0, got {self.baumgarte}")
+
+    def validate(self, tree):
+        require_symmetric("Coupled", tree)
+
+    def acceleration(self, loops, t, q, u):
+        return coupled_acceleration(loops, q, u, t, self.baumgarte)[0]
+
+    def loads(self, loops, t, q, u):
+        """The multipliers K_c (Jerkovsky 1978 eq 92): A^t K_c is the generalized constraint force."""
+        return coupled_acceleration(loops, q, u, t, self.baumgarte)[1]

@@ -1,0 +1,167 @@
+"""Closed mechanisms as systems for `mbjax.simulate`: any tree closed by cut joints and
+prescribed motions, solved by a loop method passed in (diffrax-style strategies).
+
+    ClosedSystem(tree, closures, method=Coupled(baumgarte=...) | Momentum() | Stabilized(...),
+                 projection=False)
+
+The tree (`mbjax.rigid.TreeSystem`, `mbjax.flex.FlexibleSystem`) carries the applied forces:
+its control and external wrenches (also settable here with `control=` and `external=`). After
+each step `simulate` calls `constrain` (projection onto Phi = 0 and A v + B = 0 when
+`projection=True`, differentiable: `mbjax._src.loops.projection`), and at every saved state `check`,
+which flags `Status.CONSTRAINT_VIOLATED` once |Phi| exceeds `tolerance` and `Status.REDUNDANT`
+when the constraint Jacobian has lost rank (redundant closures, a singular configuration; the
+least-squares loads of `mbjax._src.loops.multipliers` keep the run finite).
+"""
+
+import equinox as eqx
+import jax.numpy as jnp
+from jax import Array
+
+from mbjax._src.control import as_control
+from mbjax._src.system.driven import check_points
+from mbjax._src.system.invariants import energy_invariant
+from mbjax._src.system.status import Status
+from mbjax._src.system.system import AbstractSystem
+from mbjax._src.system.tree_system import AbstractTreeSystem
+from mbjax._src.model.closures import Prescribed
+from mbjax._src.loops.constraints import Loops
+from mbjax._src.loops.coupled import Coupled
+from mbjax._src.loops.method import AbstractLoopMethod
+from mbjax._src.loops.multipliers import numerical_rank
+from mbjax._src.loops.projection import ITERATIONS, project_configuration, project_velocity
+from mbjax._src.loops.stabilized import Stabilized
+
+TOLERANCE = 1e-6
+
+
+def _with_forces(tree: AbstractTreeSystem, control, external, external_point) -> AbstractTreeSystem:
+    """The tree with the closed system's control and external loads put on it."""
+    new = {"control": as_control(control), "external": as_control(external),
+           "external_point": check_points(external_point, tree.n)}
+    new = {name: value for name, value in new.items() if value is not None}
+    for name in new:
+        if getattr(tree, name) is not None:
+            raise ValueError(f"the tree already has its {name}: give it to the tree or to "
+                             "ClosedSystem, not both")
+    if not new:
+        return tree
+    return eqx.tree_at(lambda s: tuple(getattr(s, name) for name in new), tree,
+                       tuple(new.values()), is_leaf=lambda x: x is None)
+
+
+class ClosedSystem(AbstractSystem):
+    """A tree closed by `closures` (`CutJoint`s and `Prescribed` motions), solved by `method`
+    (default: `Coupled()` for trees with a symmetric mass matrix, `Stabilized()` otherwise).
+
+    The velocity state u is the method's: the joint velocities v (`Coupled`, `Stabilized()`),
+    the momenta M v (`Momentum`), or v and the loads (`Stabilized(epsilon > 0)`); make it with
+    `initial_state(q, v)` and read v back with `velocity(q, u)`."""
+
+    loops: Loops
+    method: AbstractLoopMethod
+    projection: bool = eqx.field(static=True)
+    tolerance: float = eqx.field(static=True)
+    iterations: int = eqx.field(static=True)
+
+    def __init__(self, tree: AbstractTreeSystem, closures, method: AbstractLoopMethod | None = None,
+                 projection: bool = False, tolerance: float = TOLERANCE, *, control=None,
+                 external=None, external_point=None, iterations: int = ITERATIONS):
+        if isinstance(method, type):
+            raise TypeError(f"method must be an instance, e.g. {method.__name__}(), "
+                            "not the class")
+        if not isinstance(tree, AbstractTreeSystem):
+            Loops(tree, closures)                    # raises with the right message
+        if method is None:
+            method = Coupled() if tree.symmetric_dynamics else Stabilized()
+        if not isinstance(method, AbstractLoopMethod):
+            raise TypeError(f"method must be Coupled(...), Momentum() or Stabilized(...), got "
+                            f"{type(method).__name__}")
+        method.validate(tree)
+        if not tolerance > 0:
+            raise ValueError(f"tolerance must be positive, got {tolerance}")
+        if int(iterations) < 1:
+            raise ValueError(f"iterations must be >= 1, got {iterations}")
+        self.loops = Loops(_with_forces(tree, control, external, external_point), closures)
+        self.method = method
+        self.projection = bool(projection)
+        self.tolerance = float(tolerance)
+        self.iterations = int(iterations)
+
+    @property
+    def tree(self) -> AbstractTreeSystem:
+        return self.loops.tree
+
+    @property
+    def closures(self) -> tuple:
+        return self.loops.closures
+
+    # -- the method's state -----------------------------------------------------------------------
+
+    def velocity(self, q: Array, u: Array) -> Array:
+        """The joint velocities v in the state u."""
+        return self.method.velocity(self.loops, q, u)
+
+    def initial_state(self, q: Array, v: Array, t=0.0, *, consistent: bool = True) -> Array:
+        """The state u for joint velocities v (`Stabilized(epsilon > 0)`: with the algebraic
+        loads when consistent, else eq 89's)."""
+        q, v = jnp.asarray(q, float), jnp.asarray(v, float)
+        return self.method.initial_state(self.loops, q, v, jnp.asarray(t, q.dtype), consistent)
+
+    def loads(self, t, q: Array, u: Array) -> Array:
+        """The constraint loads on the rows of A (`Coupled`, `Momentum`: the multipliers K_c,
+        A^t K_c the generalized constraint force; `Stabilized`: f_c = -K_c)."""
+        return self.method.loads(self.loops, t, q, u)
+
+    # -- AbstractSystem ---------------------------------------------------------------------------
+
+    def kinematics(self, q, u):
+        return self.tree.q_dot(q, self.velocity(q, u))
+
+    def acceleration(self, t, q, u):
+        return self.method.acceleration(self.loops, t, q, u)
+
+    def retract(self, q0, xi):
+        return self.tree.retract(q0, xi)
+
+    def local_rate(self, q0, xi, u):
+        return self.tree.local_rate(q0, xi, self.velocity(self.retract(q0, xi), u))
+
+    def project(self, q):
+        return self.tree.normalize(q)
+
+    def hold(self, t, q, u):
+        tree = self.tree.hold(t, q, self.velocity(q, u))
+        return self if tree is self.tree else eqx.tree_at(lambda s: s.loops.tree, self, tree)
+
+    def constrain(self, t, q, u):
+        if not self.projection:
+            return q, u
+        q = project_configuration(self.loops, q, t, iterations=self.iterations)[0]
+        v = project_velocity(self.loops, q, self.velocity(q, u), t)
+        return q, self.method.with_velocity(self.loops, q, u, v)
+
+    def check(self, t, q, u):
+        violated = jnp.linalg.norm(self.loops.phi(q, t)) > self.tolerance
+        A = self.loops.jacobian(q, t)
+        redundant = numerical_rank(A @ A.T) < self.loops.m
+        return (jnp.where(violated, int(Status.CONSTRAINT_VIOLATED), 0)
+                | jnp.where(redundant, int(Status.REDUNDANT), 0)
+                | self.tree.check(t, q, self.velocity(q, u))).astype(jnp.int32)
+
+    # -- invariants -------------------------------------------------------------------------------
+
+    def energy(self, q, u):
+        """The tree's energy (kinetic, gravitational, strain) at the state's velocities; the work
+        of the applied forces and prescribed motions is not included."""
+        return self.tree.energy(q, self.velocity(q, u))
+
+    def invariants(self, t, q, u):
+        """The tree's energy where the tree is passive and no closure is a prescribed motion
+        (the closures' loads do no work then); None otherwise. The constraint residual is the
+        other invariant, held to `tolerance` by `check`."""
+        if not self.tree.passive or any(isinstance(c, Prescribed) for c in self.closures):
+            return None
+        v = self.velocity(q, u)
+        return energy_invariant(self.tree.energy(q, v), self.tree.kinetic_energy(q, v),
+                                self.tree.dissipative())
+

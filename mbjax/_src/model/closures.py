@@ -1,0 +1,157 @@
+"""Loop closures: cut joints and prescribed motions as holonomic constraints Phi(q, t) = 0
+(Jerkovsky 1978 eq 85, Anderson 1993 eq 87).
+
+A closed chain is modelled as a spanning tree (`mbjax.model.Model`) plus cut joints. A cut joint
+ties a frame A fixed in body `body_a` to a frame B fixed in body `body_b` (or in the ground,
+body_b = -1); each frame is a placement (rotation, origin) in its body's frame, and the joint's
+axis is the frame's z axis. Its residual, from the poses of the two frames (ground components):
+
+    spherical      p_A - p_B                                                     3
+    revolute       p_A - p_B, z_A . x_B, z_A . y_B                                5
+    universal      p_A - p_B, x_A . y_B          (cross axes x_A and y_B)         4
+    weld           p_A - p_B, vee(R_B^T R_A - R_A^T R_B) / 2                      6
+    prismatic      (p_A - p_B) . x_B, (p_A - p_B) . y_B, vee(...) / 2  (along z_B) 5
+    point_on_line  (p_A - p_B) . x_B, (p_A - p_B) . y_B  (p_A on the line z_B)   2
+    point_on_plane (p_A - p_B) . z_B                     (p_A on the plane z_B)  1
+
+A `Coupling` ties one configuration coordinate to another, q_a = multiplier q_b + offset (URDF's
+mimic joints, MJCF's joint equality). A `Prescribed` motion drives one velocity coordinate, q_j = q0 + rate t (a rheonomic constraint,
+e.g. a crank turning at constant speed), or q_j = motion(t) for any differentiable motion (a
+spin-up profile): its velocity and acceleration terms come from autodiff in t.
+
+Planar mechanisms built from revolute cut joints carry redundant equations (a planar loop needs
+only two); the solvers detect the rank and report it, see `mbjax._src.loops.coupled`.
+"""
+
+from collections.abc import Callable
+
+import equinox as eqx
+import jax.numpy as jnp
+import numpy as np
+from jax import Array
+
+GROUND = -1
+SIZES = {"spherical": 3, "revolute": 5, "universal": 4, "weld": 6, "prismatic": 5,
+         "point_on_line": 2, "point_on_plane": 1}
+
+
+def _vee_antisym(R: Array) -> Array:
+    """vee((R - R^T) / 2): sin(angle) * axis, zero at R = I."""
+    return 0.5 * jnp.array([R[2, 1] - R[1, 2], R[0, 2] - R[2, 0], R[1, 0] - R[0, 1]])
+
+
+class CutJoint(eqx.Module):
+    """A joint between frame A in body `body_a` and frame B in body `body_b` (-1: the ground),
+    cut to make the mechanism a tree; see the module docstring for the residual of each kind."""
+
+    kind: str = eqx.field(static=True)
+    body_a: int = eqx.field(static=True)
+    body_b: int = eqx.field(static=True)
+    rotation_a: Array
+    origin_a: Array
+    rotation_b: Array
+    origin_b: Array
+
+    def __init__(self, kind: str, body_a: int, body_b: int = GROUND, *, origin_a=(0.0, 0.0, 0.0),
+                 origin_b=(0.0, 0.0, 0.0), rotation_a=None, rotation_b=None):
+        if kind not in SIZES:
+            raise ValueError(f"cut joint kind must be one of {sorted(SIZES)}, got {kind!r}")
+        if not (isinstance(body_a, int | np.integer) and isinstance(body_b, int | np.integer)):
+            raise TypeError("body_a and body_b must be body indices (int; -1 for the ground)")
+        if body_a == body_b:
+            raise ValueError(f"a cut joint needs two different bodies, got body {body_a} twice")
+        if body_a < 0:
+            raise ValueError("body_a must be a body of the model (the ground can only be body_b)")
+        self.kind, self.body_a, self.body_b = kind, int(body_a), int(body_b)
+        self.rotation_a = jnp.asarray(np.eye(3) if rotation_a is None else rotation_a, float)
+        self.rotation_b = jnp.asarray(np.eye(3) if rotation_b is None else rotation_b, float)
+        self.origin_a = jnp.asarray(origin_a, float)
+        self.origin_b = jnp.asarray(origin_b, float)
+
+    @property
+    def size(self) -> int:
+        return SIZES[self.kind]
+
+    def residual(self, R: Array, p: Array, q: Array, t) -> Array:
+        """Phi of this joint from the body poses R (n, 3, 3), p (n, 3)."""
+        RA = R[self.body_a] @ self.rotation_a
+        pA = p[self.body_a] + R[self.body_a] @ self.origin_a
+        if self.body_b == GROUND:
+            RB, pB = self.rotation_b, self.origin_b
+        else:
+            RB = R[self.body_b] @ self.rotation_b
+            pB = p[self.body_b] + R[self.body_b] @ self.origin_b
+        d = pA - pB
+        x_A, y_A, z_A = RA.T
+        x_B, y_B, z_B = RB.T
+        if self.kind == "point_on_plane":       # a massless slider pinned to a planar mechanism
+            return (d @ z_B)[None]
+        orientation = _vee_antisym(RB.T @ RA)
+        if self.kind == "spherical":
+            return d
+        if self.kind == "revolute":
+            return jnp.concatenate([d, jnp.stack([z_A @ x_B, z_A @ y_B])])
+        if self.kind == "universal":
+            return jnp.concatenate([d, (x_A @ y_B)[None]])
+        if self.kind == "weld":
+            return jnp.concatenate([d, orientation])
+        across = jnp.stack([d @ x_B, d @ y_B])
+        if self.kind == "prismatic":
+            return jnp.concatenate([across, orientation])
+        return across                                   # point_on_line
+
+
+class Prescribed(eqx.Module):
+    """Velocity coordinate `dof` (a 1-dof joint's angle or slide) driven as q0 + rate t, or as
+    motion(t) (a differentiable callable of time) when `motion` is given."""
+
+    dof: int = eqx.field(static=True)
+    q0: Array
+    rate: Array
+    motion: Callable | None
+
+    def __init__(self, dof: int, q0=0.0, rate=0.0, motion: Callable | None = None):
+        if not isinstance(dof, int | np.integer) or dof < 0:
+            raise ValueError(f"dof must be a non-negative int, got {dof!r}")
+        if motion is not None and not callable(motion):
+            raise TypeError("motion must be a callable t -> coordinate")
+        self.dof = int(dof)
+        self.q0 = jnp.asarray(q0, float)
+        self.rate = jnp.asarray(rate, float)
+        self.motion = motion
+
+    @property
+    def size(self) -> int:
+        return 1
+
+    def residual(self, R: Array, p: Array, q: Array, t) -> Array:
+        if self.motion is not None:
+            return (q[self.dof] - self.motion(t))[None]
+        return (q[self.dof] - self.q0 - self.rate * t)[None]
+
+
+class Coupling(eqx.Module):
+    """Configuration coordinate `coordinate` tied to `reference`: q_a = multiplier q_b + offset
+    (a URDF mimic joint or an MJCF joint equality; indices into q)."""
+
+    coordinate: int = eqx.field(static=True)
+    reference: int = eqx.field(static=True)
+    multiplier: Array
+    offset: Array
+
+    def __init__(self, coordinate: int, reference: int, multiplier=1.0, offset=0.0):
+        for what, value in (("coordinate", coordinate), ("reference", reference)):
+            if not isinstance(value, int | np.integer) or value < 0:
+                raise ValueError(f"{what} must be a non-negative int, got {value!r}")
+        if coordinate == reference:
+            raise ValueError(f"coordinate {coordinate} cannot be coupled to itself")
+        self.coordinate, self.reference = int(coordinate), int(reference)
+        self.multiplier = jnp.asarray(multiplier, float)
+        self.offset = jnp.asarray(offset, float)
+
+    @property
+    def size(self) -> int:
+        return 1
+
+    def residual(self, R: Array, p: Array, q: Array, t) -> Array:
+        return (q[self.coordinate] - self.multiplier * q[self.reference] - self.offset)[None]

@@ -1,0 +1,134 @@
+"""Joint models: what each joint type contributes to the tree recursions.
+
+For joint k between its proximal body and body k, `joint_calc` gives (Featherstone's jcalc; Anderson
+1993 eqs 21, 23, 25, 27, 29, 31 for one subjoint each):
+
+    R_J, p_J   orientation and origin of body k's frame in the joint frame (x_joint = R_J x_k + p_J),
+    S          the motion subspace, 6 x width in body-k coordinates: V_rel = S v_k,
+    S_dot      its rate dS/dt (non-zero for the universal joint only), so that the
+               velocity-product term is S_dot v_k,
+
+and `joint_rate` maps (q_k, v_k) to q_dot_k. The joint frame sits in the proximal body at the
+placement (R_T, p_T); a revolute or prismatic axis is a unit vector in the joint frame.
+
+Types, with (nq, nv):
+    revolute   (1, 1)  rotation q about `axis` (Anderson 1993's revolute subjoint, lambda = axis);
+    prismatic  (1, 1)  translation q along `axis` (the prismatic subjoint);
+    universal  (2, 2)  a Hooke joint: two revolute subjoints, about `axis` then about `axis2`
+                       (Anderson 1993 §2.3(i): a multi-DOF joint as a sequence of 1-DOF subjoints);
+    spherical  (4, 3)  manifold coordinates: a unit quaternion (w, x, y, z); v = body angular
+                       velocity;
+    free       (7, 6)  floating base: origin position (3) then a unit quaternion (4);
+                       v = (omega, v_origin) in body coordinates.
+Quaternions are normalized where they are read, so a drifted state still gives a rotation.
+"""
+
+from typing import NamedTuple
+
+import jax.numpy as jnp
+from jax import Array
+
+from mbjax._src.lie import gamma_inv, quat_from_rotvec, quat_multiply, quat_to_matrix
+from mbjax._src.spatial import skew
+
+
+class JointType(NamedTuple):
+    nq: int
+    nv: int
+
+
+JOINT_TYPES = {
+    "revolute": JointType(1, 1),
+    "prismatic": JointType(1, 1),
+    "universal": JointType(2, 2),
+    "spherical": JointType(4, 3),
+    "free": JointType(7, 6),
+}
+
+NEUTRAL = {  # the zero configuration of each type
+    "revolute": (0.0,),
+    "prismatic": (0.0,),
+    "universal": (0.0, 0.0),
+    "spherical": (1.0, 0.0, 0.0, 0.0),
+    "free": (0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0),
+}
+
+
+def axis_rotation(axis: Array, angle: Array) -> Array:
+    """Rodrigues: the rotation by `angle` about the unit vector `axis`."""
+    K = skew(axis)
+    return jnp.eye(3, dtype=K.dtype) + jnp.sin(angle) * K + (1 - jnp.cos(angle)) * (K @ K)
+
+
+def _unit(q: Array) -> Array:
+    return q / jnp.linalg.norm(q)
+
+
+def joint_calc(kind: str, q: Array, v: Array, axis: Array, axis2: Array, width: int):
+    """(R_J, p_J, S, S_dot) of one joint; q and v are the joint's own coordinates. S and S_dot are
+    padded with zero columns to `width` (the model's widest joint) so every body has one shape."""
+    dtype = axis.dtype
+    zero3 = jnp.zeros(3, dtype)
+    eye = jnp.eye(3, dtype=dtype)
+    if kind == "revolute":
+        R, p = axis_rotation(axis, q[0]), zero3
+        S = jnp.concatenate([axis, zero3])[:, None]
+    elif kind == "prismatic":
+        R, p = eye, axis * q[0]
+        S = jnp.concatenate([zero3, axis])[:, None]
+    elif kind == "universal":
+        R2 = axis_rotation(axis2, q[1])
+        R, p = axis_rotation(axis, q[0]) @ R2, zero3
+        a1 = R2.T @ axis                    # the first axis seen from body k
+        S = jnp.stack([jnp.concatenate([a1, zero3]), jnp.concatenate([axis2, zero3])], -1)
+        # d/dt (R2^T axis) = (R2^T axis) x axis2 q2_dot; axis2 is fixed in body k
+        S_dot = jnp.stack([jnp.concatenate([jnp.cross(a1, axis2) * v[1], zero3]),
+                           jnp.zeros(6, dtype)], -1)
+    elif kind == "spherical":
+        R, p = quat_to_matrix(_unit(q[:4])), zero3
+        S = jnp.concatenate([eye, jnp.zeros((3, 3), dtype)])
+    elif kind == "free":
+        R, p = quat_to_matrix(_unit(q[3:7])), q[:3]
+        S = jnp.eye(6, dtype=dtype)
+    else:
+        raise ValueError(f"unknown joint type {kind!r}; choose from {sorted(JOINT_TYPES)}")
+    if kind != "universal":
+        S_dot = jnp.zeros_like(S)
+    pad = ((0, 0), (0, width - S.shape[1]))
+    return R, p, jnp.pad(S, pad), jnp.pad(S_dot, pad)
+
+
+def joint_rate(kind: str, q: Array, v: Array) -> Array:
+    """q_dot of one joint (padded like q): v itself, or the quaternion kinematics q * (0, w) / 2."""
+    if kind == "spherical":
+        return 0.5 * quat_multiply(_unit(q[:4]), jnp.concatenate([jnp.zeros(1, v.dtype), v[:3]]))
+    if kind == "free":
+        R = quat_to_matrix(_unit(q[3:7]))
+        quat_dot = 0.5 * quat_multiply(_unit(q[3:7]),
+                                       jnp.concatenate([jnp.zeros(1, v.dtype), v[:3]]))
+        return jnp.concatenate([R @ v[3:6], quat_dot])
+    return v[: JOINT_TYPES[kind].nq]
+
+
+def joint_retract(kind: str, q0: Array, xi: Array) -> Array:
+    """The configuration at chart point xi (in R^nv) about q0: q0 + xi for Euclidean joints; a
+    body-frame rotation increment quat0 * exp(xi) (Borri 1990 §2) for quaternions, and for a free
+    joint also the origin moved by xi's ground-frame part."""
+    if kind == "spherical":
+        return quat_multiply(_unit(q0[:4]), quat_from_rotvec(xi[:3]))
+    if kind == "free":
+        return jnp.concatenate([q0[:3] + xi[3:6],
+                                quat_multiply(_unit(q0[3:7]), quat_from_rotvec(xi[:3]))])
+    n = JOINT_TYPES[kind].nq
+    return q0[:n] + xi[:n]
+
+
+def joint_local_rate(kind: str, q0: Array, xi: Array, v: Array) -> Array:
+    """xi_dot for velocity v: Gamma(xi)^-T omega for the rotation increment (Borri 1990 eq 2.8) and
+    R v_origin for a free joint's origin; v itself for Euclidean joints."""
+    if kind == "spherical":
+        return gamma_inv(xi[:3]).T @ v[:3]
+    if kind == "free":
+        R = quat_to_matrix(joint_retract(kind, q0, xi)[3:7])
+        return jnp.concatenate([gamma_inv(xi[:3]).T @ v[:3], R @ v[3:6]])
+    return v[: JOINT_TYPES[kind].nv]

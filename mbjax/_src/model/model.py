@@ -1,0 +1,429 @@
+"""`Model`: a tree of rigid bodies connected by joints (DESIGN.md "Data model").
+
+Topology, joint types and names are static (hashable; changing them recompiles). Placements, axes,
+masses, centres of mass, inertias and gravity are array leaves with a leading body axis, so they can
+be differentiated, vmapped and swept without recompiling.
+
+Body k hangs from body `parents[k]` (-1: the ground) through joint k. Generalized coordinates q
+(length nq) and velocities v (length nv) are the joints' own, concatenated in body order; bodies are
+numbered depth-first with children in document order, which is Pinocchio's ordering.
+"""
+
+from functools import lru_cache
+
+import equinox as eqx
+import jax
+import jax.numpy as jnp
+import numpy as np
+from jax import Array
+
+from mbjax._src.model.joints import (
+    JOINT_TYPES,
+    NEUTRAL,
+    joint_calc,
+    joint_local_rate,
+    joint_rate,
+    joint_retract,
+)
+from mbjax._src.model.checks import check_body
+from mbjax._src.tree.take import take
+from mbjax._src.spatial import inertia_matrix
+from mbjax._src.tree import Topology
+
+
+@lru_cache(maxsize=None)
+def _layout(joint_types: tuple[str, ...]):
+    """Static index maps: each joint type's bodies and coordinates, the orders that put them back
+    in body and coordinate order, the padded velocity columns' mask and the widths."""
+    nqs = [JOINT_TYPES[k].nq for k in joint_types]
+    nvs = [JOINT_TYPES[k].nv for k in joint_types]
+    q0, v0 = np.cumsum([0, *nqs]), np.cumsum([0, *nvs])
+    wq, wv = max(nqs), max(nvs)
+    v_mask = np.array([[j < nvs[k] for j in range(wv)] for k in range(len(nvs))])
+    groups = {kind: np.array([k for k, t in enumerate(joint_types) if t == kind])
+              for kind in dict.fromkeys(joint_types)}
+    # each joint type's own coordinates (bodies of the type, its nq or nv columns), and where the
+    # bodies and coordinates of all types, concatenated type by type, go back to in body order
+    q_own = {kind: q0[idx][:, None] + np.arange(JOINT_TYPES[kind].nq) for kind, idx in groups.items()}
+    v_own = {kind: v0[idx][:, None] + np.arange(JOINT_TYPES[kind].nv) for kind, idx in groups.items()}
+
+    def order(maps):
+        return np.argsort(np.concatenate([m.ravel() for m in maps]), kind="stable")
+    return dict(nq=int(q0[-1]), nv=int(v0[-1]), q_start=tuple(int(x) for x in q0[:-1]),
+                v_start=tuple(int(x) for x in v0[:-1]), v_mask=v_mask, q_width=wq, width=wv,
+                groups=groups, q_own=q_own, v_own=v_own,
+                body_order=order(groups.values()), q_order=order(q_own.values()),
+                v_order=order(v_own.values()))
+
+
+class Model(eqx.Module):
+    """A rigid-body tree. Build it with `Model(parents, joint_types, ...)`, the builders in
+    `mbjax._src.model.builders` or `mbjax.load_urdf`.
+
+    Per body k (arrays with leading axis n):
+        placement_rotation (n, 3, 3), placement_translation (n, 3): joint k's frame in body
+            parents[k]'s frame (in the ground frame for a base body);
+        axis, axis2 (n, 3): joint axes in the joint frame (axis2 only for universal joints);
+        mass (n,), com (n, 3) in body k's frame, inertia (n, 3, 3) about the centre of mass;
+        gravity (3,): the ground-frame acceleration of gravity.
+
+    Per coordinate (joint data, as URDF and MJCF give it):
+        lower, upper (nq,): position limits (-inf, inf where there are none; a revolute joint
+            without limits is a URDF "continuous" joint);
+        velocity_limit, effort_limit (nv,): |v| and |tau| bounds (inf: none). Limits are data
+            (bounds for trajectory optimisation, `mbjax._src.model.limits.excess`, checked by
+            `TreeSystem.check` in `simulate`'s status), not contact forces;
+        damping (nv,): viscous joint damping, a force -damping * v in the dynamics;
+        armature (nv,): rotor inertia reflected to the joint, added to the mass matrix diagonal
+            (Featherstone's ABA adds it to D; MuJoCo's and Pinocchio's armature);
+        friction (nv,): dry friction, kept as data (not used by the dynamics).
+
+    Named frames (URDF links merged through fixed joints, fixed joints, MJCF sites):
+        frame_names, frame_parents: static names and the body each frame is fixed to (-1: the
+            ground); frame_rotation (m, 3, 3), frame_translation (m, 3): its pose in that body.
+        See `mbjax.frame_pose` and `mbjax.frame_jacobian` (`mbjax._src.rigid.frames`).
+
+    Bodies with implausible but computable mass data (a triangle-inequality violation, negative
+    moments, a massless leaf without armature) load with a `ModelWarning` (`mbjax._src.model.checks`);
+    `strict=True` makes it an error.
+    """
+
+    topology: Topology = eqx.field(static=True)
+    joint_types: tuple[str, ...] = eqx.field(static=True)
+    names: tuple[str, ...] = eqx.field(static=True)
+    joint_names: tuple[str, ...] = eqx.field(static=True)
+    placement_rotation: Array
+    placement_translation: Array
+    axis: Array
+    axis2: Array
+    mass: Array
+    com: Array
+    inertia: Array
+    gravity: Array
+    lower: Array
+    upper: Array
+    velocity_limit: Array
+    effort_limit: Array
+    damping: Array
+    armature: Array
+    friction: Array
+    frame_names: tuple[str, ...] = eqx.field(static=True)
+    frame_parents: tuple[int, ...] = eqx.field(static=True)
+    frame_rotation: Array
+    frame_translation: Array
+
+    def __init__(self, parents, joint_types, *, mass, inertia, com=None, axis=None, axis2=None,
+                 placement_rotation=None, placement_translation=None,
+                 gravity=(0.0, 0.0, -9.81), names=None, joint_names=None, lower=None,
+                 upper=None, velocity_limit=None, effort_limit=None, damping=None,
+                 armature=None, friction=None, frame_names=(), frame_parents=(),
+                 frame_rotation=None, frame_translation=None, strict: bool = False):
+        self.topology = parents if isinstance(parents, Topology) else Topology(parents)
+        n = self.topology.n
+        joint_types = (joint_types,) * n if isinstance(joint_types, str) else tuple(joint_types)
+        if len(joint_types) != n:
+            raise ValueError(f"{len(joint_types)} joint types for {n} bodies")
+        for k, kind in enumerate(joint_types):
+            if kind not in JOINT_TYPES:
+                raise ValueError(f"body {k}: unknown joint type {kind!r}; choose from "
+                                 f"{sorted(JOINT_TYPES)}")
+        self.joint_types = joint_types
+        digits = len(str(n - 1))     # zero-padded defaults sort like the body indices (URDF order)
+        self.names = (tuple(names) if names is not None
+                      else tuple(f"body{k:0{digits}d}" for k in range(n)))
+        self.joint_names = (tuple(joint_names) if joint_names is not None
+                            else tuple(f"joint{k:0{digits}d}" for k in range(n)))
+        if len(self.names) != n or len(self.joint_names) != n:
+            raise ValueError(f"{len(self.names)} names and {len(self.joint_names)} joint names "
+                             f"for {n} bodies")
+
+        def field(value, default, shape, what, unit_rows=False):
+            # concrete data is shaped in NumPy (array operations outside jit would each compile
+            # a program); traced data (a model built inside jax.grad or vmap) in JAX
+            value = default if value is None else value
+            xp = jnp if _traced(value) else np
+            try:
+                arr = xp.asarray(value, dtype=float)
+            except (TypeError, ValueError) as error:
+                raise TypeError(f"{what} must be real numbers of shape {shape}, got "
+                                f"{value!r:.80}") from error
+            if arr.shape != shape:
+                arr = xp.broadcast_to(arr, shape) if arr.ndim < len(shape) else arr
+            if arr.shape != shape:
+                raise ValueError(f"{what} must have shape {shape}, got {np.shape(value)}")
+            if unit_rows:           # a zero row is reported below, by name
+                with np.errstate(invalid="ignore", divide="ignore"):
+                    # scaled by the largest component first: |a|^2 overflows from 1.3e154
+                    arr = arr / xp.max(xp.abs(arr), axis=-1, keepdims=True)
+                    arr = arr / xp.linalg.norm(arr, axis=-1, keepdims=True)
+            return jnp.asarray(arr, dtype=float)
+
+        self.mass = field(mass, None, (n,), "mass")
+        self.inertia = field(inertia, None, (n, 3, 3), "inertia")
+        self.com = field(com, np.zeros((n, 3)), (n, 3), "com")
+        self.axis = field(axis, np.tile([0.0, 0.0, 1.0], (n, 1)), (n, 3), "axis", unit_rows=True)
+        self.axis2 = field(axis2, np.tile([0.0, 1.0, 0.0], (n, 1)), (n, 3), "axis2",
+                           unit_rows=True)
+        self.placement_rotation = field(placement_rotation, np.tile(np.eye(3), (n, 1, 1)),
+                                        (n, 3, 3), "placement_rotation")
+        self.placement_translation = field(placement_translation, np.zeros((n, 3)), (n, 3),
+                                           "placement_translation")
+        self.gravity = field(gravity, None, (3,), "gravity")
+        nq, nv = _layout(joint_types)["nq"], _layout(joint_types)["nv"]
+        inf = np.inf
+        self.lower = field(lower, np.full(nq, -inf), (nq,), "lower")
+        self.upper = field(upper, np.full(nq, inf), (nq,), "upper")
+        self.velocity_limit = field(velocity_limit, np.full(nv, inf), (nv,), "velocity_limit")
+        self.effort_limit = field(effort_limit, np.full(nv, inf), (nv,), "effort_limit")
+        self.damping = field(damping, np.zeros(nv), (nv,), "damping")
+        self.armature = field(armature, np.zeros(nv), (nv,), "armature")
+        self.friction = field(friction, np.zeros(nv), (nv,), "friction")
+        self.frame_names, self.frame_parents = tuple(frame_names), tuple(int(k) for k in frame_parents)
+        m = len(self.frame_names)
+        if len(self.frame_parents) != m:
+            raise ValueError(f"{m} frame names and {len(self.frame_parents)} frame parents")
+        for name, k in zip(self.frame_names, self.frame_parents):
+            if not -1 <= k < n:
+                raise ValueError(f"frame {name!r}: parent body {k} is not in 0 ... {n - 1} or -1")
+        self.frame_rotation = field(frame_rotation, np.tile(np.eye(3), (m, 1, 1)), (m, 3, 3),
+                                    "frame_rotation")
+        self.frame_translation = field(frame_translation, np.zeros((m, 3)), (m, 3),
+                                       "frame_translation")
+        for what, raw, uses in (("axis", axis, ("revolute", "prismatic", "universal")),
+                                ("axis2", axis2, ("universal",))):
+            if raw is not None and not isinstance(raw, jax.core.Tracer):
+                norms = np.max(np.abs(np.broadcast_to(np.asarray(raw, float), (n, 3))), axis=-1)
+                for k, kind in enumerate(joint_types):
+                    if kind in uses and not norms[k] > 0:
+                        raise ValueError(f"body {self.names[k]!r}: the {kind} joint's {what} is "
+                                         f"zero (or not finite); give a nonzero direction")
+        if not isinstance(self.placement_rotation, jax.core.Tracer):
+            self._check_geometry()
+        if not isinstance(self.mass, jax.core.Tracer):
+            mass, inertia = np.asarray(self.mass), np.asarray(self.inertia)
+            rotor = np.asarray(self.armature) > 0
+            dof_body = self.dof_body()
+            for k in range(n):
+                check_body(float(mass[k]), inertia[k], f"body {self.names[k]!r}",
+                           carries=bool(self.topology.distal(k)) or bool(rotor[dof_body == k].all()),
+                           strict=strict)
+        if not isinstance(self.lower, jax.core.Tracer):
+            self._check_joint_data()
+
+    def _check_geometry(self) -> None:
+        """Finite placements, centres of mass, axes, frames and gravity; rotations that are
+        rotations (orthonormal, det +1, to ROTATION_TOLERANCE); a universal joint's two axes
+        not parallel (its motion subspace would lose a column)."""
+        per_body = (("placement_rotation", self.names), ("placement_translation", self.names),
+                    ("com", self.names), ("axis", self.names), ("axis2", self.names),
+                    ("frame_rotation", self.frame_names), ("frame_translation", self.frame_names))
+        for what, owners in per_body:
+            value = np.asarray(getattr(self, what))
+            if not value.size:
+                continue
+            bad = np.flatnonzero(~np.isfinite(value.reshape(len(value), -1)).all(-1))
+            if bad.size:
+                raise ValueError(f"{what} of {owners[bad[0]]!r} must be finite, got "
+                                 f"{value[bad[0]].tolist()}")
+        if not np.isfinite(np.asarray(self.gravity)).all():
+            raise ValueError(f"gravity must be finite, got {np.asarray(self.gravity).tolist()}")
+        for what, owners in (("placement_rotation", self.names),
+                             ("frame_rotation", self.frame_names)):
+            R = np.asarray(getattr(self, what))
+            if not len(R):
+                continue
+            orthogonality = np.abs(np.swapaxes(R, -1, -2) @ R - np.eye(3)).max(axis=(-1, -2))
+            det = np.linalg.det(R)
+            bad = np.flatnonzero((orthogonality > ROTATION_TOLERANCE)
+                                 | (np.abs(det - 1.0) > ROTATION_TOLERANCE))
+            if bad.size:
+                k = bad[0]
+                kind = "a reflection (det -1)" if det[k] < 0 else "not orthonormal"
+                raise ValueError(
+                    f"{what} of {owners[k]!r} is {kind}: R^T R - I up to {orthogonality[k]:.2g}, "
+                    f"det {det[k]:.6g}, for R = {R[k].tolist()}; give a rotation matrix (the "
+                    f"polar factor U V^T of an SVD R = U S V^T is the nearest one)")
+        axis, axis2 = np.asarray(self.axis), np.asarray(self.axis2)
+        for k, kind in enumerate(self.joint_types):
+            if kind == "universal" and np.linalg.norm(np.cross(axis[k], axis2[k])) < 1e-6:
+                raise ValueError(f"body {self.names[k]!r}: the universal joint's axis "
+                                 f"{axis[k].tolist()} and axis2 {axis2[k].tolist()} are parallel, "
+                                 "so it turns about one axis only; give two independent axes "
+                                 "(or a revolute joint)")
+
+    def _check_joint_data(self) -> None:
+        """Limits in order; limits non-negative (infinite: none); damping, armature and
+        friction non-negative and finite. Errors name the joint of the offending coordinate."""
+        layout = _layout(self.joint_types)
+
+        def joint(index: int, starts) -> str:
+            return repr(self.joint_names[int(np.searchsorted(starts, index, side="right")) - 1])
+
+        lower, upper = np.asarray(self.lower), np.asarray(self.upper)
+        bad = np.flatnonzero(~(lower <= upper))
+        if bad.size:
+            raise ValueError(f"lower must not exceed upper; joint {joint(bad[0], layout['q_start'])}"
+                             f" (coordinate {bad[0]}): lower {lower[bad[0]]}, upper "
+                             f"{upper[bad[0]]}")
+        for what in ("velocity_limit", "effort_limit", "damping", "armature", "friction"):
+            value = np.asarray(getattr(self, what))
+            infinite_allowed = what.endswith("limit")           # an infinite limit: none
+            bad = np.flatnonzero(np.isnan(value) | (value < 0)
+                                 | (np.isinf(value) & (not infinite_allowed)))
+            if bad.size:
+                raise ValueError(f"{what} must be non-negative"
+                                 f"{'' if infinite_allowed else ' and finite'}; joint "
+                                 f"{joint(bad[0], layout['v_start'])} (coordinate {bad[0]}) has "
+                                 f"{value[bad[0]]}")
+
+    # -- sizes and layout -----------------------------------------------------------------------
+
+    @property
+    def n(self) -> int:
+        return self.topology.n
+
+    @property
+    def n_frames(self) -> int:
+        """Frames of the tree: its bodies (a flexible model adds markers)."""
+        return self.topology.n
+
+    @property
+    def nq(self) -> int:
+        return _layout(self.joint_types)["nq"]
+
+    @property
+    def nv(self) -> int:
+        return _layout(self.joint_types)["nv"]
+
+    @property
+    def width(self) -> int:
+        """Columns of the widest joint's motion subspace (1 for revolute/prismatic trees)."""
+        return _layout(self.joint_types)["width"]
+
+    def neutral(self) -> Array:
+        """The zero configuration: zero angles and displacements, identity quaternions."""
+        return jnp.asarray([x for kind in self.joint_types for x in NEUTRAL[kind]], dtype=float)
+
+    @property
+    def v_mask(self) -> np.ndarray:
+        """(n, width) static mask: which padded joint columns are real velocity coordinates."""
+        return _layout(self.joint_types)["v_mask"]
+
+    def body_v(self, v: Array) -> Array:
+        """Per-body velocities (n, width, ...), zero-padded, of v (nv, ...)."""
+        layout, width = _layout(self.joint_types), self.width
+        return _by_body(layout, [
+            jnp.pad(take(v, own), [(0, 0), (0, width - own.shape[1])] + [(0, 0)] * (v.ndim - 1))
+            for own in layout["v_own"].values()])
+
+    def flat_v(self, per_body: Array) -> Array:
+        """Inverse of body_v: (n, width, ...) -> (nv, ...)."""
+        layout = _layout(self.joint_types)
+        return _flat(layout, "v", per_body)
+
+    def dof_body(self) -> np.ndarray:
+        """The body each velocity coordinate belongs to."""
+        return np.repeat(np.arange(self.n), [JOINT_TYPES[k].nv for k in self.joint_types])
+
+    # -- joints ---------------------------------------------------------------------------------
+
+    def _per_type(self, fn, q: Array, *vs: Array):
+        """Apply fn(kind, q_k, *v_k, axis_k, axis2_k) to every body, grouped by joint type so each
+        type is one vmapped call (no Python loop over bodies). Each v in vs has length nv."""
+        layout = _layout(self.joint_types)
+        outs = [jax.vmap(lambda qk, a, a2, *vk, kind=kind: fn(kind, qk, *vk, a, a2))(
+                    take(q, layout["q_own"][kind]), take(self.axis, idx), take(self.axis2, idx),
+                    *[take(v, layout["v_own"][kind]) for v in vs])
+                for kind, idx in layout["groups"].items()]
+        return jax.tree.map(lambda *pieces: _by_body(layout, pieces), *outs)
+
+    def joints(self, q: Array, v: Array):
+        """Per-body (R, p, S, S_dot): body k's orientation and origin in its proximal body's frame,
+        its motion subspace (n, 6, width) and that subspace's rate, body coordinates."""
+        width = self.width
+        R_J, p_J, S, S_dot = self._per_type(
+            lambda kind, qk, vk, a, a2: joint_calc(kind, qk, vk, a, a2, width), q, v)
+        R = self.placement_rotation @ R_J
+        p = self.placement_translation + jnp.einsum("kij,kj->ki", self.placement_rotation, p_J)
+        return R, p, S, S_dot
+
+    def q_dot(self, q: Array, v: Array) -> Array:
+        """dq/dt for velocity v (equal to v for revolute, prismatic and universal joints)."""
+        if self.euclidean:
+            return v
+        return self._flat_q(self._per_type(
+            lambda kind, qk, vk, a, a2: self._pad_q(kind, joint_rate(kind, qk, vk)), q, v))
+
+    @property
+    def euclidean(self) -> bool:
+        """Whether every joint's coordinates are Euclidean (revolute, prismatic, universal): then
+        q_dot = v and retract(q0, xi) = q0 + xi, with no per-joint-type gathers and scatters."""
+        return all(JOINT_TYPES[kind].nq == JOINT_TYPES[kind].nv for kind in self.joint_types)
+
+    def retract(self, q0: Array, xi: Array) -> Array:
+        """The configuration at chart point xi (length nv) about q0 (see joints.joint_retract)."""
+        if self.euclidean:
+            return q0 + xi
+        return self._flat_q(self._per_type(
+            lambda kind, qk, xk, a, a2: self._pad_q(kind, joint_retract(kind, qk, xk)), q0, xi))
+
+    def local_rate(self, q0: Array, xi: Array, v: Array) -> Array:
+        """xi_dot (length nv) at chart point xi about q0 for velocity v."""
+        if self.euclidean:
+            return v
+        width = self.width
+        rates = self._per_type(
+            lambda kind, qk, xk, vk, a, a2: jnp.pad(joint_local_rate(kind, qk, xk, vk),
+                                                    (0, width - JOINT_TYPES[kind].nv)), q0, xi, v)
+        return self.flat_v(rates)
+
+    def _pad_q(self, kind: str, qk: Array) -> Array:
+        return jnp.pad(qk, (0, _layout(self.joint_types)["q_width"] - qk.shape[0]))
+
+    def _flat_q(self, per_body: Array) -> Array:
+        return _flat(_layout(self.joint_types), "q", per_body)
+
+    def normalize(self, q: Array) -> Array:
+        """q with every quaternion scaled to unit length."""
+        layout = _layout(self.joint_types)
+        starts = [layout["q_start"][k] + offset for kind, offset in (("spherical", 0), ("free", 3))
+                  for k in layout["groups"].get(kind, ())]
+        if not starts:
+            return q
+        idx = np.asarray(starts)[:, None] + np.arange(4)
+        quats = take(q, idx)
+        units = quats / jnp.linalg.norm(quats, axis=-1, keepdims=True)
+        # q with the quaternions' entries read from the unit ones appended after it: a static
+        # map (slices where it is a few runs), no scatter to keep a loop from one kernel
+        source = np.arange(q.shape[0])
+        source[idx.ravel()] = q.shape[0] + np.arange(idx.size)
+        return take(jnp.concatenate([q, units.ravel()]), source)
+
+    def spatial_inertia(self) -> Array:
+        """(n, 6, 6) spatial inertias about each body's origin, body coordinates."""
+        return inertia_matrix(self.mass, self.com, self.inertia)
+
+
+def _by_body(layout: dict, pieces) -> Array:
+    """Per-type arrays (one per joint type, leading axis that type's bodies) in body order."""
+    if len(pieces) == 1:
+        return pieces[0]
+    return take(jnp.concatenate(pieces), layout["body_order"])
+
+
+def _flat(layout: dict, which: str, per_body: Array) -> Array:
+    """Per-body padded rows (n, width, ...) -> the flat coordinates (nq or nv, ...) they hold."""
+    blocks = [take(per_body, idx)[:, :own.shape[1]].reshape(-1, *per_body.shape[2:])
+              for idx, own in zip(layout["groups"].values(), layout[f"{which}_own"].values(),
+                                  strict=True)]
+    return take(jnp.concatenate(blocks), layout[f"{which}_order"])
+
+
+# how far a given rotation matrix may be from orthonormal with det +1 (rounded source data)
+ROTATION_TOLERANCE = 1e-6
+
+
+def _traced(value) -> bool:
+    """Whether value (an array, or nested lists of numbers and arrays) holds a tracer of jit,
+    grad or vmap."""
+    return any(isinstance(leaf, jax.core.Tracer) for leaf in jax.tree.leaves(value))

@@ -1,0 +1,154 @@
+"""State converters between mbjax and Pinocchio or MuJoCo: `(model, q, v) -> (q, v)`.
+
+The coordinates of one joint differ between the engines only in their layout; the joints come in
+the same order when the peer numbers them as mbjax does (`load_urdf`'s default sibling order is
+Pinocchio's; `load_mjcf`, `from_mujoco` and `load_urdf(..., sibling_order="document")` follow
+MuJoCo's).
+
+    joint       mbjax q, v                       Pinocchio q, v                 MuJoCo qpos, qvel
+    revolute    angle, rate                      same; a joint without limits   same
+                                                 (URDF continuous): cos, sin
+    prismatic   displacement, rate               same                           same
+    spherical   quaternion wxyz,                 quaternion xyzw, omega_body    wxyz, omega_body
+                omega_body
+    free        origin, quaternion wxyz;         origin, xyzw;                  origin, wxyz;
+                (omega_body; v_origin body)      (v_origin body; omega_body)    (v_origin world;
+                                                                                omega_body)
+
+Universal joints have no counterpart in either engine. Each conversion is a few gathers and
+scatters with index maps built once per joint layout (no loop over the joints in traced code), so
+it composes with jit, vmap and grad; an acceleration converts by `jax.jvp` of the velocity map
+along (q_dot, v_dot). Which revolute joints are continuous is read from the model's limits, which
+must then be concrete (close over the model rather than passing it through `jax.jit`).
+"""
+
+from functools import lru_cache
+
+import jax
+import jax.numpy as jnp
+import numpy as np
+from jax import Array
+
+from mbjax._src.lie import quat_to_matrix
+from mbjax._src.model.joints import JOINT_TYPES
+from mbjax._src.model.model import Model
+
+_XYZW = (1, 2, 3, 0)           # Pinocchio's quaternion (x, y, z, w) from mbjax's (w, x, y, z)
+
+
+def _check(model: Model, q: Array, v: Array, peer: str) -> tuple[Array, Array]:
+    q, v = jnp.asarray(q), jnp.asarray(v)
+    for k, kind in enumerate(model.joint_types):
+        if kind == "universal":
+            raise ValueError(f"joint {model.joint_names[k]!r} is universal: {peer} has no such "
+                             "joint (make it two revolute joints)")
+    return q, v
+
+
+def _continuous(model: Model) -> tuple[bool, ...]:
+    """Per joint: a revolute joint without position limits (URDF's continuous joint)."""
+    lower, upper = model.lower, model.upper
+    if isinstance(lower, jax.core.Tracer) or isinstance(upper, jax.core.Tracer):
+        raise TypeError("the Pinocchio converters read which revolute joints are continuous from "
+                        "the model's limits, which are traced here: close over the model instead "
+                        "of passing it through jax.jit")
+    starts = np.cumsum([0] + [JOINT_TYPES[k].nq for k in model.joint_types])[:-1]
+    lower, upper = np.asarray(lower), np.asarray(upper)
+    return tuple(bool(kind == "revolute" and np.isinf(lower[i]) and np.isinf(upper[i]))
+                 for kind, i in zip(model.joint_types, starts, strict=True))
+
+
+@lru_cache(maxsize=None)
+def _pinocchio_layout(joint_types: tuple[str, ...], continuous: tuple[bool, ...]):
+    """Static index maps: Pinocchio's q[dst] = mbjax's q[src] (a permutation of the plain
+    coordinates), the continuous joints' (cos, sin) slots, and v_pin = v[v_src]."""
+    src, dst, angle, cos_sin, v_src = [], [], [], [], []
+    iq = ip = iv = 0
+    for kind, cont in zip(joint_types, continuous, strict=True):
+        nq, nv = JOINT_TYPES[kind]
+        if cont:
+            angle.append(iq)
+            cos_sin.append((ip, ip + 1))
+            ip += 2
+        else:
+            order = {"spherical": _XYZW, "free": (0, 1, 2, *(3 + i for i in _XYZW))}.get(
+                kind, tuple(range(nq)))
+            src += [iq + i for i in order]
+            dst += list(range(ip, ip + nq))
+            ip += nq
+        v_src += [iv + i for i in ((3, 4, 5, 0, 1, 2) if kind == "free" else range(nv))]
+        iq, iv = iq + nq, iv + nv
+    as_array = lambda x: np.asarray(x, dtype=int).reshape(-1)  # noqa: E731
+    return dict(nq=ip, src=as_array(src), dst=as_array(dst), angle=as_array(angle),
+                cos=as_array([c for c, _ in cos_sin]), sin=as_array([s for _, s in cos_sin]),
+                v_src=as_array(v_src), v_dst=np.argsort(v_src))
+
+
+def state_to_pinocchio(model: Model, q: Array, v: Array) -> tuple[Array, Array]:
+    """(q, v) in Pinocchio's layout for the model Pinocchio builds from the same URDF (a free
+    base: `pin.JointModelFreeFlyer()` as the root joint)."""
+    q, v = _check(model, q, v, "Pinocchio")
+    lay = _pinocchio_layout(model.joint_types, _continuous(model))
+    q_pin = (jnp.zeros(lay["nq"], q.dtype).at[lay["dst"]].set(q[lay["src"]])
+             .at[lay["cos"]].set(jnp.cos(q[lay["angle"]]))
+             .at[lay["sin"]].set(jnp.sin(q[lay["angle"]])))
+    return q_pin, v[lay["v_src"]]
+
+
+def state_from_pinocchio(model: Model, q: Array, v: Array) -> tuple[Array, Array]:
+    """Inverse of `state_to_pinocchio`."""
+    q, v = _check(model, q, v, "Pinocchio")
+    lay = _pinocchio_layout(model.joint_types, _continuous(model))
+    if q.shape != (lay["nq"],) or v.shape != (model.nv,):
+        raise ValueError(f"Pinocchio q and v must have {lay['nq']} and {model.nv} entries for "
+                         f"this model, got {q.shape[0]} and {v.shape[0]}")
+    q_mb = (jnp.zeros(model.nq, q.dtype).at[lay["src"]].set(q[lay["dst"]])
+            .at[lay["angle"]].set(jnp.arctan2(q[lay["sin"]], q[lay["cos"]])))
+    return q_mb, v[lay["v_dst"]]
+
+
+@lru_cache(maxsize=None)
+def _free_joints(joint_types: tuple[str, ...], parents: tuple[int, ...]):
+    """(quaternion indices (k, 4), linear-velocity indices (k, 3), angular (k, 3)) of the free
+    joints, which MuJoCo allows only on bodies hanging from the world."""
+    quat, linear, angular = [], [], []
+    iq = iv = 0
+    for kind, parent in zip(joint_types, parents, strict=True):
+        if kind == "free":
+            if parent >= 0:
+                raise ValueError("MuJoCo allows free joints only on bodies that hang from the "
+                                 "world")
+            quat.append(range(iq + 3, iq + 7))
+            angular.append(range(iv, iv + 3))
+            linear.append(range(iv + 3, iv + 6))
+        iq, iv = iq + JOINT_TYPES[kind].nq, iv + JOINT_TYPES[kind].nv
+    shape = lambda x, n: np.asarray(x, dtype=int).reshape(-1, n)  # noqa: E731
+    return shape(quat, 4), shape(linear, 3), shape(angular, 3)
+
+
+def _mujoco_velocity(model: Model, q: Array, v: Array, to_world: bool) -> Array:
+    """A free joint's (omega; v_origin) in the body frame and MuJoCo's (v_origin in the world;
+    omega): the same components, reordered, with the linear part rotated."""
+    quat, linear, angular = _free_joints(model.joint_types, model.topology.parents)
+    if not quat.size:
+        return v
+    R = jax.vmap(quat_to_matrix)(q[quat] / jnp.linalg.norm(q[quat], axis=-1, keepdims=True))
+    if to_world:          # mbjax (omega; v_body) -> MuJoCo (R v_body; omega)
+        return (v.at[angular].set(jnp.einsum("kij,kj->ki", R, v[linear]))
+                .at[linear].set(v[angular]))
+    # MuJoCo (v_world; omega) in mbjax's slots: v_world at `angular`, omega at `linear`
+    return (v.at[angular].set(v[linear])
+            .at[linear].set(jnp.einsum("kji,kj->ki", R, v[angular])))
+
+
+def state_to_mujoco(model: Model, q: Array, v: Array) -> tuple[Array, Array]:
+    """(qpos, qvel) for the MuJoCo model of the same mechanism (`load_mjcf`/`from_mujoco`
+    numbering)."""
+    q, v = _check(model, q, v, "MuJoCo")
+    return q, _mujoco_velocity(model, q, v, to_world=True)
+
+
+def state_from_mujoco(model: Model, q: Array, v: Array) -> tuple[Array, Array]:
+    """Inverse of `state_to_mujoco`."""
+    q, v = _check(model, q, v, "MuJoCo")
+    return q, _mujoco_velocity(model, q, v, to_world=False)

@@ -1,0 +1,195 @@
+"""A single rigid body: free, or turning about a fixed point, under gravity.
+
+Configuration q = (rotation coordinates, x) and velocity u = (Omega, v), angular before linear as
+everywhere in mbjax; Omega is the body-frame angular velocity (R_dot = R (Omega x I)) and v the
+velocity of the centre of mass. A body about a fixed point (a heavy top, or a torque-free body
+turning about its centre of mass) has no translational part.
+
+Rotation coordinates are either unit quaternions (w, x, y, z), q_dot = q * (0, Omega) / 2, or
+rotation vectors r with r_dot = Gamma(r)^-T Omega (Borri 1990 eqs 2.8, A.21: omega = R Omega =
+Gamma r_dot and Gamma^-1 R = Gamma^-T by eq A.24), rescaled to |r| <= pi after each step
+(eq A.29).
+"""
+
+import equinox as eqx
+import jax
+import jax.numpy as jnp
+import numpy as np
+from jax import Array
+
+from mbjax._src import lie
+from mbjax._src.control import AbstractControl, as_control
+from mbjax._src.system.driven import (about_origins, body_wrenches, check_actuation, check_control,
+                                   check_points, generalized_control, hold)
+from mbjax._src.system.invariants import Invariants, along_gravity, energy_invariant, join
+from mbjax._src.system.system import AbstractSystem
+from mbjax._src.spatial import check_inertia
+
+ROTATIONS = ("quaternion", "rotvec")
+
+
+class RigidBody(AbstractSystem):
+    """A rigid body of `mass` and body-frame `inertia` under uniform `gravity`.
+
+    fixed_point=False: a free body; `inertia` is about the centre of mass and q = (rot, x).
+    fixed_point=True: the body turns about a fixed point at the origin; `inertia` is about that
+    point, `com` is the centre of mass in the body frame, and q = rot.
+
+    control: a callable (t, q, u) -> generalized forces on u = (Omega, v): a body-frame torque
+    (and, for a free body, a world-frame force), or on the `actuation` coordinates only; a
+    constant array is a constant control. external: a callable (t, q, u) -> (1, 6), a world-frame
+    wrench (torque; force) at the body's origin (its centre of mass; the fixed point) or at
+    external_point (body frame, from that origin).
+    """
+
+    mass: Array
+    inertia: Array
+    com: Array
+    gravity: Array
+    control: AbstractControl | None
+    external: AbstractControl | None
+    external_point: Array | None
+    actuation: tuple[int, ...] | None = eqx.field(static=True)
+    fixed_point: bool = eqx.field(static=True)
+    rotation: str = eqx.field(static=True)
+
+    def __init__(self, mass, inertia, *, com=(0.0, 0.0, 0.0), gravity=(0.0, 0.0, -9.81),
+                 fixed_point: bool = False, rotation: str = "quaternion", control=None,
+                 external=None, external_point=None, actuation=None):
+        if rotation not in ROTATIONS:
+            raise ValueError(f"rotation must be one of {ROTATIONS}, got {rotation!r}")
+        check_inertia(inertia, "RigidBody")
+        if not isinstance(mass, jax.core.Tracer) and not float(mass) > 0:
+            raise ValueError(f"mass must be positive, got {mass}")
+        if not fixed_point and not isinstance(com, jax.core.Tracer) and np.any(np.asarray(com)):
+            raise ValueError("a free body is described about its centre of mass: com must be 0")
+        self.mass = jnp.asarray(mass, dtype=float)
+        self.inertia = jnp.asarray(inertia, dtype=float)
+        self.com = jnp.asarray(com, dtype=float)
+        self.gravity = jnp.asarray(gravity, dtype=float)
+        self.fixed_point = fixed_point
+        self.rotation = rotation
+        nv = 3 if fixed_point else 6
+        self.actuation = check_actuation(actuation, nv)
+        self.control = check_control(control, self.actuation, nv)
+        self.external = as_control(external)
+        self.external_point = check_points(external_point, 1)
+
+    # -- coordinates ---------------------------------------------------------------------------
+
+    @property
+    def n_rot(self) -> int:
+        return 4 if self.rotation == "quaternion" else 3
+
+    def rotation_matrix(self, q: Array) -> Array:
+        """R, body to space."""
+        rot = q[: self.n_rot]
+        return lie.quat_to_matrix(rot) if self.rotation == "quaternion" else lie.exp(rot)
+
+    def position(self, q: Array) -> Array:
+        """Centre of mass in space."""
+        if self.fixed_point:
+            return self.rotation_matrix(q) @ self.com
+        return q[self.n_rot:]
+
+    def initial_state(self, R0, Omega0, x0=(0.0, 0.0, 0.0), v0=(0.0, 0.0, 0.0)):
+        """(q0, u0) from a rotation matrix, body angular velocity and (free body) COM motion."""
+        R0 = jnp.asarray(R0, dtype=float)
+        rot = lie.quat_from_matrix(R0) if self.rotation == "quaternion" else lie.log(R0)
+        Omega0 = jnp.asarray(Omega0, dtype=float)
+        if self.fixed_point:
+            return rot, Omega0
+        return (jnp.concatenate([rot, jnp.asarray(x0, dtype=float)]),
+                jnp.concatenate([Omega0, jnp.asarray(v0, dtype=float)]))
+
+    # -- AbstractSystem ------------------------------------------------------------------------
+
+    def kinematics(self, q, u):
+        rot, Omega = q[: self.n_rot], u[:3]
+        if self.rotation == "quaternion":
+            rot_dot = 0.5 * lie.quat_multiply(rot, jnp.concatenate([jnp.zeros(1, Omega.dtype), Omega]))
+        else:
+            rot_dot = lie.gamma_inv(rot).T @ Omega
+        return rot_dot if self.fixed_point else jnp.concatenate([rot_dot, u[3:]])
+
+    def acceleration(self, t, q, u):
+        """Euler's equations J Omega_dot = tau - Omega x J Omega, solved by Cholesky; the COM
+        falls freely (free body) or gravity gives tau = com x (m R^T g) (fixed point). The
+        control and the external wrench add to tau (and to the force on the COM)."""
+        Omega = u[:3]
+        R = self.rotation_matrix(q)
+        tau = jnp.cross(self.com, self.mass * (R.T @ self.gravity))
+        force = jnp.zeros(3, u.dtype)
+        f = body_wrenches(self.external, 1, t, q, u)
+        if f is not None:
+            f = about_origins(f, R[None], self.external_point)[0]
+            tau, force = tau + R.T @ f[:3], force + f[3:]
+        applied = generalized_control(self.control, self.actuation, u.shape[0], t, q, u)
+        tau = tau + applied[:3]
+        chol = jax.scipy.linalg.cho_factor(self.inertia)
+        Omega_dot = jax.scipy.linalg.cho_solve(chol, tau - jnp.cross(Omega, self.inertia @ Omega))
+        if self.fixed_point:
+            return Omega_dot
+        return jnp.concatenate([Omega_dot, self.gravity + (force + applied[3:]) / self.mass])
+
+    def retract(self, q0, xi):
+        """R = R0 exp(xi_rot) (body-frame increment), x = x0 + xi_x."""
+        rot0 = q0[: self.n_rot]
+        if self.rotation == "quaternion":
+            rot = lie.quat_multiply(rot0, lie.quat_from_rotvec(xi[:3]))
+        else:
+            rot = lie.rotvec_from_quat(
+                lie.quat_multiply(lie.quat_from_rotvec(rot0), lie.quat_from_rotvec(xi[:3])))
+        return rot if self.fixed_point else jnp.concatenate([rot, q0[self.n_rot:] + xi[3:]])
+
+    def local_rate(self, q0, xi, u):
+        """xi_dot = Gamma(xi)^-T Omega, the body-frame dexp^-1 (Borri 1990 eq 2.8)."""
+        xi_dot = lie.gamma_inv(xi[:3]).T @ u[:3]
+        return xi_dot if self.fixed_point else jnp.concatenate([xi_dot, u[3:]])
+
+    def hold(self, t, q, u):
+        return hold(self, t, q, u)
+
+    def project(self, q):
+        rot = q[: self.n_rot]
+        rot = lie.quat_normalize(rot) if self.rotation == "quaternion" else lie.rescale(rot)
+        return rot if self.fixed_point else jnp.concatenate([rot, q[self.n_rot:]])
+
+    # -- invariants ----------------------------------------------------------------------------
+
+    def kinetic_energy(self, q, u):
+        Omega = u[:3]
+        T = 0.5 * Omega @ self.inertia @ Omega
+        return T if self.fixed_point else T + 0.5 * self.mass * u[3:] @ u[3:]
+
+    def potential_energy(self, q):
+        return -self.mass * self.gravity @ self.position(q)
+
+    def energy(self, q, u):
+        return self.kinetic_energy(q, u) + self.potential_energy(q)
+
+    def angular_momentum(self, q, u):
+        """Spatial angular momentum about the origin (the fixed point, if any)."""
+        h = self.rotation_matrix(q) @ (self.inertia @ u[:3])
+        return h if self.fixed_point else h + self.mass * jnp.cross(q[self.n_rot:], u[3:])
+
+    def invariants(self, t, q, u):
+        """Without control or external load: the energy (against the kinetic energy), the
+        angular momentum about the origin along gravity (all of it without gravity: gravity's
+        moment is normal to it) and, for a free body, the momentum less the weight's impulse,
+        m (v - g t) (against the momenta's magnitudes). None otherwise."""
+        if self.control is not None or self.external is not None:
+            return None
+        spin = self.rotation_matrix(q) @ (self.inertia @ u[:3])
+        orbital = (jnp.zeros(3, u.dtype) if self.fixed_point
+                   else self.mass * jnp.cross(q[self.n_rot:], u[3:]))
+        g = self.gravity
+        H = along_gravity(spin + orbital, g)
+        parts = [energy_invariant(self.energy(q, u), self.kinetic_energy(q, u), False),
+                 Invariants(H, jnp.full(3, jnp.linalg.norm(spin) + jnp.linalg.norm(orbital)),
+                            jnp.ones(3, bool), jnp.zeros(3, bool))]
+        if not self.fixed_point:
+            P = self.mass * (u[3:] - g * t)
+            parts.append(Invariants(P, jnp.full(3, self.mass * jnp.linalg.norm(u[3:])),
+                                    jnp.ones(3, bool), jnp.zeros(3, bool)))
+        return join(*parts)

@@ -1,0 +1,74 @@
+"""Named frames of a tree: their world poses and Jacobians.
+
+A name is looked up among the model's named frames (URDF links merged through fixed joints and
+the fixed joints themselves, MJCF sites: `Model.frame_names`), then its bodies (`Model.names`,
+the URDF links or MJCF bodies) and its joints (`Model.joint_names`, whose frame is the body's).
+"""
+
+from functools import partial
+
+import jax
+import jax.numpy as jnp
+import numpy as np
+from jax import Array
+
+from mbjax._src.model import Model
+from mbjax._src.rigid.kinematics import body_kinematics, forward_kinematics
+
+
+def frame_names(model: Model) -> tuple[str, ...]:
+    """Every name `frame_pose` accepts: named frames, bodies, joints."""
+    return tuple(dict.fromkeys((*model.frame_names, *model.names, *model.joint_names)))
+
+
+def frame_placement(model: Model, name: str) -> tuple[int, Array, Array]:
+    """(body, R, p): the frame's body (-1: the ground) and its pose in that body's frame; a
+    KeyError that lists the model's names when there is no such frame, body or joint."""
+    if name in model.frame_names:
+        i = model.frame_names.index(name)
+        return model.frame_parents[i], model.frame_rotation[i], model.frame_translation[i]
+    for names in (model.names, model.joint_names):
+        if name in names:
+            k = names.index(name)
+            return k, jnp.eye(3, dtype=model.mass.dtype), jnp.zeros(3, model.mass.dtype)
+    known = frame_names(model)
+    raise KeyError(f"no frame, body or joint named {name!r}; the model has {len(known)}: "
+                   f"{', '.join(known[:12])}{', ...' if len(known) > 12 else ''}")
+
+
+@partial(jax.jit, static_argnames="name")
+def frame_pose(model: Model, q: Array, name: str) -> tuple[Array, Array]:
+    """World orientation (3, 3) and origin (3,) of the frame, body or joint called `name`."""
+    body, R_f, p_f = frame_placement(model, name)
+    if body < 0:
+        return R_f, p_f
+    R, p = forward_kinematics(model, q)
+    return R[body] @ R_f, p[body] + R[body] @ p_f
+
+
+@partial(jax.jit, static_argnames="name")
+def frame_jacobian(model: Model, q: Array, name: str) -> Array:
+    """J (6, nv) with (omega; v) = J v: the frame's angular velocity and the velocity of its
+    origin, world components (Pinocchio's LOCAL_WORLD_ALIGNED, in (angular; linear) order)."""
+    body, R_f, p_f = frame_placement(model, name)
+    if body < 0:
+        return jnp.zeros((6, model.nv), q.dtype)
+    kin = body_kinematics(model, q, jnp.zeros(model.nv, q.dtype))
+    x = kin.p[body] + kin.R[body] @ p_f                   # the frame origin, world
+    S = model.flat_v(jnp.swapaxes(kin.S, -1, -2))          # (nv, 6) at the ground origin
+    w, v0 = S[:, :3], S[:, 3:]
+    support = np.isin(model.dof_body(), (*model.topology.ancestors(body), body))
+    columns = jnp.concatenate([w, v0 + jnp.cross(w, x)], -1)
+    return jnp.where(support[:, None], columns, 0.0).T
+
+
+@jax.jit
+def frame_poses(model: Model, q: Array) -> tuple[Array, Array]:
+    """World orientations (m, 3, 3) and origins (m, 3) of all the named frames
+    (`Model.frame_names`) at once."""
+    R, p = forward_kinematics(model, q)
+    parents = np.asarray(model.frame_parents, dtype=int)
+    on_ground = jnp.asarray(parents < 0)[:, None]
+    R_b = jnp.where(on_ground[..., None], jnp.eye(3, dtype=q.dtype), R[np.maximum(parents, 0)])
+    p_b = jnp.where(on_ground, 0.0, p[np.maximum(parents, 0)])
+    return R_b @ model.frame_rotation, p_b + jnp.einsum("mij,mj->mi", R_b, model.frame_translation)

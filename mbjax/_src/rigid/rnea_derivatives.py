@@ -1,0 +1,88 @@
+"""The RNEA's directional derivative in (q, v), written out: two vector passes, no derivative of
+a rotation matrix.
+
+For trees of revolute, prismatic, spherical and free joints, in ground coordinates at the ground
+origin (see `kinematics`): moving joint j along one column S_c of its motion subspace moves its
+outward set, body j included, rigidly about the screw S_c, so every ground-frame quantity X that
+rides on a body of that set changes by S_c x X (motion vectors: S_c x m, forces: S_c x* f,
+inertias: S_c x* I - I S_c x). This needs the columns fixed in body j (a universal joint's first
+axis is fixed in its parent instead: not covered). Differentiating the RNEA
+(`rnea.rnea_passes`: V_k, A_k, f_k = I_k A_k + V_k x* I_k V_k, F_k the sum of the f of k's
+outward set, tau_k = S_k^T F_k) with that rule and collecting the sums over outward sets (the
+analysis of Carpentier and Mansard, RSS 2018, "Analytical derivatives of rigid body dynamics
+algorithms", here for one direction at a time) gives, with e_j the joint's increments along
+its columns (dq itself for a revolute or prismatic joint), U_j = V and B_j = A of j's parent
+(the ground's: 0 and -g) and h_k = I_k V_k,
+
+    s_j = S_j e_j,  w_j = S_j dv_j                                 (the joint's twists)
+    g2_j = (s_j x U_j) x U_j - s_j x B_j - w_j x U_j - w_j x V_j,   g3_j = s_j x U_j - w_j
+    (P2, P3) = the outward sums of (g2, g3)                         (one outward pass)
+    o_k = s_k x* F_k
+    L_k = I_k P2_k - P3_k x* h_k - I_k (P3_k x V_k) - V_k x* I_k P3_k + o_k
+    dtau_k = S_k^T (the sum of L over k's outward set - o_k) + damping_k dv_k   (one inward pass)
+
+The formulas are linear in the columns of S, so each joint enters through its two twists s and
+w. It is linear in (dq, dv), so reverse mode transposes it into the same two passes run the
+other way: the adjoint's RNEA VJP at the solved accelerations (`mbjax._src.rigid.adjoint`) without
+differentiating the kinematics. Agrees with `jax.jvp` of `inverse_dynamics` to rounding
+(tests/rigid/test_adjoint.py).
+"""
+
+import jax.numpy as jnp
+import numpy as np
+from jax import Array
+
+from mbjax._src.model import Model
+from mbjax._src.rigid.kinematics import columns, fixed_in_body, gravity_acceleration, joint_increments
+from mbjax._src.rigid.rnea import rnea_passes
+from mbjax._src.spatial import cross_force, cross_motion
+from mbjax._src.tree import backward_pass, forward_pass
+from mbjax._src.tree.take import take
+
+def applies(model: Model) -> bool:
+    """Whether every joint of the tree is revolute, prismatic, spherical or free."""
+    return fixed_in_body(model)
+
+
+def rnea_jvp(model: Model, q: Array, v: Array, a: Array, dq: Array, dv: Array) -> Array:
+    """d tau = d/de RNEA(model, q + e dq, v + e dv, a) at e = 0 (armature and damping included),
+    for a tree of the joints `applies` accepts. dq is a tangent of the coordinates q (a
+    quaternion's included, as the RNEA reads it, normalized)."""
+    F, kin, A = rnea_passes(model, q, v, a, None)
+    S, V, I = kin.S, kin.V, kin.I                     # noqa: E741 (the papers' name)
+    h = _times(I, V)
+    ground = gravity_acceleration(model)
+    U = _parent(model, V, jnp.zeros_like(ground))
+    B = _parent(model, A, ground)
+    # the joints' twists along (dq, dv): s = S e, w = S dv (the formulas are linear in S's columns)
+    s, w = columns(S, joint_increments(model, q, v, dq)), columns(S, model.body_v(dv))
+    sU = cross_motion(s, U)
+    g = jnp.concatenate([cross_motion(sU, U) - cross_motion(s, B) - cross_motion(w, U)
+                         - cross_motion(w, V), sU - w], -1)
+    P = _outward_sum(model, g, jnp.zeros(12, q.dtype))
+    P2, P3 = P[:, :6], P[:, 6:]
+    own = cross_force(s, F)
+    L = (_times(I, P2) - cross_force(P3, h) - _times(I, cross_motion(P3, V))
+         - cross_force(V, _times(I, P3)) + own)
+    dtau = jnp.einsum("kic,ki->kc", S, _inward_sum(model, L) - own)
+    return model.flat_v(dtau) + model.damping * dv
+
+
+def _times(I: Array, x: Array) -> Array:       # noqa: E741
+    return jnp.einsum("kij,kj->ki", I, x)
+
+
+def _outward_sum(model: Model, x: Array, ground: Array) -> Array:
+    """ground plus the sum of x over each body's path from the ground (an outward pass)."""
+    return forward_pass(model.topology, lambda parent, own: parent + own, ground, x)
+
+
+def _inward_sum(model: Model, x: Array) -> Array:
+    """The sum of x over each body's outward set (an inward pass)."""
+    return backward_pass(model.topology, lambda received, _: (received, received), x)[0]
+
+
+def _parent(model: Model, x: Array, ground: Array) -> Array:
+    """Each body's parent's row of x (n, ...), `ground` for a base body."""
+    parents = np.asarray(model.topology.parents)
+    return take(jnp.concatenate([x, ground[None]]), np.where(parents < 0, model.n, parents))

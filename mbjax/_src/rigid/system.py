@@ -1,0 +1,203 @@
+"""Trees as systems for `mbjax.simulate`, every integrator and `mbjax.loops.ClosedSystem`.
+
+`TreeSystem` integrates (q, v) with the velocity form (Anderson 1993's recursion or Jerkovsky 1978 eq 74);
+`MomentumSystem` integrates (q, p) with Jerkovsky 1978's momentum form (eqs 72-73); `BatchTreeSystem`
+B copies at once in the throughput layout.
+
+Systems are equinox modules (their model and controls are array leaves), so compile their bound
+methods with `eqx.filter_jit(system.energy)`, or pass the system as an argument:
+`jax.jit(TreeSystem.energy)(system, q, u)`. (`jax.jit(system.energy)` fails: a bound method
+holding arrays is not hashable.)
+"""
+
+from typing import ClassVar
+
+import equinox as eqx
+import jax.numpy as jnp
+from jax import Array
+
+from mbjax._src.control import AbstractControl, as_control
+from mbjax._src.system.driven import (
+    about_origins,
+    body_wrenches,
+    check_actuation,
+    check_control,
+    check_points,
+    generalized_control,
+    hold,
+)
+from mbjax._src.system.invariants import join
+from mbjax._src.system.system import AbstractSystem
+from mbjax._src.system.tree_system import AbstractTreeSystem
+from mbjax._src.system.status import Status
+from mbjax._src.model import Model
+from mbjax._src.model.limits import exceeded
+from mbjax._src.rigid.aba import aba_responses
+from mbjax._src.rigid.batched import batch_aba
+from mbjax._src.rigid.dense import dense_responses
+from mbjax._src.rigid.dynamics import METHODS, choose_method, forward_dynamics, mass_matrix
+from mbjax._src.rigid.energy import energy, floating, free_momenta, kinetic_energy
+from mbjax._src.rigid.kinematics import forward_kinematics
+from mbjax._src.rigid.momentum import momentum_rate, velocity_from_momentum
+from mbjax._src.rigid.rnea import inverse_dynamics
+
+
+def _model(model) -> Model:
+    if not isinstance(model, Model):
+        raise TypeError(f"model must be a mbjax.Model, got {type(model).__name__}"
+                        + ("; a flexible tree goes in mbjax.flex.FlexibleSystem"
+                           if type(model).__name__ == "FlexibleModel" else ""))
+    return model
+
+
+class TreeSystem(AbstractTreeSystem):
+    """A rigid tree: u = v, v_dot = forward dynamics under gravity, the control and the external
+    wrenches, by Anderson 1993's O(n) recursion or Jerkovsky 1978 eq 74 (`method`, as in
+    `mbjax.forward_dynamics`).
+
+    control: a callable (t, q, v) -> forces on the actuated coordinates (a `mbjax.control`
+        module, any function, or a constant array: a constant tau); actuation: the indices of
+        the velocity coordinates it drives (all by default);
+    external: a callable (t, q, v) -> (n, 6) world-frame wrenches (torque; force) on the bodies,
+        at their origins or at external_point (n, 3), body-frame points."""
+
+    model: Model
+    control: AbstractControl | None
+    external: AbstractControl | None
+    external_point: Array | None
+    actuation: tuple[int, ...] | None = eqx.field(static=True)
+    method: str = eqx.field(static=True)
+    symmetric_dynamics: ClassVar[bool] = True
+
+    def __init__(self, model: Model, control=None, *, external=None, external_point=None,
+                 actuation=None, method: str = "auto"):
+        if method not in METHODS:
+            raise ValueError(f"method must be one of {METHODS}, got {method!r}")
+        self.model = _model(model)
+        self.actuation = check_actuation(actuation, model.nv)
+        self.control = check_control(control, self.actuation, model.nv)
+        self.external = as_control(external)
+        self.external_point = check_points(external_point, model.n)
+        self.method = method
+
+    def frames(self, q):
+        return forward_kinematics(self.model, q)
+
+    def check(self, t, q, u):
+        """`Status.LIMIT_EXCEEDED` where the state or the control is beyond the model's joint
+        limits (`mbjax._src.model.limits`); limits are data here, not contact forces."""
+        over = exceeded(self.model, q, u, self.applied(t, q, u))
+        return jnp.where(over, int(Status.LIMIT_EXCEEDED), 0).astype(jnp.int32)
+
+    def energy(self, q, v):
+        return energy(self.model, q, v)
+
+    def kinetic_energy(self, q, v):
+        return kinetic_energy(self.model, q, v)
+
+    def dissipative(self):
+        return jnp.any(self.model.damping != 0)
+
+    def invariants(self, t, q, u):
+        """The energy of a passive tree, and, where every base body hangs from a free joint,
+        the momenta of `free_momenta`."""
+        energy_part = super().invariants(t, q, u)
+        if energy_part is None or not floating(self.model):
+            return energy_part
+        return join(energy_part, free_momenta(self.model, t, q, u))
+
+    def mass_matrix(self, q):
+        return mass_matrix(self.model, q)
+
+    def responses(self, t, q, v, loads):
+        tau, f = self.applied(t, q, v), self.wrenches(t, q, v)
+        method = choose_method(self.model) if self.method == "auto" else self.method
+        route = aba_responses if method == "recursive" else dense_responses
+        return route(self.model, q, v, tau, loads, f)
+
+    def acceleration(self, t, q, u):
+        """`forward_dynamics` under the control and the external wrenches (its derivatives by the
+        adjoint rule of `mbjax._src.rigid.adjoint`)."""
+        return forward_dynamics(self.model, q, u, self.applied(t, q, u), self.method,
+                                self.wrenches(t, q, u))
+
+    def bias(self, t, q, v):
+        """The RNEA at zero acceleration (velocity terms, gravity, external wrenches) less the
+        control: M v_dot + bias = 0."""
+        return (inverse_dynamics(self.model, q, v, jnp.zeros_like(v), self.wrenches(t, q, v))
+                - self.applied(t, q, v))
+
+
+class BatchTreeSystem(AbstractSystem):
+    """B copies of a tree of revolute and prismatic joints in one system, batch last: q and u are
+    (nv, B) and u_dot = `batch_aba(model, q, u, tau)`. `simulate` integrates all of them in one
+    scan, with the throughput layout of `mbjax._src.rigid.batched` (the same trajectories as
+    `jax.vmap` of a `TreeSystem` simulation). tau is (nv,) for every copy or (nv, B)."""
+
+    model: Model
+    tau: Array
+
+    def __init__(self, model: Model, tau=None):
+        self.model = model
+        self.tau = jnp.zeros(model.nv) if tau is None else jnp.asarray(tau)
+
+    def kinematics(self, q, u):
+        return u
+
+    def acceleration(self, t, q, u):
+        return batch_aba(self.model, q, u, self.tau)
+
+
+class MomentumSystem(AbstractSystem):
+    """u = p = M(q) v, the free momenta (Jerkovsky 1978 eq 73); u_dot from eq 72. Controls and
+    external wrenches as for `TreeSystem`."""
+
+    model: Model
+    control: AbstractControl | None
+    external: AbstractControl | None
+    external_point: Array | None
+    actuation: tuple[int, ...] | None = eqx.field(static=True)
+
+    def __init__(self, model: Model, control=None, *, external=None, external_point=None,
+                 actuation=None):
+        self.model = _model(model)
+        self.actuation = check_actuation(actuation, model.nv)
+        self.control = check_control(control, self.actuation, model.nv)
+        self.external = as_control(external)
+        self.external_point = check_points(external_point, model.n)
+
+    def velocity(self, q, p):
+        return velocity_from_momentum(self.model, q, p)
+
+    def kinematics(self, q, u):
+        return self.model.q_dot(q, self.velocity(q, u))
+
+    def acceleration(self, t, q, u):
+        v = self.velocity(q, u)
+        f = body_wrenches(self.external, self.model.n, t, q, v)
+        if f is not None and self.external_point is not None:
+            f = about_origins(f, forward_kinematics(self.model, q)[0], self.external_point)
+        tau = generalized_control(self.control, self.actuation, self.model.nv, t, q, v)
+        return momentum_rate(self.model, q, v, tau, f)
+
+    def retract(self, q0, xi):
+        return self.model.retract(q0, xi)
+
+    def local_rate(self, q0, xi, u):
+        return self.model.local_rate(q0, xi, self.velocity(self.model.retract(q0, xi), u))
+
+    def project(self, q):
+        return self.model.normalize(q)
+
+    def hold(self, t, q, u):
+        return hold(self, t, q, self.velocity(q, u))
+
+    def energy(self, q, u):
+        return energy(self.model, q, self.velocity(q, u))
+
+    def invariants(self, t, q, u):
+        """As `TreeSystem`'s, at the velocities of the momenta (none under a control or an
+        external load)."""
+        if self.control is not None or self.external is not None:
+            return None
+        return TreeSystem(self.model).invariants(t, q, self.velocity(q, u))

@@ -1,0 +1,116 @@
+"""XLA's and JAX's CPU runtime settings for mbjax's programs, applied when mbjax is imported.
+
+mbjax's kernels are loops of small operations: a tree pass is a `lax.scan` over bodies whose step
+is a few dozen 6-vector and 6x6 operations, and a rollout is a scan of those. XLA's CPU runtime
+launches each fused operation of a loop body as a kernel of its own (a thunk), about 20 ns each;
+at a few dozen per body, the launches are the cost, not the arithmetic.
+
+The first setting lets XLA compile a whole loop as one kernel. Its CPU compiler has a pass that
+does exactly this (`SmallWhileLoopHoistingPass`: the loop becomes one function of straight-line
+code, emitted by the classic IR emitter), for loops whose operations it can emit that way (no
+scatter, sort or library call) and whose cost analysis reads fewer bytes than a threshold, 1 kB
+by default, which no tree pass meets. mbjax raises it
+(``--xla_backend_extra_options=xla_cpu_small_while_loop_byte_threshold=1000000000``). Measured
+with `mbjax bench speed` (benchmarks/README.md, float64, 2-core x86_64 CPU), forward dynamics
+inside a jitted 1000-step rollout: the 7-link chain 7.1 -> 1.2 us per evaluation, the 30-link
+chain 37.7 -> 5.4 us, the Panda 14.2 -> 2.1 us, the G1 humanoid 32.6 -> 11.1 us (Pinocchio's
+`aba`: 2.7, 8.7, 3.3, 8.2 us); compile times fall too (0.57 -> 0.31 s). Results agree to a few
+ulps in the tests' rollout (to the bit with XLA's default emitters; see the third setting). For
+loops to qualify, mbjax's tree passes and their derivatives hold no scatter (`mbjax._src.tree.take`).
+
+The second is the scheduler (``--xla_cpu_enable_concurrency_optimized_scheduler=false``): XLA's
+CPU runtime schedules the kernels of a program for concurrency by default, which pays off for
+large independent operations and costs a thread hand-off per small one. With it off, the 7-link
+chain's forward dynamics inside a jitted rollout 11.5 -> 7.1 us per evaluation (before the first
+setting), one jitted call 60 -> 28 us; batched throughput unchanged. It changes the order kernels
+run in, not what they compute.
+
+The third is how XLA emits the fusions outside such loops (``--xla_cpu_use_fusion_emitters=false``:
+the classic elemental emitter instead of the MLIR fusion emitters). It changes compile times, not
+run times: a program of one eager operation 20 -> 13 ms, the Carpal Wrist's forward dynamics
+0.73 -> 0.44 s, `mbjax tour --quick` from a cold cache 90 -> 67 s, against the same evaluation
+and `vmap` times within noise (7-link chain, `mbjax bench speed --quick`; 1.25 us per state at
+B = 4096 either way). The two emitters round a few operations differently (a few ulps after a
+200-step rollout). A program of a few operations is mostly compile time, and programs outside
+`jit` (arrays handled op by op) are compiled one per operation and shape. The design notes'
+jaxlib 0.10 measurement found the same flag necessary for MJX's deep gather graphs.
+
+The fourth is JAX's: its CPU client runs a program on a worker thread and hands the result back
+(`jax_cpu_enable_async_dispatch`), so that Python can go on while a large program runs. For
+mbjax's calls, whose programs run for microseconds, the hand-off is the cost: one jitted
+forward-dynamics call of the 7-link chain, median of 2000, 62 -> 15.5 us with the model closed
+over and 94 -> 24 us with the model an argument (min 18 -> 15 and 27 -> 23: the hand-off is what
+varies). With dispatch synchronous the call returns when its result is ready; nothing else changes.
+
+All are read once, when JAX first starts a backend. So `import mbjax` sets them only if no
+backend has started yet, each only if the user has not set it (XLA_FLAGS naming the flag or
+option; JAX_CPU_ENABLE_ASYNC_DISPATCH), and the XLA flags only on a jaxlib known to have them (an
+unknown flag aborts the process). MBJAX_XLA_DEFAULTS=0 leaves all alone. `applied()` and
+`synchronous()` say whether the running process has them.
+"""
+
+import os
+
+HOIST_BYTES = 1_000_000_000
+FLAGS = (f"--xla_backend_extra_options=xla_cpu_small_while_loop_byte_threshold={HOIST_BYTES}",
+         "--xla_cpu_enable_concurrency_optimized_scheduler=false",
+         "--xla_cpu_use_fusion_emitters=false")
+# what names each flag in XLA_FLAGS (the user's own setting of it wins); the extra options are
+# one flag, so a user's own --xla_backend_extra_options keeps the threshold at XLA's default
+NAMES = ("--xla_backend_extra_options", "--xla_cpu_enable_concurrency_optimized_scheduler",
+         "--xla_cpu_use_fusion_emitters")
+FLAG = " ".join(FLAGS)
+# jaxlib releases whose XLA has the flags (checked on each; an unknown XLA flag is fatal)
+TESTED = ((0, 10),)
+
+
+def _jaxlib_version() -> tuple[int, int]:
+    import jaxlib
+
+    major, minor = jaxlib.__version__.split(".")[:2]
+    return int(major), int(minor)
+
+
+def configure_xla() -> bool:
+    """Add FLAGS to XLA_FLAGS and make CPU dispatch synchronous, where the user has not chosen and
+    it can still take effect (see the module); True if any flag was added."""
+    if os.environ.get("MBJAX_XLA_DEFAULTS", "") in ("0", "false", "no"):
+        return False
+    import jax
+    from jax._src import xla_bridge
+
+    if xla_bridge.backends_are_initialized():
+        return False
+    if "JAX_CPU_ENABLE_ASYNC_DISPATCH" not in os.environ:
+        jax.config.update("jax_cpu_enable_async_dispatch", False)
+    flags = os.environ.get("XLA_FLAGS", "")
+    if _jaxlib_version() not in TESTED:
+        return False
+    added = [flag for flag, name in zip(FLAGS, NAMES, strict=True) if name not in flags]
+    if added:
+        os.environ["XLA_FLAGS"] = " ".join([flags, *added]).strip()
+    return bool(added)
+
+
+def applied() -> bool:
+    """Whether this process's XLA runs with all of FLAGS (XLA_FLAGS names them)."""
+    flags = os.environ.get("XLA_FLAGS", "")
+    return all(flag in flags for flag in FLAGS)
+
+
+def hoisting() -> bool:
+    """Whether this process's XLA compiles small loops as one kernel with mbjax's threshold."""
+    return FLAGS[0] in os.environ.get("XLA_FLAGS", "")
+
+
+def synchronous() -> bool:
+    """Whether JAX's CPU client runs programs on the calling thread (async dispatch off)."""
+    import jax
+
+    return not jax.config.read("jax_cpu_enable_async_dispatch")
+
+
+configure_xla()
+
+# Read once, here, so that algorithm choices made while tracing do not read the environment.
+HOISTING = hoisting()

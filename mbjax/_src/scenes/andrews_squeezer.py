@@ -1,0 +1,212 @@
+"""Andrews' squeezing mechanism: seven planar bodies, three closed loops, a spring and a motor.
+
+The problem `andrews` of the IVP test set (F. Mazzia, C. Magherini et al., "Test Set for IVP
+Solvers", University of Bari, https://archimede.uniba.it/~testset/, problem "andrews"; from
+E. Hairer and G. Wanner, Solving Ordinary Differential Equations II, 2nd ed., §VII.7, eqs 7.3-7.11
+and Fig. 7.1-7.2, after Giles 1978 and Manning 1981; also benchmark A03 of the IFToMM library of
+computational benchmark problems), built from mbjax bodies, joints and cut joints rather than from
+the test set's hand-written mass matrix.
+
+Constants, initial values and the reference solution at t = 0.03 s are the test set's; they were
+read, and checked digit by digit against each other, in
+
+- the test set's Fortran driver and problem routines (`SUBROUTINE F`, `INITIAL`, `SOLN`: the
+  MEBDFI driver of the index-3 Andrews problem, and its MATLAB port `ANDREW`),
+- the R package deTestSet (K. Soetaert, J. Cash, F. Mazzia), `pkg/deTestSet/R/ex_andrews.R`
+  in rforge/bvpsolve (the parameter vector and `yini`),
+- pySDC's `pySDC/projects/DAE/problems/andrewsSqueezingMechanism.py` (lisawim/pySDC: the
+  parameters, `qend_ref_testset`, and the position constraints g(q)).
+
+The reference (test set `SOLN`) was computed by CWI with PSIDE at rtol = atol = 1e-14 on a Cray
+C90; the test set prints it to 16 significant digits.
+
+Geometry, from the test set's position constraints g(q) (ground frame x, y; R(a) the rotation by
+a): the crank (beta) turns about the origin O; the rod (Theta, relative to the crank) is hinged on
+it at R(beta)(rr, 0); the rod's far end is the point
+
+    P = R(beta)(rr, 0) + R(beta + Theta)(-d, 0),
+
+where the three loops close (the test set's E):
+
+    g1,2:  P = B + R(gamma)(0, -ss)                                      body gamma turns about B
+    g3,4:  P = A + R(delta)(zt, 0) + R(Phi + delta)(0, -e)               Phi relative to delta
+    g5,6:  P = A + R(epsilon)(0, -u) + R(Omega + epsilon)(zf, 0)         Omega relative to epsilon
+
+so Theta, Phi and Omega are relative angles (of the rod to the crank, of body Phi to body delta,
+of body Omega to body epsilon), and beta, gamma, delta, epsilon absolute ones.
+
+The tree (`Model`): every joint a revolute joint about z, its angle one of the test set's. mbjax
+numbers a body after its parent (Anderson 1993 §2.1 rule (i)), and Phi's body hangs from delta's,
+Omega's from epsilon's, so the tree's order is (beta, Theta, gamma, delta, Phi, epsilon, Omega):
+
+    body 0  beta     ground, at O                 m1, centre (ra, 0),         i1
+    body 1  Theta    body 0, at (rr, 0)           m2, centre (-da, 0),        i2
+    body 2  gamma    ground, at B = (xb, yb)      m3, centre (sa, sb),        i3
+    body 3  delta    ground, at A = (xa, ya)      m5, centre (ta, tb),        i5
+    body 4  Phi      body 3, at (zt, 0)           m4, centre (0, -(e - ea)),  i4
+    body 5  epsilon  ground, at A                 m7, centre (ua, ub),        i7
+    body 6  Omega    body 5, at (0, -u)           m6, centre (zf - fa, 0),    i6
+
+q_tree = y[TREE_ORDER] with y the test set's (beta, Theta, gamma, Phi, delta, Omega, epsilon);
+`to_testset` / `from_testset` convert (the permutation swaps two pairs and is its own inverse).
+Same angles and signs, so the tree's mass matrix is the test set's m(i, j) permuted (the tests
+check it). Only the distance of a centre of mass from a fixed pivot enters the equations for the
+bodies turning about O, B and A, so the directions chosen for (ra, 0), (sa, sb), (ta, tb),
+(ua, ub) are immaterial; the rod's, Phi's and Omega's centres lie on the lines to P as the test
+set's coupling terms require. The test set gives the moments of inertia about the plane's normal
+only; the 3x3 inertias here are those of thin plates, diag(i/2, i/2, i), which never enter a
+planar motion.
+
+The cuts: the rod's point P = (-d, 0) coincides with (0, -ss) on body gamma, with (0, -e) on body
+Phi and with (zf, 0) on body Omega; each is a `point_on_line` cut joint with the line along z,
+normal to the plane: two equations per loop, six in all as in the test set, full rank 6 (no
+redundancy). The residuals are g(q) of the test set rotated into the second body's frame (same
+zero set, same norm per loop).
+
+Loads: the driving torque mom on the crank's joint (`tau`), and the spring of stiffness c0 and
+rest length l0 from D = B + R(gamma)(sd, -sc) on body gamma to the fixed point C = (xc, yc)
+(`PointSpring`, the generalized force J^T F). No gravity. At t = 0 the mechanism is at rest.
+"""
+
+from typing import NamedTuple
+
+import equinox as eqx
+import jax
+import jax.numpy as jnp
+import numpy as np
+from jax import Array
+
+from mbjax._src.control import AbstractControl, Constant
+from mbjax._src.loops import ClosedSystem, CutJoint
+from mbjax._src.model import Model
+from mbjax._src.rigid import TreeSystem
+from mbjax._src.rigid.kinematics import forward_kinematics
+
+# masses [kg] and moments of inertia about the centres of mass [kg m^2] (test set F)
+m1, m2, m3, m4, m5, m6, m7 = 0.04325, 0.00365, 0.02373, 0.00706, 0.07050, 0.00706, 0.05498
+i1, i2, i3, i4, i5, i6, i7 = 2.194e-6, 4.410e-7, 5.255e-6, 5.667e-7, 1.169e-5, 5.667e-7, 1.912e-5
+# fixed points A, B, C [m]
+xa, ya = -0.06934, -0.00227
+xb, yb = -0.03635, 0.03273
+xc, yc = 0.014, 0.072
+# lengths [m]
+d, da, e, ea = 28e-3, 115e-4, 2e-2, 1421e-5
+rr, ra = 7e-3, 92e-5
+ss, sa, sb, sc, sd = 35e-3, 1874e-5, 1043e-5, 18e-3, 2e-2
+ta, tb = 2308e-5, 916e-5
+u, ua, ub = 4e-2, 1228e-5, 449e-5
+zf, zt = 2e-2, 4e-2
+fa = 1421e-5
+# driving torque [N m], spring stiffness [N/m] and rest length [m]
+mom = 33e-3
+c0, l0 = 4530.0, 7785e-5
+
+T1 = 0.03
+ANGLES = ("beta", "Theta", "gamma", "Phi", "delta", "Omega", "epsilon")
+TREE_ORDER = (0, 1, 2, 4, 3, 6, 5)      # q_tree = y[TREE_ORDER] and y = q_tree[TREE_ORDER]
+
+# test set INITIAL: y(1..7); all velocities are zero
+Y0 = (-0.0617138900142764496358948458001, 0.0, 0.455279819163070380255912382449,
+      0.222668390165885884674473185609, 0.487364979543842550225598953530,
+      -0.222668390165885884674473185609, 1.23054744454982119249735015568)
+# test set SOLN: y(1..7) at t = 0.03 s (PSIDE, rtol = atol = 1e-14)
+REFERENCE = (0.1581077119629904e2, -0.1575637105984298e2, 0.4082224013073101e-1,
+             -0.5347301163226948e0, 0.5244099658805304e0, 0.5347301163226948e0,
+             0.1048080741042263e1)
+
+
+def to_testset(q: Array) -> Array:
+    """Tree coordinates (..., 7) to the test set's order (beta, Theta, gamma, Phi, delta, Omega,
+    epsilon)."""
+    return q[..., jnp.array(TREE_ORDER)]
+
+
+def from_testset(y) -> Array:
+    """The test set's y(1..7) (..., 7) to tree coordinates."""
+    return jnp.asarray(y, dtype=float)[..., jnp.array(TREE_ORDER)]
+
+
+class PointSpring(AbstractControl):
+    """A linear spring from `point` (body `body`'s frame) to the fixed `anchor` (ground frame),
+    stiffness `stiffness` and rest length `rest_length`: energy V = stiffness (L - rest_length)^2
+    / 2 with L the length; force on the point F = -stiffness (L - rest_length) (x - anchor) / L,
+    generalized force J^T F with J = dx/dv (Hairer & Wanner II §VII.7, the test set's
+    fx, fy and ff(3); here for any tree, by a reverse-mode pass through the kinematics).
+    Call as force(t, q, v) -> (nv,), a control of the tree. All parameters are leaves:
+    differentiable and sweepable."""
+
+    model: Model
+    body: int = eqx.field(static=True)
+    point: Array
+    anchor: Array
+    stiffness: Array
+    rest_length: Array
+
+    def __init__(self, model: Model, body: int, point, anchor, stiffness, rest_length):
+        if not 0 <= body < model.n:
+            raise ValueError(f"body {body} is not in the model (0 ... {model.n - 1})")
+        self.model, self.body = model, int(body)
+        self.point = jnp.asarray(point, float)
+        self.anchor = jnp.asarray(anchor, float)
+        self.stiffness = jnp.asarray(stiffness, float)
+        self.rest_length = jnp.asarray(rest_length, float)
+
+    def position(self, q: Array) -> Array:
+        """The spring's end on the body, ground frame."""
+        R, p = forward_kinematics(self.model, q)
+        return p[self.body] + R[self.body] @ self.point
+
+    def energy(self, q: Array) -> Array:
+        length = jnp.linalg.norm(self.position(q) - self.anchor)
+        return 0.5 * self.stiffness * (length - self.rest_length) ** 2
+
+    def __call__(self, t, q: Array, v: Array) -> Array:
+        delta = self.position(q) - self.anchor
+        length = jnp.linalg.norm(delta)
+        F = -self.stiffness * (length - self.rest_length) / length * delta
+        # J v = d/dt position along q_dot = q_dot(q, v); J^T F by one reverse pass of that map
+        def velocity(w):
+            return jax.jvp(self.position, (q,), (self.model.q_dot(q, w),))[1]
+
+        return jax.vjp(velocity, jnp.zeros_like(v))[1](F)[0]
+
+
+class Squeezer(NamedTuple):
+    """What `build` returns: the tree (driven by the motor torque `tau` plus the `spring`), its
+    cut joints, and the initial state (tree order). `system(method, **kw)` closes the tree:
+    `ClosedSystem(tree, closures, method, **kw)`."""
+
+    tree: TreeSystem
+    closures: tuple
+    spring: PointSpring
+    tau: Array
+    q0: Array
+    v0: Array
+
+    def system(self, method=None, **kwargs) -> ClosedSystem:
+        return ClosedSystem(self.tree, self.closures, method, **kwargs)
+
+
+def build() -> Squeezer:
+    """Andrews' squeezer as a `Squeezer` (tree, closures, spring, tau, q0, v0); see the module
+    docstring."""
+    parents = (-1, 0, -1, -1, 3, -1, 5)
+    mass = (m1, m2, m3, m5, m4, m7, m6)
+    moments = np.array([i1, i2, i3, i5, i4, i7, i6])
+    inertia = moments[:, None, None] * np.diag([0.5, 0.5, 1.0])    # thin plates in the x-y plane
+    com = [(ra, 0, 0), (-da, 0, 0), (sa, sb, 0), (ta, tb, 0), (0, -(e - ea), 0), (ua, ub, 0),
+           (zf - fa, 0, 0)]
+    placement = [(0, 0, 0), (rr, 0, 0), (xb, yb, 0), (xa, ya, 0), (zt, 0, 0), (xa, ya, 0),
+                 (0, -u, 0)]
+    model = Model(parents, "revolute", mass=mass, inertia=inertia, com=com, axis=(0.0, 0.0, 1.0),
+                  placement_translation=placement, gravity=(0.0, 0.0, 0.0),
+                  names=("crank_beta", "rod_Theta", "gamma", "delta", "Phi", "epsilon", "Omega"))
+    P = (-d, 0.0, 0.0)                     # the rod's far end, where the three loops close
+    cuts = [CutJoint("point_on_line", 1, 2, origin_a=P, origin_b=(0.0, -ss, 0.0)),
+            CutJoint("point_on_line", 1, 4, origin_a=P, origin_b=(0.0, -e, 0.0)),
+            CutJoint("point_on_line", 1, 6, origin_a=P, origin_b=(zf, 0.0, 0.0))]
+    spring = PointSpring(model, 2, point=(sd, -sc, 0.0), anchor=(xc, yc, 0.0), stiffness=c0,
+                         rest_length=l0)
+    tau = jnp.zeros(7).at[0].set(mom)
+    tree = TreeSystem(model, Constant(tau) + spring)
+    return Squeezer(tree, tuple(cuts), spring, tau, from_testset(Y0), jnp.zeros(7))

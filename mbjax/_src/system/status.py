@@ -1,0 +1,67 @@
+"""The status every run reports: `Status` flags, results that carry them, and the error a
+failed run raises when asked to (throw=True)."""
+
+import enum
+
+import equinox as eqx
+import jax.numpy as jnp
+import numpy as np
+from jax import Array
+
+
+class Status(enum.IntFlag):
+    """Flags OR-ed into `Solution.status`; 0 means success without remarks."""
+
+    SUCCESS = 0
+    NONFINITE = 1          # a state became inf or NaN (the step is beyond the method's stability)
+    NOT_CONVERGED = 2      # an implicit step's Newton iteration missed its tolerance
+    SOLVER_FAILED = 4      # the adaptive reference solver stopped (step-size underflow, max_steps)
+    CONSTRAINT_VIOLATED = 8  # a closed loop's residual |Phi| grew past the system's tolerance
+    REDUNDANT = 16         # a note, not a failure: the constraint Jacobian lost rank (redundant
+                           # closures or a singular configuration); least-squares loads were used
+    LIMIT_EXCEEDED = 32    # a note: a saved state or control is beyond the model's joint limits
+                           # (position, velocity or effort; `mbjax._src.model.limits`)
+    INACCURATE = 64        # the estimated error exceeds the tolerance asked for (`simulate`'s
+                           # rtol and atol; `Solution.error`)
+    SINGULAR = 128         # a saved state at (or within the system's tolerance of) a singular
+                           # configuration, where the dynamics are not defined (the Carpal
+                           # Wrist's inverse or direct singularity: `WristSystem.check`)
+
+    @classmethod
+    def failures(cls) -> int:
+        """The flags that make a run fail (`REDUNDANT` and `LIMIT_EXCEEDED` only inform)."""
+        return (cls.NONFINITE | cls.NOT_CONVERGED | cls.SOLVER_FAILED | cls.CONSTRAINT_VIOLATED
+                | cls.INACCURATE | cls.SINGULAR)
+
+
+def raise_on_failure(result, throw: bool, who: str):
+    """`result` (a `WithStatus`) as it is, or, with throw=True, an error (`eqx.error_if`, so also
+    under jit and vmap) naming the first failure flag set in its status, as diffrax's
+    throw=True does; the default returns the status for the caller to read."""
+    if not throw:
+        return result
+    failures = [flag for flag in Status if flag & Status.failures()]
+    failed = (result.status & Status.failures()) != 0
+    first = jnp.argmax(jnp.stack([(result.status & flag) != 0 for flag in failures]), axis=0)
+    messages = [f"{who}: the run failed with status {flag.name.lower().replace('_', ' ')} "
+                f"({flag.value}; throw=False returns the result with its status instead)"
+                for flag in failures]
+    return eqx.branched_error_if(result, jnp.any(failed), jnp.max(first), messages)
+
+
+class WithStatus(eqx.Module):
+    """A result carrying an integer `status` array of `Status` flags (one per run; batched under
+    vmap)."""
+
+    @property
+    def ok(self) -> Array:
+        """True where the run succeeded (no failure flag; the notes only inform)."""
+        return (self.status & Status.failures()) == 0
+
+    def messages(self) -> list[str]:
+        """Human-readable status for each (possibly batched) run; needs concrete values."""
+        out = []
+        for code in np.atleast_1d(np.asarray(self.status)).ravel():
+            flags = [f.name.lower().replace("_", " ") for f in Status if f and Status(int(code)) & f]
+            out.append(", ".join(flags) if flags else "success")
+        return out

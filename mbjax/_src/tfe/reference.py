@@ -1,0 +1,93 @@
+"""Reference configurations and incremental coordinates (Borri 1990 §2).
+
+Over an element starting at t_1 the motion is written about a prescribed reference (x_o(t),
+R_o(t)) as x = x_o + x_* and R = R_* R_o with R_* = exp(r_* x I); the unknowns are the incremental
+coordinates q = (r_*, x_*), zero at t_1 when the reference starts from the initial state.
+Two references (§2) are built afresh for every element from its initial state: "constant" (held
+at the initial configuration) and "constant_velocity" (moving with the initial linear and angular
+velocity, R_o = exp((t - t_1) omega_o x I) R_1). A march can instead follow one prescribed
+`Reference` throughout, the steady rotation of eq 7.1 say; the incremental coordinates then carry
+over from element to element, as in the linearized analysis of §6 (eq 6.7).
+"""
+
+import equinox as eqx
+import jax.numpy as jnp
+from jax import Array
+
+from mbjax._src import lie
+from mbjax._src.tfe.body import Body
+
+REFERENCES = ("constant", "constant_velocity")
+
+
+class Reference(eqx.Module):
+    """x_o(t) = x_1 + t v_o, R_o(t) = exp(t omega_o x I) R_1 (t from the element's start); the
+    reference velocities v_o, omega_o (eqs 2.2-2.3) are constant in space."""
+
+    R1: Array
+    x1: Array
+    omega: Array
+    v: Array
+
+    def at(self, t) -> tuple[Array, Array]:
+        """(R_o(t), x_o(t))."""
+        return lie.exp(t * self.omega) @ self.R1, self.x1 + t * self.v
+
+    def shifted(self, t) -> "Reference":
+        """The same motion, its time counted from t."""
+        R, x = self.at(t)
+        return Reference(R, x, self.omega, self.v)
+
+
+def make_reference(kind: str, body: Body, R1: Array, x1: Array, p_hat1: Array) -> Reference:
+    """The reference of an element whose initial state is (R1, x1, p_hat1)."""
+    if kind not in REFERENCES:
+        raise ValueError(f"reference must be one of {REFERENCES}, got {kind!r}")
+    w1 = body.momentum_to_velocity(R1, p_hat1)
+    if kind == "constant":
+        w1 = jnp.zeros_like(w1)
+    v = jnp.zeros(3, w1.dtype) if body.fixed_point else w1[3:]
+    return Reference(R1, x1, w1[:3], v)
+
+
+def configuration(body: Body, ref: Reference, q: Array, t) -> tuple[Array, Array]:
+    """Absolute (R, x) from the incremental coordinates q at element time t."""
+    R_o, x_o = ref.at(t)
+    R = lie.exp(q[:3]) @ R_o
+    return R, (x_o if body.fixed_point else x_o + q[3:])
+
+
+def increment(body: Body, ref: Reference, R: Array, x: Array) -> Array:
+    """The incremental coordinates q = (r_*, x_*) of (R, x) at the reference's start, the inverse
+    of `configuration` at t = 0 (principal rotation vector, |r_*| <= pi)."""
+    r = lie.log(R @ ref.R1.T, check=False)
+    return r if body.fixed_point else jnp.concatenate([r, x - ref.x1])
+
+
+def X_matrix(body: Body, q: Array) -> Array:
+    """X = diag(Gamma(r_*), I) of eq 3.18 (angular block first)."""
+    G = lie.gamma(q[:3])
+    return G if body.fixed_point else jnp.block([[G, jnp.zeros((3, 3))], [jnp.zeros((3, 3)), jnp.eye(3)]])
+
+
+def X_inverse(body: Body, q: Array, w: Array) -> Array:
+    """X^-1 w = (Gamma^-1(r_*) omega, v) (eq 3.18)."""
+    omega = lie.gamma_inv(q[:3]) @ w[:3]
+    return omega if body.fixed_point else jnp.concatenate([omega, w[3:]])
+
+
+def X_inverse_transpose(body: Body, q: Array, p: Array) -> Array:
+    """X^-T p = (Gamma^-T(r_*) p_r, p_x): p_hat from p = X^T p_hat (eq 3.17)."""
+    h = lie.gamma_inv(q[:3]).T @ p[:3]
+    return h if body.fixed_point else jnp.concatenate([h, p[3:]])
+
+
+def w_n(body: Body, ref: Reference, q: Array) -> Array:
+    """w_n = (R_* omega_o, v_o) of eq 3.21: the reference's velocity carried by the increment."""
+    omega = lie.exp(q[:3]) @ ref.omega
+    return omega if body.fixed_point else jnp.concatenate([omega, ref.v])
+
+
+def velocity(body: Body, ref: Reference, q: Array, q_dot: Array) -> Array:
+    """w = X q_dot + w_n (eq 3.20): omega = Gamma(r_*) r_*_dot + R_* omega_o (eq 2.7)."""
+    return X_matrix(body, q) @ q_dot + w_n(body, ref, q)

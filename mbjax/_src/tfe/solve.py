@@ -1,0 +1,209 @@
+"""Time marching element by element: `solve_tfe` (Borri 1990 §5).
+
+Each element starts from the converged end state of the previous one. Its reference (§2) is built
+from that state and the incremental coordinates start at zero; or one prescribed reference motion
+is followed throughout and the increments carry over (§6-7). Newton solves the element's equations
+(eqs 5.3 / 5.8) and the end state (R_2, x_2, p_hat_2) is carried on. Elements are a `lax.scan`,
+Newton a `lax.while_loop` differentiated by the implicit function theorem, so `jax.grad` of any
+function of the solution with respect to the initial state or the body's parameters is exact
+and cheap.
+"""
+
+from functools import partial
+
+import equinox as eqx
+import jax
+import jax.numpy as jnp
+from jax import Array
+
+from mbjax._src.system.invariants import relative_drift
+from mbjax._src.system.accuracy import doubled
+from mbjax._src.system.accuracy import sample_indices, tolerances
+from mbjax._src.system.status import Status, WithStatus, raise_on_failure
+from mbjax._src.tfe.body import Body
+from mbjax._src.tfe.elements import Element
+from mbjax._src.tfe.form import AbstractForm
+from mbjax._src.tfe.mixed import Mixed
+from mbjax._src.tfe.newton import NewtonInfo, newton
+from mbjax._src.tfe.reference import REFERENCES, Reference, configuration, increment, make_reference
+
+
+class State(eqx.Module):
+    """The state at an element boundary: rotation R (body to space), position x of O' and the
+    spatial momentum p_hat = (h, l) about O' (h only, about a fixed point)."""
+
+    R: Array
+    x: Array
+    p_hat: Array
+
+
+def initial_state(body: Body, R0, Omega0, x0=(0.0, 0.0, 0.0), v0=(0.0, 0.0, 0.0)) -> State:
+    """State from a rotation, the body-frame angular velocity Omega0 and (free body) the velocity
+    v0 of O'. The momentum is p_hat = M6 w (eq 3.19) with w = (R0 Omega0, v0)."""
+    R0 = jnp.asarray(R0, dtype=float)
+    w = R0 @ jnp.asarray(Omega0, dtype=float)
+    if not body.fixed_point:
+        w = jnp.concatenate([w, jnp.asarray(v0, dtype=float)])
+    return State(R0, jnp.asarray(x0, dtype=float), body.mass_matrix(R0) @ w)
+
+
+class TFESolution(WithStatus):
+    """States at the element boundaries ts (n_elements + 1), per-element Newton records and a
+    `Status`: NOT_CONVERGED where an element's Newton missed its tolerance, NONFINITE where the
+    state blew up, INACCURATE past the tolerance asked for; `error` and `drift` as
+    `mbjax.integrate.Solution`'s (NaN where no tolerance was asked)."""
+
+    ts: Array
+    R: Array
+    x: Array
+    p_hat: Array
+    iterations: Array
+    residual: Array
+    status: Array
+    error: Array = float("nan")
+    drift: Array = float("nan")
+
+    def energy(self, body: Body) -> Array:
+        """Total energy at every boundary."""
+        return jax.vmap(body.energy)(self.R, self.x, self.p_hat)
+
+    def angular_momentum(self, body: Body) -> Array:
+        """Spatial angular momentum about the origin, h + x x l (eq 3.2)."""
+        h = self.p_hat[:, :3]
+        return h if body.fixed_point else h + jnp.cross(self.x, self.p_hat[:, 3:])
+
+
+def element_map(form: AbstractForm, body: Body, ref: Reference, element: Element, dt, z1: Array,
+                *, tol=1e-10, max_iter: int = 20) -> tuple[Array, NewtonInfo]:
+    """The end state z_2 = (p_2, q_2) of one element from its start z_1 = (p_1, q_1), both in the
+    form's variables about the reference `ref`. Its Jacobian dz_2/dz_1 (jax.jacfwd, through the
+    implicit function theorem) is the element's transition matrix (eq 6.7)."""
+    U, info = newton(lambda U: form.residual(body, ref, element, dt, U, z1),
+                     form.guess(body, ref, element, z1), tol=tol, max_iter=max_iter)
+    return form.final(body, ref, element, dt, U, z1), info
+
+
+def _advance(body, state: State, t, dt, tol, prescribed, *, form, element, reference,
+             max_iter) -> tuple[State, NewtonInfo]:
+    """One element of node spacing dt from `state` at time t (its reference built from the
+    state, or the prescribed one shifted to t)."""
+    nq = body.nq
+    if prescribed is None:
+        ref = make_reference(reference, body, state.R, state.x, state.p_hat)
+        q1 = jnp.zeros(nq, state.p_hat.dtype)
+    else:
+        ref = prescribed.shifted(t)
+        q1 = increment(body, ref, state.R, state.x)
+    z1 = jnp.concatenate([form.to_form(body, q1, state.p_hat), q1])
+    z2, info = element_map(form, body, ref, element, dt, z1, tol=tol, max_iter=max_iter)
+    q2 = z2[nq:]
+    R2, x2 = configuration(body, ref, q2, element.length(dt))
+    return State(R2, x2, form.from_form(body, q2, z2[:nq])), info
+
+
+_STATIC = ("form", "element", "reference", "max_iter")
+
+
+@partial(jax.jit, static_argnames=(*_STATIC, "n_elements"))
+def _march(body, state0, dt, tol, prescribed, *, form, element, n_elements, reference, max_iter):
+    h = element.length(dt)
+
+    def step(state, k):
+        new, info = _advance(body, state, k * h, dt, tol, prescribed, form=form, element=element,
+                             reference=reference, max_iter=max_iter)
+        return new, (new, info.iterations, info.residual, info.converged)
+
+    _, (states, iterations, residual, converged) = jax.lax.scan(step, state0, jnp.arange(n_elements))
+    join = lambda a, b: jnp.concatenate([a[None], b])  # noqa: E731
+    R, x, p_hat = (join(getattr(state0, k), getattr(states, k)) for k in ("R", "x", "p_hat"))
+    finite = jnp.all(jnp.isfinite(p_hat)) & jnp.all(jnp.isfinite(R))
+    status = (jnp.where(jnp.all(converged), 0, int(Status.NOT_CONVERGED))
+              | jnp.where(finite, 0, int(Status.NONFINITE)))
+    return TFESolution(jnp.arange(n_elements + 1) * h, R, x, p_hat, iterations, residual, status)
+
+
+@partial(jax.jit, static_argnames=(*_STATIC, "n_elements"))
+def _error_estimate(body, states: State, ts, dt, tol, prescribed, rtol, atol, *, form, element,
+                    n_elements, reference, max_iter):
+    """(estimated global error, its ratio to the tolerance) by step doubling from the sampled
+    boundary states (see `solve_tfe`)."""
+    advance = partial(_advance, body, tol=tol, prescribed=prescribed, form=form, element=element,
+                      reference=reference, max_iter=max_iter)
+    h = element.length(dt)
+
+    def flat(s):
+        return jnp.concatenate([s.R.ravel(), s.x, s.p_hat])
+
+    def local(state, t):
+        full, _, half = doubled(lambda s, t, dt: advance(s, t, dt)[0], state, t, dt, h)
+        full, half = flat(full), flat(half)
+        e = full - half
+        scale = atol + rtol * jnp.maximum(jnp.abs(flat(state)), jnp.abs(full))
+        return jnp.max(jnp.abs(e)), jnp.sqrt(jnp.mean((e / scale) ** 2))
+
+    errors, ratios = jax.vmap(local)(states, ts)
+    return n_elements * jnp.mean(errors), n_elements * jnp.mean(ratios)
+
+
+@jax.jit
+def _drift(body, solution):
+    """The body's invariants' largest relative drift over the boundaries (`Body.invariants`)."""
+    return relative_drift(jax.vmap(body.invariants)(solution.ts, solution.R, solution.x,
+                                                    solution.p_hat))
+
+
+def solve_tfe(body: Body, state0: State, *, dt, n_elements: int, form: AbstractForm = Mixed(),
+              element: Element = Element(4), reference: str | Reference = "constant_velocity",
+              tol=1e-10, max_iter: int = 20, rtol: float | None = None,
+              atol: float | None = None, throw: bool = False) -> TFESolution:
+    """March `n_elements` time elements of `element` (node spacing dt, so each spans
+    (nodes - 1) dt) of the weak `form` from `state0`.
+
+    `reference` is one of `REFERENCES`, built afresh for each element from its initial state, or
+    a `Reference` motion (from t = 0) followed by the whole march: the increments then carry over
+    between elements, as in the linearized analysis of §6-7, and must stay below pi in rotation.
+
+    Jitted once per (form, element, n_elements, reference, max_iter); dt, tol, the body and the
+    state are traced, so sweeps over them do not recompile and they can be differentiated.
+    throw=True raises an error naming the failure (an element's Newton iteration not converged,
+    a non-finite state, an inaccurate run) instead of returning the solution with its status.
+
+    rtol, atol: a tolerance, as `mbjax.simulate`'s. Given either, the solution carries
+    `error`, a step-doubling estimate of the final state's error (at up to `ERROR_SAMPLES`
+    boundaries, one element against two of half the spacing; their difference is taken as the
+    element's local error, the elements being of high order, and summed over the march; the
+    rotation matrix, position and momentum components together), and `drift`, the largest
+    relative drift of the body's invariants (`Body.invariants`: the energy, the momenta), and
+    the status INACCURATE where the first exceeds the tolerance (root mean square norm) or the
+    second exceeds a positive rtol. The primal form past its stability boundary is caught
+    this way (tests/tfe/test_accuracy.py).
+    """
+    prescribed = reference if isinstance(reference, Reference) else None
+    if prescribed is not None:
+        reference = "prescribed"
+    elif reference not in REFERENCES:
+        raise ValueError(f"reference must be one of {REFERENCES} or a tfe.Reference, "
+                         f"got {reference!r}")
+    if not (isinstance(n_elements, int) and n_elements >= 1):
+        raise ValueError(f"n_elements must be a positive int, got {n_elements!r}")
+    if not isinstance(element, Element):
+        raise TypeError(f"element must be a tfe.Element, got {type(element).__name__}")
+    dt = jnp.asarray(dt, dtype=float)
+    checked = rtol is not None or atol is not None
+    if checked:
+        rtol, atol = tolerances(rtol, atol)
+    tol = jnp.asarray(tol, dtype=float)
+    static = dict(form=form, element=element, n_elements=n_elements, reference=reference,
+                  max_iter=max_iter)
+    solution = _march(body, state0, dt, tol, prescribed, **static)
+    if checked:
+        picks = jnp.asarray(sample_indices(n_elements))
+        states = State(solution.R[picks], solution.x[picks], solution.p_hat[picks])
+        error, ratio = _error_estimate(body, states, solution.ts[picks], dt, tol, prescribed,
+                                       rtol, atol, **static)
+        drift = _drift(body, solution)
+        inaccurate = (ratio > 1.0) | (drift > rtol) & (rtol > 0)
+        status = solution.status | jnp.where(inaccurate, int(Status.INACCURATE), 0)
+        solution = eqx.tree_at(lambda s: (s.status, s.error, s.drift), solution,
+                               (status.astype(solution.status.dtype), error, drift))
+    return raise_on_failure(solution, throw, "mbjax.tfe.solve_tfe")

@@ -1,0 +1,48 @@
+"""Co-design: the gradient of a problem's optimal cost with respect to the design (a link's
+length or mass, a cost weight, the initial state).
+
+J*(theta) = min_u J(u; theta) over controls within bounds that do not depend on theta. At the
+optimum u*(theta) the cost is stationary in u (on the free controls; the ones held at a bound
+stay there), so by the implicit function theorem the controls' own change drops out of
+dJ*/dtheta (the envelope theorem):
+
+    dJ*/dtheta = dJ/dtheta (u*, theta),
+
+one reverse-mode pass through the rollout at the solved controls, however the solver got there
+(its iterations are never differentiated). This holds to the accuracy of the solve: the error is
+of the order of the remaining gradient in u times du*/dtheta.
+"""
+
+from collections.abc import Callable
+
+import jax
+from jax import Array
+
+from mbjax._src.trajopt.ilqr import ILQR
+from mbjax._src.trajopt.problem import Problem
+from mbjax._src.trajopt.result import AbstractSolver
+from mbjax._src.trajopt.solve import solve
+
+
+def optimal_cost(build: Callable[..., Problem], theta, solver: AbstractSolver = ILQR(),
+                 us0: Array | None = None) -> Array:
+    """J*(theta): the cost `solver` reaches on `build(theta)` (a `Problem` for the design
+    theta, any pytree) from us0; `jax.grad` of it with respect to theta is the envelope
+    theorem's (see the module). Check the solve's status (`solve(build(theta), solver, us0)`)
+    before trusting either."""
+
+    @jax.custom_vjp
+    def value(theta):
+        return solve(build(theta), solver, us0).cost
+
+    def forward(theta):
+        result = solve(build(theta), solver, us0)
+        return result.cost, (theta, result.us)
+
+    def backward(residuals, cotangent):
+        theta, us = residuals
+        grad = jax.grad(lambda design: build(design).objective(us))(theta)
+        return (jax.tree.map(lambda g: cotangent * g, grad),)
+
+    value.defvjp(forward, backward)
+    return value(theta)

@@ -1,0 +1,160 @@
+"""Multiple shooting: the states at the knots are unknowns beside the controls, and the
+dynamics are constraints, the defects e_k = f(x_k, u_k) - x_{k+1} = 0 (Bock and Plitt 1984),
+enforced by an augmented Lagrangian (Hestenes 1969; Powell 1969):
+
+    M(xs, us) = sum_k l(x_k, u_k) dt + l_N(x_N) + sum_k lambda_k^T e_k + rho / 2 sum_k |e_k|^2.
+
+Inner iterations take Gauss-Newton steps on M for (xs, us) together (`ILQR`'s expansion: the
+dynamics' Jacobians A_k, B_k and the costs' Gauss-Newton Hessians, all vmapped over the knots).
+The step's linear-quadratic problem has the knots' states free, tied by the penalty: in the
+backward pass each next state y is eliminated in closed form. With V(y) = 1/2 y^T V y + v^T y the
+value at k + 1 and w = e_k + A dx + B du,
+
+    min_y rho/2 |w - y|^2 + lambda^T (w - y) + V(y):   y = S (rho w + lambda - v),
+    S = (rho I + V)^-1, value 1/2 w^T P w + p^T w with P = rho S V, p = S V lambda + rho S v,
+
+so the Riccati recursion of `ILQR` runs with (p + P e_k, P) in place of (V_x, V_xx); as rho
+grows it becomes DDP's with the gaps e_k carried (as in Crocoddyl's FDDP). The step is applied
+along the knots (no nonlinear rollout), with a backtracking line search on M: each trial is one
+vmapped evaluation of all the knots at once. After an inner solve the multipliers take
+lambda_k += rho e_k, and rho grows tenfold when the largest defect has not fallen to a quarter.
+
+The first guess's states are the rollout of its controls. The trajectory returned is the
+rollout of the final controls (its `cost` the problem's objective of it), which the knots match
+to the defect tolerance; `costs` holds the merit M after each inner iteration. Success when the
+largest defect is below `defect_tolerance` and the last inner solve's relative decrease fell
+below `tolerance`.
+"""
+
+import equinox as eqx
+import jax
+import jax.numpy as jnp
+from jax import Array
+
+from mbjax._src.trajopt.ilqr import ILQR, riccati_step
+from mbjax._src.trajopt.problem import Problem
+from mbjax._src.trajopt.result import (AbstractSolver, Result, history, require_vector_state,
+                                  rollout_result)
+
+STEPS = tuple(0.5**k for k in range(10))
+
+
+class MultipleShooting(AbstractSolver):
+    """See the module. `iterations`: Gauss-Newton steps in all at most, `inner` of them at most
+    between two multiplier updates; `penalty`: rho's first
+    value; `tolerance`: an inner solve ends when a step lowers the merit by less than this
+    (relative); `defect_tolerance`: the largest defect accepted; `regularization`: added to the
+    control blocks, raised tenfold after a failed step."""
+
+    iterations: int = eqx.field(static=True, default=300)
+    inner: int = eqx.field(static=True, default=20)
+    penalty: float = 1e2
+    tolerance: float = 1e-8
+    defect_tolerance: float = 1e-9
+    regularization: float = 1e-6
+    qp_iterations: int = eqx.field(static=True, default=8)
+
+    def solve(self, problem: Problem, us: Array) -> Result:
+        require_vector_state(problem, "MultipleShooting")
+        steps = jnp.arange(problem.horizon)
+        alphas = jnp.asarray(STEPS, us.dtype)
+
+        def defects(xs, us):
+            return jax.vmap(problem.step)(xs[:-1], us, steps) - xs[1:]
+
+        def merit(xs, us, lam, rho):
+            e = defects(xs, us)
+            return problem.cost(xs, us) + jnp.sum(lam * e) + 0.5 * rho * jnp.sum(e * e)
+
+        def direction(xs, us, lam, rho, mu):
+            """The Gauss-Newton step (dxs, dus) of the merit, and whether it is finite."""
+            (A, B, lx, lu, lxx, lux, luu), (vx, Vxx) = ILQR._linearize(problem, xs, us)
+            e = defects(xs, us)
+            eye_x = jnp.eye(problem.nx, dtype=us.dtype)
+
+            def back(carry, inputs):
+                v, V = carry
+                A, B, lx, lu, lxx, lux, luu, u, e, lam = inputs
+                S = jnp.linalg.inv(rho * eye_x + V)
+                P = rho * S @ V
+                P = 0.5 * (P + P.T)
+                g = S @ (V @ lam + rho * v) + P @ e          # the value's gradient at w = e
+                k, K, v, V, _, _ = riccati_step(problem, (A, B, lx, lu, lxx, lux, luu), u, g, P,
+                                                mu, self.qp_iterations)
+                return (v, V), (k, K, S, v, V)
+
+            _, (k, K, S, v, V) = jax.lax.scan(back, (vx, Vxx), (A, B, lx, lu, lxx, lux, luu, us,
+                                                                e, lam), reverse=True)
+            # the values at k + 1 that each stage's y needs: V_{k+1}, v_{k+1} (terminal last)
+            v_next = jnp.concatenate([v[1:], vx[None]])
+
+            def forward(dx, inputs):
+                A, B, k, K, S, v, e, lam = inputs
+                du = k + K @ dx
+                w = e + A @ dx + B @ du
+                y = S @ (rho * w + lam - v)
+                return y, (du, y)
+
+            _, (dus, dys) = jax.lax.scan(forward, jnp.zeros(problem.nx, us.dtype),
+                                         (A, B, k, K, S, v_next, e, lam))
+            dxs = jnp.concatenate([jnp.zeros((1, problem.nx), us.dtype), dys])
+            ok = jnp.all(jnp.isfinite(dxs)) & jnp.all(jnp.isfinite(dus))
+            return dxs, dus, ok
+
+        def inner(s):
+            xs, us, lam, rho, mu, value, _, i, costs = s
+            dxs, dus, ok = direction(xs, us, lam, rho, mu)
+
+            def trial(j):
+                u = jnp.clip(us + alphas[j] * dus, problem.lower, problem.upper)
+                x = xs + alphas[j] * dxs
+                return x, u, merit(x, u, lam, rho)
+
+            def worse(t):
+                _, _, m, j = t
+                return ok & ~(m < value) & (j < len(STEPS))
+
+            def next_trial(t):
+                j = t[3]
+                return (*trial(j), j + 1)
+
+            x, u, m, _ = jax.lax.while_loop(worse, next_trial, (xs, us, value, jnp.array(0)))
+            accept = ok & (m < value)
+            xs, us = jnp.where(accept, x, xs), jnp.where(accept, u, us)
+            change = value - m
+            value = jnp.where(accept, m, value)
+            settled = accept & (change <= self.tolerance * jnp.abs(value))
+            mu = jnp.where(accept, jnp.maximum(mu / 10.0, 1e-9), mu * 10.0)
+            return xs, us, lam, rho, mu, value, settled, i + 1, costs.at[i + 1].set(value)
+
+        def outer(s):
+            xs, us, lam, rho, mu, value, _, i, costs, defect = s
+            stop = jnp.minimum(i + self.inner, self.iterations)
+
+            def more(t):
+                return ~t[6] & (t[7] < stop) & (t[4] < 1e10)
+
+            xs, us, lam, rho, mu, value, settled, i, costs = jax.lax.while_loop(
+                more, inner, (xs, us, lam, rho, mu, value, jnp.array(False), i, costs))
+            e = defects(xs, us)
+            new = jnp.max(jnp.abs(e))
+            lam = lam + rho * e
+            rho = jnp.where(new > 0.25 * defect, 10.0 * rho, rho)
+            return (xs, us, lam, rho, mu, merit(xs, us, lam, rho), settled, i, costs, new)
+
+        def running(s):
+            settled, i, mu, defect = s[6], s[7], s[4], s[9]
+            done = settled & (defect <= self.defect_tolerance)
+            return ~done & (i < self.iterations) & (mu < 1e10)
+
+        xs = problem.rollout(us)
+        lam = jnp.zeros((problem.horizon, problem.nx), us.dtype)
+        rho = jnp.asarray(self.penalty, us.dtype)
+        value = merit(xs, us, lam, rho)
+        s = (xs, us, lam, rho, jnp.asarray(self.regularization, us.dtype), value,
+             jnp.array(False), jnp.array(0), history(self.iterations + 1, value),
+             jnp.asarray(jnp.inf, us.dtype))
+        s = jax.lax.while_loop(running, outer, s)
+        us, settled, iterations, costs, defect = s[1], s[6], s[7], s[8], s[9]
+        return rollout_result(problem, us, costs, iterations,
+                              settled & (defect <= self.defect_tolerance))

@@ -1,0 +1,29 @@
+"""The one entry point of trajectory optimisation: `solve(problem, solver, us0)`."""
+
+import equinox as eqx
+from jax import Array
+
+from mbjax._src.system.status import raise_on_failure
+
+from mbjax._src.trajopt.ilqr import ILQR
+from mbjax._src.trajopt.problem import Problem
+from mbjax._src.trajopt.result import AbstractSolver, Result
+
+
+@eqx.filter_jit
+def solve(problem: Problem, solver: AbstractSolver = ILQR(), us0: Array | None = None,
+          throw: bool = False) -> Result:
+    """Optimise `problem`'s controls with `solver` (a strategy: `ILQR()`, ...) from `us0`
+    (horizon, nu), zeros by default, clipped to the bounds. One compiled program: the solver's
+    iterations run inside it, and `jax.vmap` solves many problems at once. A second problem of
+    the same shapes (another target, another model parameter) reuses the program where its
+    costs hold their data as leaves (equinox modules, or `eqx.Partial` of module-level
+    functions, as `mbjax._src.scenes.arm.reach_problem` builds them); a fresh closure is a new
+    function, and compiles anew. throw=True raises an error naming the failure (not
+    converged, non-finite) instead of returning the result with its status."""
+    if not isinstance(problem, Problem):
+        raise TypeError(f"problem must be a mbjax.trajopt.Problem, got {type(problem).__name__}")
+    if not isinstance(solver, AbstractSolver):
+        raise TypeError(f"solver must be a solver instance such as ILQR(), got {solver!r}")
+    return raise_on_failure(solver.solve(problem, problem.initial_controls(us0)), throw,
+                            "mbjax._src.trajopt.solve")

@@ -1,0 +1,50 @@
+"""Parameter sweeps for any system: one jitted `vmap` on one device, the same computation
+sharded across devices with `jax.sharding`.
+
+A batch is any pytree whose array leaves carry a leading variant axis: a dict of parameter
+arrays, a model or a wrist batched by `batch` or `grid`. `sweep(fn, params)` maps fn over that
+axis in one compiled call; with `devices`, the variant axis is split over a one-axis mesh
+(`NamedSharding(mesh, P("variants"))`) and XLA partitions the vmapped computation, so each
+device runs its share. The same code runs on
+the GPUs of a host, or, after `jax.distributed.initialize()`, over the devices of several hosts
+(`jax.devices()` then lists them all; only one host is tested here, with forced CPU devices).
+"""
+
+import jax
+import jax.numpy as jnp
+import numpy as np
+from jax.sharding import Mesh, NamedSharding, PartitionSpec
+
+
+def size(params) -> int:
+    """The number of variants in a batch: the leading axis every array leaf shares."""
+    leaves = jax.tree.leaves(params)
+    shapes = {np.shape(x)[:1] for x in leaves}
+    if not leaves or len(shapes) != 1 or shapes == {()}:
+        raise ValueError("params must be a pytree whose array leaves all share a leading "
+                         f"(variant) axis; got leading sizes {sorted(s for s in shapes)}")
+    return shapes.pop()[0]
+
+
+def sweep(fn, params, *, devices=None, trim: bool = True):
+    """fn(p) for every variant p of params: any pytree whose array leaves share a leading
+    variant axis (a dict of arrays, a batched model or wrist, a tuple), as jit(vmap(fn)).
+
+    With `devices` (several, e.g. jax.devices()), the variants are split over them: padded with
+    copies of the last one to a multiple of their number, and the outputs computed and returned
+    sharded over the devices. `trim=True` returns the n variants given; where padding was
+    needed that slice is gathered onto every device (JAX shards only axes the devices divide).
+    `trim=False` keeps the padded outputs sharded, the first n rows the variants, for sharded
+    work downstream."""
+    params = jax.tree.map(jnp.asarray, params)
+    n = size(params)
+    mapped = jax.vmap(fn)
+    if devices is None or len(devices) == 1:
+        return jax.jit(mapped)(params)
+    pad = -n % len(devices)
+    if pad:
+        params = jax.tree.map(lambda x: jnp.concatenate([x, jnp.repeat(x[-1:], pad, axis=0)]),
+                              params)
+    sharding = NamedSharding(Mesh(np.asarray(devices), ("variants",)), PartitionSpec("variants"))
+    out = jax.jit(mapped, out_shardings=sharding)(jax.device_put(params, sharding))
+    return jax.tree.map(lambda x: x[:n], out) if pad and trim else out

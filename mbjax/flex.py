@@ -1,0 +1,21 @@
+"""Flexible bodies (Anderson 1993): beam finite elements and Craig-Bampton modal reduction, the
+modal body's coefficients and geometric stiffening, flexible trees in the O(n) recursion, and a
+geometrically nonlinear ANCF beam as the independent reference."""
+
+from mbjax._src.flex.beam import Beam as Beam
+from mbjax._src.flex.modal import ModalBasis as ModalBasis
+from mbjax._src.flex.modal import craig_bampton as craig_bampton
+from mbjax._src.flex.body import ModalBody as ModalBody
+from mbjax._src.flex.builders import beam_body as beam_body
+from mbjax._src.flex.model import FlexibleModel as FlexibleModel
+from mbjax._src.flex.system import FlexibleSystem as FlexibleSystem
+from mbjax._src.flex.aba import flexible_aba as flexible_aba
+from mbjax._src.flex.points import centreline as centreline
+from mbjax._src.flex.ancf import AncfBeam as AncfBeam
+from mbjax._src.flex.ancf import simulate_ancf as simulate_ancf
+
+__all__ = [
+    "Beam", "ModalBasis", "craig_bampton", "ModalBody", "beam_body", "FlexibleModel",
+    "FlexibleSystem", "flexible_aba", "centreline", "AncfBeam",
+    "simulate_ancf"
+]

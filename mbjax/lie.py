@@ -1,0 +1,18 @@
+"""Rotations: the rotation vector, its tangent map Gamma (Borri 1990 App. A) and quaternions
+(w, x, y, z). Every function is exact and differentiable, to any order, at and near zero rotation."""
+
+from mbjax._src.lie.rotation_vector import exp as exp
+from mbjax._src.lie.rotation_vector import log as log
+from mbjax._src.lie.rotation_vector import hat as hat
+from mbjax._src.lie.rotation_vector import vee as vee
+from mbjax._src.lie.rotation_vector import gamma as gamma
+from mbjax._src.lie.rotation_vector import gamma_inv as gamma_inv
+from mbjax._src.lie.quaternion import quat_from_rotvec as quat_from_rotvec
+from mbjax._src.lie.quaternion import rotvec_from_quat as rotvec_from_quat
+from mbjax._src.lie.quaternion import quat_to_matrix as quat_to_matrix
+from mbjax._src.lie.quaternion import quat_from_matrix as quat_from_matrix
+
+__all__ = [
+    "exp", "log", "hat", "vee", "gamma", "gamma_inv", "quat_from_rotvec",
+    "rotvec_from_quat", "quat_to_matrix", "quat_from_matrix"
+]

@@ -1,0 +1,18 @@
+"""Trajectory optimisation for any system: a `Problem`, `solve` with a solver strategy (`ILQR`,
+`MultipleShooting`, `Shooting`), its `Result`, `optimal_cost` for co-design, and `sweep` for
+batches of problems or parameters."""
+
+from mbjax._src.trajopt.problem import Problem as Problem
+from mbjax._src.trajopt.solve import solve as solve
+from mbjax._src.trajopt.result import AbstractSolver as AbstractSolver
+from mbjax._src.trajopt.result import Result as Result
+from mbjax._src.trajopt.ilqr import ILQR as ILQR
+from mbjax._src.trajopt.multiple_shooting import MultipleShooting as MultipleShooting
+from mbjax._src.trajopt.shooting import Shooting as Shooting
+from mbjax._src.trajopt.codesign import optimal_cost as optimal_cost
+from mbjax._src.trajopt.sweep import sweep as sweep
+
+__all__ = [
+    "Problem", "solve", "AbstractSolver", "Result", "ILQR", "MultipleShooting", "Shooting",
+    "optimal_cost", "sweep"
+]

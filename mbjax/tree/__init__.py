@@ -1,6 +1,0 @@
-"""Tree topology (Jerkovsky 1978 §II, Anderson 1993 §2.1) and the tree passes every algorithm runs on."""
-
-from mbjax.tree.passes import backward_pass, forward_pass
-from mbjax.tree.topology import Topology
-
-__all__ = ["Topology", "backward_pass", "forward_pass"]

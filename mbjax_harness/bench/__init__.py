@@ -1,0 +1,23 @@
+"""Benchmark suites for `mbjax bench SUITE` (their timing helper is `mbjax_harness.timing`).
+
+Each suite is run(out: Path, quick: bool) -> list of records, written as out/SUITE.jsonl and
+out/SUITE.png. Peers (MuJoCo, Pinocchio, exudyn, Crocoddyl) are measured in the same process when installed.
+"""
+
+from mbjax_harness.bench import (compile_time, flexible, integrators, loops, rigid, speed, tfe, throughput,
+                         trajopt, wrist)
+
+SUITES = {
+    compile_time.NAME: compile_time.run,
+    flexible.NAME: flexible.run,
+    integrators.NAME: integrators.run,
+    loops.NAME: loops.run,
+    rigid.NAME: rigid.run,
+    speed.NAME: speed.run,
+    tfe.NAME: tfe.run,
+    throughput.NAME: throughput.run,
+    trajopt.NAME: trajopt.run,
+    wrist.NAME: wrist.run,
+}
+
+__all__ = ["SUITES"]

@@ -1,0 +1,312 @@
+"""Peer engines, built to match mbjax scenes, for benchmarks and cross-engine tests.
+
+Each peer is optional: `available(name)` says whether it imports.
+"""
+
+import importlib.util
+
+import numpy as np
+
+MUJOCO_INTEGRATORS = ("Euler", "RK4", "implicit", "implicitfast")
+
+
+def available(name: str) -> bool:
+    return importlib.util.find_spec(name) is not None
+
+
+def mujoco_heavy_top(mass: float, inertia_pivot, com, gravity: float, dt: float,
+                     integrator: str = "RK4"):
+    """The heavy top as a MuJoCo ball joint. MuJoCo takes the inertia about the centre of mass:
+    J_com = J_pivot - m (|c|^2 I - c c^T). Returns (model, data)."""
+    import mujoco
+
+    c = np.asarray(com, dtype=float)
+    J_com = np.asarray(inertia_pivot, dtype=float) - mass * (c @ c * np.eye(3) - np.outer(c, c))
+    full = " ".join(f"{v:.17g}" for v in (J_com[0, 0], J_com[1, 1], J_com[2, 2],
+                                           J_com[0, 1], J_com[0, 2], J_com[1, 2]))
+    xml = f"""
+    <mujoco>
+      <option gravity="0 0 {-gravity:.17g}" timestep="{dt:.17g}" integrator="{integrator}"/>
+      <worldbody>
+        <body name="top">
+          <joint type="ball" damping="0" armature="0"/>
+          <inertial pos="{c[0]:.17g} {c[1]:.17g} {c[2]:.17g}" mass="{mass:.17g}" fullinertia="{full}"/>
+        </body>
+      </worldbody>
+    </mujoco>"""
+    model = mujoco.MjModel.from_xml_string(xml)
+    return model, mujoco.MjData(model)
+
+
+def mujoco_rollout(model, data, quat0, Omega0, nstep: int):
+    """Roll the ball-joint model out for nstep steps from unit quaternion quat0 (w, x, y, z) and
+    body angular velocity Omega0 (MuJoCo's ball-joint qvel is in the body frame), batched over
+    leading dimensions of quat0 / Omega0. Returns (quat, Omega) at the end, each (batch, .)."""
+    import mujoco
+    from mujoco import rollout
+
+    quat0 = np.atleast_2d(quat0)
+    Omega0 = np.atleast_2d(Omega0)
+    spec = mujoco.mjtState.mjSTATE_FULLPHYSICS
+    states = []
+    for q, w in zip(quat0, Omega0, strict=True):
+        mujoco.mj_resetData(model, data)
+        data.qpos[:] = q
+        data.qvel[:] = w
+        state = np.empty(mujoco.mj_stateSize(model, spec))
+        mujoco.mj_getState(model, data, state, spec)
+        states.append(state)
+    out, _ = rollout.rollout(model, data, np.array(states), nstep=nstep)
+    final = out[:, -1]
+    # FULLPHYSICS layout: time, qpos, qvel, ...
+    return final[:, 1:1 + model.nq], final[:, 1 + model.nq:1 + model.nq + model.nv]
+
+
+def _exudyn_solve(mbs, ts, dt: float, spectral_radius: float, absolute_tolerance: float) -> None:
+    """exudyn's implicit generalized-alpha over [0, ts[-1]] at the fixed step dt, sensors kept
+    every ts[1] - ts[0], Newton's absolute tolerance as given, nothing written to disk."""
+    import exudyn as exu
+
+    settings = exu.SimulationSettings()
+    settings.timeIntegration.endTime = float(ts[-1])
+    settings.timeIntegration.numberOfSteps = int(round(ts[-1] / dt))
+    settings.timeIntegration.generalizedAlpha.spectralRadius = spectral_radius
+    settings.timeIntegration.adaptiveStep = False
+    settings.timeIntegration.newton.absoluteTolerance = absolute_tolerance
+    settings.timeIntegration.verboseMode = 0
+    settings.solution.file.write = False
+    settings.solution.sensors.writePeriod = float(ts[1] - ts[0])
+    mbs.SolveDynamic(settings)
+
+
+def exudyn_spin_up_beam(n_elements: int, dt: float, ts, *, length=10.0, E=7.0e10, A=4.0e-4,
+                        I=2.0e-7, mass=12.0, T_s=15.0, omega_s=6.0,  # noqa: E741 (the paper's I)
+                        spectral_radius=0.8):
+    """Kane's spin-up beam (as `mbjax._src.flex.references.spin_up_beam_reference`) in exudyn: n
+    `ObjectANCFCable2D` elements along x, the root's position fixed and its slope direction
+    prescribed by theta(t) through a `GenericJoint` (x, y and the rotation about z locked) with an
+    offset user function, so the root's stretch stays free; implicit generalized-alpha at fixed
+    step dt with spectral radius 0.8 (at 1, no numerical damping, Newton fails near t = 11-12 s
+    at every step tried, 1e-2 ... 2e-3 s), Newton's absolute tolerance raised to 1e-6 N (with
+    EA = 2.8e7 N the default 1e-10 stalls in round-off at the first step). Returns the tip deflection along the rotating y axis at the times ts
+    (multiples of the sensor period ts[1] - ts[0])."""
+    import exudyn as exu
+    from exudyn.itemInterface import (GenericJoint, MarkerBodyRigid, NodePoint2DSlope1,
+                                      ObjectANCFCable2D, ObjectGround, SensorNode)
+
+    c = T_s / (2 * np.pi)
+
+    def ramp(t):   # NumPy, not spin_up_theta's jnp: exudyn calls it per Newton iteration
+        return omega_s / T_s * (t**2 / 2 + c**2 * (np.cos(t / c) - 1))
+
+    def theta(t):
+        return ramp(t) if t < T_s else ramp(T_s) + omega_s * (t - T_s)
+
+    ts = np.asarray(ts, float)
+    sc = exu.SystemContainer()
+    mbs = sc.AddSystem()
+    le = length / n_elements
+    nodes = [mbs.AddNode(NodePoint2DSlope1(referenceCoordinates=[i * le, 0.0, 1.0, 0.0]))
+             for i in range(n_elements + 1)]
+    cables = [mbs.AddObject(ObjectANCFCable2D(length=le, massPerLength=mass / length,
+                                              bendingStiffness=E * I, axialStiffness=E * A,
+                                              nodeNumbers=[nodes[i], nodes[i + 1]]))
+              for i in range(n_elements)]
+    ground = mbs.AddMarker(MarkerBodyRigid(bodyNumber=mbs.AddObject(ObjectGround())))
+    root = mbs.AddMarker(MarkerBodyRigid(bodyNumber=cables[0], localPosition=[0.0, 0.0, 0.0]))
+    mbs.AddObject(GenericJoint(markerNumbers=[ground, root], constrainedAxes=[1, 1, 0, 0, 0, 1],
+                               offsetUserFunction=lambda mbs, t, item, p: [0, 0, 0, 0, 0, theta(t)]))
+    sensor = mbs.AddSensor(SensorNode(nodeNumber=nodes[-1], storeInternal=True,
+                                      outputVariableType=exu.OutputVariableType.Coordinates))
+    mbs.Assemble()
+
+    _exudyn_solve(mbs, ts, dt, spectral_radius, absolute_tolerance=1e-6)
+
+    data = mbs.GetSensorStoredData(sensor)        # t, displacements (x, y, x', y') of the tip
+    t = data[:, 0]
+    th = np.array([theta(s) for s in t])
+    deflection = -np.sin(th) * (length + data[:, 1]) + np.cos(th) * data[:, 2]
+    return np.interp(ts, t, deflection)
+
+
+def exudyn_slider_crank(n_elements: int, dt: float, ts, *, crank=6 * 0.0254, rod=12 * 0.0254,
+                        diameter=0.25 * 0.0254, E=3.0e7 * 4.4482216152605 / 0.0254**2,
+                        mass=0.1667 * 0.45359237, Omega=125.6, spectral_radius=0.8):
+    """Anderson 1993's flexible slider-crank (as `mbjax._src.flex.references.slider_crank_reference`) in
+    exudyn: the rod as n `ObjectANCFCable2D` elements from P to Q, P's coordinates prescribed on
+    the crank circle (two `CoordinateConstraint`s with offset user functions), Q's y held at 0
+    (the massless slider), both slopes and Q's x free; started straight and unstrained with the
+    rigid mechanism's velocities (at t = 0 a pure translation, P's velocity (-crank Omega, 0));
+    implicit generalized-alpha at fixed step dt. Returns the midpoint deflection from the chord
+    PQ [in], positive away from O at t = 0, at the times ts (multiples of ts[1] - ts[0])."""
+    import exudyn as exu
+    from exudyn.itemInterface import (CoordinateConstraint, MarkerNodeCoordinate,
+                                      MarkerNodePosition, NodePoint2DSlope1, NodePointGround,
+                                      ObjectANCFCable2D, SensorMarker, SensorNode)
+
+    inch = 0.0254
+    area, inertia = np.pi * diameter**2 / 4, np.pi * diameter**4 / 64
+    p0 = np.array([0.0, crank])
+    q0 = np.array([np.sqrt(rod**2 - crank**2), 0.0])
+    u = (q0 - p0) / rod
+    le = rod / n_elements
+    v0 = np.array([-crank * Omega, 0.0])
+    sc = exu.SystemContainer()
+    mbs = sc.AddSystem()
+    nodes = [mbs.AddNode(NodePoint2DSlope1(referenceCoordinates=[*(p0 + i * le * u), *u],
+                                           initialVelocities=[*v0, 0.0, 0.0]))
+             for i in range(n_elements + 1)]
+    for i in range(n_elements):
+        mbs.AddObject(ObjectANCFCable2D(length=le, massPerLength=mass / rod,
+                                        bendingStiffness=E * inertia, axialStiffness=E * area,
+                                        nodeNumbers=[nodes[i], nodes[i + 1]]))
+    ground = mbs.AddMarker(MarkerNodeCoordinate(nodeNumber=mbs.AddNode(NodePointGround()),
+                                                coordinate=0))
+
+    def prescribe(node, coordinate, displacement):
+        marker = mbs.AddMarker(MarkerNodeCoordinate(nodeNumber=nodes[node], coordinate=coordinate))
+        mbs.AddObject(CoordinateConstraint(
+            markerNumbers=[ground, marker],
+            offsetUserFunction=lambda mbs, t, item, offset: displacement(t)))
+
+    prescribe(0, 0, lambda t: crank * np.cos(np.pi / 2 + Omega * t) - p0[0])
+    prescribe(0, 1, lambda t: crank * np.sin(np.pi / 2 + Omega * t) - p0[1])
+    prescribe(n_elements, 1, lambda t: 0.0)
+    at = [mbs.AddMarker(MarkerNodePosition(nodeNumber=nodes[i])) for i in (0, n_elements)]
+    sensors = [mbs.AddSensor(SensorMarker(markerNumber=m, storeInternal=True,
+                                          outputVariableType=exu.OutputVariableType.Position))
+               for m in at]
+    mid = n_elements // 2 if n_elements % 2 == 0 else None
+    if mid is None:
+        raise ValueError("exudyn_slider_crank: n_elements must be even (the midpoint is a node)")
+    sensors.append(mbs.AddSensor(SensorNode(nodeNumber=nodes[mid], storeInternal=True,
+                                            outputVariableType=exu.OutputVariableType.Position)))
+    mbs.Assemble()
+
+    ts = np.asarray(ts, float)
+    _exudyn_solve(mbs, ts, dt, spectral_radius, absolute_tolerance=1e-8)
+
+    P, Q, M = (mbs.GetSensorStoredData(s) for s in sensors)
+    t = P[:, 0]
+    chord = Q[:, 1:3] - P[:, 1:3]
+    chord /= np.linalg.norm(chord, axis=1, keepdims=True)
+    d = np.sum((M[:, 1:3] - P[:, 1:3]) * np.stack([-chord[:, 1], chord[:, 0]], 1), axis=1)
+    return np.interp(ts, t, d / inch)
+
+
+def crocoddyl_working() -> str | None:
+    """None when Crocoddyl imports and its forward dynamics agree with Pinocchio's `aba` (to
+    1e-9 relative on a random 7-dof state), else why not: crocoddyl 3.2.1 with pin 4.1.0
+    imports but returns accelerations of about 1e-309 (pin 4.0.0 is right)."""
+    if not (available("crocoddyl") and available("pinocchio")):
+        return "crocoddyl is not installed (pip install 'mbjax[bench]')"
+    import crocoddyl
+    import pinocchio as pin
+
+    from mbjax.data import ARM7
+
+    model = pin.buildModelFromUrdf(str(ARM7))
+    rng = np.random.default_rng(0)
+    q, v, tau = (rng.uniform(-1.0, 1.0, model.nv) for _ in range(3))
+    expected = pin.aba(model, model.createData(), q, v, tau)
+    state = crocoddyl.StateMultibody(model)
+    dam = crocoddyl.DifferentialActionModelFreeFwdDynamics(
+        state, crocoddyl.ActuationModelFull(state), crocoddyl.CostModelSum(state, model.nv))
+    data = dam.createData()
+    dam.calc(data, np.concatenate([q, v]), tau)
+    if not np.allclose(data.xout, expected, rtol=1e-9, atol=1e-9 * np.abs(expected).max()):
+        return (f"crocoddyl {crocoddyl.__version__} with pin {pin.__version__} disagrees with "
+                "pin.aba (a known mismatch: use pin 4.0.0 with crocoddyl 3.2.1)")
+    return None
+
+
+def _crocoddyl_point(model, joint: int, offset, name: str) -> int:
+    """A frame `name` at `offset` in joint `joint`'s frame of a Pinocchio model."""
+    import pinocchio as pin
+
+    frame = pin.Frame(name, joint, 0, pin.SE3(np.eye(3), np.asarray(offset, float)),
+                      pin.FrameType.OP_FRAME)
+    return model.addFrame(frame)
+
+
+def _crocoddyl_terms(state, nu: int, terms) -> "object":
+    """A CostModelSum from (name, residual, weights or None, weight) tuples: each term is
+    weight/2 |diag(sqrt(weights)) r|^2, Crocoddyl's quadratic activation."""
+    import crocoddyl
+
+    costs = crocoddyl.CostModelSum(state, nu)
+    for name, residual, weights, weight in terms:
+        cost = (crocoddyl.CostModelResidual(state, residual) if weights is None else
+                crocoddyl.CostModelResidual(
+                    state, crocoddyl.ActivationModelWeightedQuad(np.asarray(weights, float)),
+                    residual))
+        costs.addCost(name, cost, float(weight))
+    return costs
+
+
+def _crocoddyl_shooting(state, actuation, x0, dt: float, horizon: int, running, terminal):
+    """Crocoddyl's shooting problem with semi-implicit Euler steps (its
+    `IntegratedActionModelEuler`: v+ = v + dt a, q+ = q + dt v+, running costs times dt)."""
+    import crocoddyl
+
+    def model(terms, step):
+        costs = _crocoddyl_terms(state, actuation.nu, terms)
+        dam = crocoddyl.DifferentialActionModelFreeFwdDynamics(state, actuation, costs)
+        return crocoddyl.IntegratedActionModelEuler(dam, step)
+
+    return crocoddyl.ShootingProblem(np.asarray(x0, float), [model(running, dt)] * horizon,
+                                     model(terminal, 0.0))
+
+
+def crocoddyl_reach(urdf: str, q0, target, gravity_torque, flange, dt: float, horizon: int):
+    """`mbjax._src.scenes.arm.reach_problem`'s costs in Crocoddyl's terms (mbjax's residual c r, cost
+    1/2 c^2 |r|^2, is Crocoddyl's residual r with weight c^2):
+    running 0.02 |p - target|^2 / 2 + 2e-4 |x - x0|^2 / 2 + 2e-4 |u - g|^2 / 2, terminal
+    2e4 |p - target|^2 / 2 + 2 |v|^2 / 2, p the flange. Returns (problem, set_target)."""
+    import crocoddyl
+    import pinocchio as pin
+
+    model = pin.buildModelFromUrdf(urdf)
+    frame = _crocoddyl_point(model, model.njoints - 1, flange, "flange")
+    state = crocoddyl.StateMultibody(model)
+    actuation = crocoddyl.ActuationModelFull(state)
+    nu, nv = actuation.nu, model.nv
+    x0 = np.concatenate([np.asarray(q0, float), np.zeros(nv)])
+    goal = crocoddyl.ResidualModelFrameTranslation(state, frame, np.asarray(target, float), nu)
+    running = [("goal", goal, None, 0.02),
+               ("state", crocoddyl.ResidualModelState(state, x0, nu), None, 2e-4),
+               ("control", crocoddyl.ResidualModelControl(state, np.asarray(gravity_torque, float)),
+                None, 2e-4)]
+    terminal = [("goal", goal, None, 2e4),
+                ("velocity", crocoddyl.ResidualModelState(state, x0, nu),
+                 np.r_[np.zeros(nv), np.ones(nv)], 2.0)]
+    problem = _crocoddyl_shooting(state, actuation, x0, dt, horizon, running, terminal)
+
+    def set_target(target):
+        goal.reference = np.asarray(target, float)
+
+    return problem, set_target
+
+
+def crocoddyl_swingup(urdf: str, q0, goal, length: float, dt: float, horizon: int):
+    """`mbjax._src.scenes.acrobot.swingup_problem`'s costs in Crocoddyl's terms: running
+    0.01 |p - goal|^2 / 2 + 1e-4 |v|^2 / 2 + 0.01 u^2 / 2, terminal 1e4 |p - goal|^2 / 2 +
+    100 |v|^2 / 2, p the tip; the elbow alone actuated (Crocoddyl's own double-pendulum
+    actuation, `crocoddyl.utils.pendulum`, a Python model called at every knot)."""
+    import crocoddyl
+    import pinocchio as pin
+    from crocoddyl.utils.pendulum import ActuationModelDoublePendulum
+
+    model = pin.buildModelFromXML(urdf)
+    frame = _crocoddyl_point(model, model.njoints - 1, [0.0, 0.0, -length], "tip")
+    state = crocoddyl.StateMultibody(model)
+    actuation = ActuationModelDoublePendulum(state, actLink=2)
+    nu, nv = actuation.nu, model.nv
+    x0 = np.concatenate([np.asarray(q0, float), np.zeros(nv)])
+    tip = crocoddyl.ResidualModelFrameTranslation(state, frame, np.asarray(goal, float), nu)
+    velocity = crocoddyl.ResidualModelState(state, np.zeros(model.nq + nv), nu)
+    only_v = np.r_[np.zeros(nv), np.ones(nv)]
+    running = [("tip", tip, None, 0.01), ("velocity", velocity, only_v, 1e-4),
+               ("control", crocoddyl.ResidualModelControl(state, nu), None, 0.01)]
+    terminal = [("tip", tip, None, 1e4), ("velocity", velocity, only_v, 100.0)]
+    return _crocoddyl_shooting(state, actuation, x0, dt, horizon, running, terminal)

@@ -1,0 +1,305 @@
+"""`mbjax bench trajopt`: trajectory optimisation, mbjax's iLQR against Crocoddyl's FDDP on
+identical problems, one at a time and 64 at once.
+
+Problems (`mbjax.scenes`): `arm-reach`, the 7-dof arm's flange moved 0.4 m, and
+`acrobot-swingup`, the double pendulum driven at its elbow to upright; each built twice, as an
+`mbjax.trajopt.Problem` and as a Crocoddyl shooting problem (`mbjax_harness.bench.peers`: Pinocchio
+models of the same URDF, the same residuals and weights, the same horizon and step), both with
+semi-implicit Euler steps (Crocoddyl's `IntegratedActionModelEuler`), both from the same first
+guess (the arm: the torque that holds its start; the acrobot: zero) and its rollout. The run
+checks that the two are one problem: the guess's rollouts agree (`dynamics_agreement`, largest
+state difference) and so do their costs (`cost_agreement`, relative).
+
+mbjax's iLQR runs with Crocoddyl's globalization (`ILQR(**CROCODDYL_SCHEDULE)`: the same
+step lengths, acceptance test and regularization schedule), so the two differ in their
+derivatives and their code, not in their strategy.
+
+Timing. Each solver runs until its own convergence test passes (mbjax: a relative decrease below
+1e-8; Crocoddyl: its stopping criterion, 1e-9 on the expected improvement) or 200 iterations, from
+the rolled-out guess. `seconds` is the median wall time of that solve (mbjax after compiling,
+`compile_s` apart); `seconds_to_tolerance` is the median wall time of a solve stopped after the
+iterations the solver needed to come within 1e-6 (relative) of the better of the two final costs
+(`TOLERANCE`, found from each solver's cost history), so a solver is not charged for a tail
+that its convergence test, not the problem, asks for (a full solve passes that point, so its
+time bounds the truncated one's, which on a busy machine can measure longer). Crocoddyl runs
+single-threaded from Python.
+
+Many targets: `N_TARGETS` flange targets 0.4 m from the start in a 30-degree cone about the
+single problem's direction (seeded), solved by mbjax as one `jax.vmap`ped solve (every problem
+iterates until the slowest is done), by mbjax one jitted solve at a time, and by Crocoddyl in a
+Python loop (its targets changed in place). JSON lines + PNG; the last record (kind "summary")
+holds the targets: the better problem's `seconds_to_tolerance` within 2x Crocoddyl's, and
+the 64 targets ahead of Crocoddyl's loop.
+"""
+
+import platform
+import time
+from pathlib import Path
+
+import jax
+import jax.numpy as jnp
+import numpy as np
+
+from mbjax_harness.bench import peers
+from mbjax._src.integrate import SemiImplicitEuler
+from mbjax_harness.timing import measure, write_jsonl
+from mbjax._src.trajopt import ILQR, solve
+from mbjax._src.trajopt.ilqr import CROCODDYL_SCHEDULE
+
+NAME = "trajopt"
+TOLERANCE = 1e-6
+ITERATIONS = 200
+N_TARGETS, QUICK_TARGETS = 64, 8
+CONE = np.radians(30.0)
+
+
+def targets(n: int, seed: int = 0) -> np.ndarray:
+    """n offsets [m] of length 0.4 in a cone of half-angle CONE about +y (`scenes.arm.REACH`)."""
+    rng = np.random.default_rng(seed)
+    cos = rng.uniform(np.cos(CONE), 1.0, n)
+    phi = rng.uniform(0.0, 2 * np.pi, n)
+    sin = np.sqrt(1.0 - cos**2)
+    return 0.4 * np.stack([sin * np.cos(phi), cos, sin * np.sin(phi)], 1)
+
+
+def arm_reach():
+    """(mbjax problem, first guess, final error of a final q, Crocoddyl builder)."""
+    from mbjax.data import ARM7
+    from mbjax._src.rigid import inverse_dynamics
+    from mbjax._src.scenes import arm
+
+    problem = arm.reach_problem(integrator=SemiImplicitEuler())
+    model = problem.system.model
+    target = arm.reach_target(model)
+    zero = jnp.zeros(model.nv)
+
+    def crocoddyl(target=target):
+        return peers.crocoddyl_reach(str(ARM7), problem.q0, target,
+                                     inverse_dynamics(model, problem.q0, zero, zero), arm.FLANGE,
+                                     problem.dt, problem.horizon)
+
+    return (problem, arm.hold(problem),
+            lambda q: float(jnp.linalg.norm(arm.flange(model, q) - target)), crocoddyl)
+
+
+def acrobot_swingup():
+    from mbjax._src.model.urdf import to_urdf
+    from mbjax._src.scenes import acrobot
+
+    problem = acrobot.swingup_problem(integrator=SemiImplicitEuler())
+    model = problem.system.model
+    goal = jnp.array([0.0, 0.0, 2 * acrobot.LENGTH])
+
+    def crocoddyl():
+        problem_ = peers.crocoddyl_swingup(to_urdf(model), problem.q0, goal, acrobot.LENGTH,
+                                           problem.dt, problem.horizon)
+        return problem_, None
+
+    return (problem, jnp.zeros((problem.horizon, problem.nu)),
+            lambda q: float(jnp.linalg.norm(acrobot.tip(model, q) - goal)), crocoddyl)
+
+
+PROBLEMS = {"arm-reach": arm_reach, "acrobot-swingup": acrobot_swingup}
+
+
+def _to_tolerance(costs, best: float) -> int:
+    """The first iteration whose cost is within TOLERANCE of best (the last if none)."""
+    costs = np.asarray(costs)
+    within = np.flatnonzero(costs <= best + TOLERANCE * abs(best))
+    return int(within[0]) if len(within) else len(costs) - 1
+
+
+class _Crocoddyl:
+    """One Crocoddyl problem's FDDP solver, from a fixed first guess and its rollout."""
+
+    def __init__(self, problem, us0):
+        import crocoddyl
+
+        self.problem, self.us0 = problem, [np.asarray(u, float) for u in us0]
+        self.solver = crocoddyl.SolverFDDP(problem)
+
+    def solve(self, iterations: int) -> bool:
+        xs0 = self.problem.rollout(self.us0)
+        return self.solver.solve(xs0, self.us0, iterations, True)
+
+    def history(self) -> list[float]:
+        """The cost before and after each iteration of a full solve."""
+        import crocoddyl
+
+        costs = []
+
+        class Record(crocoddyl.CallbackAbstract):
+            def __call__(self, solver):
+                costs.append(solver.cost)
+
+        xs0 = self.problem.rollout(self.us0)
+        first = self.problem.calc(xs0, self.us0)
+        self.solver.setCallbacks([Record()])
+        self.solve(ITERATIONS)
+        self.solver.setCallbacks([])
+        return [first] + costs
+
+    def timed(self, iterations: int, repeats: int) -> float:
+        """The median wall time of a solve of at most `iterations` (after one warm-up)."""
+        return measure(self.solve, iterations, repeats=repeats)[1].run_s
+
+
+def single(name: str, repeats: int, common: dict) -> list[dict]:
+    """Both engines on one problem: cost histories, times to convergence and to TOLERANCE."""
+    problem, us0, final_error, build = PROBLEMS[name]()
+    ilqr = ILQR(iterations=ITERATIONS, **CROCODDYL_SCHEDULE)
+    result, timing = measure(solve, problem, ilqr, us0, repeats=repeats)
+    iterations = int(result.iterations)
+    costs = np.asarray(result.costs)[:iterations + 1]
+    mbjax = {**common, "kind": "single", "problem": name, "engine": "mbjax", "solver": "ILQR",
+             "iterations": iterations, "seconds": timing.run_s, "compile_s": timing.compile_s,
+             "cost": float(result.cost), "final_error": final_error(result.qs[-1]),
+             "status": result.messages()[0], "history": costs.tolist()}
+    records = [mbjax]
+    why = peers.crocoddyl_working()
+    if why is not None:
+        records.append({**common, "kind": "single", "problem": name, "engine": "crocoddyl",
+                        "skipped": why})
+        best = mbjax["cost"]
+    else:
+        croc_problem, _ = build()
+        croc = _Crocoddyl(croc_problem, us0)
+        xs_mbjax = np.asarray(problem.rollout(jnp.asarray(us0)))
+        xs_croc = np.array(croc_problem.rollout(croc.us0))
+        cost_mbjax = float(problem.cost(jnp.asarray(xs_mbjax), jnp.asarray(us0)))
+        cost_croc = croc_problem.calc(list(xs_croc), croc.us0)
+        history = croc.history()
+        converged = croc.solve(ITERATIONS)
+        q_end = np.asarray(croc.solver.xs[-1])[:problem.nq]
+        records.append({
+            **common, "kind": "single", "problem": name, "engine": "crocoddyl",
+            "solver": "SolverFDDP", "iterations": int(croc.solver.iter),
+            "seconds": croc.timed(ITERATIONS, repeats), "cost": float(croc.solver.cost),
+            "final_error": final_error(jnp.asarray(q_end)),
+            "status": "success" if converged else "not converged", "history": history,
+            "dynamics_agreement": float(np.max(np.abs(xs_croc - xs_mbjax))),
+            "cost_agreement": abs(cost_croc - cost_mbjax) / abs(cost_mbjax)})
+        best = min(mbjax["cost"], records[-1]["cost"])
+        k = _to_tolerance(history, best)
+        records[-1].update(iterations_to_tolerance=k, seconds_to_tolerance=min(
+            croc.timed(max(k, 1), repeats), records[-1]["seconds"]))
+    k = _to_tolerance(costs, best)
+    stopped = ILQR(iterations=max(k, 1), **CROCODDYL_SCHEDULE)
+    truncated = (timing.run_s if k >= iterations
+                 else min(measure(solve, problem, stopped, us0, repeats=repeats)[1].run_s,
+                          timing.run_s))
+    mbjax.update(iterations_to_tolerance=k, seconds_to_tolerance=truncated)
+    for r in records:
+        r["best_cost"] = best
+    return records
+
+
+def many(n: int, repeats: int, common: dict, loop: bool = True) -> list[dict]:
+    """The arm's reach to n targets: mbjax vmapped, mbjax one by one (unless not `loop`: on a
+    GPU each solve is thousands of small kernels), Crocoddyl in a loop."""
+    from mbjax._src.scenes import arm
+
+    problem, us0, _, build = arm_reach()
+    model = problem.system.model
+    offsets = targets(n)
+
+    def one(offset):
+        return solve(arm.reach_problem(offset, arm=model, integrator=SemiImplicitEuler()),
+                     ILQR(iterations=ITERATIONS, **CROCODDYL_SCHEDULE), us0)
+
+    def summary(engine, how, seconds, iterations, converged, **extra):
+        return {**common, "kind": "many", "problem": "arm-reach", "engine": engine, "how": how,
+                "targets": n, "seconds": seconds, "mean_iterations": float(np.mean(iterations)),
+                "max_iterations": int(np.max(iterations)), "converged": int(np.sum(converged)),
+                **extra}
+
+    batched = jax.jit(jax.vmap(one))
+    results, timing = measure(batched, jnp.asarray(offsets), repeats=repeats)
+    records = [summary("mbjax", "one vmapped solve", timing.run_s, np.asarray(results.iterations),
+                       np.asarray(results.status) == 0, compile_s=timing.compile_s)]
+    if loop:
+        single_solve = jax.jit(one)
+        jax.block_until_ready(single_solve(jnp.asarray(offsets[0])))
+        start = time.perf_counter()
+        looped = [jax.block_until_ready(single_solve(jnp.asarray(o))) for o in offsets]
+        records.append(summary("mbjax", "a loop of jitted solves", time.perf_counter() - start,
+                               [int(r.iterations) for r in looped],
+                               [int(r.status) == 0 for r in looped]))
+    why = peers.crocoddyl_working()
+    if why is not None:
+        records.append({**common, "kind": "many", "problem": "arm-reach", "engine": "crocoddyl",
+                        "skipped": why})
+        return records
+    croc_problem, set_target = build()
+    croc = _Crocoddyl(croc_problem, us0)
+    start_flange = np.asarray(arm.flange(model, problem.q0))
+    iterations, converged = [], []
+    start = time.perf_counter()
+    for offset in offsets:
+        set_target(start_flange + offset)
+        converged.append(croc.solve(ITERATIONS))
+        iterations.append(croc.solver.iter)
+    records.append(summary("crocoddyl", "a Python loop", time.perf_counter() - start, iterations,
+                           converged))
+    return records
+
+
+def summarize(records: list[dict], common: dict) -> dict:
+    """The targets, met or missed, from the records."""
+    out = {**common, "kind": "summary"}
+    singles = {(r["problem"], r["engine"]): r for r in records
+               if r["kind"] == "single" and "skipped" not in r}
+    ratios = {p: singles[p, "mbjax"]["seconds_to_tolerance"]
+              / singles[p, "crocoddyl"]["seconds_to_tolerance"]
+              for p in PROBLEMS if (p, "crocoddyl") in singles}
+    out["single_ratio"] = ratios
+    out["single_met"] = min(ratios.values()) <= 2.0 if ratios else None
+    many_ = {(r["engine"], r.get("how")): r for r in records
+             if r["kind"] == "many" and "skipped" not in r}
+    croc = [r for (engine, _), r in many_.items() if engine == "crocoddyl"]
+    if croc:
+        best = min(r["seconds"] for (engine, _), r in many_.items() if engine == "mbjax")
+        out["many_ratio"] = best / croc[0]["seconds"]
+        out["many_met"] = out["many_ratio"] < 1.0
+    else:
+        out["many_ratio"] = out["many_met"] = None
+    return out
+
+
+def run(out: Path, quick: bool = False) -> list[dict]:
+    common = {"machine": platform.machine(), "jax": jax.__version__,
+              "device": jax.devices()[0].device_kind, "backend": jax.default_backend()}
+    if peers.available("crocoddyl"):
+        import crocoddyl
+        import pinocchio
+
+        common.update(crocoddyl=crocoddyl.__version__, pinocchio=pinocchio.__version__)
+    repeats = 1 if quick else 3
+    records = []
+    for name in PROBLEMS:
+        records += single(name, repeats, common)
+    records += many(QUICK_TARGETS if quick else N_TARGETS, 1, common)
+    records.append(summarize(records, common))
+
+    out.mkdir(parents=True, exist_ok=True)
+    write_jsonl(out / f"{NAME}.jsonl", records)
+    from mbjax_harness.plot.bench import trajopt_bench_figure
+    trajopt_bench_figure(records).savefig(out / f"{NAME}.png", dpi=120)
+    for r in records:
+        if "skipped" in r:
+            print(f"{r['kind']:6s} {r['problem']:16s} {r['engine']:9s} skipped: {r['skipped']}")
+        elif r["kind"] == "single":
+            print(f"single {r['problem']:16s} {r['engine']:9s} {r['iterations']:4d} iterations "
+                  f"{r['seconds'] * 1e3:8.1f} ms, to 1e-6: {r['iterations_to_tolerance']:4d} "
+                  f"iterations {r['seconds_to_tolerance'] * 1e3:8.1f} ms, cost {r['cost']:.9g}, "
+                  f"final error {r['final_error']:.2e} ({r['status']})")
+        elif r["kind"] == "many":
+            print(f"many   {r['targets']} targets {r['engine']:9s} {r['how']:24s} "
+                  f"{r['seconds']:7.2f} s, iterations mean {r['mean_iterations']:.0f} max "
+                  f"{r['max_iterations']}, converged {r['converged']}/{r['targets']}")
+        else:
+            print(f"targets: one problem within 2x Crocoddyl: {r['single_met']} "
+                  f"({r['single_ratio']}); many targets ahead: {r['many_met']} "
+                  f"(ratio {r['many_ratio']})")
+    print(f"wrote {out / (NAME + '.jsonl')} and {out / (NAME + '.png')}")
+    return records

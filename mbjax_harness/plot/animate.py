@@ -1,0 +1,168 @@
+"""Animations of a mechanism moving: a 3-D stick-and-frame view, written as a GIF.
+
+`stick_animation` draws, at each saved state, a stick from every body's frame origin to its
+parent's (the ground origin for a base body), each frame's axes as a small red-green-blue triad,
+and the path of one chosen point (a tool, a flange, a tip). It takes the world poses that every
+tree system's `frames(q)` returns (`mbjax.rigid.TreeSystem`, `mbjax.flex.FlexibleSystem`, a
+`ClosedSystem`'s tree; a robot loaded from URDF or MJCF included), so any model animates without
+code of its own. `frames_along` evaluates them along a trajectory in one vmapped call;
+`animate` picks the picture for any system (`wrist_animation` for the Carpal Wrist, whose legs
+are not a tree).
+"""
+
+from collections.abc import Sequence
+from pathlib import Path
+
+import jax
+import numpy as np
+from matplotlib.animation import FuncAnimation, PillowWriter
+from matplotlib.figure import Figure
+from matplotlib.ticker import MaxNLocator
+
+from mbjax_harness.progress import step
+
+__all__ = ["animate", "frames_along", "stick_animation", "wrist_animation"]
+
+AXIS_COLORS = ("#d62728", "#2ca02c", "#1f77b4")     # x, y, z
+
+
+def frames_along(system, qs):
+    """(R (T, m, 3, 3), p (T, m, 3)) of the system's frames at each saved configuration."""
+    R, p = jax.jit(jax.vmap(system.frames))(qs)
+    return np.asarray(R), np.asarray(p)
+
+
+def _limits(points: np.ndarray):
+    """Equal-aspect cube around every point of the motion."""
+    lo, hi = points.reshape(-1, 3).min(0), points.reshape(-1, 3).max(0)
+    centre, half = (lo + hi) / 2, max(float(np.max(hi - lo)) / 2, 1e-3) * 1.1
+    return [(c - half, c + half) for c in centre]
+
+
+def stick_animation(path: Path, ts, R, p, parents, *, title: str = "",
+                    trace: int | Sequence[int] | None = None, axis_length: float | None = None,
+                    frames: int = 60, fps: int = 15, triads: bool | Sequence[int] = True,
+                    view: tuple[float, float] | None = None, anchors=None) -> Path:
+    """Write a GIF of the mechanism moving.
+
+    ts (T,): save times; R (T, m, 3, 3), p (T, m, 3): world poses of the m frames at each time
+    (the first len(parents) are bodies; any further ones, markers or named frames, are drawn as
+    triads only); parents: each body's parent (-1: the ground); trace: the frame, or frames, whose
+    origin leaves a path (default: the last body); axis_length: the triads' length (default: a
+    tenth of the motion's extent); triads: True draws every frame's triad, False none (a beam's
+    centreline as a chain of points, say), a sequence the triads of those frames; view: the
+    camera's (elevation, azimuth) in degrees, (90, -90) looking down on the x-y plane; anchors
+    (n, 3): where each base body's stick starts (default: the ground origin; anchored at its own
+    origin or at NaN, a body is a dot). At most `frames` of the saved states are drawn, evenly
+    spaced."""
+    step(f"animation {Path(path).name}")
+    ts, R, p = np.asarray(ts), np.asarray(R), np.asarray(p)
+    parents = np.asarray(parents, dtype=int)
+    n = len(parents)
+    keep = np.unique(np.linspace(0, len(ts) - 1, min(frames, len(ts))).round().astype(int))
+    anchors = np.zeros((n, 3)) if anchors is None else np.asarray(anchors, dtype=float)
+    fixed = anchors[parents < 0]
+    limits = _limits(np.concatenate([p.reshape(-1, 3), fixed[np.isfinite(fixed).all(axis=1)]]))
+    length = axis_length or 0.1 * (limits[0][1] - limits[0][0])
+    traced = [n - 1] if trace is None else list(np.atleast_1d(trace))
+    with_triads = range(p.shape[1]) if triads is True else [] if triads is False else list(triads)
+
+    fig = Figure(figsize=(5.2, 5.2), layout="constrained")
+    ax = fig.add_subplot(projection="3d")
+    ax.set(xlim=limits[0], ylim=limits[1], zlim=limits[2], xlabel="x [m]", ylabel="y [m]",
+           zlabel="z [m]")
+    ax.set_box_aspect((1, 1, 1))
+    for axis in (ax.xaxis, ax.yaxis, ax.zaxis):
+        axis.set_major_locator(MaxNLocator(4))      # tick labels that never run into each other
+    if view is not None:
+        ax.view_init(*view)
+        if abs(view[0]) == 90:          # looking along z: its ticks would pile up on one corner
+            ax.set_zticks([])
+            ax.set_zlabel("")
+    sticks = [ax.plot([], [], [], "-o", color="0.25", lw=2.5, ms=3)[0] for _ in range(n)]
+    triad_lines = {f: [ax.plot([], [], [], color=c, lw=1.2)[0] for c in AXIS_COLORS]
+                   for f in with_triads}
+    paths = {f: ax.plot([], [], [], color="#9467bd", lw=1, alpha=0.7)[0] for f in traced}
+    label = ax.set_title("")
+
+    def draw(i):
+        k = keep[i]
+        for body, stick in enumerate(sticks):
+            start = p[k, parents[body]] if parents[body] >= 0 else anchors[body]
+            seg = np.stack([start, p[k, body]])
+            stick.set_data_3d(seg[:, 0], seg[:, 1], seg[:, 2])
+        for f, triad in triad_lines.items():
+            for a, line in enumerate(triad):
+                seg = np.stack([p[k, f], p[k, f] + length * R[k, f, :, a]])
+                line.set_data_3d(seg[:, 0], seg[:, 1], seg[:, 2])
+        for f, line in paths.items():
+            trail = p[keep[:i + 1], f]
+            line.set_data_3d(trail[:, 0], trail[:, 1], trail[:, 2])
+        label.set_text(f"{title}  t = {ts[k]:.2f} s".strip())
+        return [*sticks, *(line for triad in triad_lines.values() for line in triad),
+                *paths.values(), label]
+
+    animation = FuncAnimation(fig, draw, frames=len(keep), blit=False)
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    animation.save(path, writer=PillowWriter(fps=fps), dpi=72)
+    return path
+
+
+def animate(path: Path, system, ts, qs, *, title: str = "", frames: int = 60) -> Path:
+    """Write a GIF of any mbjax system moving through the saved configurations qs at times ts:
+    the Carpal Wrist's legs and plates (`wrist_animation`), a closed loop's spanning tree with a
+    stick from each body of a cut joint to the joint's frame on it (so the loop is seen closed),
+    or a tree system's bodies (`stick_animation` of its `frames`)."""
+    if hasattr(system, "wrist"):
+        return wrist_animation(path, system.wrist, ts, qs, title=title, frames=frames)
+    tree = getattr(system, "tree", system)          # a ClosedSystem draws its tree
+    R, p = frames_along(tree, qs)
+    parents = list(tree.model.topology.parents)
+    n, m = len(parents), p.shape[1]                # bodies, then markers or named frames
+    anchors = np.zeros((n, 3))
+    extra = []                                      # (parent body or -1, points (T, 3), anchor)
+    for joint in getattr(system, "closures", ()):
+        if not hasattr(joint, "origin_a"):          # a prescribed motion: nothing to draw
+            continue
+        a, b = joint.body_a, joint.body_b
+        extra.append((a, p[:, a] + R[:, a] @ np.asarray(joint.origin_a), None))
+        if b >= 0:
+            extra.append((b, p[:, b] + R[:, b] @ np.asarray(joint.origin_b), None))
+        else:                                       # on the ground: a fixed dot
+            extra.append((-1, np.broadcast_to(np.asarray(joint.origin_b), p[:, 0].shape),
+                          np.asarray(joint.origin_b)))
+    if extra:
+        body_R, body_p = R[:, :n], p[:, :n]
+        points = np.stack([points for _, points, _ in extra], axis=1)
+        R = np.concatenate([body_R, np.broadcast_to(np.eye(3), (*points.shape[:2], 3, 3)),
+                            R[:, n:]], axis=1)
+        p = np.concatenate([body_p, points, p[:, n:]], axis=1)
+        anchors = np.concatenate([anchors, [np.zeros(3) if anchor is None else anchor
+                                            for _, _, anchor in extra]])
+        parents += [parent for parent, _, _ in extra]
+    triads = [*range(n), *range(n + len(extra), m + len(extra))]   # not the cut joints' points
+    return stick_animation(path, ts, R, p, parents, title=title, frames=frames,
+                           trace=n - 1, triads=triads, anchors=anchors)
+
+
+def wrist_animation(path: Path, wrist, ts, thetas, *, title: str = "", frames: int = 60) -> Path:
+    """Write a GIF of the Carpal Wrist moving through the input angles thetas (T, 3): the three
+    legs (base revolute, knee, distal revolute: `CarpalWrist.leg_points`), the base and distal
+    plates, and the tool (its frame at the plate's centre, a stick along its axis whose end
+    leaves its path)."""
+    legs = np.asarray(jax.jit(jax.vmap(wrist.leg_points))(thetas))   # (T, joint, leg, 3)
+    pose = jax.jit(jax.vmap(wrist.forward_kinematics))(thetas)
+    centre, R = np.asarray(pose.centre), np.asarray(pose.rotation)
+    b, m, d = legs[:, 0], legs[:, 1], legs[:, 2]
+    tip = centre + 0.8 * float(wrist.base_radius) * R[:, :, 2]
+    # frames: b (dots), m, d (the legs), the plates' edges, the tool's centre and tip
+    p = np.concatenate([b, m, d, d[:, [1, 2, 0]], b[:, [1, 2, 0]], centre[:, None], tip[:, None]],
+                       axis=1)
+    parents = [-1, -1, -1, 0, 1, 2, 3, 4, 5, 6, 7, 8, 0, 1, 2, -1, 15]
+    anchors = np.zeros((17, 3))
+    anchors[:3] = b[0]          # dots at the base revolutes
+    anchors[15] = np.nan        # the tool's frame at the moving plate centre: no stick to it
+    Rs = np.broadcast_to(R[:, None], (len(R), 17, 3, 3))
+    return stick_animation(path, ts, Rs, p, parents, anchors=anchors, title=title, trace=16,
+                           triads=[15], frames=frames)
