@@ -7,12 +7,13 @@ from mbjax._src.lie.rotation_vector import hat as hat
 from mbjax._src.lie.rotation_vector import vee as vee
 from mbjax._src.lie.rotation_vector import gamma as gamma
 from mbjax._src.lie.rotation_vector import gamma_inv as gamma_inv
-from mbjax._src.lie.quaternion import quat_from_rotvec as quat_from_rotvec
-from mbjax._src.lie.quaternion import rotvec_from_quat as rotvec_from_quat
+from mbjax._src.lie.coordinates import AbstractRotation as AbstractRotation
+from mbjax._src.lie.coordinates import Quaternion as Quaternion
+from mbjax._src.lie.coordinates import RotationVector as RotationVector
 from mbjax._src.lie.quaternion import quat_to_matrix as quat_to_matrix
 from mbjax._src.lie.quaternion import quat_from_matrix as quat_from_matrix
 
 __all__ = [
-    "exp", "log", "hat", "vee", "gamma", "gamma_inv", "quat_from_rotvec",
-    "rotvec_from_quat", "quat_to_matrix", "quat_from_matrix"
+    "AbstractRotation", "Quaternion", "RotationVector",
+    "exp", "log", "hat", "vee", "gamma", "gamma_inv", "quat_to_matrix", "quat_from_matrix"
 ]

@@ -6,7 +6,6 @@ batches of wrists for `mbjax.trajopt.sweep`."""
 from mbjax._src.wrist.model import CarpalWrist as CarpalWrist
 from mbjax._src.wrist.system import WristSystem as WristSystem
 from mbjax._src.wrist.kinematics import Pose as Pose
-from mbjax._src.wrist.kinematics import SingularityMeasures as SingularityMeasures
 from mbjax._src.wrist.kinematics import pose_error as pose_error
 from mbjax._src.wrist.kinematics import rotation_angle as rotation_angle
 from mbjax._src.wrist.torques import servo as servo
@@ -21,7 +20,7 @@ from mbjax._src.synthesis.sweeps import grid as grid
 from mbjax._src.synthesis.sweeps import peak_torque as peak_torque
 
 __all__ = [
-    "CarpalWrist", "WristSystem", "Pose", "SingularityMeasures", "pose_error", "rotation_angle",
+    "CarpalWrist", "WristSystem", "Pose", "pose_error", "rotation_angle",
     "servo", "ToolPath", "feedforward_torques", "synthesize", "NeuralController", "train_controller", "make_episodes", "evaluate_controller", "grid",
     "peak_torque"
 ]

@@ -115,7 +115,7 @@ def animate(path: Path, system, ts, qs, *, title: str = "", frames: int = 60) ->
     stick from each body of a cut joint to the joint's frame on it (so the loop is seen closed),
     or a tree system's bodies (`stick_animation` of its `frames`)."""
     if hasattr(system, "wrist"):
-        return wrist_animation(path, system.wrist, ts, qs, title=title, frames=frames)
+        return wrist_animation(path, system.model, ts, qs, title=title, frames=frames)
     tree = getattr(system, "tree", system)          # a ClosedSystem draws its tree
     R, p = frames_along(tree, qs)
     parents = list(tree.model.topology.parents)

@@ -127,20 +127,20 @@ def integrator_study(steps, seconds: dict | None = None, methods=METHODS,
     ref = reference.qs[-1]
     if motion is not None:
         motion.update(ts=np.asarray(reference.ts), qs=np.asarray(reference.qs))
-    E0 = jax.jit(lambda q, u: free.wrist.energy(q, u))(q0, u0)
+    E0 = jax.jit(lambda q, u: free.model.energy(q, u))(q0, u0)
     law = servo.control
 
     @jax.jit
     def servo_energy(q, u):
         e = q - law.q_ref
-        return 0.5 * law.kp * e @ e + 0.5 * u @ servo.wrist.mass_matrix(q) @ u
+        return 0.5 * law.kp * e @ e + 0.5 * u @ servo.model.mass_matrix(q) @ u
 
     rows = []
     for name in methods:
         integrator = INTEGRATORS[name]()
         timings = {} if seconds is not None else None
         q, _, drift = masked_rollout(free, integrator, q0, u0, steps, scene.FREE_DURATION,
-                                     lambda q, u: jnp.abs(free.wrist.energy(q, u) - E0) / E0, timings)
+                                     lambda q, u: jnp.abs(free.model.energy(q, u) - E0) / E0, timings)
         if seconds is not None:
             seconds[name] = timings["run_s"] / timings["steps"]
         qs, us, _ = masked_rollout(servo, integrator, s0, v0, steps, scene.SERVO_DURATION, lambda q, u: 0.0)

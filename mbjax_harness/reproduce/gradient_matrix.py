@@ -125,7 +125,7 @@ _slider_crank = _built_once(lambda: fsc.build(n_elements=1))
 def wrist(p, integrator):
     """The Carpal Wrist under its servo plus a torque spline."""
     servoed, theta0, _ = _servo()
-    w = eqx.tree_at(lambda w: w.tool_mass, servoed.wrist, servoed.wrist.tool_mass * (1.0 + p[2]))
+    w = eqx.tree_at(lambda w: w.tool_mass, servoed.model, servoed.model.tool_mass * (1.0 + p[2]))
     feedforward = CubicSpline(jnp.array([[0.1, -0.1, 0.0], [0.3, 0.0, -0.2], [0.0, 0.2, 0.1],
                                          [-0.1, 0.1, 0.0]]) * (1.0 + p[1]), 0.1)
     system = WristSystem(w, servoed.control + feedforward)

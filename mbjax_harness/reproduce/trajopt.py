@@ -83,7 +83,7 @@ def carpal_wrist():
     from mbjax._src.wrist import kinematics
 
     problem = cw.synthesis_problem()
-    wrist = problem.system.wrist
+    wrist = problem.system.model
     goal = goal_pose(wrist, cw.GOAL)
 
     def final_error(result):

@@ -5,6 +5,8 @@ import jax.numpy as jnp
 import numpy as np
 import pytest
 
+from mbjax.lie import Quaternion, RotationVector
+
 from mbjax import lie
 from mbjax_harness.bench import peers
 from mbjax.integrate import RK4, RKMK4, ImplicitMidpoint, simulate, solve_reference
@@ -29,7 +31,8 @@ def test_closed_form_satisfies_euler_equations():
 
 # quaternions by default; rotation-vector coordinates (their own compilation) run with -m slow
 # and are covered by default by test_quaternion_and_rotation_vector_coordinates_agree
-@pytest.mark.parametrize("rotation", ["quaternion", pytest.param("rotvec", marks=pytest.mark.slow)])
+@pytest.mark.parametrize("rotation", [Quaternion(), pytest.param(RotationVector(), marks=pytest.mark.slow)],
+                         ids=["quaternion", "rotvec"])
 def test_torque_free_body_converges_to_closed_form(rotation):
     """RKMK4 approaches eqs 8.7-8.8 at fourth order over the whole 6 s (about 100 rad)."""
     body, q0, u0 = tfb.build(rotation)
@@ -53,7 +56,7 @@ def test_diffrax_reference_matches_closed_form():
 def test_quaternion_and_rotation_vector_coordinates_agree():
     """Rotation vectors pass |r| = pi many times in 6 s (about 100 rad), rescaled by eq A.29."""
     runs = []
-    for rotation in ("quaternion", "rotvec"):
+    for rotation in (Quaternion(), RotationVector()):
         body, q0, u0 = tfb.build(rotation)
         sol = simulate(body, RK4(), q0, u0, dt=1e-3, t1=tfb.DURATION, saveat=[tfb.DURATION])
         runs.append(body.rotation_matrix(sol.qs[-1]))

@@ -17,14 +17,39 @@ from jax import Array
 
 
 class AbstractControl(eqx.Module):
-    """A control law tau = control(t, q, v) on a system's actuated velocity coordinates."""
+    """A control law tau = control(t, q, v) on a system's actuated velocity coordinates.
+
+    Subclasses implement `__call__`, and `hold` where the control is sampled. Controls add:
+    `a + b` is `Sum((a, b))`, and a callable or a constant array on either side is wrapped
+    first.
+    """
 
     @abc.abstractmethod
     def __call__(self, t: Array, q: Array, v: Array) -> Array:
-        """The generalized forces at time t and state (q, v)."""
+        """The generalized forces at time t and state (q, v).
+
+        Args:
+            t: time [s], a scalar.
+            q: configuration, shape (nq,).
+            v: generalized velocity, shape (nv,).
+
+        Returns:
+            The generalized forces on the actuated coordinates, shape (n_actuated,) (or, for
+            `external=`, the world-frame wrenches, shape (n_bodies, 6)).
+        """
 
     def hold(self, t: Array, q: Array, v: Array) -> "AbstractControl":
-        """The control over one step that starts at (t, q, v); the law itself unless sampled."""
+        """The control over one step of `mbjax.simulate` that starts at (t, q, v).
+
+        Args:
+            t: time at the step's start [s], a scalar.
+            q: configuration at the step's start, shape (nq,).
+            v: generalized velocity at the step's start, shape (nv,).
+
+        Returns:
+            The law itself for a law of continuous time; for a sampled one (`ZeroOrderHold`,
+            `SampleAndHold`) a `Constant` holding its value at the step's start.
+        """
         return self
 
     def __add__(self, other) -> "Sum":
@@ -35,7 +60,12 @@ class AbstractControl(eqx.Module):
 
 
 class Constant(AbstractControl):
-    """tau = value, whatever the time and state (the shorthand a constant `tau` stands for)."""
+    """tau = value, whatever the time and state (what a constant `tau` given as a control means).
+
+    Args:
+        value: the generalized forces, shape (n_actuated,) (or a scalar); a differentiable
+            leaf.
+    """
 
     value: Array
 
@@ -47,7 +77,15 @@ class Constant(AbstractControl):
 
 
 class Sum(AbstractControl):
-    """The sum of several controls (feed-forward plus feedback, a spring plus a motor, ...)."""
+    """The sum of several controls (feed-forward plus feedback, a spring plus a motor, ...).
+
+    Also written `a + b`. Nested sums are flattened; a sum of sampled controls holds each term
+    as the term does.
+
+    Args:
+        terms: the controls to add, a sequence of `AbstractControl`s, callables
+            (t, q, v) -> tau or constant arrays.
+    """
 
     terms: tuple
 
@@ -65,8 +103,14 @@ class Sum(AbstractControl):
 
 
 class Function(AbstractControl):
-    """Any callable fn(t, q, v) as a control. Its parameters are differentiable when fn is an
-    equinox module (a plain Python function has none)."""
+    """Any callable fn(t, q, v) -> tau as a control.
+
+    Its parameters are differentiable when fn is an equinox module (a plain Python function has
+    none).
+
+    Args:
+        fn: the control law, a callable (t, q, v) -> generalized forces.
+    """
 
     fn: Callable
 
@@ -75,7 +119,17 @@ class Function(AbstractControl):
 
 
 class Saturated(AbstractControl):
-    """limit tanh(control / limit): smooth, and inside +-limit by construction."""
+    """A control saturated smoothly: tau = limit tanh(control(t, q, v) / limit).
+
+    Smooth, and inside +-limit by construction, so gradient descent on the inner control's
+    parameters needs no constraint.
+
+    Args:
+        control: the control to saturate (an `AbstractControl`, a callable (t, q, v) -> tau or
+            a constant array).
+        limit: the saturation level, in the control's units (N or N m): a scalar or one per
+            actuated coordinate, shape (n_actuated,); must be positive.
+    """
 
     control: AbstractControl
     limit: Array
@@ -92,12 +146,31 @@ class Saturated(AbstractControl):
 
 
 def saturate(x: Array, limit: Array | None) -> Array:
-    """limit tanh(x / limit), or x when limit is None: the one saturation every control uses."""
+    """limit tanh(x / limit), or x when limit is None: the one saturation every control uses.
+
+    Args:
+        x: the unsaturated values, any shape.
+        limit: the saturation level, broadcastable to x, or None for none.
+
+    Returns:
+        The saturated values, x's shape.
+    """
     return x if limit is None else limit * jnp.tanh(x / limit)
 
 
 def as_control(control) -> AbstractControl | None:
-    """None, an `AbstractControl`, any callable (t, q, v) -> tau, or a constant array."""
+    """A control from what a system's `control=` accepts.
+
+    Args:
+        control: None, an `AbstractControl`, any callable (t, q, v) -> tau, or a constant real
+            array.
+
+    Returns:
+        None, the control itself, a `Function` of the callable or a `Constant` of the array.
+
+    Raises:
+        TypeError: control is a class rather than an instance, or an array that is not real.
+    """
     if control is None or isinstance(control, AbstractControl):
         return control
     if isinstance(control, type):

@@ -13,12 +13,27 @@ def _index(index):
 
 
 class PD(AbstractControl):
-    """tau = kp (q_ref - q[q_index]) + kd (v_ref - v[v_index]) + feedforward.
+    """A PD servo: tau = kp (q_ref - q[q_index]) + kd (v_ref - v[v_index]) + feedforward.
 
-    q_index and v_index pick the coordinates the servo acts on (all of them by default); they
-    differ where a joint's configuration and velocity coordinates do (after a floating base's
-    7 and 6). The gains may be scalars or one per coordinate; every array is a differentiable
-    leaf."""
+    Every array is a differentiable leaf; gains and targets may be scalars or one per servoed
+    coordinate.
+
+    Args:
+        kp: stiffness, a scalar or shape (m,) [N m / rad or N / m].
+        kd: damping, a scalar or shape (m,) [N m s / rad or N s / m].
+        q_ref: target configuration of the servoed coordinates, a scalar or shape (m,).
+        v_ref: target velocity, a scalar or shape (m,); 0 by default.
+        feedforward: force added to the feedback (a gravity torque, say), a scalar or shape
+            (m,); 0 by default.
+        q_index: the configuration coordinates the servo acts on, m indices; None (default)
+            for all of them. They differ from v_index where a joint's configuration and
+            velocity coordinates do (after a floating base's 7 and 6).
+        v_index: the velocity coordinates the servo acts on, m indices; given together with
+            q_index.
+
+    Raises:
+        ValueError: only one of q_index and v_index is given, or they differ in length.
+    """
 
     kp: Array
     kd: Array
@@ -44,10 +59,27 @@ class PD(AbstractControl):
 
 
 class MLPPolicy(AbstractControl):
-    """tau = scale MLP(q, v) (or of (t, q, v) with time=True), saturated at `limit` if given.
+    """A neural-network policy: tau = scale MLP(q, v), saturated at `limit` if given.
 
     The output layer starts at zero, so the untrained policy is no control at all and can be
-    added to a servo (`PD(...) + MLPPolicy(...)`) without disturbing it."""
+    added to a servo (`PD(...) + MLPPolicy(...)`) without disturbing it. The network's weights
+    are the trainable leaves.
+
+    Args:
+        n_in: the network's inputs, nq + nv of the system (time is added by `time=True`).
+        n_out: its outputs, the number of actuated coordinates.
+        key: a `jax.random` key for the hidden layers' initialization.
+        width: hidden layer width.
+        depth: number of hidden layers.
+        scale: factor on the network's output, in the control's units (N m).
+        limit: saturation level, limit tanh(tau / limit), a scalar or shape (n_out,); None
+            for none.
+        time: whether the network also takes t as its first input.
+        activation: the hidden layers' activation function.
+
+    Raises:
+        ValueError: when called on a state whose size does not match n_in.
+    """
 
     mlp: eqx.nn.MLP
     scale: Array

@@ -17,9 +17,21 @@ _GRID_TOLERANCE = 1e-6
 
 
 class ZeroOrderHold(AbstractControl):
-    """values[k] on [t0 + k dt, t0 + (k + 1) dt): a control history on a step grid, (K, ...)
-    (values[0] before t0, values[-1] after the last interval). A history of wrenches for
-    `external=` is (K, n_bodies, 6)."""
+    """A control history on a step grid: tau(t) = values[k] on [t0 + k dt, t0 + (k + 1) dt).
+
+    values[0] holds before t0 and values[-1] after the last interval. Inside `simulate`, every
+    stage of a step sees the value of the step's start (`hold`). The values are a
+    differentiable leaf.
+
+    Args:
+        values: the samples, shape (K, m) (a 1-D history of K samples is taken as (K, 1)); a
+            history of wrenches for `external=` is (K, n_bodies, 6).
+        dt: the sample interval [s], positive (normally the simulation's step).
+        t0: the time of values[0] [s].
+
+    Raises:
+        ValueError: values is empty or dt is not positive.
+    """
 
     values: Array
     dt: float = eqx.field(static=True)
@@ -38,6 +50,7 @@ class ZeroOrderHold(AbstractControl):
         self.t0 = float(t0)
 
     def index(self, t: Array) -> Array:
+        """The sample index k in effect at time t, clipped to 0 ... K - 1 (int32)."""
         k = jnp.floor((t - self.t0) / self.dt + _GRID_TOLERANCE)
         return jnp.clip(k, 0, self.values.shape[0] - 1).astype(jnp.int32)
 
@@ -49,8 +62,15 @@ class ZeroOrderHold(AbstractControl):
 
 
 class SampleAndHold(AbstractControl):
-    """Any control sampled at the start of each step of `simulate` and held over it (a feedback
-    law run at the simulation rate, as MuJoCo applies `ctrl`). Called directly, it is the law."""
+    """Any control sampled at the start of each step of `simulate` and held over it.
+
+    A feedback law run at the simulation rate, as MuJoCo applies `ctrl`. Called directly, it is
+    the law itself.
+
+    Args:
+        control: the law to sample (an `AbstractControl`, a callable (t, q, v) -> tau or a
+            constant array).
+    """
 
     control: AbstractControl
 

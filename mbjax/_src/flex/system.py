@@ -13,16 +13,15 @@ import jax
 import jax.numpy as jnp
 from jax import Array
 
-from mbjax._src.control import AbstractControl, as_control
-from mbjax._src.system.driven import about_origins, check_actuation, check_control, check_points
+from mbjax._src.control import AbstractControl
+from mbjax._src.system.driven import about_origins, drive
+from mbjax._src.system.dynamics import AbstractForwardDynamics, Auto, Recursive, as_dynamics
 from mbjax._src.flex.aba import flexible_aba_responses
 from mbjax._src.flex.body import kinetic_energy as body_kinetic_energy
 from mbjax._src.flex.kinematics import body_velocities, frame_poses, marker_forces
 from mbjax._src.flex.lagrange import dense_forward_dynamics, potential_energy
 from mbjax._src.flex.model import FlexibleModel
 from mbjax._src.system.tree_system import AbstractTreeSystem
-
-METHODS = ("recursive", "dense")
 
 
 class FlexibleSystem(AbstractTreeSystem):
@@ -47,21 +46,17 @@ class FlexibleSystem(AbstractTreeSystem):
     external: AbstractControl | None
     external_point: Array | None
     actuation: tuple[int, ...] | None = eqx.field(static=True)
-    method: str = eqx.field(static=True)
+    method: AbstractForwardDynamics = eqx.field(static=True)
     symmetric_dynamics: ClassVar[bool] = False
 
     def __init__(self, model: FlexibleModel, control=None, *, external=None, external_point=None,
-                 actuation=None, method: str = "recursive"):
+                 actuation=None, method: AbstractForwardDynamics = Auto()):
         if not isinstance(model, FlexibleModel):
             raise TypeError(f"model must be a FlexibleModel, got {type(model).__name__}")
-        if method not in METHODS:
-            raise ValueError(f"method must be one of {METHODS}, got {method!r}")
         self.model = model
-        self.actuation = check_actuation(actuation, model.nv)
-        self.control = check_control(control, self.actuation, model.nv)
-        self.external = as_control(external)
-        self.external_point = check_points(external_point, model.n)
-        self.method = method
+        self.control, self.external, self.external_point, self.actuation = drive(
+            control, external, external_point, actuation, nv=model.nv, n=model.n)
+        self.method = as_dynamics(method)
 
     def frames(self, q):
         """Body frames (joint grids), then the markers at grid points, deformation included."""
@@ -112,6 +107,6 @@ class FlexibleSystem(AbstractTreeSystem):
 
     def responses(self, t, q, v, loads):
         tau, f = self._loads(t, q, v)
-        if self.method == "dense":
-            return dense_forward_dynamics(self.model, q, v, tau, f, loads)
-        return flexible_aba_responses(self.model, q, v, tau, loads, f)
+        if isinstance(self.method.resolve(self.nv), Recursive):
+            return flexible_aba_responses(self.model, q, v, tau, loads, f)
+        return dense_forward_dynamics(self.model, q, v, tau, f, loads)

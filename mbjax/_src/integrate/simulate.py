@@ -14,7 +14,6 @@ from mbjax._src.integrate.solution import Solution
 from mbjax._src.system.accuracy import ERROR_SAMPLES, doubled, number, sample_indices, tolerances
 from mbjax._src.system.status import Status, raise_on_failure
 from mbjax._src.system.system import AbstractSystem
-from mbjax._src.system.tree_system import state_sizes
 
 
 def _state(x, name: str, size: int | None) -> Array:
@@ -131,7 +130,7 @@ def simulate(system: AbstractSystem, integrator: AbstractIntegrator, q0: Array, 
     # with a tolerance the rollout also keeps the states the error estimate samples
     kept = np.union1d(idx, _sample_steps(n_steps, idx)) if checked else idx
     block = math.gcd(*kept.tolist(), n_steps)
-    nq, nv = state_sizes(system)
+    nq, nv = system.state_sizes()
     q0, u0 = _state(q0, "q0", nq), _state(u0, "u0", nv)
     qs, us, status = _rollout(system, integrator, q0, u0, float(t0), float(dt), block,
                               n_steps // block, tuple((kept // block).tolist()),

@@ -15,7 +15,21 @@ from mbjax._src.lie.series import COS_HALF, SIN_HALF_OVER_PHI, even_series
 
 @jax.jit
 def quat_multiply(p: Array, q: Array) -> Array:
-    """Hamilton product p * q."""
+    """The Hamilton product p * q of two quaternions (w, x, y, z).
+
+    quat_to_matrix(p * q) == quat_to_matrix(p) @ quat_to_matrix(q) for unit quaternions.
+
+    Args:
+        p: the left factor, shape (4,).
+        q: the right factor, shape (4,).
+
+    Returns:
+        The product, shape (4,).
+
+    Raises:
+        ValueError: p or q does not have shape (4,).
+        TypeError: p or q is complex or not numeric.
+    """
     p, q = _inputs.quaternion(p, "quat_multiply", "p"), _inputs.quaternion(q, "quat_multiply")
     pw, pv = p[0], p[1:]
     qw, qv = q[0], q[1:]
@@ -27,21 +41,55 @@ def quat_multiply(p: Array, q: Array) -> Array:
 
 @jax.jit
 def quat_conjugate(q: Array) -> Array:
-    """The inverse rotation of a unit quaternion."""
+    """The conjugate (w, -x, -y, -z): the inverse rotation of a unit quaternion.
+
+    Args:
+        q: quaternion (w, x, y, z), shape (4,).
+
+    Returns:
+        The conjugate quaternion, shape (4,).
+
+    Raises:
+        ValueError: q does not have shape (4,).
+        TypeError: q is complex or not numeric.
+    """
     q = _inputs.quaternion(q, "quat_conjugate")
     return q * jnp.array([1.0, -1.0, -1.0, -1.0], dtype=q.dtype)
 
 
 @jax.jit
 def quat_normalize(q: Array) -> Array:
-    """Project q onto the unit sphere."""
+    """q scaled to unit length (projected onto the unit sphere).
+
+    Args:
+        q: a nonzero quaternion (w, x, y, z), shape (4,).
+
+    Returns:
+        q / |q|, shape (4,).
+
+    Raises:
+        ValueError: q does not have shape (4,).
+        TypeError: q is complex or not numeric.
+    """
     q = _inputs.quaternion(q, "quat_normalize")
     return q / jnp.linalg.norm(q)
 
 
 @jax.jit
 def quat_to_matrix(q: Array) -> Array:
-    """Rotation matrix of a unit quaternion."""
+    """The rotation matrix of a unit quaternion.
+
+    Args:
+        q: unit quaternion (w, x, y, z), w the scalar part, shape (4,). It is not normalized
+            here: normalize a drifted one first (`quat_normalize`).
+
+    Returns:
+        The rotation matrix, equal to exp(r) for q = (cos(phi/2), sin(phi/2) e), shape (3, 3).
+
+    Raises:
+        ValueError: q does not have shape (4,).
+        TypeError: q is complex or not numeric.
+    """
     q = _inputs.quaternion(q, "quat_to_matrix")
     w, x, y, z = q
     return jnp.array([
@@ -53,7 +101,20 @@ def quat_to_matrix(q: Array) -> Array:
 
 @jax.jit
 def quat_from_rotvec(r: Array) -> Array:
-    """q = (cos(phi/2), sin(phi/2)/phi r), exact and differentiable at r = 0."""
+    """The unit quaternion of a rotation vector: q = (cos(phi/2), sin(phi/2) / phi r).
+
+    Exact and differentiable at r = 0 (power series below phi = 0.5).
+
+    Args:
+        r: rotation vector phi e (angle phi [rad] about the unit axis e), shape (3,).
+
+    Returns:
+        The unit quaternion (w, x, y, z), shape (4,).
+
+    Raises:
+        ValueError: r does not have shape (3,).
+        TypeError: r is complex or not numeric.
+    """
     r = _inputs.rotation_vector(r, "quat_from_rotvec")
     phi2 = jnp.dot(r, r)
     w = even_series(phi2, lambda p2: jnp.cos(0.5 * jnp.sqrt(p2)), COS_HALF)
@@ -63,7 +124,21 @@ def quat_from_rotvec(r: Array) -> Array:
 
 @jax.jit
 def rotvec_from_quat(q: Array) -> Array:
-    """Principal rotation vector (|r| <= pi) of a unit quaternion: r = 2 atan2(|v|, w) v / |v|."""
+    """The principal rotation vector of a unit quaternion: r = 2 atan2(|v|, w) v / |v|.
+
+    q and -q are the same rotation; the one with w >= 0 is used, so that |r| <= pi.
+    Differentiable to every order at the identity and at a half turn.
+
+    Args:
+        q: unit quaternion (w, x, y, z) = (w, v), shape (4,).
+
+    Returns:
+        The rotation vector r, |r| <= pi, shape (3,).
+
+    Raises:
+        ValueError: q does not have shape (4,).
+        TypeError: q is complex or not numeric.
+    """
     q = _inputs.quaternion(q, "rotvec_from_quat")
     q = jnp.where(q[0] < 0, -q, q)  # q and -q are the same rotation; w >= 0 picks |r| <= pi
     w, v = q[0], q[1:]
@@ -83,11 +158,22 @@ def rotvec_from_quat(q: Array) -> Array:
 
 @jax.jit
 def quat_from_matrix(R: Array) -> Array:
-    """Unit quaternion of a rotation matrix by Shepperd's method.
+    """The unit quaternion of a rotation matrix, by Shepperd's method.
 
     Of the four equivalent formulas the one with the largest pivot 4 q_k^2 (>= 1) is used, so
     the square root and the division are always well conditioned; the others are fed a safe
     value so that their (discarded) derivatives stay finite.
+
+    Args:
+        R: rotation matrix, shape (3, 3). It is not checked to be a rotation (`log` checks).
+
+    Returns:
+        A unit quaternion (w, x, y, z) of R, shape (4,); its sign is that of the formula
+        chosen (q and -q are the same rotation).
+
+    Raises:
+        ValueError: R does not have shape (3, 3).
+        TypeError: R is complex or not numeric.
     """
     R = _inputs.matrix(R, "quat_from_matrix")
     tr = R[0, 0] + R[1, 1] + R[2, 2]

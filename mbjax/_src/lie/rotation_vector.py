@@ -26,7 +26,18 @@ from mbjax._src.lie.quaternion import quat_from_matrix, rotvec_from_quat
 
 @jax.jit
 def hat(v: Array) -> Array:
-    """The skew matrix v x I, so that hat(v) @ w == cross(v, w)."""
+    """The skew matrix v x I, so that hat(v) @ w == cross(v, w).
+
+    Args:
+        v: a 3-vector, shape (3,).
+
+    Returns:
+        The skew-symmetric matrix of v, shape (3, 3).
+
+    Raises:
+        ValueError: v does not have shape (3,) (map a batch with `jax.vmap`).
+        TypeError: v is complex or not numeric.
+    """
     v = _inputs.real(v, (3,), "hat", "v", "a 3-vector")
     zero = jnp.zeros_like(v[0])
     return jnp.array([
@@ -38,7 +49,18 @@ def hat(v: Array) -> Array:
 
 @jax.jit
 def vee(S: Array) -> Array:
-    """The vector of the skew part of S (inverse of `hat` on skew matrices)."""
+    """The vector of the skew part of S, the inverse of `hat` on skew matrices.
+
+    Args:
+        S: a matrix, shape (3, 3); its symmetric part is ignored.
+
+    Returns:
+        The vector v with hat(v) = (S - S^T) / 2, shape (3,).
+
+    Raises:
+        ValueError: S does not have shape (3, 3).
+        TypeError: S is complex or not numeric.
+    """
     S = _inputs.matrix(S, "vee", "S")
     return 0.5 * jnp.array([S[2, 1] - S[1, 2], S[0, 2] - S[2, 0], S[1, 0] - S[0, 1]])
 
@@ -56,7 +78,21 @@ def _coefficients(r: Array):
 
 @jax.jit
 def exp(r: Array) -> Array:
-    """Rotation matrix R = exp(r x I) = I + a_o (r x I) + a_1 (r x I)^2 (Borri 1990 eqs A.3, A.6)."""
+    """The rotation matrix of a rotation vector: R = exp(r x I) (Borri 1990 eqs A.3, A.6).
+
+    Evaluated as R = I + a_o (r x I) + a_1 (r x I)^2 with a_o = sin(phi) / phi and
+    a_1 = (1 - cos phi) / phi^2 (eq A.23), phi = |r|; exact and differentiable at r = 0.
+
+    Args:
+        r: rotation vector phi e (angle phi [rad] about the unit axis e), shape (3,).
+
+    Returns:
+        The rotation matrix R, shape (3, 3).
+
+    Raises:
+        ValueError: r does not have shape (3,) (map a batch with `jax.vmap`).
+        TypeError: r is complex or not numeric.
+    """
     r = _inputs.rotation_vector(r, "exp")
     a_o, a_1, _ = _coefficients(r)
     K = hat(r)
@@ -65,7 +101,23 @@ def exp(r: Array) -> Array:
 
 @jax.jit
 def gamma(r: Array) -> Array:
-    """Tangent map Gamma(r) = I + a_1 (r x I) + b_1 (r x I)^2, omega = Gamma r_dot (eqs 2.9, A.17)."""
+    """The tangent map Gamma(r), which gives the angular velocity omega = Gamma(r) r_dot.
+
+    Gamma(r) = I + a_1 (r x I) + b_1 (r x I)^2 with a_1 = (1 - cos phi) / phi^2 and
+    b_1 = (phi - sin phi) / phi^3 (Borri 1990 eqs 2.9, A.17, A.23); omega is the spatial
+    angular velocity (eq A.11). The same Gamma maps variations of r to virtual rotations
+    (eq A.19).
+
+    Args:
+        r: rotation vector, shape (3,).
+
+    Returns:
+        Gamma(r), shape (3, 3).
+
+    Raises:
+        ValueError: r does not have shape (3,).
+        TypeError: r is complex or not numeric.
+    """
     r = _inputs.rotation_vector(r, "gamma")
     _, a_1, b_1 = _coefficients(r)
     K = hat(r)
@@ -74,11 +126,22 @@ def gamma(r: Array) -> Array:
 
 @jax.jit
 def gamma_inv(r: Array) -> Array:
-    """Gamma^-1 = I - (r x I)/2 + (1 - a_o / (2 a_1)) / phi^2 (r x I)^2 (Borri 1990 eq A.21).
+    """The inverse tangent map Gamma(r)^-1, which gives r_dot = Gamma(r)^-1 omega.
 
+    Gamma^-1 = I - (r x I)/2 + (1 - a_o / (2 a_1)) / phi^2 (r x I)^2 (Borri 1990 eq A.21).
     The paper prints a_o / (2 b_1); the consistent coefficient, which its eq A.57 uses as
     a_o / (2 b_o) with b_o = a_1, is a_o / (2 a_1) = (phi/2) cot(phi/2). Singular at
     phi = 2 pi n, n >= 1 (eq A.28); see `rescale`.
+
+    Args:
+        r: rotation vector, shape (3,); |r| must stay away from 2 pi n, n >= 1.
+
+    Returns:
+        Gamma(r)^-1, shape (3, 3).
+
+    Raises:
+        ValueError: r does not have shape (3,).
+        TypeError: r is complex or not numeric.
     """
     r = _inputs.rotation_vector(r, "gamma_inv")
     phi2 = jnp.dot(r, r)
@@ -94,7 +157,20 @@ def gamma_inv(r: Array) -> Array:
 
 @jax.jit
 def det_gamma(r: Array) -> Array:
-    """det Gamma(r) = 2 (1 - cos phi) / phi^2 (Borri 1990 eq A.28); zero at phi = 2 pi n, n >= 1."""
+    """The determinant of the tangent map, det Gamma(r) = 2 (1 - cos phi) / phi^2.
+
+    Borri 1990 eq A.28; zero at phi = 2 pi n, n >= 1, where Gamma is singular.
+
+    Args:
+        r: rotation vector, shape (3,).
+
+    Returns:
+        det Gamma(r), a scalar.
+
+    Raises:
+        ValueError: r does not have shape (3,).
+        TypeError: r is complex or not numeric.
+    """
     r = _inputs.rotation_vector(r, "det_gamma")
     return 2.0 * _coefficients(r)[1]
 
@@ -106,6 +182,16 @@ def rescale(r: Array) -> Array:
     Both describe the same rotation and Gamma(r_p) dr_p = Gamma(r) dr (eq A.36). The paper takes
     n = int(phi / 2 pi); here n is the nearest integer, which gives the principal vector
     (|r_p| <= pi) and so stays as far as possible from the singularity of Gamma at 2 pi.
+
+    Args:
+        r: rotation vector, shape (3,).
+
+    Returns:
+        The principal rotation vector of the same rotation, |r_p| <= pi, shape (3,).
+
+    Raises:
+        ValueError: r does not have shape (3,).
+        TypeError: r is complex or not numeric.
     """
     r = _inputs.rotation_vector(r, "rescale")
     phi2 = jnp.dot(r, r)
@@ -121,14 +207,27 @@ def _rotation_tolerance(dtype) -> float:
 
 @partial(jax.jit, static_argnames="check")
 def log(R: Array, check: bool = True) -> Array:
-    """Principal rotation vector r (|r| <= pi) with exp(r) = R.
+    """The principal rotation vector r (|r| <= pi) with exp(r) = R.
 
-    Computed through the quaternion of R (Shepperd's method), which is accurate and differentiable
-    at every angle, including 0 and pi. A matrix that is not a rotation (R^T R != I or det R != 1
-    beyond round-off) raises a clear error, also under `jit`; check=False skips that test, for
-    callers whose R is a rotation by construction (a product of rotations): the run-time error is
-    a host callback, which keeps a compiled program out of the persistent compilation cache and
-    a loop around it from compiling as one kernel (`mbjax._src.runtime`).
+    Computed through the quaternion of R (Shepperd's method), which is accurate and
+    differentiable at every angle, including 0 and pi.
+
+    Args:
+        R: rotation matrix, shape (3, 3).
+        check: test that R is a rotation (R^T R = I and det R = 1 to round-off), also under
+            `jit`. Pass False where R is a rotation by construction (a product of rotations):
+            the run-time test is a host callback, which keeps a compiled program out of the
+            persistent compilation cache and a loop around it from compiling as one kernel
+            (`mbjax._src.runtime`).
+
+    Returns:
+        The rotation vector r, |r| <= pi, shape (3,).
+
+    Raises:
+        ValueError: R does not have shape (3, 3).
+        TypeError: R is complex or not numeric.
+        equinox.EquinoxRuntimeError: with check=True, R is not a rotation (raised when the
+            compiled program runs).
     """
     R = _inputs.matrix(R, "log")
     if check:

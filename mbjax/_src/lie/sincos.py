@@ -3,10 +3,9 @@
 XLA's CPU backend emits `jnp.sin` and `jnp.cos` of float64 as calls into the C library, one
 element at a time; inside a loop it compiles as one kernel (`mbjax._src.runtime`) they cost more still,
 and their cost depends on the argument. `sincos` computes both from one range reduction and two
-polynomials, multiplies and adds only, which XLA fuses and vectorizes with the code around them.
-Measured on the batched forward dynamics of the 7-link chain (`mbjax.rigid.batch_aba`, B = 4096,
-angles uniform in [-pi, pi), 2-core x86_64): the sines and cosines of the joint angles took
-0.14 us per state of the 0.72, inside the chunk loop 0.5-0.9 us (benchmarks/README.md, speed).
+polynomials, multiplies and adds only, which XLA fuses and vectorizes with the code around them;
+in the batched forward dynamics the library calls were a large share of the time (see
+benchmarks/README.md).
 
 The method is Cephes' (S. L. Moshier, Methods and Programs for Mathematical Functions, 1989;
 Cephes 2.8 `sin.c`): |x| is reduced by the nearest even multiple k of pi/4 in three parts
@@ -62,7 +61,15 @@ def _library(x: Array) -> tuple[Array, Array]:
 @jax.custom_jvp
 @jax.jit
 def sincos(x) -> tuple[Array, Array]:
-    """(sin x, cos x), elementwise (see the module)."""
+    """Sine and cosine of x together, elementwise (see the module for the method).
+
+    Args:
+        x: angles [rad], any shape; float64 takes the polynomial route, other dtypes
+            `jnp.sin` and `jnp.cos`.
+
+    Returns:
+        (sin x, cos x), each of x's shape and dtype.
+    """
     x = jnp.asarray(x)
     if x.dtype != jnp.float64:
         return _library(x)

@@ -129,6 +129,18 @@ class ClosedSystem(AbstractSystem):
     def project(self, q):
         return self.tree.normalize(q)
 
+    def state_sizes(self):
+        """The tree's nq; u is the method's (`Stabilized(epsilon > 0)` adds the loads to v)."""
+        return self.tree.nq, None
+
+    @property
+    def n_controls(self) -> int:
+        return self.tree.n_controls
+
+    def with_control(self, control) -> "ClosedSystem":
+        """The closed system with its tree driven by `control`."""
+        return eqx.tree_at(lambda s: s.loops.tree, self, self.tree.with_control(control))
+
     def hold(self, t, q, u):
         tree = self.tree.hold(t, q, self.velocity(q, u))
         return self if tree is self.tree else eqx.tree_at(lambda s: s.loops.tree, self, tree)

@@ -6,8 +6,6 @@ from mbjax._src.rigid.batched import batch_aba, batched_forward_dynamics
 from mbjax._src.rigid.body import RigidBody
 from mbjax._src.rigid.dense import constraint_forces, dense_forward_dynamics, joint_reactions
 from mbjax._src.rigid.dynamics import (
-    METHODS,
-    choose_method,
     forward_dynamics,
     inverse_dynamics,
     mass_matrix,
@@ -33,9 +31,9 @@ from mbjax._src.rigid.system import BatchTreeSystem, MomentumSystem, TreeSystem
 from mbjax._src.rigid.torque_free import torque_free_motion
 
 __all__ = [
-    "METHODS", "BatchTreeSystem", "MomentumSystem", "RigidBody", "TreeSystem", "aba", "batch_aba",
+    "BatchTreeSystem", "MomentumSystem", "RigidBody", "TreeSystem", "aba", "batch_aba",
     "batched_forward_dynamics", "body_kinematics",
-    "choose_method", "constraint_forces", "constraint_forces_momentum", "dense_forward_dynamics",
+    "constraint_forces", "constraint_forces_momentum", "dense_forward_dynamics",
     "energy", "forward_dynamics", "forward_kinematics", "frame_jacobian", "frame_names",
     "frame_placement", "frame_pose", "frame_poses", "inverse_dynamics", "inverse_operator",
     "joint_reactions",

@@ -18,17 +18,14 @@ import numpy as np
 from jax import Array
 
 from mbjax._src import lie
-from mbjax._src.control import AbstractControl, as_control
-from mbjax._src.system.driven import (about_origins, body_wrenches, check_actuation, check_control,
-                                   check_points, generalized_control, hold)
+from mbjax._src.control import AbstractControl
+from mbjax._src.lie.coordinates import AbstractRotation, Quaternion
+from mbjax._src.system.driven import AbstractDrivenSystem, about_origins, drive
 from mbjax._src.system.invariants import Invariants, along_gravity, energy_invariant, join
-from mbjax._src.system.system import AbstractSystem
 from mbjax._src.spatial import check_inertia
 
-ROTATIONS = ("quaternion", "rotvec")
 
-
-class RigidBody(AbstractSystem):
+class RigidBody(AbstractDrivenSystem):
     """A rigid body of `mass` and body-frame `inertia` under uniform `gravity`.
 
     fixed_point=False: a free body; `inertia` is about the centre of mass and q = (rot, x).
@@ -51,13 +48,14 @@ class RigidBody(AbstractSystem):
     external_point: Array | None
     actuation: tuple[int, ...] | None = eqx.field(static=True)
     fixed_point: bool = eqx.field(static=True)
-    rotation: str = eqx.field(static=True)
+    rotation: AbstractRotation = eqx.field(static=True)
 
     def __init__(self, mass, inertia, *, com=(0.0, 0.0, 0.0), gravity=(0.0, 0.0, -9.81),
-                 fixed_point: bool = False, rotation: str = "quaternion", control=None,
+                 fixed_point: bool = False, rotation: AbstractRotation = Quaternion(), control=None,
                  external=None, external_point=None, actuation=None):
-        if rotation not in ROTATIONS:
-            raise ValueError(f"rotation must be one of {ROTATIONS}, got {rotation!r}")
+        if not isinstance(rotation, AbstractRotation):
+            raise TypeError(f"rotation must be mbjax.lie.Quaternion() or mbjax.lie.RotationVector(), "
+                            f"got {rotation!r}")
         check_inertia(inertia, "RigidBody")
         if not isinstance(mass, jax.core.Tracer) and not float(mass) > 0:
             raise ValueError(f"mass must be positive, got {mass}")
@@ -69,22 +67,29 @@ class RigidBody(AbstractSystem):
         self.gravity = jnp.asarray(gravity, dtype=float)
         self.fixed_point = fixed_point
         self.rotation = rotation
-        nv = 3 if fixed_point else 6
-        self.actuation = check_actuation(actuation, nv)
-        self.control = check_control(control, self.actuation, nv)
-        self.external = as_control(external)
-        self.external_point = check_points(external_point, 1)
+        self.control, self.external, self.external_point, self.actuation = drive(
+            control, external, external_point, actuation, nv=3 if fixed_point else 6, n=1)
 
     # -- coordinates ---------------------------------------------------------------------------
 
     @property
+    def n(self) -> int:
+        """One body."""
+        return 1
+
+    @property
+    def nv(self) -> int:
+        """3 velocity coordinates about a fixed point, 6 for a free body."""
+        return 3 if self.fixed_point else 6
+
+    @property
     def n_rot(self) -> int:
-        return 4 if self.rotation == "quaternion" else 3
+        return self.rotation.size
 
     def rotation_matrix(self, q: Array) -> Array:
         """R, body to space."""
         rot = q[: self.n_rot]
-        return lie.quat_to_matrix(rot) if self.rotation == "quaternion" else lie.exp(rot)
+        return self.rotation.to_matrix(rot)
 
     def position(self, q: Array) -> Array:
         """Centre of mass in space."""
@@ -95,7 +100,7 @@ class RigidBody(AbstractSystem):
     def initial_state(self, R0, Omega0, x0=(0.0, 0.0, 0.0), v0=(0.0, 0.0, 0.0)):
         """(q0, u0) from a rotation matrix, body angular velocity and (free body) COM motion."""
         R0 = jnp.asarray(R0, dtype=float)
-        rot = lie.quat_from_matrix(R0) if self.rotation == "quaternion" else lie.log(R0)
+        rot = self.rotation.from_matrix(R0)
         Omega0 = jnp.asarray(Omega0, dtype=float)
         if self.fixed_point:
             return rot, Omega0
@@ -106,10 +111,7 @@ class RigidBody(AbstractSystem):
 
     def kinematics(self, q, u):
         rot, Omega = q[: self.n_rot], u[:3]
-        if self.rotation == "quaternion":
-            rot_dot = 0.5 * lie.quat_multiply(rot, jnp.concatenate([jnp.zeros(1, Omega.dtype), Omega]))
-        else:
-            rot_dot = lie.gamma_inv(rot).T @ Omega
+        rot_dot = self.rotation.rate(rot, Omega)
         return rot_dot if self.fixed_point else jnp.concatenate([rot_dot, u[3:]])
 
     def acceleration(self, t, q, u):
@@ -120,11 +122,11 @@ class RigidBody(AbstractSystem):
         R = self.rotation_matrix(q)
         tau = jnp.cross(self.com, self.mass * (R.T @ self.gravity))
         force = jnp.zeros(3, u.dtype)
-        f = body_wrenches(self.external, 1, t, q, u)
+        f = self.external_wrenches(t, q, u)
         if f is not None:
             f = about_origins(f, R[None], self.external_point)[0]
             tau, force = tau + R.T @ f[:3], force + f[3:]
-        applied = generalized_control(self.control, self.actuation, u.shape[0], t, q, u)
+        applied = self.applied(t, q, u)
         tau = tau + applied[:3]
         chol = jax.scipy.linalg.cho_factor(self.inertia)
         Omega_dot = jax.scipy.linalg.cho_solve(chol, tau - jnp.cross(Omega, self.inertia @ Omega))
@@ -134,12 +136,7 @@ class RigidBody(AbstractSystem):
 
     def retract(self, q0, xi):
         """R = R0 exp(xi_rot) (body-frame increment), x = x0 + xi_x."""
-        rot0 = q0[: self.n_rot]
-        if self.rotation == "quaternion":
-            rot = lie.quat_multiply(rot0, lie.quat_from_rotvec(xi[:3]))
-        else:
-            rot = lie.rotvec_from_quat(
-                lie.quat_multiply(lie.quat_from_rotvec(rot0), lie.quat_from_rotvec(xi[:3])))
+        rot = self.rotation.retract(q0[: self.n_rot], xi[:3])
         return rot if self.fixed_point else jnp.concatenate([rot, q0[self.n_rot:] + xi[3:]])
 
     def local_rate(self, q0, xi, u):
@@ -147,12 +144,9 @@ class RigidBody(AbstractSystem):
         xi_dot = lie.gamma_inv(xi[:3]).T @ u[:3]
         return xi_dot if self.fixed_point else jnp.concatenate([xi_dot, u[3:]])
 
-    def hold(self, t, q, u):
-        return hold(self, t, q, u)
-
     def project(self, q):
         rot = q[: self.n_rot]
-        rot = lie.quat_normalize(rot) if self.rotation == "quaternion" else lie.rescale(rot)
+        rot = self.rotation.normalize(rot)
         return rot if self.fixed_point else jnp.concatenate([rot, q[self.n_rot:]])
 
     # -- invariants ----------------------------------------------------------------------------
@@ -178,7 +172,7 @@ class RigidBody(AbstractSystem):
         angular momentum about the origin along gravity (all of it without gravity: gravity's
         moment is normal to it) and, for a free body, the momentum less the weight's impulse,
         m (v - g t) (against the momenta's magnitudes). None otherwise."""
-        if self.control is not None or self.external is not None:
+        if not self.passive:
             return None
         spin = self.rotation_matrix(q) @ (self.inertia @ u[:3])
         orbital = (jnp.zeros(3, u.dtype) if self.fixed_point

@@ -16,16 +16,9 @@ import equinox as eqx
 import jax.numpy as jnp
 from jax import Array
 
-from mbjax._src.control import AbstractControl, as_control
-from mbjax._src.system.driven import (
-    about_origins,
-    body_wrenches,
-    check_actuation,
-    check_control,
-    check_points,
-    generalized_control,
-    hold,
-)
+from mbjax._src.control import AbstractControl
+from mbjax._src.system.driven import AbstractDrivenSystem, about_origins, drive, held
+from mbjax._src.system.dynamics import AbstractForwardDynamics, Auto, Recursive, as_dynamics
 from mbjax._src.system.invariants import join
 from mbjax._src.system.system import AbstractSystem
 from mbjax._src.system.tree_system import AbstractTreeSystem
@@ -35,7 +28,7 @@ from mbjax._src.model.limits import exceeded
 from mbjax._src.rigid.aba import aba_responses
 from mbjax._src.rigid.batched import batch_aba
 from mbjax._src.rigid.dense import dense_responses
-from mbjax._src.rigid.dynamics import METHODS, choose_method, forward_dynamics, mass_matrix
+from mbjax._src.rigid.dynamics import forward_dynamics, mass_matrix
 from mbjax._src.rigid.energy import energy, floating, free_momenta, kinetic_energy
 from mbjax._src.rigid.kinematics import forward_kinematics
 from mbjax._src.rigid.momentum import momentum_rate, velocity_from_momentum
@@ -66,19 +59,15 @@ class TreeSystem(AbstractTreeSystem):
     external: AbstractControl | None
     external_point: Array | None
     actuation: tuple[int, ...] | None = eqx.field(static=True)
-    method: str = eqx.field(static=True)
+    method: AbstractForwardDynamics = eqx.field(static=True)
     symmetric_dynamics: ClassVar[bool] = True
 
     def __init__(self, model: Model, control=None, *, external=None, external_point=None,
-                 actuation=None, method: str = "auto"):
-        if method not in METHODS:
-            raise ValueError(f"method must be one of {METHODS}, got {method!r}")
+                 actuation=None, method: AbstractForwardDynamics = Auto()):
         self.model = _model(model)
-        self.actuation = check_actuation(actuation, model.nv)
-        self.control = check_control(control, self.actuation, model.nv)
-        self.external = as_control(external)
-        self.external_point = check_points(external_point, model.n)
-        self.method = method
+        self.control, self.external, self.external_point, self.actuation = drive(
+            control, external, external_point, actuation, nv=model.nv, n=model.n)
+        self.method = as_dynamics(method)
 
     def frames(self, q):
         return forward_kinematics(self.model, q)
@@ -111,8 +100,8 @@ class TreeSystem(AbstractTreeSystem):
 
     def responses(self, t, q, v, loads):
         tau, f = self.applied(t, q, v), self.wrenches(t, q, v)
-        method = choose_method(self.model) if self.method == "auto" else self.method
-        route = aba_responses if method == "recursive" else dense_responses
+        recursive = isinstance(self.method.resolve(self.model.nv), Recursive)
+        route = aba_responses if recursive else dense_responses
         return route(self.model, q, v, tau, loads, f)
 
     def acceleration(self, t, q, u):
@@ -148,7 +137,7 @@ class BatchTreeSystem(AbstractSystem):
         return batch_aba(self.model, q, u, self.tau)
 
 
-class MomentumSystem(AbstractSystem):
+class MomentumSystem(AbstractDrivenSystem):
     """u = p = M(q) v, the free momenta (Jerkovsky 1978 eq 73); u_dot from eq 72. Controls and
     external wrenches as for `TreeSystem`."""
 
@@ -161,10 +150,16 @@ class MomentumSystem(AbstractSystem):
     def __init__(self, model: Model, control=None, *, external=None, external_point=None,
                  actuation=None):
         self.model = _model(model)
-        self.actuation = check_actuation(actuation, model.nv)
-        self.control = check_control(control, self.actuation, model.nv)
-        self.external = as_control(external)
-        self.external_point = check_points(external_point, model.n)
+        self.control, self.external, self.external_point, self.actuation = drive(
+            control, external, external_point, actuation, nv=model.nv, n=model.n)
+
+    @property
+    def n(self) -> int:
+        return self.model.n
+
+    @property
+    def nv(self) -> int:
+        return self.model.nv
 
     def velocity(self, q, p):
         return velocity_from_momentum(self.model, q, p)
@@ -174,11 +169,10 @@ class MomentumSystem(AbstractSystem):
 
     def acceleration(self, t, q, u):
         v = self.velocity(q, u)
-        f = body_wrenches(self.external, self.model.n, t, q, v)
+        f = self.external_wrenches(t, q, v)
         if f is not None and self.external_point is not None:
             f = about_origins(f, forward_kinematics(self.model, q)[0], self.external_point)
-        tau = generalized_control(self.control, self.actuation, self.model.nv, t, q, v)
-        return momentum_rate(self.model, q, v, tau, f)
+        return momentum_rate(self.model, q, v, self.applied(t, q, v), f)
 
     def retract(self, q0, xi):
         return self.model.retract(q0, xi)
@@ -190,7 +184,7 @@ class MomentumSystem(AbstractSystem):
         return self.model.normalize(q)
 
     def hold(self, t, q, u):
-        return hold(self, t, q, self.velocity(q, u))
+        return held(self, t, q, self.velocity(q, u))
 
     def energy(self, q, u):
         return energy(self.model, q, self.velocity(q, u))
@@ -198,6 +192,6 @@ class MomentumSystem(AbstractSystem):
     def invariants(self, t, q, u):
         """As `TreeSystem`'s, at the velocities of the momenta (none under a control or an
         external load)."""
-        if self.control is not None or self.external is not None:
+        if not self.passive:
             return None
         return TreeSystem(self.model).invariants(t, q, self.velocity(q, u))

@@ -101,5 +101,5 @@ def synthesis_guess(problem) -> jnp.ndarray:
     from mbjax._src.synthesis.baseline import ToolPath, feedforward_torques
 
     ts = (np.arange(problem.horizon) + 0.5) * problem.dt
-    tau = feedforward_torques(problem.system.wrist, ToolPath(START, GOAL, DURATION), ts)
+    tau = feedforward_torques(problem.system.model, ToolPath(START, GOAL, DURATION), ts)
     return jnp.clip(jnp.asarray(tau), -TORQUE_LIMIT, TORQUE_LIMIT)

@@ -8,6 +8,7 @@ W0 = [0, 0, 50] rad/s, 10 s.
 import jax.numpy as jnp
 
 from mbjax._src import lie
+from mbjax._src.lie.coordinates import AbstractRotation, Quaternion
 from mbjax._src.rigid import RigidBody
 
 GRAVITY = 9.81
@@ -18,7 +19,7 @@ W0 = (0.0, 0.0, 50.0)
 DURATION = 10.0
 
 
-def build(rotation: str = "quaternion"):
+def build(rotation: AbstractRotation = Quaternion()):
     """(body, q0, u0) of the scene."""
     body = RigidBody(MGL / GRAVITY, jnp.diag(jnp.array(INERTIA)), com=(0.0, 0.0, 1.0),
                      gravity=(0.0, 0.0, -GRAVITY), fixed_point=True, rotation=rotation)

@@ -10,6 +10,7 @@ import jax.numpy as jnp
 import numpy as np
 
 from mbjax._src import lie
+from mbjax._src.lie.coordinates import AbstractRotation, Quaternion
 from mbjax._src.rigid import RigidBody, torque_free_motion
 
 J_AXIAL = 1.0
@@ -18,7 +19,7 @@ OMEGA0 = (10.0, 0.0, 15.0)  # body frame; the symmetry axis is body z
 DURATION = 6.0
 
 
-def build(rotation: str = "quaternion"):
+def build(rotation: AbstractRotation = Quaternion()):
     """(body, q0, u0) of the scene, starting at R0 = I."""
     body = RigidBody(1.0, np.diag([J_TRANSVERSE, J_TRANSVERSE, J_AXIAL]),
                      gravity=(0.0, 0.0, 0.0), fixed_point=True, rotation=rotation)

@@ -10,6 +10,7 @@ J_t = 1, J_a = 0.4 and m g d = 25/9 here.
 
 import jax.numpy as jnp
 
+from mbjax._src.lie.coordinates import AbstractRotation, Quaternion
 from mbjax._src.rigid import RigidBody
 from mbjax._src.tfe import Body
 
@@ -22,7 +23,7 @@ D = OMEGA**2 * J_TRANSVERSE / (MASS * GRAVITY)   # suspension point to centre of
 CRITICAL_SPIN = 2.0 * J_TRANSVERSE * OMEGA / J_AXIAL
 
 
-def rigid_body(rotation: str = "quaternion") -> RigidBody:
+def rigid_body(rotation: AbstractRotation = Quaternion()) -> RigidBody:
     """The top as a `RigidBody` about its suspension point, centre of mass d above it."""
     return RigidBody(MASS, jnp.diag(jnp.array([J_TRANSVERSE, J_TRANSVERSE, J_AXIAL])),
                      com=(0.0, 0.0, D), gravity=(0.0, 0.0, -GRAVITY), fixed_point=True,

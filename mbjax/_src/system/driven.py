@@ -1,10 +1,13 @@
-"""How a system turns its `control` and `external` into forces: the part every system shares.
+"""What every driven system shares: a control on its actuated velocity coordinates and external
+wrenches on its bodies, with their checks written once.
 
-A control acts on the system's actuated velocity coordinates (`actuation`: their indices, all of
-them by default) and returns one generalized force per actuated coordinate. An external load
-returns one world-frame wrench (torque; force) per body, acting at the body's origin, or at a
-point fixed in the body (`external_point`, body-frame coordinates) when the system has one.
+A control returns one generalized force per actuated coordinate (`actuation`: their indices, all
+of them by default). An external load returns one world-frame wrench (torque; force) per body,
+shape (n, 6), acting at the body's origin, or at a point fixed in the body (`external_point`,
+body-frame coordinates, shape (n, 3)).
 """
+
+import abc
 
 import equinox as eqx
 import jax.numpy as jnp
@@ -12,6 +15,118 @@ import numpy as np
 from jax import Array
 
 from mbjax._src.control.base import AbstractControl, as_control
+from mbjax._src.system.system import AbstractSystem
+
+
+class AbstractDrivenSystem(AbstractSystem):
+    """A system driven by `control` (t, q, v) -> forces on its `actuation` coordinates and by
+    `external` (t, q, v) -> (n, 6) world-frame wrenches on its n bodies, at their origins or at
+    `external_point` (n, 3). Final systems declare the four fields and set them in `__init__`
+    with `drive(...)`."""
+
+    control: eqx.AbstractVar[AbstractControl | None]
+    external: eqx.AbstractVar[AbstractControl | None]
+    external_point: eqx.AbstractVar[Array | None]
+    actuation: eqx.AbstractVar[tuple[int, ...] | None]
+
+    @property
+    @abc.abstractmethod
+    def nv(self) -> int:
+        """Number of velocity coordinates (what the control's forces act on)."""
+
+    @property
+    @abc.abstractmethod
+    def n(self) -> int:
+        """Number of bodies (what the external wrenches act on)."""
+
+    @property
+    def passive(self) -> bool:
+        """No control and no external load: the energy is conserved (or falls, with damping)."""
+        return self.control is None and self.external is None
+
+    @property
+    def n_controls(self) -> int:
+        return self.nv if self.actuation is None else len(self.actuation)
+
+    def with_control(self, control) -> "AbstractDrivenSystem":
+        return eqx.tree_at(lambda s: s.control, self, as_control(control),
+                           is_leaf=lambda x: x is None)
+
+    def applied(self, t: Array, q: Array, v: Array) -> Array:
+        """The control's forces on all nv velocity coordinates (zero where unactuated).
+
+        Args:
+            t: time, scalar.
+            q: configuration.
+            v: velocity, shape (nv,).
+
+        Returns:
+            Generalized forces, shape (nv,).
+        """
+        if self.control is None:
+            return jnp.zeros(self.nv, v.dtype)
+        tau = jnp.asarray(self.control(t, q, v), v.dtype)
+        if tau.shape != (self.n_controls,):
+            raise ValueError(f"the control returned shape {tau.shape}; this system expects "
+                             f"({self.n_controls},): " + (
+                                 "one force per velocity coordinate" if self.actuation is None
+                                 else f"one per actuated coordinate, actuation={self.actuation}"))
+        if self.actuation is None:
+            return tau
+        return jnp.zeros(self.nv, v.dtype).at[jnp.array(self.actuation)].set(tau)
+
+    def external_wrenches(self, t: Array, q: Array, v: Array) -> Array | None:
+        """The external wrenches as `external` returns them, checked: shape (n, 6), world frame,
+        at the bodies' origins or at `external_point`; None without an external load."""
+        if self.external is None:
+            return None
+        f = jnp.asarray(self.external(t, q, v), v.dtype)
+        if f.shape != (self.n, 6):
+            raise ValueError(f"external returned shape {f.shape}; it must return one world-frame "
+                             f"wrench (torque; force) per body, shape ({self.n}, 6)")
+        return f
+
+    def hold(self, t, q, u):
+        """The system with its control and external load as they are over one step from (t, q, u)
+        (sampled controls frozen); the velocity v is u unless the system says otherwise."""
+        return held(self, t, q, u)
+
+
+def held(system: AbstractDrivenSystem, t: Array, q: Array, v: Array) -> AbstractDrivenSystem:
+    """`system` with its control and external loads as they are over one step from (t, q, v)."""
+    if system.passive:
+        return system
+    new = tuple(None if c is None else c.hold(t, q, v) for c in (system.control, system.external))
+    return eqx.tree_at(lambda s: (s.control, s.external), system, new, is_leaf=lambda x: x is None)
+
+
+def drive(control, external, external_point, actuation, *, nv: int, n: int) -> tuple:
+    """The four driven-system fields checked, for a system of nv velocity coordinates and n bodies.
+
+    Args:
+        control: a callable (t, q, v) -> forces, an `AbstractControl`, a constant array (one
+            entry per actuated coordinate) or None.
+        external: a callable (t, q, v) -> (n, 6) world-frame wrenches, or None.
+        external_point: body-frame points where the external forces act, shape (n, 3) or (3,)
+            (the same point for every body), or None (the bodies' origins).
+        actuation: indices of the actuated velocity coordinates, a boolean mask of length nv,
+            or None (all of them).
+        nv: the system's number of velocity coordinates.
+        n: the system's number of bodies.
+
+    Returns:
+        (control, external, external_point, actuation), as the system stores them.
+
+    Raises:
+        TypeError, ValueError: naming the argument that is malformed.
+    """
+    actuation = check_actuation(actuation, nv)
+    control = as_control(control)
+    n_act = nv if actuation is None else len(actuation)
+    value = getattr(control, "value", None)
+    if value is not None and value.shape != (n_act,):
+        raise ValueError(f"the constant control (tau) must have shape ({n_act},), got {value.shape}")
+    return control, as_control(external), check_points(external_point, n), actuation
 
 
 def check_actuation(actuation, nv: int) -> tuple[int, ...] | None:
@@ -32,52 +147,8 @@ def check_actuation(actuation, nv: int) -> tuple[int, ...] | None:
     return tuple(int(i) for i in index)
 
 
-def check_control(control, actuation: tuple | None, nv: int) -> AbstractControl | None:
-    """The control as an `AbstractControl` (see `as_control`); a constant must have one entry per
-    actuated coordinate."""
-    control = as_control(control)
-    n_act = nv if actuation is None else len(actuation)
-    value = getattr(control, "value", None)
-    if value is not None and value.shape != (n_act,):
-        raise ValueError(f"the constant control (tau) must have shape ({n_act},), got {value.shape}")
-    return control
-
-
-def generalized_control(control: AbstractControl | None, actuation: tuple | None, nv: int,
-                        t: Array, q: Array, v: Array) -> Array:
-    """The control's forces scattered onto the nv velocity coordinates (zero where unactuated)."""
-    if control is None:
-        return jnp.zeros(nv, v.dtype)
-    tau = jnp.asarray(control(t, q, v), v.dtype)
-    n_act = nv if actuation is None else len(actuation)
-    if tau.shape != (n_act,):
-        raise ValueError(f"the control returned shape {tau.shape}; this system expects ({n_act},): "
-                         + ("one force per velocity coordinate" if actuation is None else
-                            f"one per actuated coordinate, actuation={actuation}"))
-    return tau if actuation is None else jnp.zeros(nv, v.dtype).at[jnp.array(actuation)].set(tau)
-
-
-def body_wrenches(external: AbstractControl | None, n: int, t: Array, q: Array, v: Array) -> Array | None:
-    """The external wrenches (n, 6), world frame, or None."""
-    if external is None:
-        return None
-    f = jnp.asarray(external(t, q, v), v.dtype)
-    if f.shape != (n, 6):
-        raise ValueError(f"external returned shape {f.shape}; it must return one world-frame "
-                         f"wrench (torque; force) per body, shape ({n}, 6)")
-    return f
-
-
-def about_origins(f: Array, R: Array, point: Array | None) -> Array:
-    """Wrenches whose forces act at body-fixed points (n, 3), moved to the bodies' origins:
-    torque + (R point) x force."""
-    if point is None:
-        return f
-    arm = jnp.einsum("kij,kj->ki", R, point)
-    return f.at[:, :3].add(jnp.cross(arm, f[:, 3:]))
-
-
 def check_points(point, n: int) -> Array | None:
+    """Body-frame points, one per body, shape (n, 3) (a single (3,) point broadcast), or None."""
     if point is None:
         return None
     point = jnp.asarray(point, dtype=float)
@@ -88,9 +159,10 @@ def check_points(point, n: int) -> Array | None:
     return point
 
 
-def hold(system, t: Array, q: Array, v: Array):
-    """The system with its control and external loads as they are over one step from (t, q, v)."""
-    if system.control is None and system.external is None:
-        return system
-    held = tuple(None if c is None else c.hold(t, q, v) for c in (system.control, system.external))
-    return eqx.tree_at(lambda s: (s.control, s.external), system, held, is_leaf=lambda x: x is None)
+def about_origins(f: Array, R: Array, point: Array | None) -> Array:
+    """Wrenches whose forces act at body-fixed points (n, 3), moved to the bodies' origins:
+    torque + (R point) x force, with R (n, 3, 3) the bodies' rotations."""
+    if point is None:
+        return f
+    arm = jnp.einsum("kij,kj->ki", R, point)
+    return f.at[:, :3].add(jnp.cross(arm, f[:, 3:]))

@@ -66,6 +66,23 @@ class AbstractSystem(eqx.Module):
         rtol=)` holds to rtol; None here: none known."""
         return None
 
+    def state_sizes(self) -> tuple[int | None, int | None]:
+        """The lengths of q and u a state of this system must have, None where the system does
+        not say (`simulate` and `mbjax.trajopt.Problem` check states against them)."""
+        return None, None
+
+    @property
+    def n_controls(self) -> int:
+        """The number of forces its control returns (its actuated coordinates)."""
+        raise TypeError(f"{type(self).__name__} has no control")
+
+    def with_control(self, control) -> "AbstractSystem":
+        """The system driven by `control` instead of its own (what trajectory optimisation
+        varies); systems without a control raise TypeError."""
+        raise TypeError(f"{type(self).__name__} has no control to optimise: a problem needs a "
+                        "system with a `control` (TreeSystem, FlexibleSystem, WristSystem, "
+                        "RigidBody, a ClosedSystem of a tree, ...)")
+
     @eqx.filter_jit
     def relative_energy_error(self, qs: Array, us: Array) -> Array:
         """(E(t) - E(0)) / |E(0)| along a saved trajectory, for systems with an `energy(q, u)`

@@ -22,21 +22,15 @@ import equinox as eqx
 import jax.numpy as jnp
 from jax import Array
 
-from mbjax._src.control import AbstractControl
-from mbjax._src.system.driven import about_origins, body_wrenches, generalized_control, hold
+from mbjax._src.system.driven import AbstractDrivenSystem, about_origins
 from mbjax._src.system.invariants import energy_invariant
-from mbjax._src.system.system import AbstractSystem
 
 
-class AbstractTreeSystem(AbstractSystem):
+class AbstractTreeSystem(AbstractDrivenSystem):
     """An open tree of bodies as a system for `simulate` and `mbjax.loops.ClosedSystem`. Its
     `model` (a `mbjax.Model` or a `mbjax.flex.FlexibleModel`) gives the coordinates."""
 
     model: eqx.AbstractVar[object]
-    control: eqx.AbstractVar[AbstractControl | None]
-    external: eqx.AbstractVar[AbstractControl | None]
-    external_point: eqx.AbstractVar[Array | None]
-    actuation: eqx.AbstractVar[tuple[int, ...] | None]
     symmetric_dynamics: eqx.AbstractClassVar[bool]
 
     # -- coordinates ----------------------------------------------------------------------------
@@ -98,11 +92,6 @@ class AbstractTreeSystem(AbstractSystem):
     def dissipative(self) -> Array:
         """True where the tree has damping (joint or modal), so that its energy can only fall."""
 
-    @property
-    def passive(self) -> bool:
-        """No control and no external load: the energy is conserved (or falls, with damping)."""
-        return self.control is None and self.external is None
-
     def invariants(self, t, q, u):
         """The energy of a passive tree (measured against its kinetic energy); None otherwise."""
         if not self.passive:
@@ -128,13 +117,9 @@ class AbstractTreeSystem(AbstractSystem):
 
     # -- applied forces -------------------------------------------------------------------------
 
-    def applied(self, t: Array, q: Array, v: Array) -> Array:
-        """The control's generalized forces on all nv coordinates."""
-        return generalized_control(self.control, self.actuation, self.nv, t, q, v)
-
     def wrenches(self, t: Array, q: Array, v: Array) -> Array | None:
         """The external wrenches (n, 6), world frame, torque about each body's origin; or None."""
-        f = body_wrenches(self.external, self.n, t, q, v)
+        f = self.external_wrenches(t, q, v)
         if f is None or self.external_point is None:
             return f
         return about_origins(f, self.frames(q)[0][:self.n], self.external_point)
@@ -150,18 +135,6 @@ class AbstractTreeSystem(AbstractSystem):
     def project(self, q):
         return self.normalize(q)
 
-    def hold(self, t, q, u):
-        return hold(self, t, q, u)
+    def state_sizes(self):
+        return self.nq, self.nv
 
-
-def state_sizes(system: AbstractSystem) -> tuple[int | None, int | None]:
-    """The lengths (of q, of u) a system's state must have, None where it is the system's own
-    affair: (nq, nv) for a tree system; (nq, None) for a closed loop of one (its method may add
-    to u, as the epsilon-dynamics add the constraint loads); (None, None) for the others (a
-    batch, a momentum form)."""
-    if isinstance(system, AbstractTreeSystem):
-        return system.nq, system.nv
-    tree = getattr(system, "tree", None)
-    if isinstance(tree, AbstractTreeSystem):
-        return tree.nq, None
-    return None, None

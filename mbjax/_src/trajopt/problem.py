@@ -35,23 +35,6 @@ from mbjax._src.control import Constant
 from mbjax._src.integrate import RK4
 from mbjax._src.integrate.base import AbstractIntegrator
 from mbjax._src.system.system import AbstractSystem
-from mbjax._src.system.tree_system import state_sizes
-from mbjax._src.loops import ClosedSystem
-
-
-def driven(system: AbstractSystem):
-    """The part of `system` that holds its control and actuation: the system itself, or a
-    closed system's tree."""
-    return system.tree if isinstance(system, ClosedSystem) else system
-
-
-def with_control(system: AbstractSystem, control) -> AbstractSystem:
-    """`system` driven by `control` instead of its own."""
-    if not hasattr(driven(system), "control"):
-        raise TypeError(f"{type(system).__name__} has no control to optimise: a problem needs a "
-                        "system with a `control` field (TreeSystem, FlexibleSystem, WristSystem, "
-                        "a ClosedSystem of one of these, ...)")
-    return eqx.tree_at(lambda s: driven(s).control, system, control, is_leaf=lambda x: x is None)
 
 
 class Problem(eqx.Module):
@@ -90,10 +73,10 @@ class Problem(eqx.Module):
         if self.q0.ndim != 1 or self.v0.ndim != 1:
             raise ValueError(f"q0 and v0 must be vectors, got shapes {self.q0.shape} and "
                              f"{self.v0.shape}")
-        nq, nv = state_sizes(driven(system))       # a closed loop's x is its tree's (q, v)
-        if nq is not None and (self.q0.shape != (nq,) or self.v0.shape != (nv,)):
-            raise ValueError(f"q0 and v0 must have shapes ({nq},) and ({nv},) for this system, "
-                             f"got {self.q0.shape} and {self.v0.shape}")
+        system.n_controls                           # raises for a system without a control
+        for name, x, size in zip(("q0", "v0"), (self.q0, self.v0), system.state_sizes(), strict=True):
+            if size is not None and x.shape != (size,):
+                raise ValueError(f"{name} must have shape ({size},) for this system, got {x.shape}")
         self.running, self.terminal = running, terminal
         self.integrator = integrator
         self.dt, self.horizon = float(dt), int(horizon)
@@ -124,8 +107,7 @@ class Problem(eqx.Module):
 
     @property
     def nu(self) -> int:
-        actuation = getattr(driven(self.system), "actuation", None)
-        return self.nv if actuation is None else len(actuation)
+        return self.system.n_controls
 
     @property
     def x0(self) -> Array:
@@ -139,7 +121,7 @@ class Problem(eqx.Module):
         """x_{k+1}: one step of the integrator from t_k = k dt with the control held at u."""
         q, v = self.split(x)
         t = jnp.asarray(k, x.dtype) * self.dt
-        system = with_control(self.system, Constant(u)).hold(t, q, v)
+        system = self.system.with_control(Constant(u)).hold(t, q, v)
         q1, v1, _ = self.integrator.step(system, t, q, v, jnp.asarray(self.dt, x.dtype))
         q1, v1 = system.constrain(t + self.dt, q1, v1)
         return jnp.concatenate([q1, v1])

@@ -4,12 +4,10 @@ import equinox as eqx
 import jax.numpy as jnp
 from jax import Array
 
-from mbjax._src.control import AbstractControl, as_control
-from mbjax._src.system.driven import (body_wrenches, check_actuation, check_control, check_points,
-                                   generalized_control, hold)
+from mbjax._src.control import AbstractControl
+from mbjax._src.system.driven import AbstractDrivenSystem, drive
 from mbjax._src.system.invariants import energy_invariant
 from mbjax._src.system.status import Status
-from mbjax._src.system.system import AbstractSystem
 from mbjax._src.wrist import dynamics, kinematics
 from mbjax._src.wrist.model import CarpalWrist
 
@@ -19,64 +17,72 @@ from mbjax._src.wrist.model import CarpalWrist
 SINGULAR_TOLERANCE = 1e-3
 
 
-class WristSystem(AbstractSystem):
+class WristSystem(AbstractDrivenSystem):
     """q = theta, u = theta_dot; theta_ddot from eq 6.21 under the motor torques of `control`
     (t, theta, theta_dot) -> (3,) (a `mbjax.control` module such as a torque spline or a servo,
     a controller from `mbjax.trajopt`, any callable or a constant; none: unpowered motors; on
     the `actuation` motors only if given) and an `external` (t, theta, theta_dot) -> (1, 6)
     world-frame wrench (torque; force) on the tool at the distal-plate centre, or at
-    `external_point` (tool frame D). With `ExplicitEuler` this is the chapter's eq 6.45."""
+    `external_point` (tool frame D, shape (1, 3)). With `ExplicitEuler` this is the chapter's eq 6.45."""
 
-    wrist: CarpalWrist
+    model: CarpalWrist
     control: AbstractControl | None
     external: AbstractControl | None
     external_point: Array | None
     actuation: tuple[int, ...] | None = eqx.field(static=True)
 
-    def __init__(self, wrist: CarpalWrist, control=None, *, external=None, external_point=None,
+    def __init__(self, model: CarpalWrist, control=None, *, external=None, external_point=None,
                  actuation=None):
-        if not isinstance(wrist, CarpalWrist):
-            raise TypeError(f"wrist must be a CarpalWrist, got {type(wrist).__name__}")
-        self.wrist = wrist
-        self.actuation = check_actuation(actuation, 3)
-        self.control = check_control(control, self.actuation, 3)
-        self.external = as_control(external)
-        point = check_points(external_point, 1)
-        self.external_point = None if point is None else point[0]
+        if not isinstance(model, CarpalWrist):
+            raise TypeError(f"model must be a CarpalWrist, got {type(model).__name__}")
+        self.model = model
+        self.control, self.external, self.external_point, self.actuation = drive(
+            control, external, external_point, actuation, nv=3, n=1)
+
+    @property
+    def n(self) -> int:
+        """One body, the tool (distal plate)."""
+        return 1
+
+    @property
+    def nv(self) -> int:
+        """The three motor angles' rates."""
+        return 3
+
+    def state_sizes(self):
+        return 3, 3
 
     def torques(self, t: Array, q: Array, u: Array) -> Array:
         """The motor torques of the control plus the torques equivalent to the external wrench."""
-        tau = generalized_control(self.control, self.actuation, 3, t, q, u)
-        f = body_wrenches(self.external, 1, t, q, u)
+        tau = self.applied(t, q, u)
+        f = self.external_wrenches(t, q, u)
         if f is None:
             return tau
-        return tau + dynamics.external_torques(self.wrist, q, f[0], self.external_point)
+        point = None if self.external_point is None else self.external_point[0]
+        return tau + dynamics.external_torques(self.model, q, f[0], point)
 
     def kinematics(self, q: Array, u: Array) -> Array:
         return u
 
     def acceleration(self, t: Array, q: Array, u: Array) -> Array:
-        return dynamics.forward_dynamics(self.wrist, q, u, self.torques(t, q, u))
-
-    def hold(self, t, q, u):
-        return hold(self, t, q, u)
+        return dynamics.forward_dynamics(self.model, q, u, self.torques(t, q, u))
 
     def check(self, t: Array, q: Array, u: Array) -> Array:
         """SINGULAR where the wrist is within SINGULAR_TOLERANCE of an inverse or a direct
         singularity (`kinematics.singularity_measures`): there the accelerations of eq 6.21
         are not defined (1e17 rad/s^2 at the knees' tangency, measured)."""
-        m = kinematics.singularity_measures(self.wrist, q)
+        m = kinematics.singularity_measures(self.model, q)
         near = jnp.minimum(jnp.abs(m.inverse), jnp.abs(m.direct)) < SINGULAR_TOLERANCE
         return jnp.where(near, int(Status.SINGULAR), 0).astype(jnp.int32)
 
     def energy(self, q: Array, u: Array) -> Array:
         """T + V of the tool; the work of the motors and the external wrench is not included."""
-        return dynamics.energy(self.wrist, q, u)
+        return dynamics.energy(self.model, q, u)
 
     def invariants(self, t, q, u):
         """The tool's energy with unpowered motors and no external wrench; None otherwise."""
-        if self.control is not None or self.external is not None:
+        if not self.passive:
             return None
-        return energy_invariant(dynamics.energy(self.wrist, q, u),
-                                dynamics.kinetic_energy(self.wrist, q, u), False)
+        return energy_invariant(dynamics.energy(self.model, q, u),
+                                dynamics.kinetic_energy(self.model, q, u), False)
 
