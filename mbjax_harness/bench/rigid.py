@@ -42,6 +42,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
+from mbjax import Dense, Recursive
 from mbjax_harness.bench import peers
 from mbjax_harness.timing import Timing, measure, write_jsonl
 from mbjax._src.integrate import RK4, simulate
@@ -51,6 +52,8 @@ from mbjax._src.rigid import TreeSystem, forward_dynamics
 
 NAME = "rigid"
 METHODS = ("recursive", "dense")
+# the strategy each method name stands for (the records keep the names)
+STRATEGY = {"recursive": Recursive(), "dense": Dense()}
 NS = (1, 7, 30, 100, 300, 1000)
 QUICK_NS = (1, 7, 30, 100)
 BATCHES = (1, 64, 1024, 4096)
@@ -95,7 +98,7 @@ def states(n: int, batch: int, seed: int = SEED):
 
 def single_fn(method: str):
     """One state per call, the model an argument (its parameters are leaves)."""
-    return jax.jit(partial(forward_dynamics, method=method))
+    return jax.jit(partial(forward_dynamics, method=STRATEGY[method]))
 
 
 def lower_compile_time(method: str, *args) -> float:
@@ -107,7 +110,7 @@ def lower_compile_time(method: str, *args) -> float:
 
 
 def batched_fn(method: str):
-    return jax.jit(jax.vmap(partial(forward_dynamics, method=method), in_axes=(None, 0, 0, 0)))
+    return jax.jit(jax.vmap(partial(forward_dynamics, method=STRATEGY[method]), in_axes=(None, 0, 0, 0)))
 
 
 def pinocchio_available(n: int) -> bool:
@@ -175,7 +178,7 @@ def looped_fn(method: str, evaluations: int):
     dispatch of `single_fn` (tens of us on CPU, more than the whole recursion for small n)."""
     def run(model, q, v, tau):
         def body(_, acc):
-            return forward_dynamics(model, q, v + 1e-12 * acc, tau, method=method)
+            return forward_dynamics(model, q, v + 1e-12 * acc, tau, method=STRATEGY[method])
         return jax.lax.fori_loop(0, evaluations, body, jnp.zeros_like(v))
 
     return jax.jit(run)
@@ -213,7 +216,7 @@ def _gradient_records(methods, repeats: int, common: dict) -> list[dict]:
     T = GRAD_DT * GRAD_STEPS
     records = []
     for method in methods:
-        system = TreeSystem(model, method=method)
+        system = TreeSystem(model, method=STRATEGY[method])
 
         def loss(q0, v0, system=system):
             sol = simulate(system, RK4(), q0, v0, dt=GRAD_DT, t1=T, saveat=[T])

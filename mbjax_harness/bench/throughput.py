@@ -38,6 +38,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
+from mbjax import Recursive
 from mbjax_harness.bench import peers
 from mbjax_harness.bench.rigid import pinocchio_loop, relative_difference, states, timed
 from mbjax_harness.timing import write_jsonl
@@ -97,12 +98,12 @@ def _sharded_fn(devices):
     `batch_aba` split by its last axis: 7-link chain, B = 4096, 0.70 against 0.93 us per state
     (one A/B script, two devices)."""
     spec = jax.sharding.PartitionSpec("batch")
-    fd = jax.vmap(partial(forward_dynamics, method="recursive"), in_axes=(None, 0, 0, 0))
+    fd = jax.vmap(partial(forward_dynamics, method=Recursive()), in_axes=(None, 0, 0, 0))
     return _split(fd, devices, (jax.sharding.PartitionSpec(), spec, spec, spec), spec)
 
 
 def _vmap_fn():
-    return jax.jit(jax.vmap(partial(forward_dynamics, method="recursive"), in_axes=(None, 0, 0, 0)))
+    return jax.jit(jax.vmap(partial(forward_dynamics, method=Recursive()), in_axes=(None, 0, 0, 0)))
 
 
 def pinocchio_parallel(urdf: str, Q, V, T, repeats: int, budget_s: float) -> dict:

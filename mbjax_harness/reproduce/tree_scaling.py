@@ -10,7 +10,7 @@ slopes show. An mbjax time is that of one evaluation among many in a jitted loop
 evaluations per loop), as a simulation meets it, free of the per-call dispatch of a lone jitted
 call (tens of microseconds on CPU, which would hide the small-n end of the chart):
 
-- recursive_s: `forward_dynamics(..., method="recursive")`, Anderson 1993 §2.3, O(n);
+- recursive_s: `forward_dynamics(..., method=Recursive())`, Anderson 1993 §2.3, O(n);
 - dense_s: `method="dense"`, Jerkovsky 1978's transformation operator and a Cholesky solve, O(n^3);
 - pinocchio_aba_s (when Pinocchio is installed): `pin.aba` on the same chain loaded from
   `to_urdf`, the median of single calls from Python (so it includes under 1 us of binding).
@@ -30,6 +30,7 @@ from pathlib import Path
 import jax.numpy as jnp
 import numpy as np
 
+from mbjax import Recursive
 from mbjax_harness.bench import peers
 from mbjax_harness.bench.rigid import loop_length, looped_fn, states, timed
 from mbjax._src.model import chain

@@ -9,6 +9,7 @@ import jax.numpy as jnp
 import numpy as np
 import pytest
 
+from mbjax import Dense, Recursive
 from mbjax.control import PD, Constant, CubicSpline, MLPPolicy, SampleAndHold, Saturated, Sum, ZeroOrderHold
 from mbjax.integrate import RK4, simulate
 from mbjax.model import Model, chain
@@ -102,7 +103,7 @@ def _generalized(model, q, wrench, point):
     return jax.grad(power)(jnp.zeros(model.nv))
 
 
-@pytest.mark.parametrize("method", ["recursive", "dense"])
+@pytest.mark.parametrize("method", [Recursive(), Dense()], ids=["recursive", "dense"])
 def test_external_wrenches_and_actuation_on_a_tree(method):
     """A chain with a control on two of its joints and a world wrench on every body at a body
     point: the same accelerations as the plain forward dynamics under tau = B u + J^T f."""

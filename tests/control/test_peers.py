@@ -13,6 +13,7 @@ import numpy as np
 import pytest
 
 import mbjax
+from mbjax import Dense
 from mbjax.control import ZeroOrderHold
 from mbjax.integrate import RK4, simulate
 from mbjax.model import Model, chain, random_tree
@@ -96,7 +97,7 @@ def test_external_wrenches_match_pinocchio_aba_with_fext(floating):
     def ours(q, v, tau):
         system = TreeSystem(model, tau, external=lambda t, q_, v_: jnp.asarray(wrenches))
         return system.acceleration(0.0, q, v), mbjax.forward_dynamics(model, q, v, tau, f_ext=wrenches,
-                                                                     method="dense")
+                                                                     method=Dense())
 
     for seed in (0, 1):
         q, v, tau = random_state(model, seed)

@@ -9,8 +9,9 @@ import jax.numpy as jnp
 import numpy as np
 import pytest
 
+from mbjax import Recursive, Dense
 from mbjax.flex import Beam, FlexibleModel, FlexibleSystem, ModalBody, beam_body, craig_bampton, flexible_aba
-from mbjax._src.flex import dense_forward_dynamics, energy
+from mbjax._src.flex import lagrangian_forward_dynamics, energy
 from mbjax._src.flex.body import mass_matrix
 from mbjax.integrate import RK4, simulate
 from mbjax.lie import exp
@@ -94,7 +95,7 @@ def test_recursion_matches_the_lagrangian_route(stiffening):
     q = jnp.asarray(rng.normal(size=model.nq)) * 0.5
     v, tau = jnp.asarray(rng.normal(size=model.nv)), jnp.asarray(rng.normal(size=model.nv))
     recursive = jax.jit(flexible_aba)(model, q, v, tau)
-    dense = jax.jit(dense_forward_dynamics)(model, q, v, tau)
+    dense = jax.jit(lagrangian_forward_dynamics)(model, q, v, tau)
     np.testing.assert_allclose(recursive, dense, rtol=1e-11, atol=1e-11)
 
 
@@ -175,7 +176,7 @@ def test_a_child_is_its_reaction_at_the_grid_point():
     moment_on_child = Ic @ al + jnp.cross(w, Ic @ w) + jnp.cross(c, m * a_com)   # about its origin
     F = -jnp.concatenate([R[1] @ moment_on_child, R[1] @ force_on_child])        # world, on the beam
 
-    def alone(beam_body, method="recursive"):
+    def alone(beam_body, method=Recursive()):
         rigid = Model([-1], ["revolute"], mass=[0.85], com=[[0.5, 0, 0]],
                       inertia=[np.diag([1e-5, 0.07, 0.07])], axis=[[0, 1, 0]])
         beam = FlexibleModel(rigid, {0: beam_body}, markers=((0, 0),))
@@ -188,7 +189,7 @@ def test_a_child_is_its_reaction_at_the_grid_point():
     loaded, keep = alone(cantilever_body())
     np.testing.assert_allclose(loaded, v_dot[keep], rtol=1e-10, atol=1e-10 * float(jnp.max(jnp.abs(v_dot))))
     # the Lagrangian route takes the load at the marker through the same virtual work
-    np.testing.assert_allclose(alone(cantilever_body(), "dense")[0], loaded, rtol=1e-10,
+    np.testing.assert_allclose(alone(cantilever_body(), Dense())[0], loaded, rtol=1e-10,
                                atol=1e-10 * float(jnp.max(jnp.abs(v_dot))))
     linear, _ = alone(cantilever_body().without_stiffening())
     assert float(jnp.max(jnp.abs(linear[1:] - loaded[1:]))) > 1e-3 * float(jnp.max(jnp.abs(loaded[1:])))
@@ -241,7 +242,7 @@ def test_closed_loop_routes_agree_with_the_constraint_load_stiffening():
     q = q0.at[2:].set(jnp.asarray(rng.normal(size=3)) * 1e-4)
     v = v0.at[2:].set(jnp.asarray(rng.normal(size=3)))
     dense = eqx.tree_at(lambda s: s.loops.tree, system,
-                        FlexibleSystem(system.tree.model, method="dense"))
+                        FlexibleSystem(system.tree.model, method=Dense()))
     accelerate = eqx.filter_jit(lambda s_, q_, v_: s_.acceleration(0.003, q_, v_))
     recursive = accelerate(system, q, v)
     np.testing.assert_allclose(accelerate(dense, q, v), recursive, rtol=1e-9,

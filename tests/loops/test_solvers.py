@@ -8,10 +8,11 @@ import jax.numpy as jnp
 import numpy as np
 import pytest
 
+from mbjax import Dense
 from mbjax.integrate import RK4, simulate
 from mbjax._src.integrate import Status
 from mbjax.loops import GROUND, ClosedSystem, Coupled, CutJoint, Loops, Momentum, Prescribed, Stabilized, consistent_state
-from mbjax._src.loops import coupled_acceleration, eta_and_gamma, momentum_rate
+from mbjax._src.loops import coupled_acceleration, eta_and_gamma, loop_momentum_rate
 from mbjax.rigid import TreeSystem
 from mbjax._src.rigid.dynamics import forward_dynamics, mass_matrix
 from mbjax.scenes import closed_chain
@@ -30,7 +31,7 @@ def test_momentum_form_multipliers_equal_the_velocity_forms():
     def both_forms(q, v):
         v_dot, K_c, _ = coupled_acceleration(LOOPS, q, v)
         mu = mass_matrix(MODEL, q)
-        G_dot, K_c_momentum, rank = momentum_rate(LOOPS, q, mu @ v)
+        G_dot, K_c_momentum, rank = loop_momentum_rate(LOOPS, q, mu @ v)
         mu_dot = jax.jvp(lambda q_: mass_matrix(MODEL, q_), (q,), (MODEL.q_dot(q, v),))[1]
         return v_dot, K_c, mu, G_dot, K_c_momentum, rank, mu_dot
 
@@ -60,8 +61,8 @@ def test_one_triangularization_gives_the_unit_load_responses():
         eta, Gamma, A = eta_and_gamma(LOOPS, q, v)
         unloaded = eqx.tree_at(lambda m: m.gravity, MODEL, jnp.zeros(3))
         dense = jax.vmap(lambda load: forward_dynamics(unloaded, q, jnp.zeros(6), load,
-                                                       method="dense"))(A).T
-        return eta, Gamma, forward_dynamics(MODEL, q, v, TAU, method="dense"), dense
+                                                       method=Dense()))(A).T
+        return eta, Gamma, forward_dynamics(MODEL, q, v, TAU, method=Dense()), dense
 
     eta, Gamma, eta_dense, dense = loads_and_dense(Q0, V0)
     np.testing.assert_allclose(eta, eta_dense, rtol=1e-10, atol=1e-10)

@@ -351,9 +351,9 @@ def _check_closure(xml, kind, assembled=True):
     """The cut joint has MuJoCo's residual and, where qpos0 is assembled (Phi(qpos0) = 0), the
     loop's acceleration is MuJoCo's with the constraint hard."""
     mjmodel = mujoco.MjModel.from_xml_string(xml)
-    with pytest.warns(ModelWarning, match="closures=True"):
-        mbjax.from_mujoco(mjmodel)
-    model, cuts = _load(xml, closures=True)[1]
+    with pytest.warns(ModelWarning, match="model.closures"):
+        model = mbjax.from_mujoco(mjmodel)
+    cuts = model.closures
     assert len(cuts) == 1 and isinstance(cuts[0], CutJoint) and cuts[0].kind == kind
     loops = Loops(TreeSystem(model), cuts)
     phi = jax.jit(Loops.phi)
@@ -442,12 +442,11 @@ def test_ignored_features_are_named_in_one_warning():
     message = str(caught[0].message)
     for what in ("contacts (2 geom pairs", "actuator forces (1", "tendons (1)", "joint springs (1)",
                  "joint, tendon, flex and distance equality constraints (1)",
-                 "connect and weld equality constraints (1; load with closures=True"):
+                 "connect and weld equality constraints in TreeSystem(model) (1; they are "
+                 "model.closures"):
         assert what in message, message
     assert model.nv == 2
-    with pytest.warns(ModelWarning) as records:
-        mbjax.from_mujoco(mjmodel, closures=True)
-    assert "connect" not in str(records[0].message)
+    assert len(model.closures) == 1 and model.closures[0].kind == "spherical"
     _check(mjmodel, model)       # with what mbjax ignores switched off in MuJoCo
 
 

@@ -7,6 +7,7 @@ import numpy as np
 import pytest
 
 import mbjax
+from mbjax import Recursive, Dense
 from mbjax import rigid
 from mbjax.model import Model, chain, random_tree
 from mbjax._src.model.checks import ModelWarning
@@ -260,8 +261,8 @@ def _symmetric(M):
 @eqx.filter_jit
 def _dynamics(model, q, v, tau):
     """Both forward-dynamics routes and the mass matrix in one compiled call per model."""
-    return (rigid.forward_dynamics(model, q, v, tau, method="recursive"),
-            rigid.forward_dynamics(model, q, v, tau, method="dense"),
+    return (rigid.forward_dynamics(model, q, v, tau, method=Recursive()),
+            rigid.forward_dynamics(model, q, v, tau, method=Dense()),
             rigid.mass_matrix(model, q))
 
 

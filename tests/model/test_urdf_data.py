@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 
 import mbjax
+from mbjax import Dense, Recursive
 from mbjax.integrate import RK4, simulate
 from mbjax._src.integrate import Status
 from mbjax.loops import ClosedSystem, Coupled, Coupling
@@ -129,7 +130,7 @@ def test_damping_and_armature_against_mujoco():
     q, v, tau = _random_state(model, 2)
     data.qpos[:], data.qvel[:], data.qfrc_applied[:] = q, v, tau
     mujoco.mj_forward(mj, data)
-    for method in ("recursive", "dense"):
+    for method in (Recursive(), Dense()):
         a = mbjax.forward_dynamics(model, q, v, tau, method=method)
         np.testing.assert_allclose(a, data.qacc, rtol=1e-10, atol=1e-10)
     import equinox as eqx
@@ -200,10 +201,10 @@ MIMIC = _robot(_link("base"), _link("a"), _link("b"),
 
 
 def test_mimic_joints_load_independent_with_their_couplings():
-    with pytest.warns(ModelWarning, match=r"j2 = -2.0 j1 \+ 0.1.*closures=True"):
+    with pytest.warns(ModelWarning, match=r"j2 = -2.0 j1 \+ 0.1.*model.closures"):
         model = mbjax.load_urdf(MIMIC)
     assert model.nv == 2
-    model, closures = mbjax.load_urdf(MIMIC, closures=True)
+    closures = model.closures
     (coupling,) = closures
     assert isinstance(coupling, Coupling) and (coupling.coordinate, coupling.reference) == (1, 0)
     system = ClosedSystem(TreeSystem(model), closures, Coupled(baumgarte=(10.0, 10.0)))

@@ -8,6 +8,7 @@ import jax.numpy as jnp
 import numpy as np
 import pytest
 
+from mbjax import Recursive
 from mbjax.model import random_tree
 from mbjax.rigid import forward_dynamics, mass_matrix
 from mbjax._src.rigid.aba import aba, aba_factored, solve
@@ -133,7 +134,7 @@ def test_second_derivatives_against_central_differences():
     q, v, tau = (jnp.asarray(rng.standard_normal(model.nv)) for _ in range(3))
 
     def f(q):
-        return jnp.sum(forward_dynamics(model, q, v, tau, method="recursive") ** 3)
+        return jnp.sum(forward_dynamics(model, q, v, tau, method=Recursive()) ** 3)
 
     H = jax.jit(jax.hessian(f))(q)
     grad, eps = jax.jit(jax.grad(f)), 1e-6

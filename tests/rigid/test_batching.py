@@ -8,6 +8,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
+from mbjax import Recursive
 from mbjax.model import random_tree
 from mbjax.rigid import forward_dynamics
 from mbjax._src.rigid import batch_aba
@@ -16,7 +17,7 @@ from mbjax._src.rigid.batching import BATCH_CROSSOVER, batchable
 
 B = BATCH_CROSSOVER
 MODEL = random_tree(5, seed=4, joint_types=("revolute", "prismatic"))
-forward_dynamics = partial(forward_dynamics, method="recursive")     # not the dense form at nv = 5
+forward_dynamics = partial(forward_dynamics, method=Recursive())     # not the dense form at nv = 5
 
 
 def _states(model, batch, seed=0):

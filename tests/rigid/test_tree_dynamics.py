@@ -15,6 +15,7 @@ import pytest
 from jax.test_util import check_grads
 
 import mbjax
+from mbjax import Recursive, Dense
 from mbjax._src import rigid
 from mbjax.integrate import RK4, RKMK4, simulate
 from mbjax.model import Model, chain, random_tree
@@ -92,10 +93,10 @@ def _tilde(r):
 def _dynamics(model: Model, q, v, tau, a):
     """Every quantity the identity and peer tests compare, in one compiled call per model."""
     out = {}
-    out["fd_recursive"] = rigid.forward_dynamics(model, q, v, tau, method="recursive")
-    out["fd_dense"] = rigid.forward_dynamics(model, q, v, tau, method="dense")
+    out["fd_recursive"] = rigid.forward_dynamics(model, q, v, tau, method=Recursive())
+    out["fd_dense"] = rigid.forward_dynamics(model, q, v, tau, method=Dense())
     out["tau_of_a"] = tau_a = rigid.inverse_dynamics(model, q, v, a)
-    out["fd_of_id"] = rigid.forward_dynamics(model, q, v, tau_a, method="recursive")
+    out["fd_of_id"] = rigid.forward_dynamics(model, q, v, tau_a, method=Recursive())
 
     out["M"] = M = rigid.mass_matrix(model, q)
     out["M_hessian"] = jax.jit(jax.hessian(lambda v_: rigid.kinetic_energy(model, q, v_)))(v)
@@ -440,7 +441,8 @@ def _forward_dynamics_of(method):
     return f
 
 
-FORWARD_DYNAMICS = {method: _forward_dynamics_of(method) for method in ("recursive", "dense")}
+FORWARD_DYNAMICS = {name: _forward_dynamics_of(method)
+                    for name, method in (("recursive", Recursive()), ("dense", Dense()))}
 
 
 @pytest.mark.parametrize("method", ["recursive", pytest.param("dense", marks=pytest.mark.slow)])

@@ -9,8 +9,17 @@ from mbjax._src.control.base import AbstractControl, saturate
 
 
 def bspline_basis(t: Array, duration: float, n_knots: int, t0: float = 0.0) -> Array:
-    """Weights (n_knots,) of the uniform cubic B-spline with n_knots control points spanning
-    [t0, t0 + duration] (n_knots - 3 segments), at time t (clamped into that interval)."""
+    """The weights of a uniform cubic B-spline's control points at time t.
+
+    Args:
+        t: time [s], a scalar; clamped into [t0, t0 + duration].
+        duration: the span of the spline [s], n_knots - 3 segments.
+        n_knots: the number of control points, at least 4.
+        t0: the start of the span [s].
+
+    Returns:
+        The weights, shape (n_knots,): s(t) = weights @ knots.
+    """
     n_seg = n_knots - 3
     s = jnp.clip((t - t0) / duration, 0.0, 1.0) * n_seg
     i = jnp.clip(jnp.floor(s), 0, n_seg - 1)
@@ -21,11 +30,25 @@ def bspline_basis(t: Array, duration: float, n_knots: int, t0: float = 0.0) -> A
 
 
 class CubicSpline(AbstractControl):
-    """tau(t) = s(t), a uniform cubic B-spline with control values `knots` (n_knots, m) over
-    [t0, t0 + duration] (constant outside), or limit tanh(s(t) / limit) when `limit` is given:
-    smooth, and inside +-limit by construction, so gradient descent on the knots needs no
-    constraint. C2 in time; the knots are the spline's control points, not values it passes
-    through (`fit` finds the knots of given samples)."""
+    """A control history as a uniform cubic B-spline in time, optionally saturated.
+
+    tau(t) = s(t) over [t0, t0 + duration] (constant outside), or limit tanh(s(t) / limit) when
+    `limit` is given: smooth, and inside +-limit by construction, so gradient descent on the
+    knots needs no constraint. C2 in time; the knots are the spline's control points, not
+    values it passes through (`fit` finds the knots of given samples). It ignores the state.
+
+    Args:
+        knots: the control points, shape (n_knots, m), n_knots >= 4 (a 1-D array is taken as
+            (n_knots, 1)); a differentiable leaf.
+        duration: the span of the spline [s], positive.
+        limit: saturation level, a scalar or shape (m,), in the control's units; None for
+            none.
+        t0: the start of the span [s].
+
+    Raises:
+        ValueError: knots has fewer than 4 rows or more than 2 dimensions, or duration is not
+            positive.
+    """
 
     knots: Array
     limit: Array | None
@@ -46,6 +69,7 @@ class CubicSpline(AbstractControl):
         self.t0 = float(t0)
 
     def unsaturated(self, t: Array) -> Array:
+        """The spline s(t) before saturation, shape (m,), at time t [s]."""
         return bspline_basis(t, self.duration, self.knots.shape[0], self.t0) @ self.knots
 
     def __call__(self, t, q=None, v=None):
@@ -53,8 +77,20 @@ class CubicSpline(AbstractControl):
 
     @classmethod
     def fit(cls, ts, values, n_knots: int, duration: float, limit=None, t0: float = 0.0) -> "CubicSpline":
-        """The least-squares spline through samples (ts, values (len(ts), m)), which must lie
-        inside +-limit when a limit is given."""
+        """The least-squares spline through samples of a history.
+
+        Args:
+            ts: sample times [s], shape (S,).
+            values: samples, shape (S, m); inside +-limit when a limit is given (they are
+                mapped through limit artanh(values / limit), clipped at 0.999 of the limit).
+            n_knots: the spline's number of control points, at least 4.
+            duration: the span of the spline [s].
+            limit: saturation level, or None.
+            t0: the start of the span [s].
+
+        Returns:
+            The `CubicSpline` whose knots fit the samples in the least-squares sense.
+        """
         values = jnp.asarray(values, dtype=float)
         if limit is not None:
             values = limit * jnp.arctanh(jnp.clip(values / limit, -0.999, 0.999))
@@ -63,7 +99,19 @@ class CubicSpline(AbstractControl):
 
     @classmethod
     def constant(cls, value, n_knots: int, duration: float, limit=None, t0: float = 0.0) -> "CubicSpline":
-        """The spline holding `value` (inside +-limit) for the whole duration."""
+        """The spline holding a constant value for the whole duration.
+
+        Args:
+            value: the value to hold, a scalar or shape (m,); strictly inside +-limit when a
+                limit is given.
+            n_knots: the spline's number of control points, at least 4.
+            duration: the span of the spline [s].
+            limit: saturation level, or None.
+            t0: the start of the span [s].
+
+        Returns:
+            The `CubicSpline` equal to value on [t0, t0 + duration].
+        """
         value = jnp.atleast_1d(jnp.asarray(value, dtype=float))
         s = value if limit is None else limit * jnp.arctanh(value / limit)
         return cls(jnp.tile(s, (n_knots, 1)), duration, limit, t0)

@@ -100,7 +100,7 @@ def _partial_velocities(shapes, q: Array) -> Array:
     return jnp.concatenate([Gw, do + skew(o) @ Gw])
 
 
-def frame_poses(model: FlexibleModel, q: Array) -> tuple[Array, Array, Array, Array]:
+def body_and_marker_poses(model: FlexibleModel, q: Array) -> tuple[Array, Array, Array, Array]:
     """(R, p) of every body frame, and (R, p) of every marker (`FlexibleModel.markers`)."""
     R, p, _ = _poses(model, q, jnp.zeros(model.nv, q.dtype))
     return (R, p, *_markers(model, R, p, model.split(q)[1]))
@@ -134,7 +134,7 @@ def marker_forces(model: FlexibleModel, q: Array, f: Array) -> Array:
     with the markers' motion from their poses, grid points' second-order part included (so a
     load at a grid point stiffens its body, `grid_point`)."""
     def power(v):
-        (R, p), (R_dot, p_dot) = jax.jvp(lambda q_: frame_poses(model, q_)[2:], (q,),
+        (R, p), (R_dot, p_dot) = jax.jvp(lambda q_: body_and_marker_poses(model, q_)[2:], (q,),
                                          (model.q_dot(q, v),))
         omega = jax.vmap(vee)(R_dot @ jnp.swapaxes(R, -1, -2))        # world components
         return jnp.sum(f[:, :3] * omega) + jnp.sum(f[:, 3:] * p_dot)

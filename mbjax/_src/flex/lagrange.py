@@ -1,7 +1,7 @@
 """The dense route for flexible trees: Lagrange's equations from the energies, by autodiff, O(n^3).
 
 An independent check of the O(n) recursion (`mbjax._src.flex.aba`) that shares none of its partial
-velocities or remainder terms: only the frame poses (`frame_poses`) and each body's generalized
+velocities or remainder terms: only the frame poses (`body_and_marker_poses`) and each body's generalized
 mass (`mbjax._src.flex.body.mass_matrix`). The body-frame velocities come from differentiating the
 poses, omega~ = R^T R_dot, v = R^T p_dot, so
 
@@ -19,7 +19,7 @@ import jax.numpy as jnp
 from jax import Array
 
 from mbjax._src.flex.body import kinetic_energy as body_kinetic_energy
-from mbjax._src.flex.kinematics import frame_poses
+from mbjax._src.flex.kinematics import body_and_marker_poses
 from mbjax._src.flex.model import FlexibleModel
 from mbjax._src.flex.stiffening import inertial_scalars
 from mbjax._src.lie import vee
@@ -35,7 +35,7 @@ def _body_motion(model: FlexibleModel, q: Array, v: Array, v_dot: Array):
     """Per body: R, p, body-frame (omega, v), and body-frame (alpha, a) with a the classical
     acceleration of the frame origin less gravity, all from derivatives of the poses."""
     def poses(q_):
-        R, p, _, _ = frame_poses(model, q_)
+        R, p, _, _ = body_and_marker_poses(model, q_)
         return R, p
 
     def rates(q_, v_):
@@ -61,7 +61,7 @@ def kinetic_energy(model: FlexibleModel, q: Array, v: Array) -> Array:
 
 def potential_energy(model: FlexibleModel, q: Array) -> Array:
     """Gravity's potential (zero at the ground origin) plus the modal strain energy."""
-    R, p, _, _ = frame_poses(model, q)
+    R, p, _, _ = body_and_marker_poses(model, q)
     _, qf = model.split(q)
     b = model.bodies
     q_bar = jnp.concatenate([jnp.ones((model.n, 1), q.dtype), qf], -1)
@@ -101,7 +101,7 @@ def external_forces(model: FlexibleModel, q: Array, f_ext: Array) -> Array:
     return jax.grad(power)(jnp.zeros(model.nv, q.dtype))
 
 
-def dense_forward_dynamics(model: FlexibleModel, q: Array, v: Array, tau: Array,
+def lagrangian_forward_dynamics(model: FlexibleModel, q: Array, v: Array, tau: Array,
                            f_ext: Array | None = None, loads: Array | None = None):
     """v_dot from Lagrange's equations (the residual's Jacobian in v_dot solved densely), under
     generalized forces tau and external wrenches f_ext (as `external_forces`); with `loads`

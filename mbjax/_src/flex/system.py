@@ -18,8 +18,8 @@ from mbjax._src.system.driven import about_origins, drive
 from mbjax._src.system.dynamics import AbstractForwardDynamics, Auto, Recursive, as_dynamics
 from mbjax._src.flex.aba import flexible_aba_responses
 from mbjax._src.flex.body import kinetic_energy as body_kinetic_energy
-from mbjax._src.flex.kinematics import body_velocities, frame_poses, marker_forces
-from mbjax._src.flex.lagrange import dense_forward_dynamics, potential_energy
+from mbjax._src.flex.kinematics import body_velocities, body_and_marker_poses, marker_forces
+from mbjax._src.flex.lagrange import lagrangian_forward_dynamics, potential_energy
 from mbjax._src.flex.model import FlexibleModel
 from mbjax._src.system.tree_system import AbstractTreeSystem
 
@@ -60,7 +60,7 @@ class FlexibleSystem(AbstractTreeSystem):
 
     def frames(self, q):
         """Body frames (joint grids), then the markers at grid points, deformation included."""
-        R, p, R_markers, p_markers = frame_poses(self.model, q)
+        R, p, R_markers, p_markers = body_and_marker_poses(self.model, q)
         return jnp.concatenate([R, R_markers]), jnp.concatenate([p, p_markers])
 
     def kinetic_energy(self, q, v):
@@ -109,4 +109,4 @@ class FlexibleSystem(AbstractTreeSystem):
         tau, f = self._loads(t, q, v)
         if isinstance(self.method.resolve(self.nv), Recursive):
             return flexible_aba_responses(self.model, q, v, tau, loads, f)
-        return dense_forward_dynamics(self.model, q, v, tau, f, loads)
+        return lagrangian_forward_dynamics(self.model, q, v, tau, f, loads)

@@ -10,10 +10,10 @@ from mbjax._src.system.system import AbstractSystem
 
 
 class AbstractIntegrator(eqx.Module):
-    """One step (q, u) at t -> (q, u) at t + dt of an `AbstractSystem`.
+    """A fixed-step integrator: one step (q, u) at t -> (q, u) at t + dt of an `AbstractSystem`.
 
-    `step` also returns a boolean scalar that is False when an inner solve did not converge;
-    `simulate` turns it into the solution's status.
+    Integrators are strategies passed to `mbjax.simulate` (and to `mbjax.trajopt.Problem`).
+    Each has a class attribute `order` (its order of accuracy) and `name`.
     """
 
     order: ClassVar[int]
@@ -22,4 +22,18 @@ class AbstractIntegrator(eqx.Module):
     @abc.abstractmethod
     def step(self, system: AbstractSystem, t: Array, q: Array, u: Array,
              dt: Array) -> tuple[Array, Array, Array]:
-        """Advance one step; return (q, u, converged)."""
+        """Advance the system one step.
+
+        Args:
+            system: the system whose `kinematics` and `acceleration` are integrated.
+            t: time at the step's start [s], a scalar.
+            q: configuration at t, shape (nq,).
+            u: velocity coordinates at t, shape (nv,).
+            dt: the step [s], a scalar.
+
+        Returns:
+            q1: configuration at t + dt, projected (`system.project`), shape (nq,).
+            u1: velocity coordinates at t + dt, shape (nv,).
+            converged: a boolean scalar, False when an inner solve (an implicit step's Newton
+                iteration) did not converge; `simulate` turns it into the solution's status.
+        """

@@ -6,8 +6,12 @@ from mbjax._src.integrate.base import AbstractIntegrator
 
 
 class ExplicitEuler(AbstractIntegrator):
-    """q1 = q0 + dt q_dot(q0, u0), u1 = u0 + dt u_dot(t0, q0, u0). Order 1; it adds energy to
-    every undamped oscillation and so is unconditionally unstable for conservative mechanics."""
+    """Explicit (forward) Euler: q1 = q0 + dt q_dot(q0, u0), u1 = u0 + dt u_dot(t0, q0, u0).
+
+    Order 1. It adds energy to every undamped oscillation and so is unconditionally unstable
+    for conservative mechanics; it is here as the Carpal Wrist chapter's time stepping
+    (Canfield 1997 eq 6.45). Takes no arguments.
+    """
 
     order = 1
     name = "explicit_euler"

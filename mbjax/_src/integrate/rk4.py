@@ -12,13 +12,16 @@ C = (0.0, 0.5, 0.5, 1.0)
 
 
 class RK4(AbstractIntegrator):
-    """Classical RK4 on (q, u), coordinates projected after the step. Order 4; conditionally
-    stable (|lambda dt| < 2.83 on the imaginary axis).
+    """The classical fourth-order Runge-Kutta method on (q, u), coordinates projected after the step.
+
+    Order 4; conditionally stable (|lambda dt| < 2.83 on the imaginary axis). Takes no
+    arguments.
 
     The four stages run as one `lax.scan` over the tableau rows, so the system's equations of
-    motion are traced and compiled once per step, not four times: for a heavy right-hand side
-    (an autodiff Lagrangian, a flexible body) this cuts compile time by about 3x, and more under
-    `jax.grad`, at no cost in run time."""
+    motion are traced and compiled once per step, not four times, which shortens compilation
+    for a heavy right-hand side (an autodiff Lagrangian, a flexible body) at no cost in run
+    time; see benchmarks/README.md.
+    """
 
     order = 4
     name = "rk4"

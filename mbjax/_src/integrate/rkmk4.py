@@ -13,7 +13,12 @@ from mbjax._src.integrate.base import AbstractIntegrator
 
 
 class RKMK4(AbstractIntegrator):
-    """Lie-group RK4 (Munthe-Kaas 1999). Order 4; on Euclidean systems it is RK4."""
+    """Runge-Kutta-Munthe-Kaas of order 4: RK4 in a chart that moves with the solution (Munthe-Kaas 1999).
+
+    Each step integrates the local coordinate xi about the step's start configuration and
+    retracts (see the module): rotations stay exactly on the rotation group. Order 4; on
+    Euclidean systems it is RK4. Takes no arguments.
+    """
 
     order = 4
     name = "rkmk4"

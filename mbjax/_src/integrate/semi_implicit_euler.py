@@ -6,8 +6,11 @@ from mbjax._src.integrate.base import AbstractIntegrator
 
 
 class SemiImplicitEuler(AbstractIntegrator):
-    """u1 = u0 + dt u_dot(t0, q0, u0), then q1 = q0 + dt q_dot(q0, u1). Order 1; symplectic for
-    separable Hamiltonians, so energy errors stay bounded instead of growing."""
+    """Semi-implicit (symplectic) Euler: u1 = u0 + dt u_dot(t0, q0, u0), then q1 = q0 + dt q_dot(q0, u1).
+
+    Order 1; symplectic for separable Hamiltonians, so energy errors stay bounded instead of
+    growing. Takes no arguments.
+    """
 
     order = 1
     name = "semi_implicit_euler"

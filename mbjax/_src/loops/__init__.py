@@ -9,7 +9,7 @@ triangularization with its epsilon-dynamics (`Stabilized`). Projection onto the 
 after every step (differentiable, by the implicit function theorem) and of initial conditions
 (`consistent_state`), and the status flags of a run (`Status.CONSTRAINT_VIOLATED`,
 `Status.REDUNDANT`) complete the set. The algorithms are also plain functions of a `Loops`
-(the tree with its closures): `coupled_acceleration`, `momentum_rate`, `eta_and_gamma`,
+(the tree with its closures): `coupled_acceleration`, `loop_momentum_rate`, `eta_and_gamma`,
 `stabilized_acceleration`.
 """
 
@@ -17,7 +17,7 @@ from mbjax._src.model.closures import GROUND, Coupling, CutJoint, Prescribed
 from mbjax._src.loops.constraints import Loops
 from mbjax._src.loops.coupled import Coupled, coupled_acceleration
 from mbjax._src.loops.method import AbstractLoopMethod
-from mbjax._src.loops.momentum import Momentum, momentum_rate
+from mbjax._src.loops.momentum import Momentum, loop_momentum_rate
 from mbjax._src.loops.multipliers import multipliers, numerical_rank
 from mbjax._src.loops.projection import consistent_state, gauss_newton, project_configuration, project_velocity
 from mbjax._src.loops.stabilized import Stabilized, eta_and_gamma, stabilized_acceleration
@@ -25,5 +25,5 @@ from mbjax._src.loops.system import ClosedSystem
 
 __all__ = ["GROUND", "AbstractLoopMethod", "ClosedSystem", "Coupled", "Coupling", "CutJoint", "Loops",
            "Momentum", "Prescribed", "Stabilized", "consistent_state", "coupled_acceleration",
-           "eta_and_gamma", "gauss_newton", "momentum_rate", "multipliers", "numerical_rank",
+           "eta_and_gamma", "gauss_newton", "loop_momentum_rate", "multipliers", "numerical_rank",
            "project_configuration", "project_velocity", "stabilized_acceleration"]

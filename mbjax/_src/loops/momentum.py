@@ -14,7 +14,7 @@ from mbjax._src.loops.method import AbstractLoopMethod, require_symmetric
 from mbjax._src.loops.multipliers import multipliers
 
 
-def momentum_rate(loops: Loops, q: Array, G: Array, t=0.0) -> tuple[Array, Array, Array]:
+def loop_momentum_rate(loops: Loops, q: Array, G: Array, t=0.0) -> tuple[Array, Array, Array]:
     """(G_dot, K_c, rank) of the momentum formulation, Jerkovsky 1978 eqs 95-98, for momenta G = mu v,
     under the tree's forces."""
     tree = loops.tree
@@ -48,7 +48,7 @@ class Momentum(AbstractLoopMethod):
         return loops.tree.mass_matrix(q) @ v
 
     def acceleration(self, loops, t, q, u):
-        return momentum_rate(loops, q, u, t)[0]
+        return loop_momentum_rate(loops, q, u, t)[0]
 
     def loads(self, loops, t, q, u):
-        return momentum_rate(loops, q, u, t)[1]
+        return loop_momentum_rate(loops, q, u, t)[1]

@@ -29,12 +29,12 @@ The mapping (MuJoCo body frames, joints and names to mbjax):
       velocity, whose rate in mbjax's body-frame velocity has a term omega x v that a diagonal
       armature cannot give (its damping and rotational armature map exactly).
     - Active connect and weld equality constraints (body or site semantics) become
-      `mbjax.loops.CutJoint`s ("spherical", "weld") with the same zero set as MuJoCo's residual,
-      returned with `closures=True`.
+      `mbjax.loops.CutJoint`s ("spherical", "weld") with the same zero set as MuJoCo's residual:
+      the model's `closures`.
 
 What mbjax does not model (contacts, actuator forces, tendons, springs, polynomial damping,
 gravity compensation, fluid forces, flexes, plugins, ball joint limits, other equality
-constraints, connect and weld constraints unless closures=True, free joints' translational
+constraints, free joints' translational
 armature) is named in one `ModelWarning`; `strict=True` makes it an error, as it does for
 implausible inertias.
 """
@@ -133,7 +133,7 @@ def _contact_pairs(m, filter_parent: bool) -> int:
     return int(np.triu(can, 1).sum()) + int(m.npair)
 
 
-def _ignored(m, mujoco, connect_weld: int, closures: bool) -> list[str]:
+def _ignored(m, mujoco) -> list[str]:
     """What the compiled model uses that the mbjax Model does not represent."""
     disabled = int(m.opt.disableflags)
     off = lambda flag: bool(disabled & int(flag))  # noqa: E731
@@ -171,17 +171,14 @@ def _ignored(m, mujoco, connect_weld: int, closures: bool) -> list[str]:
                                               int(mujoco.mjtEq.mjEQ_WELD)))))
     if other and _equality_on(m, mujoco):
         out.append(f"joint, tendon, flex and distance equality constraints ({other})")
-    if connect_weld and not closures:
-        out.append(f"connect and weld equality constraints ({connect_weld}; load with "
-                   "closures=True to get them as mbjax.loops.CutJoint)")
     return out
 
 
-def from_mujoco(mjmodel, *, strict: bool = False, closures: bool = False):
+def from_mujoco(mjmodel, *, strict: bool = False) -> Model:
     """A `Model` from a compiled `mujoco.MjModel` (see the module docstring for the mapping).
 
-    closures=True returns (model, cut_joints): the active connect and weld equality constraints
-    as `mbjax.loops.CutJoint`s, for `mbjax.loops.ClosedSystem(TreeSystem(model), cut_joints)`.
+    The active connect and weld equality constraints are the model's `closures`
+    (`mbjax.loops.CutJoint`s), for `mbjax.loops.ClosedSystem(TreeSystem(model), model.closures)`.
     What mbjax does not model is named in one `ModelWarning`; strict=True makes implausible
     inertias errors (`mbjax._src.model.checks`), not the features mbjax leaves out."""
     mujoco = _mujoco()
@@ -259,7 +256,11 @@ def from_mujoco(mjmodel, *, strict: bool = False, closures: bool = False):
     if int(m.opt.disableflags) & int(mujoco.mjtDisableBit.mjDSBL_GRAVITY):
         gravity = np.zeros(3)
     cuts, connect_weld = _cut_joints(m, mujoco, where)
-    ignored = _ignored(m, mujoco, connect_weld, closures)
+    ignored = _ignored(m, mujoco)
+    if connect_weld:
+        ignored.append(f"connect and weld equality constraints in TreeSystem(model) "
+                       f"({connect_weld}; they are model.closures, which "
+                       "mbjax.loops.ClosedSystem(TreeSystem(model), model.closures) enforces)")
     if free_armature:
         ignored.append(f"armature on free joints' translation ({free_armature})")
     if ignored:
@@ -278,8 +279,9 @@ def from_mujoco(mjmodel, *, strict: bool = False, closures: bool = False):
         effort_limit=effort, **per_dof, frame_names=[f[0] for f in frames],
         frame_parents=[f[1] for f in frames],
         frame_rotation=np.reshape([f[2] for f in frames], (-1, 3, 3)),
-        frame_translation=np.reshape([f[3] for f in frames], (-1, 3)), strict=strict)
-    return (model, cuts) if closures else model
+        frame_translation=np.reshape([f[3] for f in frames], (-1, 3)), closures=cuts,
+        strict=strict)
+    return model
 
 
 def _equality_on(m, mujoco) -> bool:
@@ -326,7 +328,7 @@ def _cut_joints(m, mujoco, where) -> tuple[list, int]:
     return cuts, count
 
 
-def load_mjcf(source: str | os.PathLike, *, strict: bool = False, closures: bool = False):
+def load_mjcf(source: str | os.PathLike, *, strict: bool = False) -> Model:
     """A `Model` from an MJCF file path or XML string (one starting with '<'), compiled by MuJoCo
     (`pip install mujoco`); see `from_mujoco` for the result and the options."""
     mujoco = _mujoco()
@@ -335,4 +337,4 @@ def load_mjcf(source: str | os.PathLike, *, strict: bool = False, closures: bool
         mjmodel = mujoco.MjModel.from_xml_string(text)
     else:
         mjmodel = mujoco.MjModel.from_xml_path(text)
-    return from_mujoco(mjmodel, strict=strict, closures=closures)
+    return from_mujoco(mjmodel, strict=strict)

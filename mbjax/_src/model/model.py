@@ -83,6 +83,11 @@ class Model(eqx.Module):
             ground); frame_rotation (m, 3, 3), frame_translation (m, 3): its pose in that body.
         See `mbjax.frame_pose` and `mbjax.frame_jacobian` (`mbjax._src.rigid.frames`).
 
+    Closures (`closures`): the loop-closing constraints the model file declares (a URDF's mimic
+    joints as `mbjax.loops.Coupling`s, an MJCF's connect and weld equalities as
+    `mbjax.loops.CutJoint`s); `TreeSystem(model)` leaves them out and
+    `ClosedSystem(TreeSystem(model), model.closures)` enforces them.
+
     Bodies with implausible but computable mass data (a triangle-inequality violation, negative
     moments, a massless leaf without armature) load with a `ModelWarning` (`mbjax._src.model.checks`);
     `strict=True` makes it an error.
@@ -111,13 +116,15 @@ class Model(eqx.Module):
     frame_parents: tuple[int, ...] = eqx.field(static=True)
     frame_rotation: Array
     frame_translation: Array
+    closures: tuple
 
     def __init__(self, parents, joint_types, *, mass, inertia, com=None, axis=None, axis2=None,
                  placement_rotation=None, placement_translation=None,
                  gravity=(0.0, 0.0, -9.81), names=None, joint_names=None, lower=None,
                  upper=None, velocity_limit=None, effort_limit=None, damping=None,
                  armature=None, friction=None, frame_names=(), frame_parents=(),
-                 frame_rotation=None, frame_translation=None, strict: bool = False):
+                 frame_rotation=None, frame_translation=None, closures=(), strict: bool = False):
+        self.closures = tuple(closures)
         self.topology = parents if isinstance(parents, Topology) else Topology(parents)
         n = self.topology.n
         joint_types = (joint_types,) * n if isinstance(joint_types, str) else tuple(joint_types)

@@ -27,6 +27,7 @@ import os
 import xml.etree.ElementTree as ET
 from pathlib import Path
 
+import equinox as eqx
 import numpy as np
 
 from mbjax._src.model.checks import combine, warn
@@ -127,8 +128,7 @@ def _read(text: str):
 
 def load_urdf(source: str | os.PathLike, *, floating_base: bool = False,
               gravity=(0.0, 0.0, -9.81), sibling_order: str = "name", armature=0.0,
-              min_mass: float = 0.0, min_inertia: float = 0.0, strict: bool = False,
-              closures: bool = False):
+              min_mass: float = 0.0, min_inertia: float = 0.0, strict: bool = False) -> Model:
     """A Model from a URDF path or XML string (a string starting with '<' is read as XML).
 
     sibling_order: "name" (Pinocchio's numbering) or "document" (MuJoCo's; see the module).
@@ -136,7 +136,7 @@ def load_urdf(source: str | os.PathLike, *, floating_base: bool = False,
     min_mass, min_inertia: lower bounds on the mass and the principal moments of every body (like
         MuJoCo's boundmass and boundinertia), a remedy for massless leaves on moving joints.
     strict: turn the warnings on implausible data into errors (not the note on mimic joints).
-    closures: also return the mimic joints' couplings, `(model, [mbjax.loops.Coupling, ...])`.
+    The mimic joints' couplings are the model's `closures` (`mbjax.loops.Coupling`s).
     """
     if sibling_order not in ("name", "document"):
         raise ValueError(f"sibling_order must be 'name' or 'document', got {sibling_order!r}")
@@ -263,11 +263,10 @@ def load_urdf(source: str | os.PathLike, *, floating_base: bool = False,
         frame_names=[f[0] for f in frames], frame_parents=[f[1] for f in frames],
         frame_rotation=np.reshape([f[2] for f in frames], (-1, 3, 3)),
         frame_translation=np.reshape([f[3] for f in frames], (-1, 3)), strict=strict)
-    couplings = _mimics(model, bodies, quiet=closures)
-    return (model, couplings) if closures else model
+    return eqx.tree_at(lambda m: m.closures, model, tuple(_mimics(model, bodies)))
 
 
-def _mimics(model: Model, bodies: list, quiet: bool) -> list:
+def _mimics(model: Model, bodies: list) -> list:
     """The mimic joints' couplings q = multiplier q_reference + offset."""
     from mbjax._src.model.closures import Coupling
 
@@ -287,10 +286,11 @@ def _mimics(model: Model, bodies: list, quiet: bool) -> list:
                             _attribute(mimic, "multiplier", what, 1.0),
                             _attribute(mimic, "offset", what, 0.0)))
         names.append(f"{b['joint']} = {out[-1].multiplier} {reference} + {out[-1].offset}")
-    if names and not (quiet and len(names) == len(out)):
-        warn(f"URDF: mimic joints load as independent joints, as Pinocchio and MuJoCo load them "
-             f"({'; '.join(names)}); load_urdf(..., closures=True) also returns the couplings "
-             "as mbjax.loops.Coupling closures for mbjax.loops.ClosedSystem", strict=False)
+    if names:
+        warn(f"URDF: mimic joints ({'; '.join(names)}): TreeSystem(model) moves them as "
+             "independent joints, as Pinocchio and MuJoCo load them; the couplings are "
+             "model.closures, for mbjax.loops.ClosedSystem(TreeSystem(model), model.closures)",
+             strict=False)
     return out
 
 

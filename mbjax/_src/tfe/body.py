@@ -24,9 +24,24 @@ from mbjax._src.spatial import check_inertia
 
 
 class Body(eqx.Module):
-    """A rigid body of `mass` with `inertia` about O' and centre of mass `com` (both in the body
-    frame) under uniform `gravity`. fixed_point=True: O' does not move and q = r_* (3 dof);
-    otherwise q = (r_*, x_*) (6 dof), O' anywhere in the body."""
+    """A rigid body as the time finite elements see it (Borri 1990 §3), under uniform gravity.
+
+    Quantities are referred to the body point O' and ordered (angular; linear). With
+    fixed_point=True O' does not move and the coordinates are q = r_* (3 dof, a top about its
+    suspension point); otherwise q = (r_*, x_*) (6 dof), O' anywhere in the body.
+
+    Args:
+        mass: mass [kg], positive.
+        inertia: second moment about O' in the body frame (J_bar of eq 3.9), shape (3, 3)
+            [kg m^2]; symmetric, positive definite, satisfying the triangle inequality.
+        com: centre of mass relative to O' in the body frame (c_bar), shape (3,) [m].
+        gravity: acceleration of gravity in space, shape (3,) [m/s^2].
+        fixed_point: whether O' is a fixed point (3 rotational dof) or free (6 dof).
+
+    Raises:
+        ValueError: mass is not positive, com is not a finite 3-vector, or inertia is not a
+            valid inertia matrix.
+    """
 
     mass: Array
     com: Array
@@ -50,8 +65,15 @@ class Body(eqx.Module):
 
     @classmethod
     def from_rigid(cls, body: RigidBody) -> "Body":
-        """The same body as an `mbjax.rigid.RigidBody` (O' = its fixed point or its centre of
-        mass)."""
+        """The same body as a given `mbjax.rigid.RigidBody`.
+
+        Args:
+            body: the rigid body; O' becomes its fixed point or, for a free body, its
+                reference point.
+
+        Returns:
+            The `Body` with the same mass, inertia, centre of mass, gravity and fixed point.
+        """
         return cls(body.mass, body.inertia, com=body.com, gravity=body.gravity,
                    fixed_point=body.fixed_point)
 
@@ -61,7 +83,17 @@ class Body(eqx.Module):
         return 3 if self.fixed_point else 6
 
     def mass_matrix(self, R: Array) -> Array:
-        """M6(R) of eqs 3.8-3.9, (nq, nq)."""
+        """The generalized mass M6(R) in space (Borri 1990 eqs 3.8-3.9).
+
+        M6(R) = [[J, S], [S^T, M I]] with J = R J_bar R^T and S = M (R c_bar) x I; only J
+        about a fixed point.
+
+        Args:
+            R: rotation body to space, shape (3, 3).
+
+        Returns:
+            M6(R), shape (nq, nq).
+        """
         J = R @ self.inertia @ R.T
         if self.fixed_point:
             return J
@@ -69,11 +101,21 @@ class Body(eqx.Module):
         return jnp.block([[J, S], [S.T, self.mass * jnp.eye(3)]])
 
     def momentum_to_velocity(self, R: Array, p_hat: Array) -> Array:
-        """w_hat = M6^-1 p_hat (eq 3.19) in closed form. About a fixed point omega = R J_bar^-1
-        R^T h; for a free body, eliminating v from l = S^T omega + M v leaves J_c omega = h -
-        S l / M with J_c = J - S S^T / M = R J_bar_c R^T, the inertia about the centre of mass
-        (J_bar_c = J_bar + M c_bar x c_bar x), then v = (l - S^T omega) / M. Only 3x3 solves with
-        constant matrices, so derivatives in R stay cheap (no factorization to differentiate)."""
+        """The velocity w_hat = M6^-1 p_hat of a momentum (Borri 1990 eq 3.19), in closed form.
+
+        About a fixed point omega = R J_bar^-1 R^T h; for a free body, eliminating v from
+        l = S^T omega + M v leaves J_c omega = h - S l / M with J_c = J - S S^T / M =
+        R J_bar_c R^T, the inertia about the centre of mass (J_bar_c = J_bar + M c_bar x
+        c_bar x), then v = (l - S^T omega) / M. Only 3x3 solves with constant matrices, so
+        derivatives in R stay cheap (no factorization to differentiate).
+
+        Args:
+            R: rotation body to space, shape (3, 3).
+            p_hat: spatial momentum (h, l) about O' (h only about a fixed point), shape (nq,).
+
+        Returns:
+            w_hat = (omega, v) (omega only about a fixed point), shape (nq,).
+        """
         if self.fixed_point:
             return R @ jnp.linalg.solve(self.inertia, R.T @ p_hat)
         h, linear = p_hat[:3], p_hat[3:]
@@ -84,24 +126,60 @@ class Body(eqx.Module):
         return jnp.concatenate([omega, (linear - self.mass * jnp.cross(omega, c)) / self.mass])
 
     def applied(self, R: Array) -> Array:
-        """f_hat = (m, b): gravity's moment about O' and force (eq 3.16)."""
+        """The applied load f_hat = (m, b): gravity's moment about O' and its force (eq 3.16).
+
+        Args:
+            R: rotation body to space, shape (3, 3).
+
+        Returns:
+            f_hat, shape (nq,) (the moment m only about a fixed point) [N m, N].
+        """
         b = self.mass * self.gravity
         m = jnp.cross(R @ self.com, b)
         return m if self.fixed_point else jnp.concatenate([m, b])
 
     def kinetic_energy(self, R: Array, p_hat: Array) -> Array:
-        """p_hat . M6^-1 p_hat / 2 (eq 3.25)."""
+        """The kinetic energy p_hat . M6^-1 p_hat / 2 (eq 3.25).
+
+        Args:
+            R: rotation body to space, shape (3, 3).
+            p_hat: spatial momentum about O', shape (nq,).
+
+        Returns:
+            The kinetic energy [J], a scalar.
+        """
         return 0.5 * p_hat @ self.momentum_to_velocity(R, p_hat)
 
     def energy(self, R: Array, x: Array, p_hat: Array) -> Array:
-        """Kinetic (eq 3.25: p_hat . M6^-1 p_hat / 2) plus potential energy."""
+        """The total energy: kinetic (eq 3.25, p_hat . M6^-1 p_hat / 2) plus gravity's potential.
+
+        Args:
+            R: rotation body to space, shape (3, 3).
+            x: position of O' in space, shape (3,) [m] (ignored about a fixed point).
+            p_hat: spatial momentum about O', shape (nq,).
+
+        Returns:
+            The energy [J], a scalar.
+        """
         centre = R @ self.com + (0.0 if self.fixed_point else x)
         return self.kinetic_energy(R, p_hat) - self.mass * self.gravity @ centre
 
     def invariants(self, t, R: Array, x: Array, p_hat: Array) -> Invariants:
-        """What the motion conserves (as `mbjax.rigid.RigidBody.invariants`): the energy, the
-        angular momentum about the origin h + x x l along gravity (all of it without gravity)
-        and, for a free body, l - M g t."""
+        """What the motion conserves, for the drift check of `solve_tfe`.
+
+        As `mbjax.rigid.RigidBody.invariants`: the energy, the angular momentum about the
+        origin h + x x l along gravity (all of it without gravity) and, for a free body,
+        l - M g t.
+
+        Args:
+            t: time [s], a scalar.
+            R: rotation body to space, shape (3, 3).
+            x: position of O' in space, shape (3,) [m].
+            p_hat: spatial momentum about O', shape (nq,).
+
+        Returns:
+            The invariants with their scales (`mbjax._src.system.invariants.Invariants`).
+        """
         h = p_hat[:3]
         orbital = jnp.zeros(3, h.dtype) if self.fixed_point else jnp.cross(x, p_hat[3:])
         g = self.gravity

@@ -20,8 +20,18 @@ QUADRATURES = ("exact", "reduced")
 
 
 def gauss_legendre(points: int) -> tuple[np.ndarray, np.ndarray]:
-    """Gauss-Legendre abscissae on [0, 1] and weights summing to 1; exact for polynomials of
-    degree 2 points - 1."""
+    """The Gauss-Legendre rule on [0, 1], exact for polynomials of degree 2 points - 1.
+
+    Args:
+        points: the number of points, a positive int.
+
+    Returns:
+        abscissae: the points in (0, 1), shape (points,).
+        weights: their weights, summing to 1, shape (points,).
+
+    Raises:
+        ValueError: points is not a positive int.
+    """
     if not (isinstance(points, int | np.integer) and points >= 1):
         raise ValueError(f"a Gauss rule needs at least one point, got {points!r}")
     x, w = np.polynomial.legendre.leggauss(int(points))
@@ -29,8 +39,19 @@ def gauss_legendre(points: int) -> tuple[np.ndarray, np.ndarray]:
 
 
 def lagrange(nodes: np.ndarray, tau) -> tuple[np.ndarray, np.ndarray]:
-    """Values s_k(tau) and derivatives ds_k/dtau, each (len(tau), len(nodes)), of the Lagrange
-    polynomials through `nodes` (s_k(nodes_j) = delta_kj)."""
+    """The Lagrange polynomials through `nodes` (s_k(nodes_j) = delta_kj) and their derivatives.
+
+    Args:
+        nodes: distinct nodes, shape (n,).
+        tau: where to evaluate, a scalar or shape (P,).
+
+    Returns:
+        values: s_k(tau), shape (P, n).
+        derivatives: ds_k/dtau, shape (P, n).
+
+    Raises:
+        ValueError: the nodes are not distinct.
+    """
     nodes = np.asarray(nodes, dtype=float)
     tau = np.atleast_1d(np.asarray(tau, dtype=float))
     n = len(nodes)
@@ -50,12 +71,20 @@ def lagrange(nodes: np.ndarray, tau) -> tuple[np.ndarray, np.ndarray]:
 
 @dataclass(frozen=True)
 class Element:
-    """An n-node time element with its quadrature rule (hashable: a static argument).
+    """An n-node Lagrange time element with its quadrature rule (Borri 1990 §5).
 
-    Tables on the unit parameter tau in [0, 1]: `s` and `ds` (points, nodes) are the shape
-    functions and their tau-derivatives at the Gauss points `tau` with weights `weights`; with
-    element length h = (nodes - 1) dt, ds/dt = ds / h and the integral over the element of f is
-    h sum_g weights_g f(tau_g).
+    Hashable, so it is a static argument of `solve_tfe`. Tables on the unit parameter tau in
+    [0, 1]: `s` and `ds` (points, nodes) are the shape functions and their tau-derivatives at
+    the Gauss points `tau` with weights `weights`; with element length h = (nodes - 1) dt,
+    ds/dt = ds / h and the integral over the element of f is h sum_g weights_g f(tau_g).
+
+    Args:
+        nodes: the number of nodes, at least 2, equally spaced dt apart.
+        quadrature: "exact" (Gauss-Legendre with `nodes` points) or "reduced" (one point
+            fewer; the single Gauss point of §7 for the two-node element).
+
+    Raises:
+        ValueError: nodes is not an int >= 2, or quadrature is not one of `QUADRATURES`.
     """
 
     nodes: int = 2
@@ -69,26 +98,32 @@ class Element:
 
     @property
     def points(self) -> int:
+        """The number of Gauss points: nodes (exact) or nodes - 1 (reduced)."""
         return self.nodes if self.quadrature == "exact" else self.nodes - 1
 
     @cached_property
     def node_tau(self) -> np.ndarray:
+        """The nodes on the unit parameter, shape (nodes,)."""
         return np.linspace(0.0, 1.0, self.nodes)
 
     @cached_property
     def tau(self) -> np.ndarray:
+        """The Gauss points on the unit parameter, shape (points,)."""
         return gauss_legendre(self.points)[0]
 
     @cached_property
     def weights(self) -> np.ndarray:
+        """The Gauss weights, summing to 1, shape (points,)."""
         return gauss_legendre(self.points)[1]
 
     @cached_property
     def s(self) -> np.ndarray:
+        """The shape functions at the Gauss points, shape (points, nodes)."""
         return lagrange(self.node_tau, self.tau)[0]
 
     @cached_property
     def ds(self) -> np.ndarray:
+        """The shape functions' tau-derivatives at the Gauss points, shape (points, nodes)."""
         return lagrange(self.node_tau, self.tau)[1]
 
     @cached_property
@@ -104,5 +139,12 @@ class Element:
         return lagrange(self.trial_tau, self.tau)[0]
 
     def length(self, dt: float) -> float:
-        """The element's time span for node spacing dt."""
+        """The element's time span (nodes - 1) dt.
+
+        Args:
+            dt: the node spacing [s].
+
+        Returns:
+            The element's length [s].
+        """
         return (self.nodes - 1) * dt

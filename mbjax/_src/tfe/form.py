@@ -44,32 +44,101 @@ def S1(body: Body, z: Array, y: Array) -> Array:
 
 
 class AbstractForm(eqx.Module):
-    """A weak form of Hamilton's law for the rigid body on one time element."""
+    """A weak form of Hamilton's law for the rigid body on one time element (Borri 1990 §5).
+
+    A strategy passed to `solve_tfe` (`Mixed()`, `PrimalUnsymmetric()`, ...). It turns the
+    element's weak form into a square nonlinear system residual(U; z_1) = 0 in its unknowns U,
+    given the state at the element's start z_1 = (p_1, q_1), and gives the end state
+    z_2 = final(U; z_1) once converged (see the module). The concrete forms take no arguments.
+    """
 
     name: eqx.AbstractClassVar[str]
 
     @abc.abstractmethod
     def n_unknowns(self, element: Element, nq: int) -> int:
-        """Size of U."""
+        """The number of unknowns U of one element.
+
+        Args:
+            element: the time element.
+            nq: the body's number of coordinates (3 or 6).
+
+        Returns:
+            The size of U.
+        """
 
     @abc.abstractmethod
     def guess(self, body: Body, ref: Reference, element: Element, z1: Array) -> Array:
-        """The Newton starting point: the reference motion."""
+        """The Newton starting point: the reference motion.
+
+        Args:
+            body: the body.
+            ref: the element's reference motion.
+            element: the time element.
+            z1: the start state (p_1, q_1) in the form's variables, shape (2 nq,).
+
+        Returns:
+            The initial U, shape (n_unknowns,).
+        """
 
     @abc.abstractmethod
     def residual(self, body: Body, ref: Reference, element: Element, dt, U: Array,
                  z1: Array) -> Array:
-        """The element's equations, flat, as many as U has entries."""
+        """The element's equations (the test rows of the initial and interior nodes).
+
+        Args:
+            body: the body.
+            ref: the element's reference motion.
+            element: the time element.
+            dt: the node spacing [s].
+            U: the unknowns, shape (n_unknowns,).
+            z1: the start state (p_1, q_1) in the form's variables, shape (2 nq,).
+
+        Returns:
+            The residual, flat, as many entries as U.
+        """
 
     @abc.abstractmethod
     def final(self, body: Body, ref: Reference, element: Element, dt, U: Array,
               z1: Array) -> Array:
-        """z_2 = (p_2, q_2) at the element's end."""
+        """The end state z_2 = (p_2, q_2) from the last test row.
+
+        Args:
+            body: the body.
+            ref: the element's reference motion.
+            element: the time element.
+            dt: the node spacing [s].
+            U: the converged unknowns, shape (n_unknowns,).
+            z1: the start state (p_1, q_1) in the form's variables, shape (2 nq,).
+
+        Returns:
+            z_2 in the form's variables, shape (2 nq,).
+        """
 
     def to_form(self, body: Body, q: Array, p_hat: Array) -> Array:
-        """The form's boundary momentum p from p_hat at coordinates q."""
+        """The form's boundary momentum p from the spatial momentum p_hat.
+
+        p_hat itself for the forms tested by the virtual rotation; p = X^T p_hat (eq 3.17) for
+        those tested by delta q.
+
+        Args:
+            body: the body.
+            q: incremental coordinates, shape (nq,).
+            p_hat: spatial momentum about O', shape (nq,).
+
+        Returns:
+            p, shape (nq,).
+        """
         return p_hat
 
     def from_form(self, body: Body, q: Array, p: Array) -> Array:
-        """p_hat from the form's boundary momentum p at coordinates q."""
+        """The spatial momentum p_hat from the form's boundary momentum p (inverse of `to_form`).
+
+        Args:
+            body: the body.
+            q: incremental coordinates, shape (nq,).
+            p: the form's momentum, shape (nq,).
+
+        Returns:
+            p_hat, shape (nq,).
+        """
         return p

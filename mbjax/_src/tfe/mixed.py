@@ -66,7 +66,11 @@ class AbstractMixed(AbstractForm):
 
 
 class MixedUnsymmetric(AbstractMixed):
-    """Eq 3.28 / B.20 in (p_hat, q), tested by (d*p, dq_hat): R_m of eq B.22."""
+    """The unsymmetric mixed form (Borri 1990 eq 3.28 / B.20) in (p_hat, q), tested by (d*p, dq_hat).
+
+    R_m = (X^-1 (w_n - w_hat), f_hat + S_1(p_hat) w_hat) of eq B.22, w_hat = M6^-1 p_hat. The
+    unknowns are the n - 1 trial nodes of (p_hat, q). Takes no arguments.
+    """
 
     name = "mixed_unsymmetric"
 
@@ -79,15 +83,30 @@ class MixedUnsymmetric(AbstractMixed):
 
 
 class Mixed(AbstractMixed):
-    """Eq 3.30 / 4.9: the mixed form in the canonical pair (p, q), p = X^T p_hat (eq 3.17), with
-    R_m = (-dH/dp, -dH/dq + f) (eq 4.11) and the Hamiltonian of eq B.27,
-    H(p, q, t) = p_hat . M6^-1 p_hat / 2 - p_hat . w_n, p_hat = X^-T p, differentiated by
-    autodiff (its tangent, eq 4.12 / B.32, is symmetric in the Hamiltonian part). This is the
-    mixed form the paper discretizes (§5.2) and the one its figures compare."""
+    """The mixed form (Borri 1990 eq 3.30 / 4.9) in the canonical pair (p, q), p = X^T p_hat.
+
+    R_m = (-dH/dp, -dH/dq + f) (eq 4.11) with the Hamiltonian of eq B.27,
+    H(p, q, t) = p_hat . M6^-1 p_hat / 2 - p_hat . w_n, p_hat = X^-T p (eq 3.17),
+    differentiated by autodiff (its tangent, eq 4.12 / B.32, is symmetric in the Hamiltonian
+    part). This is the mixed form the paper discretizes (§5.2) and the one its figures
+    compare; `solve_tfe`'s default. Takes no arguments.
+    """
 
     name = "mixed"
 
     def hamiltonian(self, body: Body, ref: Reference, p: Array, q: Array, t) -> Array:
+        """The Hamiltonian H(p, q, t) of eq B.27.
+
+        Args:
+            body: the body.
+            ref: the element's reference motion.
+            p: canonical momentum X^T p_hat, shape (nq,).
+            q: incremental coordinates, shape (nq,).
+            t: element time [s], a scalar.
+
+        Returns:
+            H [J], a scalar.
+        """
         R, _ = configuration(body, ref, q, t)
         p_hat = X_inverse_transpose(body, q, p)
         return 0.5 * p_hat @ body.momentum_to_velocity(R, p_hat) - p_hat @ w_n(body, ref, q)

@@ -60,9 +60,12 @@ class AbstractPrimal(AbstractForm):
 
 
 class PrimalUnsymmetric(AbstractPrimal):
-    """Eq 3.23 / 4.1, tested by the virtual rotation: P1 = p_hat, P2 = f_hat - S_1(w) p_hat
-    (eq 4.3, B.3), with p_hat = M6 w (eq 3.19) and w = X q_dot + w_n (eq 3.20). Its tangent
-    (eq 4.4, B.5) is unsymmetric."""
+    """The unsymmetric primal form (Borri 1990 eq 3.23 / 4.1), tested by the virtual rotation.
+
+    P1 = p_hat, P2 = f_hat - S_1(w) p_hat (eq 4.3, B.3), with p_hat = M6 w (eq 3.19) and
+    w = X q_dot + w_n (eq 3.20). Its tangent (eq 4.4, B.5) is unsymmetric. The unknowns are
+    the nodal coordinates q_2 ... q_n. Takes no arguments.
+    """
 
     name = "primal"
 
@@ -74,9 +77,12 @@ class PrimalUnsymmetric(AbstractPrimal):
 
 
 class PrimalSymmetric(AbstractPrimal):
-    """Eq 3.24 / 4.5, tested by delta q: P1 = dT/dq_dot, P2 = dT/dq + X^T f_hat (eq 4.7), with
-    T(q_dot, q, t) = w . M6 w / 2 differentiated by autodiff. Its kinetic tangent (eq 4.8, B.16)
-    is symmetric; the boundary momentum is p = X^T p_hat (eq 3.17)."""
+    """The symmetric primal form (Borri 1990 eq 3.24 / 4.5), tested by delta q.
+
+    P1 = dT/dq_dot, P2 = dT/dq + X^T f_hat (eq 4.7), with T(q_dot, q, t) = w . M6 w / 2
+    differentiated by autodiff. Its kinetic tangent (eq 4.8, B.16) is symmetric; the boundary
+    momentum is p = X^T p_hat (eq 3.17). Takes no arguments.
+    """
 
     name = "primal_symmetric"
 

@@ -21,8 +21,18 @@ REFERENCES = ("constant", "constant_velocity")
 
 
 class Reference(eqx.Module):
-    """x_o(t) = x_1 + t v_o, R_o(t) = exp(t omega_o x I) R_1 (t from the element's start); the
-    reference velocities v_o, omega_o (eqs 2.2-2.3) are constant in space."""
+    """A reference motion x_o(t) = x_1 + t v_o, R_o(t) = exp(t omega_o x I) R_1 (Borri 1990 §2).
+
+    t counts from the reference's start; the reference velocities v_o, omega_o (eqs 2.2-2.3)
+    are constant in space. Given to `solve_tfe` as `reference=`, it is followed by the whole
+    march (the steady rotation of eq 7.1, say).
+
+    Args:
+        R1: rotation at t = 0, body to space, shape (3, 3).
+        x1: position of O' at t = 0, shape (3,) [m].
+        omega: spatial angular velocity omega_o, shape (3,) [rad/s].
+        v: velocity v_o of O', shape (3,) [m/s].
+    """
 
     R1: Array
     x1: Array
@@ -30,17 +40,47 @@ class Reference(eqx.Module):
     v: Array
 
     def at(self, t) -> tuple[Array, Array]:
-        """(R_o(t), x_o(t))."""
+        """The reference configuration at time t.
+
+        Args:
+            t: time from the reference's start [s], a scalar.
+
+        Returns:
+            R_o: rotation, shape (3, 3).
+            x_o: position of O', shape (3,) [m].
+        """
         return lie.exp(t * self.omega) @ self.R1, self.x1 + t * self.v
 
     def shifted(self, t) -> "Reference":
-        """The same motion, its time counted from t."""
+        """The same motion, its time counted from t.
+
+        Args:
+            t: the new origin of time [s], a scalar.
+
+        Returns:
+            The `Reference` starting at (R_o(t), x_o(t)) with the same velocities.
+        """
         R, x = self.at(t)
         return Reference(R, x, self.omega, self.v)
 
 
 def make_reference(kind: str, body: Body, R1: Array, x1: Array, p_hat1: Array) -> Reference:
-    """The reference of an element whose initial state is (R1, x1, p_hat1)."""
+    """The reference of an element whose initial state is (R1, x1, p_hat1).
+
+    Args:
+        kind: one of `REFERENCES`: "constant" (held at the initial configuration) or
+            "constant_velocity" (moving with the initial velocities).
+        body: the body.
+        R1: initial rotation, shape (3, 3).
+        x1: initial position of O', shape (3,) [m].
+        p_hat1: initial spatial momentum about O', shape (nq,).
+
+    Returns:
+        The `Reference`.
+
+    Raises:
+        ValueError: kind is not one of `REFERENCES`.
+    """
     if kind not in REFERENCES:
         raise ValueError(f"reference must be one of {REFERENCES}, got {kind!r}")
     w1 = body.momentum_to_velocity(R1, p_hat1)

@@ -22,12 +22,27 @@ from mbjax._src.tfe.reference import Reference, X_inverse, configuration, w_n
 
 
 class ThreeField(AbstractForm):
-    """The three-field form: unknowns are the n - 1 trial nodes of (p_hat, q, w)."""
+    """The three-field form (Borri 1990 eqs 3.34, B.42-B.45): q, w and p_hat independent.
+
+    The unknowns are the n - 1 trial nodes of (p_hat, q, w) (see the module). Takes no
+    arguments.
+    """
 
     name = "three_field"
 
     def pointwise(self, body: Body, ref: Reference, y: Array, t) -> tuple[Array, Array]:
-        """The (d*p, dq_hat) rows and the d*w row of eq B.45 at one time."""
+        """The (d*p, dq_hat) rows and the d*w row of eq B.45 at one time.
+
+        Args:
+            body: the body.
+            ref: the element's reference motion.
+            y: the fields (p_hat, q, w) at that time, shape (3 nq,).
+            t: element time [s], a scalar.
+
+        Returns:
+            rows: the (d*p, dq_hat) rows, shape (2 nq,).
+            constitutive: the d*w row M6 w - p_hat, shape (nq,).
+        """
         p_hat, q, w = jnp.split(y, 3)
         R, _ = configuration(body, ref, q, t)
         p_w = body.mass_matrix(R) @ w
@@ -36,7 +51,19 @@ class ThreeField(AbstractForm):
         return rows, p_w - p_hat
 
     def nodal_residual(self, body, ref, element, dt, U: Array) -> tuple[Array, Array]:
-        """(E (nodes, 2 nq), W (nodes - 1, nq)) for trial nodes U (nodes - 1, 3 nq)."""
+        """The element's test rows for given trial nodes.
+
+        Args:
+            body: the body.
+            ref: the element's reference motion.
+            element: the time element.
+            dt: the node spacing [s].
+            U: the trial nodes, shape (nodes - 1, 3 nq).
+
+        Returns:
+            E: the (d*p, dq_hat) rows per test node, shape (nodes, 2 nq).
+            W: the constitutive rows per trial node, shape (nodes - 1, nq).
+        """
         t, wh, *_ = quadrature(element, dt)
         Y = element.s_trial @ U
         rows, constitutive = jax.vmap(lambda y, tg: self.pointwise(body, ref, y, tg))(Y, t)
