@@ -1,51 +1,149 @@
-"""The package's layering, checked from the source: no subpackage imports another's private
-names, `loops/` holds no type tests on model kinds, and nothing under `scenes/` reaches up to the
-command line's `bench/`, `reproduce/`, `tour` or `cli`."""
+"""The package's structure, checked from the source so that it cannot drift: the layers read in one
+direction, the implementation is private behind a curated public API, and `import mbjax` loads no
+harness (command line, tour, benchmarks, reproductions, plotting)."""
 
 import ast
+import importlib
+import subprocess
+import sys
 from pathlib import Path
 
-PACKAGE = Path(__file__).parent.parent / "mbjax"
+import mbjax
+
+ROOT = Path(__file__).parent.parent
+PACKAGE = ROOT / "mbjax"
+SRC = PACKAGE / "_src"
+HARNESS = ROOT / "mbjax_harness"
+
+# mbjax/_src's packages and modules, lowest first: each may import its own layer and those below
+# (and `mbjax.data`, the model files shipped with the package)
+LAYERS = (
+    {"runtime", "linalg", "cache"},
+    {"lie", "spatial", "tree"},
+    {"model"},                        # with the closures' data types
+    {"control"},
+    {"system"},                       # AbstractSystem, AbstractTreeSystem, driven systems, Status
+    {"rigid", "wrist"},
+    {"flex"},                         # flexible bodies reuse the rigid kinematics
+    {"loops", "tfe"},
+    {"integrate"},
+    {"trajopt"},
+    {"synthesis", "scenes"},          # the Carpal Wrist's synthesis; the ready-made scenes
+)
+RANK = {name: rank for rank, names in enumerate(LAYERS) for name in names}
+NAMESPACES = ("lie", "model", "control", "integrate", "rigid", "flex", "loops", "tfe", "wrist",
+              "trajopt", "scenes", "data")
+MAX_PUBLIC_NAMES = 150
 
 
 def _imports(path: Path):
-    """(module, name) for every `from mbjax.x import name` and `import mbjax.x` in a file."""
+    """Every mbjax module a file imports (`from mbjax.x import y` also as mbjax.x.y)."""
     for node in ast.walk(ast.parse(path.read_text())):
-        if isinstance(node, ast.ImportFrom) and node.module and node.module.startswith("mbjax"):
-            yield from ((node.module, alias.name) for alias in node.names)
+        if isinstance(node, ast.ImportFrom) and node.module and node.module.split(".")[0] in (
+                "mbjax", "mbjax_harness"):
+            yield node.module
+            yield from (f"{node.module}.{alias.name}" for alias in node.names)
         elif isinstance(node, ast.Import):
-            yield from ((alias.name, None) for alias in node.names if alias.name.startswith("mbjax"))
+            yield from (a.name for a in node.names if a.name.split(".")[0] in ("mbjax", "mbjax_harness"))
 
 
-def _subpackage(module: str) -> str:
+def _layer(module: str) -> str | None:
     parts = module.split(".")
-    return parts[1] if len(parts) > 1 else ""
+    return parts[2] if parts[:2] == ["mbjax", "_src"] and len(parts) > 2 else None
 
 
-def test_no_subpackage_imports_another_ones_private_names():
+def test_layers_read_in_one_direction():
+    assert set(RANK) == {p.stem for p in SRC.iterdir() if p.stem != "__init__" and
+                         (p.suffix == ".py" or p.is_dir()) and p.name != "__pycache__"}
     offences = []
-    for path in PACKAGE.rglob("*.py"):
-        own = path.relative_to(PACKAGE).parts[0].removesuffix(".py")
-        for module, name in _imports(path):
-            if name and name.startswith("_") and _subpackage(module) != own:
-                offences.append(f"{path.relative_to(PACKAGE)}: {module}.{name}")
+    for path in SRC.rglob("*.py"):
+        own = path.relative_to(SRC).parts[0].removesuffix(".py")
+        if own == "__init__":
+            continue
+        for module in _imports(path):
+            if module.split(".")[0] == "mbjax_harness" or (module.startswith("mbjax") and not
+                                                           module.startswith(("mbjax._src", "mbjax.data"))):
+                offences.append(f"{path.relative_to(ROOT)} imports {module} (above the library)")
+                continue
+            layer = _layer(module)
+            if layer in RANK and RANK[layer] > RANK[own]:
+                offences.append(f"{path.relative_to(ROOT)} ({own}) imports {module} ({layer})")
+    assert not offences, "\n".join(sorted(set(offences)))
+
+
+def test_the_library_never_imports_the_harness():
+    offences = [f"{path.relative_to(ROOT)}: {module}" for path in PACKAGE.rglob("*.py")
+                for module in _imports(path) if module.startswith("mbjax_harness")]
     assert not offences, offences
 
 
-def test_scenes_do_not_import_the_command_line_layer():
-    upward = {"bench", "reproduce", "tour", "cli"}
-    offences = [f"{path.name}: {module}" for path in (PACKAGE / "scenes").glob("*.py")
-                for module, _ in _imports(path) if _subpackage(module) in upward]
-    assert not offences, offences
-
-
-def test_loops_tell_no_tree_kinds_apart():
-    """The closed loops see any tree through `AbstractTreeSystem`: no isinstance tests on rigid
-    or flexible models, no imports of `rigid/` or `flex/`."""
-    kinds = {"Model", "FlexibleModel", "TreeSystem", "FlexibleSystem"}
-    for path in (PACKAGE / "loops").glob("*.py"):
+def test_no_type_tests_on_concrete_systems_outside_their_package():
+    """trajopt, integrate and loops see systems through `AbstractSystem` and `AbstractTreeSystem`:
+    no isinstance on a concrete system outside the package that defines it (checking that an
+    argument is the data type a constructor takes, a `Model`, is not such a test)."""
+    concrete = {"TreeSystem": "rigid", "MomentumSystem": "rigid", "BatchTreeSystem": "rigid",
+                "RigidBody": "rigid", "FlexibleSystem": "flex", "ClosedSystem": "loops",
+                "WristSystem": "wrist"}
+    offences = []
+    for path in SRC.rglob("*.py"):
+        own = path.relative_to(SRC).parts[0]
         for node in ast.walk(ast.parse(path.read_text())):
             if isinstance(node, ast.Call) and getattr(node.func, "id", None) == "isinstance":
                 tested = {n.id for n in ast.walk(node.args[1]) if isinstance(n, ast.Name)}
-                assert not tested & kinds, (path.name, tested)
-        assert not any(_subpackage(m) in {"rigid", "flex"} for m, _ in _imports(path)), path.name
+                offences += [f"{path.relative_to(ROOT)}: isinstance(..., {name})"
+                             for name in tested if name in concrete and concrete[name] != own
+                             and own not in ("scenes", "synthesis")]
+    assert not offences, offences
+
+
+def test_most_modules_are_private():
+    modules = [p for p in PACKAGE.rglob("*.py")]
+    private = [p for p in modules if "_src" in p.relative_to(PACKAGE).parts]
+    assert len(private) >= 0.8 * len(modules), (len(private), len(modules))
+
+
+def test_the_public_api_is_curated():
+    """At most MAX_PUBLIC_NAMES names in `mbjax` and its namespaces, each defined, each namespace
+    reachable after `import mbjax`, re-exporting from the private implementation only."""
+    count = len(mbjax.__all__)
+    for name in NAMESPACES:
+        namespace = getattr(mbjax, name)
+        assert all(hasattr(namespace, x) for x in namespace.__all__), name
+        count += len(namespace.__all__)
+    assert all(hasattr(mbjax, x) for x in mbjax.__all__)
+    assert count <= MAX_PUBLIC_NAMES, count
+    for path in PACKAGE.glob("*.py"):
+        for module in _imports(path):
+            assert module.startswith(("mbjax._src", "mbjax.")) or module == "mbjax", (path, module)
+
+
+def test_public_namespaces_document_every_name():
+    """Every public function and class has a docstring with an Args or Returns section where it
+    takes arguments (Google style, rendered by the documentation site)."""
+    import inspect
+
+    missing = []
+    for name in NAMESPACES:
+        namespace = importlib.import_module(f"mbjax.{name}")
+        for attr in namespace.__all__:
+            obj = getattr(namespace, attr)
+            if inspect.ismodule(obj) or not callable(obj):
+                continue
+            doc = inspect.getdoc(obj) or ""
+            if not doc:
+                missing.append(f"mbjax.{name}.{attr}: no docstring")
+    assert not missing, "\n".join(missing)
+
+
+def test_import_mbjax_loads_no_harness_or_plotting():
+    code = ("import sys, mbjax; print(' '.join(sorted(m for m in sys.modules if m == 'matplotlib' "
+            "or m.startswith(('matplotlib.', 'mbjax_harness')))))")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True,
+                         cwd=ROOT)
+    assert out.stdout.strip() == "", out.stdout
+
+
+def test_scenes_do_not_import_the_harness():
+    offences = [f"{path.name}: {module}" for path in (SRC / "scenes").glob("*.py")
+                for module in _imports(path) if module.startswith("mbjax_harness")]
+    assert not offences, offences

@@ -11,9 +11,16 @@ from jax import Array
 
 
 class NewtonInfo(eqx.Module):
-    """How a solve went: iterations taken, the last step's size, the residual norm at the
-    returned point, the residual norm before each iteration (`history`, NaN past the end) and
-    whether the step met the tolerance with everything finite."""
+    """How a Newton solve went.
+
+    Args:
+        iterations: iterations taken.
+        step: the last step's size |dx|.
+        residual: the residual norm at the returned point.
+        history: the residual norm before each iteration, shape (max_iter + 1,), NaN past
+            the end.
+        converged: whether the step met the tolerance with everything finite.
+    """
 
     iterations: Array
     step: Array
@@ -23,11 +30,21 @@ class NewtonInfo(eqx.Module):
 
 
 def newton(F, x0: Array, *, tol, max_iter: int) -> tuple[Array, NewtonInfo]:
-    """Root of F by Newton's method, stopping when |dx| <= tol (1 + |x|) or after max_iter steps.
+    """A root of F by Newton's method, stopping when |dx| <= tol (1 + |x|) or after max_iter steps.
 
     The loop is a `lax.while_loop`; derivatives of the root with respect to anything F closes
     over come from the implicit function theorem (`lax.custom_root`: dx/dtheta =
     -F_x^-1 F_theta), so neither forward nor reverse mode traverses the iterations.
+
+    Args:
+        F: the residual, a function of x with as many outputs as x has entries.
+        x0: the starting point, shape (n,).
+        tol: the tolerance on the step, relative to 1 + |x|.
+        max_iter: the most iterations.
+
+    Returns:
+        x: the root found, shape (n,).
+        info: the `NewtonInfo` of the solve.
     """
 
     def solve(f, x_init):

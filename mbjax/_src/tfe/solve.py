@@ -29,8 +29,13 @@ from mbjax._src.tfe.reference import REFERENCES, Reference, configuration, incre
 
 
 class State(eqx.Module):
-    """The state at an element boundary: rotation R (body to space), position x of O' and the
-    spatial momentum p_hat = (h, l) about O' (h only, about a fixed point)."""
+    """The body's state at an element boundary (build one with `initial_state`).
+
+    Args:
+        R: rotation body to space, shape (3, 3).
+        x: position of O' in space, shape (3,) [m].
+        p_hat: spatial momentum (h, l) about O' (h only, about a fixed point), shape (nq,).
+    """
 
     R: Array
     x: Array
@@ -38,8 +43,20 @@ class State(eqx.Module):
 
 
 def initial_state(body: Body, R0, Omega0, x0=(0.0, 0.0, 0.0), v0=(0.0, 0.0, 0.0)) -> State:
-    """State from a rotation, the body-frame angular velocity Omega0 and (free body) the velocity
-    v0 of O'. The momentum is p_hat = M6 w (eq 3.19) with w = (R0 Omega0, v0)."""
+    """The initial state of `solve_tfe` from an attitude and velocities.
+
+    The momentum is p_hat = M6 w (eq 3.19) with w = (R0 Omega0, v0).
+
+    Args:
+        body: the body.
+        R0: rotation body to space, shape (3, 3).
+        Omega0: angular velocity in the body frame, shape (3,) [rad/s].
+        x0: position of O', shape (3,) [m].
+        v0: velocity of O' in space, shape (3,) [m/s] (ignored about a fixed point).
+
+    Returns:
+        The `State` (R0, x0, p_hat).
+    """
     R0 = jnp.asarray(R0, dtype=float)
     w = R0 @ jnp.asarray(Omega0, dtype=float)
     if not body.fixed_point:
@@ -48,10 +65,24 @@ def initial_state(body: Body, R0, Omega0, x0=(0.0, 0.0, 0.0), v0=(0.0, 0.0, 0.0)
 
 
 class TFESolution(WithStatus):
-    """States at the element boundaries ts (n_elements + 1), per-element Newton records and a
-    `Status`: NOT_CONVERGED where an element's Newton missed its tolerance, NONFINITE where the
-    state blew up, INACCURATE past the tolerance asked for; `error` and `drift` as
-    `mbjax.integrate.Solution`'s (NaN where no tolerance was asked)."""
+    """The result of `solve_tfe`: states at the element boundaries and per-element Newton records.
+
+    The status has NOT_CONVERGED where an element's Newton missed its tolerance, NONFINITE
+    where the state blew up, INACCURATE past the tolerance asked for.
+
+    Args:
+        ts: boundary times [s], shape (n_elements + 1,).
+        R: rotations at the boundaries, shape (n_elements + 1, 3, 3).
+        x: positions of O', shape (n_elements + 1, 3) [m].
+        p_hat: spatial momenta about O', shape (n_elements + 1, nq).
+        iterations: Newton iterations per element, shape (n_elements,).
+        residual: each element's final residual norm, shape (n_elements,).
+        status: the `Status` flags, an integer array.
+        error: the estimated error of the final state, as `mbjax.integrate.Solution`'s (NaN
+            where no tolerance was asked).
+        drift: the invariants' largest relative drift, as `mbjax.integrate.Solution`'s (NaN
+            where no tolerance was asked).
+    """
 
     ts: Array
     R: Array
@@ -64,20 +95,51 @@ class TFESolution(WithStatus):
     drift: Array = float("nan")
 
     def energy(self, body: Body) -> Array:
-        """Total energy at every boundary."""
+        """The total energy at every boundary.
+
+        Args:
+            body: the body the solution was computed for.
+
+        Returns:
+            The energy [J], shape (n_elements + 1,).
+        """
         return jax.vmap(body.energy)(self.R, self.x, self.p_hat)
 
     def angular_momentum(self, body: Body) -> Array:
-        """Spatial angular momentum about the origin, h + x x l (eq 3.2)."""
+        """The spatial angular momentum about the origin, h + x x l (eq 3.2), at every boundary.
+
+        Args:
+            body: the body the solution was computed for.
+
+        Returns:
+            The angular momentum, shape (n_elements + 1, 3) [kg m^2/s].
+        """
         h = self.p_hat[:, :3]
         return h if body.fixed_point else h + jnp.cross(self.x, self.p_hat[:, 3:])
 
 
 def element_map(form: AbstractForm, body: Body, ref: Reference, element: Element, dt, z1: Array,
                 *, tol=1e-10, max_iter: int = 20) -> tuple[Array, NewtonInfo]:
-    """The end state z_2 = (p_2, q_2) of one element from its start z_1 = (p_1, q_1), both in the
-    form's variables about the reference `ref`. Its Jacobian dz_2/dz_1 (jax.jacfwd, through the
-    implicit function theorem) is the element's transition matrix (eq 6.7)."""
+    """The end state z_2 = (p_2, q_2) of one element from its start z_1 = (p_1, q_1).
+
+    Both are in the form's variables about the reference `ref`. Its Jacobian dz_2/dz_1
+    (jax.jacfwd, through the implicit function theorem) is the element's transition matrix
+    (eq 6.7).
+
+    Args:
+        form: the weak form.
+        body: the body.
+        ref: the element's reference motion.
+        element: the time element.
+        dt: the node spacing [s].
+        z1: the start state, shape (2 nq,).
+        tol: Newton's tolerance on the step, relative to 1 + |U|.
+        max_iter: the most Newton iterations.
+
+    Returns:
+        z2: the end state, shape (2 nq,).
+        info: the Newton solve's record (`NewtonInfo`).
+    """
     U, info = newton(lambda U: form.residual(body, ref, element, dt, U, z1),
                      form.guess(body, ref, element, z1), tol=tol, max_iter=max_iter)
     return form.final(body, ref, element, dt, U, z1), info
@@ -156,27 +218,50 @@ def solve_tfe(body: Body, state0: State, *, dt, n_elements: int, form: AbstractF
               element: Element = Element(4), reference: str | Reference = "constant_velocity",
               tol=1e-10, max_iter: int = 20, rtol: float | None = None,
               atol: float | None = None, throw: bool = False) -> TFESolution:
-    """March `n_elements` time elements of `element` (node spacing dt, so each spans
-    (nodes - 1) dt) of the weak `form` from `state0`.
+    """March a body through `n_elements` time elements of a weak form (Borri 1990 §5).
 
-    `reference` is one of `REFERENCES`, built afresh for each element from its initial state, or
-    a `Reference` motion (from t = 0) followed by the whole march: the increments then carry over
-    between elements, as in the linearized analysis of §6-7, and must stay below pi in rotation.
+    Each element spans (nodes - 1) dt; Newton solves its equations, differentiated by the
+    implicit function theorem. Jitted once per (form, element, n_elements, reference,
+    max_iter); dt, tol, the body and the state are traced, so sweeps over them do not recompile
+    and they can be differentiated.
 
-    Jitted once per (form, element, n_elements, reference, max_iter); dt, tol, the body and the
-    state are traced, so sweeps over them do not recompile and they can be differentiated.
-    throw=True raises an error naming the failure (an element's Newton iteration not converged,
-    a non-finite state, an inaccurate run) instead of returning the solution with its status.
+    With a tolerance (rtol, atol, as `mbjax.simulate`'s) the solution carries `error`, a
+    step-doubling estimate of the final state's error (at up to `ERROR_SAMPLES` boundaries,
+    one element against two of half the spacing; their difference is taken as the element's
+    local error, the elements being of high order, and summed over the march; the rotation
+    matrix, position and momentum components together), and `drift`, the largest relative
+    drift of the body's invariants (`Body.invariants`: the energy, the momenta), and the status
+    INACCURATE where the first exceeds the tolerance (root mean square norm) or the second
+    exceeds a positive rtol. The primal form past its stability boundary is caught this way
+    (tests/tfe/test_accuracy.py).
 
-    rtol, atol: a tolerance, as `mbjax.simulate`'s. Given either, the solution carries
-    `error`, a step-doubling estimate of the final state's error (at up to `ERROR_SAMPLES`
-    boundaries, one element against two of half the spacing; their difference is taken as the
-    element's local error, the elements being of high order, and summed over the march; the
-    rotation matrix, position and momentum components together), and `drift`, the largest
-    relative drift of the body's invariants (`Body.invariants`: the energy, the momenta), and
-    the status INACCURATE where the first exceeds the tolerance (root mean square norm) or the
-    second exceeds a positive rtol. The primal form past its stability boundary is caught
-    this way (tests/tfe/test_accuracy.py).
+    Args:
+        body: the body.
+        state0: the initial state (`initial_state`).
+        dt: the node spacing [s].
+        n_elements: the number of elements, a positive int.
+        form: the weak form, a strategy (`Mixed()`, `PrimalUnsymmetric()`, ...).
+        element: the time element (nodes and quadrature).
+        reference: one of `REFERENCES` ("constant", "constant_velocity"), built afresh for
+            each element from its initial state, or a `Reference` motion (from t = 0) followed
+            by the whole march: the increments then carry over between elements, as in the
+            linearized analysis of §6-7, and must stay below pi in rotation.
+        tol: Newton's tolerance on the step, relative to 1 + |U|.
+        max_iter: the most Newton iterations per element.
+        rtol: relative tolerance on the final state's error and the invariants' drift.
+        atol: absolute tolerance on the final state's error.
+        throw: raise an error naming the failure (an element's Newton iteration not
+            converged, a non-finite state, an inaccurate run) instead of returning the solution
+            with its status.
+
+    Returns:
+        The `TFESolution` at the n_elements + 1 boundaries.
+
+    Raises:
+        ValueError: reference is neither one of `REFERENCES` nor a `Reference`, n_elements is
+            not a positive int, or rtol and atol are negative or both zero.
+        TypeError: element is not an `Element`.
+        equinox.EquinoxRuntimeError: with throw=True, the march failed.
     """
     prescribed = reference if isinstance(reference, Reference) else None
     if prescribed is not None:

@@ -26,7 +26,18 @@ from mbjax._src.tfe.reference import Reference
 
 
 def condensed_tangent(K: Array, nodes: int, nq: int) -> Array:
-    """K_BB~ = K_BB - K_BI K_II^-1 K_IB (eq 6.3), boundary nodes first and last."""
+    """The primal element tangent with its interior nodes condensed out (eq 6.3).
+
+    K_BB~ = K_BB - K_BI K_II^-1 K_IB, the boundary nodes being the first and the last.
+
+    Args:
+        K: the element tangent over all nodal coordinates, shape (nodes nq, nodes nq).
+        nodes: the element's number of nodes.
+        nq: the body's number of coordinates.
+
+    Returns:
+        K_BB~, shape (2 nq, 2 nq).
+    """
     blocks = K.reshape(nodes, nq, nodes, nq)
     boundary = jnp.array([0, nodes - 1])
     interior = jnp.arange(1, nodes - 1)
@@ -40,7 +51,14 @@ def condensed_tangent(K: Array, nodes: int, nq: int) -> Array:
 
 
 def primal_transition(K_tilde: Array) -> Array:
-    """T of eq 6.8 from the condensed tangent, mapping (dp_1, dq_1) to (dp_2, dq_2)."""
+    """The transition matrix T of eq 6.8 from the condensed tangent.
+
+    Args:
+        K_tilde: the condensed tangent K_BB~ (`condensed_tangent`), shape (2 nq, 2 nq).
+
+    Returns:
+        T, mapping (dp_1, dq_1) to (dp_2, dq_2), shape (2 nq, 2 nq).
+    """
     nq = K_tilde.shape[0] // 2
     K11, K12 = K_tilde[:nq, :nq], K_tilde[:nq, nq:]
     K21, K22 = K_tilde[nq:, :nq], K_tilde[nq:, nq:]
@@ -52,9 +70,23 @@ def primal_transition(K_tilde: Array) -> Array:
 
 def transition_matrix(form: AbstractForm, body: Body, ref: Reference, element: Element, dt,
                       z1: Array, U: Array | None = None) -> Array:
-    """The element's transition matrix about the solution U (default: the reference itself,
-    U = form.guess) that starts from z1 = (p_1, q_1); eq 6.8 for the primal forms, eq 6.12
-    otherwise."""
+    """The element's transition matrix T about a known motion: (dp_2, dq_2) = T (dp_1, dq_1).
+
+    Eq 6.8 for the primal forms, eq 6.12 otherwise, from the element tangent by `jax.jacfwd`.
+
+    Args:
+        form: the weak form.
+        body: the body.
+        ref: the reference motion the element is written about.
+        element: the time element.
+        dt: the node spacing [s].
+        z1: the start state (p_1, q_1) in the form's variables, shape (2 nq,).
+        U: the element's solution to linearize about; None (default) for the reference itself
+            (U = form.guess), exact where the reference solves the equations (a steady spin).
+
+    Returns:
+        T, shape (2 nq, 2 nq).
+    """
     if U is None:
         U = form.guess(body, ref, element, z1)
     nq = body.nq
@@ -70,9 +102,25 @@ def transition_matrix(form: AbstractForm, body: Body, ref: Reference, element: E
 
 
 def exponents(T: Array, h) -> Array:
-    """ln(lambda) / h for the eigenvalues lambda of T (complex), h the element length."""
+    """The discrete motion's exponents ln(lambda) / h, lambda the eigenvalues of T.
+
+    Args:
+        T: a transition matrix, shape (2 nq, 2 nq).
+        h: the element length [s].
+
+    Returns:
+        The exponents [1/s], complex, shape (2 nq,), to compare with the exact ones.
+    """
     return jnp.log(jnp.linalg.eigvals(T).astype(complex)) / h
 
 
 def spectral_radius(T: Array) -> Array:
+    """The largest |lambda| over the eigenvalues of T (above 1: the discrete motion grows).
+
+    Args:
+        T: a transition matrix, shape (2 nq, 2 nq).
+
+    Returns:
+        The spectral radius, a scalar.
+    """
     return jnp.max(jnp.abs(jnp.linalg.eigvals(T)))

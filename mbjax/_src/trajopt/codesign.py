@@ -26,10 +26,24 @@ from mbjax._src.trajopt.solve import solve
 
 def optimal_cost(build: Callable[..., Problem], theta, solver: AbstractSolver = ILQR(),
                  us0: Array | None = None) -> Array:
-    """J*(theta): the cost `solver` reaches on `build(theta)` (a `Problem` for the design
-    theta, any pytree) from us0; `jax.grad` of it with respect to theta is the envelope
-    theorem's (see the module). Check the solve's status (`solve(build(theta), solver, us0)`)
-    before trusting either."""
+    """The optimal cost J*(theta) of a design, differentiable by the envelope theorem.
+
+    `jax.grad` of it with respect to theta is dJ/dtheta at the solved controls (see the
+    module), one reverse pass through the rollout; the solver's iterations are never
+    differentiated. Check the solve's status (`solve(build(theta), solver, us0)`) before
+    trusting either.
+
+    Args:
+        build: a function of the design returning its `Problem`; the control bounds must not
+            depend on theta.
+        theta: the design, any pytree (a link's length or mass, a cost weight, the initial
+            state).
+        solver: the solver strategy.
+        us0: the first guess, shape (horizon, nu); None for zeros.
+
+    Returns:
+        The cost the solver reaches, a scalar.
+    """
 
     @jax.custom_vjp
     def value(theta):

@@ -7,20 +7,42 @@ from jax import Array
 
 
 def cosine_adam(learning_rate: float, iterations: int, final_fraction: float):
-    """optax's Adam with its learning rate cosine-decayed to `final_fraction` of itself over
-    `iterations` steps."""
+    """optax's Adam with its learning rate cosine-decayed over a run.
+
+    Args:
+        learning_rate: the first learning rate.
+        iterations: the steps over which it decays.
+        final_fraction: the fraction of learning_rate it decays to.
+
+    Returns:
+        The optax optimizer.
+    """
     return optax.adam(optax.cosine_decay_schedule(learning_rate, iterations, alpha=final_fraction))
 
 
 def adam_descent(loss, x0: Array, *, learning_rate: float, iterations: int, final_fraction: float,
                  gradient: str = "forward"):
-    """(x, loss per iteration): `iterations` Adam steps on loss(x), the learning rate
-    cosine-decayed to `final_fraction` of itself, as one `lax.scan`.
+    """Adam steps on loss(x), the learning rate cosine-decayed, as one `lax.scan`.
 
-    gradient="forward" (`jax.jacfwd`) compiles several times faster than reverse mode through the
-    simulator's third-order autodiff dynamics and wins for tens of parameters (the torque splines);
-    gradient="reverse" (`jax.value_and_grad`) costs a few forward passes whatever the parameter
-    count, so it wins for a network's hundred-odd weights once compiled."""
+    Args:
+        loss: the scalar loss, a function of x.
+        x0: the starting parameters, shape (n,).
+        learning_rate: the first learning rate.
+        iterations: the number of steps.
+        final_fraction: the fraction of learning_rate it decays to.
+        gradient: "forward" (`jax.jacfwd`), which compiles faster than reverse mode through
+            the simulator's third-order autodiff dynamics and wins for tens of parameters (the
+            torque splines); or "reverse" (`jax.value_and_grad`), which costs a few forward
+            passes whatever the parameter count, so it wins for a network's hundred-odd weights
+            once compiled.
+
+    Returns:
+        x: the final parameters, shape (n,).
+        losses: the loss at each iteration, shape (iterations,).
+
+    Raises:
+        ValueError: gradient is neither "forward" nor "reverse".
+    """
     if gradient not in ("forward", "reverse"):
         raise ValueError(f"gradient must be 'forward' or 'reverse', got {gradient!r}")
     optimizer = cosine_adam(learning_rate, iterations, final_fraction)

@@ -26,11 +26,9 @@ The defaults shrink mu after every accepted step and accept a step achieving 1e-
 predicted decrease (Armijo), with the step lengths 1, 1/2, 1/4, 1/10, ..., 1e-3.
 `ILQR(**CROCODDYL_SCHEDULE)` takes Crocoddyl's FDDP schedule instead (Mastalli et al. 2020):
 steps halving from 1 to 2^-9, a tenth of the predicted decrease to accept, mu shrunk only after
-steps above 1/2 and grown after steps of 1/100 or shorter. Measured (`mbjax bench trajopt`,
-semi-implicit Euler): on the arm's 64 reach targets that schedule converges where Crocoddyl's
-does (7 of 8 in the quick run against 3 of 8 by the defaults, the same optimum to 1e-7), and on
-the acrobot in 67 iterations against 93; with RK4 steps the acrobot's swing-up converges by the
-defaults (115 iterations) and not by that schedule (300 iterations, stuck at a cost of 1e2).
+steps above 1/2 and grown after steps of 1/100 or shorter. Neither schedule wins everywhere
+(Crocoddyl's on the semi-implicit Euler benchmark problems, the defaults on the acrobot with RK4
+steps); see benchmarks/README.md.
 
 The iterations are one `lax.while_loop`, so `solve` compiles once. It stops with success when an
 accepted step lowers the cost by less than `tolerance` relative to it (or the model predicts
@@ -113,11 +111,25 @@ def riccati_step(problem: Problem, stage: tuple, u: Array, Vx: Array, Vxx: Array
 
 
 class ILQR(AbstractSolver):
-    """See the module. `iterations`: at most this many; `tolerance`: the relative cost decrease
-    below which it stops; `regularization`: mu's first value; `steps`: the step lengths alpha
-    tried in turn in each forward pass; `acceptance`: the fraction of the predicted decrease a
-    step must achieve; `shrink_above`, `grow_below`: mu's schedule (see the module);
-    `qp_iterations`: projected Newton steps of the bounded control step."""
+    """Iterative LQR (DDP with the dynamics' first derivatives) with box-constrained controls.
+
+    A solver strategy for `mbjax.trajopt.solve`; the algorithm and its schedule are described
+    in the module. Needs a state with as many coordinates as velocities (no quaternions; use
+    `Shooting` there). The result's `feedback` holds the gains of the last accepted
+    iteration.
+
+    Args:
+        iterations: the most iterations (static).
+        tolerance: the relative cost decrease below which it stops.
+        regularization: mu's first value, the regularization of Q_uu.
+        steps: the step lengths alpha tried in turn in each forward pass, longest first
+            (static).
+        acceptance: the fraction of the predicted decrease a step must achieve.
+        shrink_above: mu shrinks tenfold after an accepted step longer than this.
+        grow_below: mu grows tenfold after an accepted step this short or shorter (and after
+            a failure).
+        qp_iterations: projected Newton steps of the bounded control step (static).
+    """
 
     iterations: int = eqx.field(static=True, default=200)
     tolerance: float = 1e-8
@@ -129,6 +141,19 @@ class ILQR(AbstractSolver):
     qp_iterations: int = eqx.field(static=True, default=8)
 
     def solve(self, problem: Problem, us: Array) -> Result:
+        """Optimise the controls of `problem` from `us` (normally through `mbjax.trajopt.solve`).
+
+        Args:
+            problem: the trajectory-optimisation problem.
+            us: the first guess, inside the bounds, shape (horizon, nu).
+
+        Returns:
+            The `Result`, its status NOT_CONVERGED where the iterations ran out or mu passed
+            its ceiling.
+
+        Raises:
+            ValueError: the problem's configuration has more coordinates than velocities.
+        """
         require_vector_state(problem, "ILQR")
         xs = problem.rollout(us)
         cost = problem.cost(xs, us)

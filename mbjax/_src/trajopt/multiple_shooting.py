@@ -40,11 +40,23 @@ STEPS = tuple(0.5**k for k in range(10))
 
 
 class MultipleShooting(AbstractSolver):
-    """See the module. `iterations`: Gauss-Newton steps in all at most, `inner` of them at most
-    between two multiplier updates; `penalty`: rho's first
-    value; `tolerance`: an inner solve ends when a step lowers the merit by less than this
-    (relative); `defect_tolerance`: the largest defect accepted; `regularization`: added to the
-    control blocks, raised tenfold after a failed step."""
+    """Multiple shooting: knot states and controls as unknowns, the dynamics enforced by an augmented Lagrangian.
+
+    A solver strategy for `mbjax.trajopt.solve`; the method is described in the module. Needs
+    a state with as many coordinates as velocities (no quaternions; use `Shooting` there).
+    Success when the largest defect is below `defect_tolerance` and the last inner solve
+    settled.
+
+    Args:
+        iterations: the most Gauss-Newton steps in all (static).
+        inner: the most Gauss-Newton steps between two multiplier updates (static).
+        penalty: rho's first value.
+        tolerance: an inner solve ends when a step lowers the merit by less than this
+            (relative).
+        defect_tolerance: the largest defect accepted, in the state's units.
+        regularization: added to the control blocks, raised tenfold after a failed step.
+        qp_iterations: projected Newton steps of the bounded control step (static).
+    """
 
     iterations: int = eqx.field(static=True, default=300)
     inner: int = eqx.field(static=True, default=20)
@@ -55,6 +67,20 @@ class MultipleShooting(AbstractSolver):
     qp_iterations: int = eqx.field(static=True, default=8)
 
     def solve(self, problem: Problem, us: Array) -> Result:
+        """Optimise the controls of `problem` from `us` (normally through `mbjax.trajopt.solve`).
+
+        Args:
+            problem: the trajectory-optimisation problem.
+            us: the first guess, inside the bounds, shape (horizon, nu); the knots' states
+                start as its rollout.
+
+        Returns:
+            The `Result`: the rollout of the final controls, `costs` the merit after each
+            inner iteration.
+
+        Raises:
+            ValueError: the problem's configuration has more coordinates than velocities.
+        """
         require_vector_state(problem, "MultipleShooting")
         steps = jnp.arange(problem.horizon)
         alphas = jnp.asarray(STEPS, us.dtype)

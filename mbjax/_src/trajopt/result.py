@@ -11,14 +11,25 @@ from mbjax._src.trajopt.problem import Problem
 
 
 class Result(WithStatus):
-    """The optimised trajectory: states `qs`, `vs` (N + 1 each), controls `us` (N), the final
-    `cost`, the cost after each iteration (`costs`, `iterations + 1` entries used, NaN after),
-    the `iterations` taken and a `Status`: success when the solver's convergence test passed,
-    NOT_CONVERGED when it ran out of iterations or could not make progress, NONFINITE when the
-    cost or the trajectory blew up. `feedback`: the time-varying gains K_k (N, nu, nx) of
-    u = u_k + K_k (x - x_k) where the solver has them (DDP: from its last accepted iteration's
-    backward pass, about the trajectory before that step, the same at convergence), else
-    zeros."""
+    """The optimised trajectory that `mbjax.trajopt.solve` returns.
+
+    The status is success when the solver's convergence test passed, NOT_CONVERGED when it ran
+    out of iterations or could not make progress, NONFINITE when the cost or the trajectory
+    blew up. N is the problem's horizon, nx = nq + nv.
+
+    Args:
+        qs: configurations, shape (N + 1, nq).
+        vs: velocities, shape (N + 1, nv).
+        us: controls, shape (N, nu).
+        cost: the final cost, a scalar.
+        costs: the cost after each iteration, shape (iterations + 1,) of the solver's
+            maximum; the entries past the iterations taken are NaN.
+        iterations: the iterations taken.
+        feedback: the time-varying gains K_k of u = u_k + K_k (x - x_k), shape (N, nu, nx),
+            where the solver has them (DDP: from its last accepted iteration's backward pass,
+            about the trajectory before that step, the same at convergence), else zeros.
+        status: the `Status` flags.
+    """
 
     qs: Array
     vs: Array
@@ -31,11 +42,22 @@ class Result(WithStatus):
 
 
 class AbstractSolver(eqx.Module):
-    """A trajectory-optimisation method: `solve(problem, us)` from the initial controls us."""
+    """A trajectory-optimisation method, a strategy passed to `mbjax.trajopt.solve`.
+
+    Subclasses implement `solve(problem, us)`.
+    """
 
     @abc.abstractmethod
     def solve(self, problem: Problem, us: Array) -> Result:
-        """Optimise the controls of `problem` starting from `us` (inside the bounds)."""
+        """Optimise the controls of `problem` starting from `us`.
+
+        Args:
+            problem: the trajectory-optimisation problem.
+            us: the first guess, inside the bounds, shape (horizon, nu).
+
+        Returns:
+            The `Result`.
+        """
 
 
 def history(length: int, first: Array) -> Array:

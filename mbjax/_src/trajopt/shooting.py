@@ -11,12 +11,11 @@ step (projected gradient for Adam; for L-BFGS a heuristic, sound where no bound 
 value (its projection on the box, for bounded controls), NOT_CONVERGED when `iterations` run out.
 
 Gauss-Newton on the controls of single shooting is not offered: with the costs' residuals
-stacked into one vector r(u), optimistix's `LevenbergMarquardt` (its QR on the dense Jacobian of
-all N nu controls) took the acrobot 200 iterations to a cost of 8.8e3 and the arm 200 iterations
-and 110 s to 6.3 (semi-implicit Euler; iLQR: 0.477 in 95 iterations, 0.0029 in 28, 0.1 s). The
-stage structure is what Gauss-Newton needs here: `ILQR` is Gauss-Newton on the controls with the
-step solved by a Riccati recursion and applied through a closed-loop rollout, and
-`MultipleShooting` is Gauss-Newton on the knots' states and controls.
+stacked into one vector r(u), a dense Levenberg-Marquardt on all N nu controls converged far
+more slowly than iLQR on the benchmark problems (see benchmarks/README.md). The stage structure
+is what Gauss-Newton needs here: `ILQR` is Gauss-Newton on the controls with the step solved by
+a Riccati recursion and applied through a closed-loop rollout, and `MultipleShooting` is
+Gauss-Newton on the knots' states and controls.
 """
 
 import equinox as eqx
@@ -33,8 +32,23 @@ METHODS = ("lbfgs", "adam")
 
 
 class Shooting(AbstractSolver):
-    """See the module. `learning_rate` is Adam's (cosine-decayed to a tenth over `iterations`);
-    L-BFGS takes its steps from the line search."""
+    """Single shooting: the controls are the unknowns, the gradient is reverse mode through the rollout.
+
+    A solver strategy for `mbjax.trajopt.solve` (see the module). It works for any system,
+    quaternion coordinates included; bounds are kept by projection, sound where none is active
+    at the optimum.
+
+    Args:
+        method: "lbfgs" (optax's L-BFGS with its zoom line search) or "adam" (static).
+        iterations: the most iterations (static).
+        tolerance: stop when the (projected) gradient's norm falls below this times its first
+            value.
+        learning_rate: Adam's, cosine-decayed to a tenth over `iterations`; L-BFGS takes its
+            steps from the line search.
+
+    Raises:
+        ValueError: method is not one of `METHODS`.
+    """
 
     method: str = eqx.field(static=True, default="lbfgs")
     iterations: int = eqx.field(static=True, default=500)
@@ -46,6 +60,15 @@ class Shooting(AbstractSolver):
             raise ValueError(f"method must be one of {METHODS}, got {self.method!r}")
 
     def solve(self, problem: Problem, us: Array) -> Result:
+        """Optimise the controls of `problem` from `us` (normally through `mbjax.trajopt.solve`).
+
+        Args:
+            problem: the trajectory-optimisation problem.
+            us: the first guess, inside the bounds, shape (horizon, nu).
+
+        Returns:
+            The `Result` (no feedback gains: `feedback` is zeros).
+        """
         shape = us.shape
 
         def objective(flat):

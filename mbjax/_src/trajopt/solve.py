@@ -13,14 +13,31 @@ from mbjax._src.trajopt.result import AbstractSolver, Result
 @eqx.filter_jit
 def solve(problem: Problem, solver: AbstractSolver = ILQR(), us0: Array | None = None,
           throw: bool = False) -> Result:
-    """Optimise `problem`'s controls with `solver` (a strategy: `ILQR()`, ...) from `us0`
-    (horizon, nu), zeros by default, clipped to the bounds. One compiled program: the solver's
-    iterations run inside it, and `jax.vmap` solves many problems at once. A second problem of
-    the same shapes (another target, another model parameter) reuses the program where its
-    costs hold their data as leaves (equinox modules, or `eqx.Partial` of module-level
-    functions, as `mbjax._src.scenes.arm.reach_problem` builds them); a fresh closure is a new
-    function, and compiles anew. throw=True raises an error naming the failure (not
-    converged, non-finite) instead of returning the result with its status."""
+    """Optimise a problem's controls with a solver strategy.
+
+    One compiled program: the solver's iterations run inside it, and `jax.vmap` solves many
+    problems at once. A second problem of the same shapes (another target, another model
+    parameter) reuses the program where its costs hold their data as leaves (equinox modules,
+    or `eqx.Partial` of module-level functions, as `mbjax.scenes.arm.reach_problem` builds
+    them); a fresh closure is a new function, and compiles anew.
+
+    Args:
+        problem: the trajectory-optimisation problem.
+        solver: the method, an `AbstractSolver` instance (`ILQR()`, `MultipleShooting()`,
+            `Shooting()`).
+        us0: the first guess, shape (horizon, nu), clipped to the bounds; None for zeros.
+        throw: raise an error naming the failure (not converged, non-finite) instead of
+            returning the result with its status.
+
+    Returns:
+        The `Result`.
+
+    Raises:
+        TypeError: problem is not a `Problem` or solver not a solver instance.
+        ValueError: us0 has the wrong shape, or the solver cannot take the problem (`ILQR` and
+            `MultipleShooting` on quaternion coordinates).
+        equinox.EquinoxRuntimeError: with throw=True, the solve failed.
+    """
     if not isinstance(problem, Problem):
         raise TypeError(f"problem must be a mbjax.trajopt.Problem, got {type(problem).__name__}")
     if not isinstance(solver, AbstractSolver):

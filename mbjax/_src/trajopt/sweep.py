@@ -17,7 +17,17 @@ from jax.sharding import Mesh, NamedSharding, PartitionSpec
 
 
 def size(params) -> int:
-    """The number of variants in a batch: the leading axis every array leaf shares."""
+    """The number of variants in a batch: the leading axis every array leaf shares.
+
+    Args:
+        params: the batch, a pytree of arrays.
+
+    Returns:
+        The shared leading size.
+
+    Raises:
+        ValueError: params has no array leaves or they do not share a leading axis.
+    """
     leaves = jax.tree.leaves(params)
     shapes = {np.shape(x)[:1] for x in leaves}
     if not leaves or len(shapes) != 1 or shapes == {()}:
@@ -27,15 +37,27 @@ def size(params) -> int:
 
 
 def sweep(fn, params, *, devices=None, trim: bool = True):
-    """fn(p) for every variant p of params: any pytree whose array leaves share a leading
-    variant axis (a dict of arrays, a batched model or wrist, a tuple), as jit(vmap(fn)).
+    """fn(p) for every variant p of a batch, as jit(vmap(fn)), optionally sharded over devices.
 
-    With `devices` (several, e.g. jax.devices()), the variants are split over them: padded with
-    copies of the last one to a multiple of their number, and the outputs computed and returned
-    sharded over the devices. `trim=True` returns the n variants given; where padding was
-    needed that slice is gathered onto every device (JAX shards only axes the devices divide).
-    `trim=False` keeps the padded outputs sharded, the first n rows the variants, for sharded
-    work downstream."""
+    Args:
+        fn: the function of one variant.
+        params: the batch, any pytree whose array leaves share a leading variant axis of n (a
+            dict of arrays, a batched model or wrist, a tuple).
+        devices: None (one device), or several devices (e.g. `jax.devices()`) to split the
+            variants over: they are padded with copies of the last one to a multiple of their
+            number, and the outputs computed and returned sharded over the devices.
+        trim: with devices, return the n variants given (where padding was needed that slice
+            is gathered onto every device: JAX shards only axes the devices divide); False
+            keeps the padded outputs sharded, the first n rows the variants, for sharded work
+            downstream.
+
+    Returns:
+        fn's outputs stacked along a leading variant axis (n rows, or the padded count with
+        trim=False).
+
+    Raises:
+        ValueError: params has no array leaves or they do not share a leading axis.
+    """
     params = jax.tree.map(jnp.asarray, params)
     n = size(params)
     mapped = jax.vmap(fn)
