@@ -475,7 +475,7 @@ def _model_peers() -> dict:
     """The arm against Pinocchio from the same URDF (`mbjax_harness.reproduce.urdf_corpus`: forward and
     inverse dynamics, mass matrix, frames) and against MuJoCo through MuJoCo's compiler and
     `from_mujoco` (`mbjax_harness.reproduce.mjcf_corpus`: accelerations), each where installed."""
-    from mbjax_harness.bench import peers
+    from mbjax_harness import peers
     from mbjax.data import ARM7
 
     out = {}

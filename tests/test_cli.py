@@ -8,7 +8,7 @@ import subprocess
 import numpy as np
 import pytest
 
-from mbjax_harness.bench import peers
+from mbjax_harness import peers
 from mbjax_harness.cli import main
 
 

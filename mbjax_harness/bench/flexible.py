@@ -44,7 +44,7 @@ from pathlib import Path
 import jax
 import numpy as np
 
-from mbjax_harness.bench import peers
+from mbjax_harness import peers
 from mbjax_harness.timing import measure, write_jsonl
 from mbjax._src.integrate import RK4, simulate
 

@@ -16,7 +16,7 @@ import jax.numpy as jnp
 import numpy as np
 
 from mbjax._src import lie
-from mbjax_harness.bench import peers
+from mbjax_harness import peers
 from mbjax_harness.timing import measure, write_jsonl
 from mbjax._src.integrate import INTEGRATORS, RKMK4, simulate, solve_reference
 from mbjax._src.scenes import heavy_top as top

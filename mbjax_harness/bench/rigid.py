@@ -43,7 +43,7 @@ import jax.numpy as jnp
 import numpy as np
 
 from mbjax import Dense, Recursive
-from mbjax_harness.bench import peers
+from mbjax_harness import peers
 from mbjax_harness.timing import Timing, measure, write_jsonl
 from mbjax._src.integrate import RK4, simulate
 from mbjax._src.model import chain

@@ -39,7 +39,7 @@ import jax.numpy as jnp
 import numpy as np
 
 from mbjax import Recursive
-from mbjax_harness.bench import peers
+from mbjax_harness import peers
 from mbjax_harness.bench.rigid import pinocchio_loop, relative_difference, states, timed
 from mbjax_harness.timing import write_jsonl
 from mbjax._src.integrate import RK4, simulate

@@ -3,7 +3,7 @@ identical problems, one at a time and 64 at once.
 
 Problems (`mbjax.scenes`): `arm-reach`, the 7-dof arm's flange moved 0.4 m, and
 `acrobot-swingup`, the double pendulum driven at its elbow to upright; each built twice, as an
-`mbjax.trajopt.Problem` and as a Crocoddyl shooting problem (`mbjax_harness.bench.peers`: Pinocchio
+`mbjax.trajopt.Problem` and as a Crocoddyl shooting problem (`mbjax_harness.peers`: Pinocchio
 models of the same URDF, the same residuals and weights, the same horizon and step), both with
 semi-implicit Euler steps (Crocoddyl's `IntegratedActionModelEuler`), both from the same first
 guess (the arm: the torque that holds its start; the acrobot: zero) and its rollout. The run
@@ -40,7 +40,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from mbjax_harness.bench import peers
+from mbjax_harness import peers
 from mbjax._src.integrate import SemiImplicitEuler
 from mbjax_harness.timing import measure, write_jsonl
 from mbjax._src.trajopt import ILQR, solve
@@ -109,7 +109,7 @@ def _to_tolerance(costs, best: float) -> int:
     return int(within[0]) if len(within) else len(costs) - 1
 
 
-class _Crocoddyl:
+class CrocoddylSolver:
     """One Crocoddyl problem's FDDP solver, from a fixed first guess and its rollout."""
 
     def __init__(self, problem, us0):
@@ -163,7 +163,7 @@ def single(name: str, repeats: int, common: dict) -> list[dict]:
         best = mbjax["cost"]
     else:
         croc_problem, _ = build()
-        croc = _Crocoddyl(croc_problem, us0)
+        croc = CrocoddylSolver(croc_problem, us0)
         xs_mbjax = np.asarray(problem.rollout(jnp.asarray(us0)))
         xs_croc = np.array(croc_problem.rollout(croc.us0))
         cost_mbjax = float(problem.cost(jnp.asarray(xs_mbjax), jnp.asarray(us0)))
@@ -231,7 +231,7 @@ def many(n: int, repeats: int, common: dict, loop: bool = True) -> list[dict]:
                         "skipped": why})
         return records
     croc_problem, set_target = build()
-    croc = _Crocoddyl(croc_problem, us0)
+    croc = CrocoddylSolver(croc_problem, us0)
     start_flange = np.asarray(arm.flange(model, problem.q0))
     iterations, converged = [], []
     start = time.perf_counter()

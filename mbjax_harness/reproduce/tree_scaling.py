@@ -31,7 +31,7 @@ import jax.numpy as jnp
 import numpy as np
 
 from mbjax import Recursive
-from mbjax_harness.bench import peers
+from mbjax_harness import peers
 from mbjax_harness.bench.rigid import loop_length, looped_fn, states, timed
 from mbjax._src.model import chain
 from mbjax._src.model.urdf import to_urdf

@@ -19,7 +19,7 @@ from mbjax.integrate import RK4, simulate
 from mbjax.model import Model, chain, random_tree
 from mbjax._src.model.urdf import to_urdf
 from mbjax.rigid import TreeSystem
-from tests.peers import pinocchio_maps, random_state
+from mbjax_harness.peers import pinocchio_maps, random_state
 
 DT, STEPS = 1e-3, 400
 

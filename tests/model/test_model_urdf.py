@@ -12,7 +12,7 @@ from mbjax import rigid
 from mbjax.model import Model, chain, random_tree
 from mbjax._src.model.checks import ModelWarning
 from mbjax._src.model.urdf import to_urdf
-from tests.peers import pinocchio_maps, random_state
+from mbjax_harness.peers import pinocchio_maps, random_state
 
 I3 = 0.01 * np.eye(3)
 

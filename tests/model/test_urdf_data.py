@@ -15,7 +15,7 @@ from mbjax.loops import ClosedSystem, Coupled, Coupling
 from mbjax._src.model.checks import ModelWarning
 from mbjax.rigid import TreeSystem
 from tests.model.test_model_urdf import LIMIT, _inertial, _joint, _link, _robot
-from tests.peers import random_state
+from mbjax_harness.peers import random_state
 
 pin = pytest.importorskip("pinocchio")
 
@@ -293,7 +293,7 @@ def test_converters_match_the_name_matched_map():
     """The public converter (joint order) against the tests' own map, which matches joints by
     name: the same Pinocchio state for a floating base with a continuous joint."""
     from tests.model.test_model_urdf import FIXED_URDF
-    from tests.peers import pinocchio_maps
+    from mbjax_harness.peers import pinocchio_maps
 
     model = mbjax.load_urdf(FIXED_URDF, floating_base=True)
     to_pin, vi = pinocchio_maps(model, pin.buildModelFromXML(FIXED_URDF, pin.JointModelFreeFlyer()))

@@ -8,7 +8,7 @@ import pytest
 from mbjax.lie import Quaternion, RotationVector
 
 from mbjax import lie
-from mbjax_harness.bench import peers
+from mbjax_harness import peers
 from mbjax.integrate import RK4, RKMK4, ImplicitMidpoint, simulate, solve_reference
 from mbjax.rigid import RigidBody, torque_free_motion
 from mbjax.scenes import heavy_top as top

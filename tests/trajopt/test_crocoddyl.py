@@ -1,14 +1,14 @@
 """iLQR against an independent optimal-control library: Crocoddyl's FDDP (analytic derivatives
 on Pinocchio) on the arm reach built from the same URDF, residuals, weights, semi-implicit Euler
-steps and first guess (`mbjax_harness.bench.peers.crocoddyl_reach`). Skipped where Crocoddyl is not
+steps and first guess (`mbjax_harness.peers.crocoddyl_reach`). Skipped where Crocoddyl is not
 installed or its pairing with Pinocchio is broken (`peers.crocoddyl_working` says which)."""
 
 import jax.numpy as jnp
 import numpy as np
 import pytest
 
-from mbjax_harness.bench import peers
-from mbjax_harness.bench.trajopt import _Crocoddyl, arm_reach
+from mbjax_harness import peers
+from mbjax_harness.bench.trajopt import CrocoddylSolver, arm_reach
 from mbjax.trajopt import ILQR, solve
 from mbjax._src.trajopt.ilqr import CROCODDYL_SCHEDULE
 
@@ -23,7 +23,7 @@ def test_arm_reach_matches_crocoddyl(schedule):
     cost to 1e-6 (relative), controls to 1e-3 of their largest, both flanges on the target."""
     problem, us0, final_error, build = arm_reach()
     croc_problem, _ = build()
-    croc = _Crocoddyl(croc_problem, us0)
+    croc = CrocoddylSolver(croc_problem, us0)
     xs = np.asarray(problem.rollout(jnp.asarray(us0)))
     np.testing.assert_allclose(np.array(croc_problem.rollout(croc.us0)), xs, atol=1e-9)
     np.testing.assert_allclose(croc_problem.calc(list(xs), croc.us0),
