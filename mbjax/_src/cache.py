@@ -12,9 +12,8 @@ import os
 from pathlib import Path
 
 # Programs that compile faster than this are not written. JAX's default is 1 s, but a tour compiles
-# about 900 small programs (arrays handled op by op outside jit, 20 ms each, 20 s in all) beside
-# its large ones: with every program kept, a second `mbjax tour --quick` took 52 s against 70 s
-# with the 0.1 s threshold used before (8.6 MB on disk; the first run 119 s against 114 s).
+# hundreds of small programs (arrays handled op by op outside jit) beside its large ones, and
+# keeping them all makes a second run markedly faster; see benchmarks/README.md.
 MIN_COMPILE_SECONDS = 0.0
 
 
@@ -25,8 +24,15 @@ def cache_folder() -> Path:
 
 
 def use_compilation_cache(folder: str | os.PathLike | None = None) -> Path | None:
-    """Turn on JAX's persistent compilation cache in `folder` (see the module); returns the
-    folder, or None where MBJAX_NO_CACHE is set."""
+    """Turn on JAX's persistent compilation cache (see the module).
+
+    Args:
+        folder: where to keep compiled programs; None for JAX_COMPILATION_CACHE_DIR, else
+            `cache_folder()`. Created if missing.
+
+    Returns:
+        The folder in use, or None where MBJAX_NO_CACHE is set (the cache stays off).
+    """
     if os.environ.get("MBJAX_NO_CACHE", "") not in ("", "0"):
         return None
     import jax

@@ -6,8 +6,8 @@ the loop then runs kernel by kernel. The blocks mbjax solves inside its loops ar
 D of Anderson 1993 eq 48, at most 6 x 6; the Carpal Wrist's 3 x 3 A of Canfield 1997 eq 6.21), and for
 those Cholesky written out over the columns is a few dozen scalar operations that XLA fuses.
 (The flexible recursion's joint blocks are not symmetric where geometric stiffening couples the
-accelerations, so `mbjax._src.flex.aba` keeps a general solve.)
-Measured: the Carpal Wrist's RK4 rollout 7.6 -> 4.4 us per evaluation (200 steps, float64).
+accelerations, so `mbjax._src.flex.aba` keeps a general solve.) Loops that hold such solves run
+markedly faster this way; see benchmarks/README.md.
 """
 
 import jax
@@ -19,9 +19,18 @@ UNROLL = 6
 
 
 def spd_solve(A: Array, b: Array, unroll: int = UNROLL) -> Array:
-    """A^-1 b for a symmetric positive-definite A (..., w, w) and b (..., w) or (..., w, k): a
-    division for w = 1, Cholesky written out for w <= unroll, else LAPACK's Cholesky. NaN where
-    A is not positive definite."""
+    """A^-1 b for a symmetric positive-definite A.
+
+    A division for w = 1, Cholesky written out for w <= unroll, else LAPACK's Cholesky.
+
+    Args:
+        A: symmetric positive-definite matrices, shape (..., w, w).
+        b: right-hand sides, shape (..., w) or (..., w, k).
+        unroll: the largest w whose Cholesky is written out.
+
+    Returns:
+        A^-1 b, b's shape; NaN where A is not positive definite.
+    """
     w = A.shape[-1]
     if w == 1:
         return b / (A[..., 0] if b.ndim < A.ndim else A)

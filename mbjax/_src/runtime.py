@@ -2,45 +2,34 @@
 
 mbjax's kernels are loops of small operations: a tree pass is a `lax.scan` over bodies whose step
 is a few dozen 6-vector and 6x6 operations, and a rollout is a scan of those. XLA's CPU runtime
-launches each fused operation of a loop body as a kernel of its own (a thunk), about 20 ns each;
-at a few dozen per body, the launches are the cost, not the arithmetic.
+launches each fused operation of a loop body as a kernel of its own (a thunk); at a few dozen per
+body, the launches are the cost, not the arithmetic. Four settings address this; the
+measurements behind them are in benchmarks/README.md.
 
-The first setting lets XLA compile a whole loop as one kernel. Its CPU compiler has a pass that
-does exactly this (`SmallWhileLoopHoistingPass`: the loop becomes one function of straight-line
-code, emitted by the classic IR emitter), for loops whose operations it can emit that way (no
-scatter, sort or library call) and whose cost analysis reads fewer bytes than a threshold, 1 kB
-by default, which no tree pass meets. mbjax raises it
-(``--xla_backend_extra_options=xla_cpu_small_while_loop_byte_threshold=1000000000``). Measured
-with `mbjax bench speed` (benchmarks/README.md, float64, 2-core x86_64 CPU), forward dynamics
-inside a jitted 1000-step rollout: the 7-link chain 7.1 -> 1.2 us per evaluation, the 30-link
-chain 37.7 -> 5.4 us, the Panda 14.2 -> 2.1 us, the G1 humanoid 32.6 -> 11.1 us (Pinocchio's
-`aba`: 2.7, 8.7, 3.3, 8.2 us); compile times fall too (0.57 -> 0.31 s). Results agree to a few
-ulps in the tests' rollout (to the bit with XLA's default emitters; see the third setting). For
-loops to qualify, mbjax's tree passes and their derivatives hold no scatter (`mbjax._src.tree.take`).
-
-The second is the scheduler (``--xla_cpu_enable_concurrency_optimized_scheduler=false``): XLA's
-CPU runtime schedules the kernels of a program for concurrency by default, which pays off for
-large independent operations and costs a thread hand-off per small one. With it off, the 7-link
-chain's forward dynamics inside a jitted rollout 11.5 -> 7.1 us per evaluation (before the first
-setting), one jitted call 60 -> 28 us; batched throughput unchanged. It changes the order kernels
-run in, not what they compute.
-
-The third is how XLA emits the fusions outside such loops (``--xla_cpu_use_fusion_emitters=false``:
-the classic elemental emitter instead of the MLIR fusion emitters). It changes compile times, not
-run times: a program of one eager operation 20 -> 13 ms, the Carpal Wrist's forward dynamics
-0.73 -> 0.44 s, `mbjax tour --quick` from a cold cache 90 -> 67 s, against the same evaluation
-and `vmap` times within noise (7-link chain, `mbjax bench speed --quick`; 1.25 us per state at
-B = 4096 either way). The two emitters round a few operations differently (a few ulps after a
-200-step rollout). A program of a few operations is mostly compile time, and programs outside
-`jit` (arrays handled op by op) are compiled one per operation and shape. The design notes'
-jaxlib 0.10 measurement found the same flag necessary for MJX's deep gather graphs.
-
-The fourth is JAX's: its CPU client runs a program on a worker thread and hands the result back
-(`jax_cpu_enable_async_dispatch`), so that Python can go on while a large program runs. For
-mbjax's calls, whose programs run for microseconds, the hand-off is the cost: one jitted
-forward-dynamics call of the 7-link chain, median of 2000, 62 -> 15.5 us with the model closed
-over and 94 -> 24 us with the model an argument (min 18 -> 15 and 27 -> 23: the hand-off is what
-varies). With dispatch synchronous the call returns when its result is ready; nothing else changes.
+1. Loops compiled as one kernel
+   (``--xla_backend_extra_options=xla_cpu_small_while_loop_byte_threshold=1000000000``). XLA's
+   CPU compiler has a pass that turns a loop into one function of straight-line code
+   (`SmallWhileLoopHoistingPass`, emitted by the classic IR emitter), for loops whose operations
+   it can emit that way (no scatter, sort or library call) and whose cost analysis reads fewer
+   bytes than a threshold, 1 kB by default, which no tree pass meets; mbjax raises it. This
+   makes forward dynamics inside a rollout several times faster and shortens compilation;
+   results agree to a few ulps. For loops to qualify, mbjax's tree passes and their derivatives
+   hold no scatter (`mbjax._src.tree.take`).
+2. No concurrency scheduling (``--xla_cpu_enable_concurrency_optimized_scheduler=false``). XLA's
+   CPU runtime schedules a program's kernels for concurrency by default, which pays off for
+   large independent operations and costs a thread hand-off per small one. It changes the order
+   kernels run in, not what they compute.
+3. The classic fusion emitter (``--xla_cpu_use_fusion_emitters=false``: the classic elemental
+   emitter instead of the MLIR fusion emitters) for the fusions outside such loops. It shortens
+   compile times, not run times, which matters because a program of a few operations is mostly
+   compile time and programs outside `jit` (arrays handled op by op) are compiled one per
+   operation and shape. The two emitters round a few operations differently (a few ulps after a
+   200-step rollout).
+4. Synchronous dispatch (JAX's `jax_cpu_enable_async_dispatch` off). JAX's CPU client runs a
+   program on a worker thread and hands the result back, so that Python can go on while a large
+   program runs; for mbjax's calls, whose programs run for microseconds, the hand-off is the
+   cost. With dispatch synchronous the call returns when its result is ready; nothing else
+   changes.
 
 All are read once, when JAX first starts a backend. So `import mbjax` sets them only if no
 backend has started yet, each only if the user has not set it (XLA_FLAGS naming the flag or
@@ -72,8 +61,14 @@ def _jaxlib_version() -> tuple[int, int]:
 
 
 def configure_xla() -> bool:
-    """Add FLAGS to XLA_FLAGS and make CPU dispatch synchronous, where the user has not chosen and
-    it can still take effect (see the module); True if any flag was added."""
+    """Add FLAGS to XLA_FLAGS and make CPU dispatch synchronous (see the module).
+
+    Only where the user has not chosen, MBJAX_XLA_DEFAULTS is not 0, no backend has started and
+    the jaxlib is one of `TESTED`.
+
+    Returns:
+        True if any flag was added to XLA_FLAGS.
+    """
     if os.environ.get("MBJAX_XLA_DEFAULTS", "") in ("0", "false", "no"):
         return False
     import jax

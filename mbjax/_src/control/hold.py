@@ -50,7 +50,15 @@ class ZeroOrderHold(AbstractControl):
         self.t0 = float(t0)
 
     def index(self, t: Array) -> Array:
-        """The sample index k in effect at time t, clipped to 0 ... K - 1 (int32)."""
+        """The sample index in effect at time t.
+
+        Args:
+            t: time [s], a scalar.
+
+        Returns:
+            k, clipped to 0 ... K - 1 (int32); times within 1e-6 of a step of a sample time
+            count as on it.
+        """
         k = jnp.floor((t - self.t0) / self.dt + _GRID_TOLERANCE)
         return jnp.clip(k, 0, self.values.shape[0] - 1).astype(jnp.int32)
 

@@ -69,7 +69,14 @@ class CubicSpline(AbstractControl):
         self.t0 = float(t0)
 
     def unsaturated(self, t: Array) -> Array:
-        """The spline s(t) before saturation, shape (m,), at time t [s]."""
+        """The spline s(t) before saturation.
+
+        Args:
+            t: time [s], a scalar.
+
+        Returns:
+            s(t), shape (m,).
+        """
         return bspline_basis(t, self.duration, self.knots.shape[0], self.t0) @ self.knots
 
     def __call__(self, t, q=None, v=None):

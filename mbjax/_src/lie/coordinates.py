@@ -17,33 +17,78 @@ from mbjax._src.lie import rotation_vector as rv
 
 
 class AbstractRotation(eqx.Module):
-    """How an orientation is written in q; see the module."""
+    """How a body's orientation is written in its configuration q (a strategy; see the module).
+
+    Passed as `rotation=` to the systems that carry an orientation (`mbjax.rigid.RigidBody`,
+    the scenes' `build`); the concrete strategies `Quaternion()` and `RotationVector()` take
+    no arguments. The class attribute `size` is the number of coordinates.
+    """
 
     size: eqx.AbstractClassVar[int]
 
     @abc.abstractmethod
     def to_matrix(self, rot: Array) -> Array:
-        """The rotation matrix R (3, 3), body to space, of coordinates `rot` (size,)."""
+        """The rotation matrix of the coordinates.
+
+        Args:
+            rot: the orientation's coordinates, shape (size,).
+
+        Returns:
+            R, body to space, shape (3, 3).
+        """
 
     @abc.abstractmethod
     def from_matrix(self, R: Array) -> Array:
-        """The coordinates (size,) of the rotation matrix R (3, 3)."""
+        """The coordinates of a rotation matrix.
+
+        Args:
+            R: rotation matrix, body to space, shape (3, 3).
+
+        Returns:
+            The coordinates, shape (size,).
+        """
 
     @abc.abstractmethod
     def rate(self, rot: Array, Omega: Array) -> Array:
-        """d rot / dt (size,) for the body-frame angular velocity Omega (3,)."""
+        """The coordinates' rate for a body-frame angular velocity.
+
+        Args:
+            rot: the coordinates, shape (size,).
+            Omega: body-frame angular velocity, shape (3,) [rad/s].
+
+        Returns:
+            d rot / dt, shape (size,).
+        """
 
     @abc.abstractmethod
     def retract(self, rot0: Array, xi: Array) -> Array:
-        """The coordinates of R0 exp(xi): a body-frame rotation vector xi (3,) applied to rot0."""
+        """The coordinates of R0 exp(xi): a body-frame rotation increment applied to rot0.
+
+        Args:
+            rot0: the coordinates of R0, shape (size,).
+            xi: body-frame rotation vector, shape (3,).
+
+        Returns:
+            The coordinates of R0 exp(xi), shape (size,).
+        """
 
     @abc.abstractmethod
     def normalize(self, rot: Array) -> Array:
-        """The canonical coordinates of the same rotation (unit length, principal angle)."""
+        """The canonical coordinates of the same rotation (unit length, principal angle).
+
+        Args:
+            rot: the coordinates, shape (size,).
+
+        Returns:
+            The normalized coordinates, shape (size,).
+        """
 
 
 class Quaternion(AbstractRotation):
-    """Unit quaternions (w, x, y, z)."""
+    """Orientations as unit quaternions (w, x, y, z), normalized after a step (4 coordinates).
+
+    rot_dot = rot * (0, Omega) / 2. Takes no arguments.
+    """
 
     size = 4
 
@@ -64,7 +109,11 @@ class Quaternion(AbstractRotation):
 
 
 class RotationVector(AbstractRotation):
-    """Borri 1990's rotation vector r, R = exp(r x I) (App. A)."""
+    """Orientations as Borri 1990's rotation vector r, R = exp(r x I) (App. A; 3 coordinates).
+
+    r_dot = Gamma(r)^-T Omega (eqs 2.8, A.21, A.24), rescaled to |r| <= pi after a step
+    (eq A.29). Takes no arguments.
+    """
 
     size = 3
 

@@ -30,7 +30,22 @@ def chain(n: int, *, joint_types="revolute", length: float = 0.3, mass: float = 
 
     seed=None gives a regular chain: uniform slender links (centre of mass mid-link), axes
     alternating between y and x. With a seed, axes, link offsets, masses, centres of mass and
-    inertias are random (a generic chain for cross-checks against other engines).
+    inertias are random (a generic chain for cross-checks against other engines): inertias of
+    solid boxes with random sides and orientation, drawn from `numpy.random.default_rng(seed)`.
+
+    Args:
+        n: the number of links, at least 1.
+        joint_types: the joints' type, one string for all (default "revolute") or n of them.
+        length: link length [m] (with a seed, the scale of the random offsets).
+        mass: each link's mass [kg] (regular chain only; random in [0.5, 2] with a seed).
+        seed: None for the regular chain, or the random generator's seed.
+        gravity: the acceleration of gravity, shape (3,) [m/s^2].
+
+    Returns:
+        The `Model` of the chain, body k hanging from body k - 1.
+
+    Raises:
+        ValueError: n < 1, or an unknown joint type.
     """
     if n < 1:
         raise ValueError(f"a chain needs at least one link, got n = {n}")
@@ -48,8 +63,26 @@ def chain(n: int, *, joint_types="revolute", length: float = 0.3, mass: float = 
 
 def random_tree(n: int, *, seed: int = 0, joint_types=("revolute", "prismatic"),
                 max_back: int = 4, length: float = 0.3, gravity=(0.0, 0.0, -9.81)) -> Model:
-    """A random tree of n bodies: body k's parent is drawn among the `max_back` bodies before it
-    (so the tree branches), and each joint type among `joint_types`."""
+    """A random tree of n bodies, for cross-checks.
+
+    Body k's parent is drawn among the `max_back` bodies before it (so the tree branches), and
+    each joint type among `joint_types`; masses, centres of mass, box inertias, axes and
+    placements are random, drawn from `numpy.random.default_rng(seed)`.
+
+    Args:
+        n: the number of bodies.
+        seed: the random generator's seed.
+        joint_types: the joint types to draw from, or one string for all.
+        max_back: how far back a body's parent may be.
+        length: the scale of the placements and centres of mass [m].
+        gravity: the acceleration of gravity, shape (3,) [m/s^2].
+
+    Returns:
+        The random `Model`.
+
+    Raises:
+        ValueError: an unknown joint type.
+    """
     rng = np.random.default_rng(seed)
     parents = np.array([-1] + [int(rng.integers(max(0, k - max_back), k)) for k in range(1, n)])
     kinds = ([joint_types] * n if isinstance(joint_types, str)

@@ -23,7 +23,14 @@ MASSLESS_REMEDY = ("give its joint armature (Model(..., armature=...)) or bound 
 
 
 class ModelWarning(UserWarning):
-    """Model data that is implausible but computable; `strict=True` makes it an error."""
+    """The warning for model data that is implausible but computable.
+
+    Raised as a warning when a model loads with inertias that break the triangle inequality,
+    negative principal moments, a body with inertia but no mass, or a massless body at the end
+    of a moving joint; the message names the body and the fix. `strict=True` (of `Model`,
+    `load_urdf`, ...) makes it a `ValueError`; `warnings.simplefilter("error", ModelWarning)`
+    turns it into an exception process-wide.
+    """
 
 
 def warn(message: str, strict: bool) -> None:
@@ -34,8 +41,20 @@ def warn(message: str, strict: bool) -> None:
 
 def check_body(mass: float, inertia: np.ndarray, name: str, *, carries: bool,
                strict: bool = False) -> None:
-    """Validate one body's mass and 3x3 inertia about its centre of mass (see the module);
-    `carries`: the body carries others, or its joint has armature (so a massless body is fine)."""
+    """Validate one body's mass and inertia about its centre of mass (see the module).
+
+    Args:
+        mass: the body's mass [kg].
+        inertia: its inertia about the centre of mass, shape (3, 3) [kg m^2].
+        name: how messages name the body.
+        carries: the body carries others, or its joint has armature (so a massless body is
+            fine).
+        strict: raise where the data is only implausible.
+
+    Raises:
+        ValueError: non-finite data, a negative mass, an asymmetric inertia; with strict=True
+            also implausible data.
+    """
     J = np.asarray(inertia, dtype=float)
     if not (np.isfinite(mass) and np.all(np.isfinite(J))):
         raise ValueError(f"{name}: mass and inertia must be finite, got mass {mass} and inertia "

@@ -33,6 +33,8 @@ from mbjax._src.spatial import skew
 
 
 class JointType(NamedTuple):
+    """A joint type's number of configuration (nq) and velocity (nv) coordinates."""
+
     nq: int
     nv: int
 
@@ -55,7 +57,15 @@ NEUTRAL = {  # the zero configuration of each type
 
 
 def axis_rotation(axis: Array, angle: Array) -> Array:
-    """Rodrigues: the rotation by `angle` about the unit vector `axis`."""
+    """The rotation by `angle` about the unit vector `axis` (Rodrigues' formula).
+
+    Args:
+        axis: unit axis, shape (3,).
+        angle: angle [rad], a scalar.
+
+    Returns:
+        The rotation matrix, shape (3, 3).
+    """
     K = skew(axis)
     return jnp.eye(3, dtype=K.dtype) + jnp.sin(angle) * K + (1 - jnp.cos(angle)) * (K @ K)
 
@@ -65,8 +75,26 @@ def _unit(q: Array) -> Array:
 
 
 def joint_calc(kind: str, q: Array, v: Array, axis: Array, axis2: Array, width: int):
-    """(R_J, p_J, S, S_dot) of one joint; q and v are the joint's own coordinates. S and S_dot are
-    padded with zero columns to `width` (the model's widest joint) so every body has one shape."""
+    """One joint's transform and motion subspace (Featherstone's jcalc; see the module).
+
+    Args:
+        kind: the joint type, a key of `JOINT_TYPES`.
+        q: the joint's own configuration, shape (nq of the type,) (or padded longer).
+        v: the joint's own velocity, shape (nv of the type,) (or padded longer).
+        axis: the joint axis in the joint frame, shape (3,).
+        axis2: a universal joint's second axis, shape (3,).
+        width: the model's widest joint; S and S_dot are padded with zero columns to it so
+            every body has one shape.
+
+    Returns:
+        R_J: body k's orientation in the joint frame, shape (3, 3).
+        p_J: body k's origin in the joint frame, shape (3,).
+        S: the motion subspace in body-k coordinates, shape (6, width).
+        S_dot: its rate, shape (6, width).
+
+    Raises:
+        ValueError: an unknown joint type.
+    """
     dtype = axis.dtype
     zero3 = jnp.zeros(3, dtype)
     eye = jnp.eye(3, dtype=dtype)
@@ -99,7 +127,16 @@ def joint_calc(kind: str, q: Array, v: Array, axis: Array, axis2: Array, width: 
 
 
 def joint_rate(kind: str, q: Array, v: Array) -> Array:
-    """q_dot of one joint (padded like q): v itself, or the quaternion kinematics q * (0, w) / 2."""
+    """One joint's configuration rate: v itself, or the quaternion kinematics q * (0, w) / 2.
+
+    Args:
+        kind: the joint type.
+        q: the joint's configuration, shape (nq,).
+        v: the joint's velocity, shape (nv,).
+
+    Returns:
+        q_dot, shape (nq,).
+    """
     if kind == "spherical":
         return 0.5 * quat_multiply(_unit(q[:4]), jnp.concatenate([jnp.zeros(1, v.dtype), v[:3]]))
     if kind == "free":
@@ -111,9 +148,19 @@ def joint_rate(kind: str, q: Array, v: Array) -> Array:
 
 
 def joint_retract(kind: str, q0: Array, xi: Array) -> Array:
-    """The configuration at chart point xi (in R^nv) about q0: q0 + xi for Euclidean joints; a
-    body-frame rotation increment quat0 * exp(xi) (Borri 1990 §2) for quaternions, and for a free
-    joint also the origin moved by xi's ground-frame part."""
+    """One joint's configuration at chart point xi about q0.
+
+    q0 + xi for Euclidean joints; a body-frame rotation increment quat0 * exp(xi) (Borri 1990
+    §2) for quaternions, and for a free joint also the origin moved by xi's ground-frame part.
+
+    Args:
+        kind: the joint type.
+        q0: the chart's base configuration, shape (nq,).
+        xi: the chart point, shape (nv,).
+
+    Returns:
+        The configuration, shape (nq,).
+    """
     if kind == "spherical":
         return quat_multiply(_unit(q0[:4]), quat_from_rotvec(xi[:3]))
     if kind == "free":
@@ -124,8 +171,20 @@ def joint_retract(kind: str, q0: Array, xi: Array) -> Array:
 
 
 def joint_local_rate(kind: str, q0: Array, xi: Array, v: Array) -> Array:
-    """xi_dot for velocity v: Gamma(xi)^-T omega for the rotation increment (Borri 1990 eq 2.8) and
-    R v_origin for a free joint's origin; v itself for Euclidean joints."""
+    """One joint's chart rate xi_dot at chart point xi about q0 for velocity v.
+
+    Gamma(xi)^-T omega for the rotation increment (Borri 1990 eq 2.8) and R v_origin for a free
+    joint's origin; v itself for Euclidean joints.
+
+    Args:
+        kind: the joint type.
+        q0: the chart's base configuration, shape (nq,).
+        xi: the chart point, shape (nv,).
+        v: the joint's velocity, shape (nv,).
+
+    Returns:
+        xi_dot, shape (nv,).
+    """
     if kind == "spherical":
         return gamma_inv(xi[:3]).T @ v[:3]
     if kind == "free":

@@ -57,40 +57,68 @@ def _layout(joint_types: tuple[str, ...]):
 
 
 class Model(eqx.Module):
-    """A rigid-body tree. Build it with `Model(parents, joint_types, ...)`, the builders in
-    `mbjax._src.model.builders` or `mbjax.load_urdf`.
+    """A tree of rigid bodies connected by joints.
 
-    Per body k (arrays with leading axis n):
-        placement_rotation (n, 3, 3), placement_translation (n, 3): joint k's frame in body
-            parents[k]'s frame (in the ground frame for a base body);
-        axis, axis2 (n, 3): joint axes in the joint frame (axis2 only for universal joints);
-        mass (n,), com (n, 3) in body k's frame, inertia (n, 3, 3) about the centre of mass;
-        gravity (3,): the ground-frame acceleration of gravity.
+    Build it with `Model(parents, joint_types, ...)`, the builders `mbjax.model.chain` and
+    `mbjax.model.random_tree`, or the loaders `mbjax.load_urdf` and `mbjax.load_mjcf`. Body k
+    hangs from body parents[k] (-1: the ground) through joint k; q (nq,) and v (nv,) are the
+    joints' own coordinates concatenated in body order (see the module). Topology, joint types
+    and names are static; every array is a leaf that can be differentiated, vmapped and swept.
+    Per-body arrays have a leading axis of n bodies; a per-body argument given for one body is
+    broadcast to all of them.
 
-    Per coordinate (joint data, as URDF and MJCF give it):
-        lower, upper (nq,): position limits (-inf, inf where there are none; a revolute joint
-            without limits is a URDF "continuous" joint);
-        velocity_limit, effort_limit (nv,): |v| and |tau| bounds (inf: none). Limits are data
-            (bounds for trajectory optimisation, `mbjax._src.model.limits.excess`, checked by
-            `TreeSystem.check` in `simulate`'s status), not contact forces;
-        damping (nv,): viscous joint damping, a force -damping * v in the dynamics;
-        armature (nv,): rotor inertia reflected to the joint, added to the mass matrix diagonal
-            (Featherstone's ABA adds it to D; MuJoCo's and Pinocchio's armature);
-        friction (nv,): dry friction, kept as data (not used by the dynamics).
-
-    Named frames (URDF links merged through fixed joints, fixed joints, MJCF sites):
-        frame_names, frame_parents: static names and the body each frame is fixed to (-1: the
-            ground); frame_rotation (m, 3, 3), frame_translation (m, 3): its pose in that body.
-        See `mbjax.frame_pose` and `mbjax.frame_jacobian` (`mbjax._src.rigid.frames`).
-
-    Closures (`closures`): the loop-closing constraints the model file declares (a URDF's mimic
-    joints as `mbjax.loops.Coupling`s, an MJCF's connect and weld equalities as
-    `mbjax.loops.CutJoint`s); `TreeSystem(model)` leaves them out and
-    `ClosedSystem(TreeSystem(model), model.closures)` enforces them.
-
-    Bodies with implausible but computable mass data (a triangle-inequality violation, negative
-    moments, a massless leaf without armature) load with a `ModelWarning` (`mbjax._src.model.checks`);
+    Limits are data (bounds for trajectory optimisation, `mbjax._src.model.limits.excess`,
+    checked by `TreeSystem.check` in `simulate`'s status), not contact forces. Bodies with
+    implausible but computable mass data (a triangle-inequality violation, negative moments, a
+    massless leaf without armature) load with a `ModelWarning` (`mbjax._src.model.checks`);
     `strict=True` makes it an error.
+
+    Args:
+        parents: each body's parent, shape (n,), parents[k] < k or -1 for a base body; or a
+            `Topology`.
+        joint_types: each joint's type, one of "revolute", "prismatic", "universal",
+            "spherical", "free" (a sequence of n, or one string for all).
+        mass: body masses, shape (n,) [kg].
+        inertia: inertias about each centre of mass in the body frame, shape (n, 3, 3)
+            [kg m^2].
+        com: centres of mass in the body frames, shape (n, 3) [m]; zeros by default.
+        axis: joint axes in the joint frames, shape (n, 3), normalized here; z by default.
+        axis2: the universal joints' second axes, shape (n, 3); y by default.
+        placement_rotation: joint k's frame in body parents[k]'s frame (the ground frame for a
+            base body), shape (n, 3, 3); identities by default.
+        placement_translation: the joint frames' origins in the parents' frames, shape (n, 3)
+            [m]; zeros by default.
+        gravity: the ground-frame acceleration of gravity, shape (3,) [m/s^2].
+        names: body names, n strings; "body0", "body1", ... by default.
+        joint_names: joint names, n strings; "joint0", ... by default.
+        lower: lower position limits, shape (nq,) [rad or m]; -inf (none) by default.
+        upper: upper position limits, shape (nq,); inf by default. A revolute joint without
+            limits is a URDF "continuous" joint.
+        velocity_limit: bounds on |v|, shape (nv,); inf (none) by default.
+        effort_limit: bounds on |tau|, shape (nv,) [N m or N]; inf by default.
+        damping: viscous joint damping, a force -damping * v in the dynamics, shape (nv,).
+        armature: rotor inertia reflected to the joint, added to the mass matrix diagonal
+            (Featherstone's ABA adds it to D; MuJoCo's and Pinocchio's armature), shape (nv,).
+        friction: dry friction, shape (nv,), kept as data (not used by the dynamics).
+        frame_names: names of extra frames fixed to bodies (URDF links merged through fixed
+            joints, fixed joints, MJCF sites), m strings; see `mbjax.rigid.frame_pose` and
+            `mbjax.rigid.frame_jacobian`.
+        frame_parents: the body each frame is fixed to (-1: the ground), m ints.
+        frame_rotation: each frame's orientation in its body, shape (m, 3, 3).
+        frame_translation: each frame's origin in its body, shape (m, 3) [m].
+        closures: the loop-closing constraints the model file declares (a URDF's mimic joints
+            as `mbjax.loops.Coupling`s, an MJCF's connect and weld equalities as
+            `mbjax.loops.CutJoint`s); `TreeSystem(model)` leaves them out and
+            `ClosedSystem(TreeSystem(model), model.closures)` enforces them.
+        strict: turn the mass-data warnings into errors.
+
+    Raises:
+        ValueError: an invalid parents array, unknown joint type, wrong number of names, an
+            array of the wrong shape, a non-finite value, a placement that is not a rotation,
+            a zero or parallel joint axis, limits out of order, negative damping, armature or
+            friction, an invalid mass or inertia (see `ModelWarning`; with strict=True also the
+            implausible ones), or a frame whose parent is not a body.
+        TypeError: an array argument that is not real numbers.
     """
 
     topology: Topology = eqx.field(static=True)
@@ -287,6 +315,7 @@ class Model(eqx.Module):
 
     @property
     def n(self) -> int:
+        """The number of bodies."""
         return self.topology.n
 
     @property
@@ -296,10 +325,12 @@ class Model(eqx.Module):
 
     @property
     def nq(self) -> int:
+        """The number of configuration coordinates (a quaternion counts 4)."""
         return _layout(self.joint_types)["nq"]
 
     @property
     def nv(self) -> int:
+        """The number of velocity coordinates (degrees of freedom)."""
         return _layout(self.joint_types)["nv"]
 
     @property
@@ -308,7 +339,11 @@ class Model(eqx.Module):
         return _layout(self.joint_types)["width"]
 
     def neutral(self) -> Array:
-        """The zero configuration: zero angles and displacements, identity quaternions."""
+        """The zero configuration: zero angles and displacements, identity quaternions.
+
+        Returns:
+            q, shape (nq,).
+        """
         return jnp.asarray([x for kind in self.joint_types for x in NEUTRAL[kind]], dtype=float)
 
     @property
@@ -317,19 +352,37 @@ class Model(eqx.Module):
         return _layout(self.joint_types)["v_mask"]
 
     def body_v(self, v: Array) -> Array:
-        """Per-body velocities (n, width, ...), zero-padded, of v (nv, ...)."""
+        """The velocity coordinates grouped per body, zero-padded to the widest joint.
+
+        Args:
+            v: velocity-like coordinates, shape (nv, ...).
+
+        Returns:
+            Per-body rows, shape (n, width, ...).
+        """
         layout, width = _layout(self.joint_types), self.width
         return _by_body(layout, [
             jnp.pad(take(v, own), [(0, 0), (0, width - own.shape[1])] + [(0, 0)] * (v.ndim - 1))
             for own in layout["v_own"].values()])
 
     def flat_v(self, per_body: Array) -> Array:
-        """Inverse of body_v: (n, width, ...) -> (nv, ...)."""
+        """The inverse of `body_v`: per-body padded rows back to flat coordinates.
+
+        Args:
+            per_body: shape (n, width, ...).
+
+        Returns:
+            The flat coordinates, shape (nv, ...).
+        """
         layout = _layout(self.joint_types)
         return _flat(layout, "v", per_body)
 
     def dof_body(self) -> np.ndarray:
-        """The body each velocity coordinate belongs to."""
+        """The body each velocity coordinate belongs to.
+
+        Returns:
+            Body indices, a NumPy int array of shape (nv,).
+        """
         return np.repeat(np.arange(self.n), [JOINT_TYPES[k].nv for k in self.joint_types])
 
     # -- joints ---------------------------------------------------------------------------------
@@ -345,8 +398,18 @@ class Model(eqx.Module):
         return jax.tree.map(lambda *pieces: _by_body(layout, pieces), *outs)
 
     def joints(self, q: Array, v: Array):
-        """Per-body (R, p, S, S_dot): body k's orientation and origin in its proximal body's frame,
-        its motion subspace (n, 6, width) and that subspace's rate, body coordinates."""
+        """Every joint's transform and motion subspace at (q, v).
+
+        Args:
+            q: configuration, shape (nq,).
+            v: velocity, shape (nv,).
+
+        Returns:
+            R: body k's orientation in its proximal body's frame, shape (n, 3, 3).
+            p: body k's origin in its proximal body's frame, shape (n, 3) [m].
+            S: the motion subspaces in body coordinates, shape (n, 6, width).
+            S_dot: their rates, shape (n, 6, width).
+        """
         width = self.width
         R_J, p_J, S, S_dot = self._per_type(
             lambda kind, qk, vk, a, a2: joint_calc(kind, qk, vk, a, a2, width), q, v)
@@ -355,7 +418,18 @@ class Model(eqx.Module):
         return R, p, S, S_dot
 
     def q_dot(self, q: Array, v: Array) -> Array:
-        """dq/dt for velocity v (equal to v for revolute, prismatic and universal joints)."""
+        """The configuration's rate dq/dt for velocity v.
+
+        Equal to v for revolute, prismatic and universal joints; the quaternion kinematics for
+        spherical and free joints.
+
+        Args:
+            q: configuration, shape (nq,).
+            v: velocity, shape (nv,).
+
+        Returns:
+            dq/dt, shape (nq,).
+        """
         if self.euclidean:
             return v
         return self._flat_q(self._per_type(
@@ -368,14 +442,33 @@ class Model(eqx.Module):
         return all(JOINT_TYPES[kind].nq == JOINT_TYPES[kind].nv for kind in self.joint_types)
 
     def retract(self, q0: Array, xi: Array) -> Array:
-        """The configuration at chart point xi (length nv) about q0 (see joints.joint_retract)."""
+        """The configuration at chart point xi about q0 (see `mbjax._src.model.joints.joint_retract`).
+
+        q0 + xi for Euclidean joints; a body-frame rotation increment for quaternions.
+
+        Args:
+            q0: the chart's base configuration, shape (nq,).
+            xi: the chart point, shape (nv,).
+
+        Returns:
+            The configuration, shape (nq,).
+        """
         if self.euclidean:
             return q0 + xi
         return self._flat_q(self._per_type(
             lambda kind, qk, xk, a, a2: self._pad_q(kind, joint_retract(kind, qk, xk)), q0, xi))
 
     def local_rate(self, q0: Array, xi: Array, v: Array) -> Array:
-        """xi_dot (length nv) at chart point xi about q0 for velocity v."""
+        """The chart coordinates' rate xi_dot at chart point xi about q0 for velocity v.
+
+        Args:
+            q0: the chart's base configuration, shape (nq,).
+            xi: the chart point, shape (nv,).
+            v: velocity, shape (nv,).
+
+        Returns:
+            xi_dot, shape (nv,).
+        """
         if self.euclidean:
             return v
         width = self.width
@@ -391,7 +484,14 @@ class Model(eqx.Module):
         return _flat(_layout(self.joint_types), "q", per_body)
 
     def normalize(self, q: Array) -> Array:
-        """q with every quaternion scaled to unit length."""
+        """q with every quaternion scaled to unit length.
+
+        Args:
+            q: configuration, shape (nq,).
+
+        Returns:
+            The normalized configuration, shape (nq,).
+        """
         layout = _layout(self.joint_types)
         starts = [layout["q_start"][k] + offset for kind, offset in (("spherical", 0), ("free", 3))
                   for k in layout["groups"].get(kind, ())]
@@ -407,7 +507,11 @@ class Model(eqx.Module):
         return take(jnp.concatenate([q, units.ravel()]), source)
 
     def spatial_inertia(self) -> Array:
-        """(n, 6, 6) spatial inertias about each body's origin, body coordinates."""
+        """The spatial inertias about each body's origin, in body coordinates.
+
+        Returns:
+            Shape (n, 6, 6), angular rows first.
+        """
         return inertia_matrix(self.mass, self.com, self.inertia)
 
 

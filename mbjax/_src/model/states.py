@@ -85,8 +85,27 @@ def _pinocchio_layout(joint_types: tuple[str, ...], continuous: tuple[bool, ...]
 
 
 def state_to_pinocchio(model: Model, q: Array, v: Array) -> tuple[Array, Array]:
-    """(q, v) in Pinocchio's layout for the model Pinocchio builds from the same URDF (a free
-    base: `pin.JointModelFreeFlyer()` as the root joint)."""
+    """A state in Pinocchio's layout, for the model Pinocchio builds from the same URDF.
+
+    A free base corresponds to `pin.JointModelFreeFlyer()` as the root joint. Quaternions are
+    reordered to (x, y, z, w), a free joint's velocity to (v_origin; omega), and a revolute
+    joint without limits (URDF continuous) becomes (cos, sin). Composes with jit, vmap and
+    grad.
+
+    Args:
+        model: the mbjax model; its limits must be concrete (close over it rather than passing
+            it through `jax.jit`).
+        q: mbjax configuration, shape (nq,).
+        v: mbjax velocity, shape (nv,).
+
+    Returns:
+        q_pin: Pinocchio's configuration, shape (model.nq + the number of continuous joints,).
+        v_pin: Pinocchio's velocity, shape (nv,).
+
+    Raises:
+        ValueError: the model has a universal joint (Pinocchio has none).
+        TypeError: the model's limits are traced.
+    """
     q, v = _check(model, q, v, "Pinocchio")
     lay = _pinocchio_layout(model.joint_types, _continuous(model))
     q_pin = (jnp.zeros(lay["nq"], q.dtype).at[lay["dst"]].set(q[lay["src"]])
@@ -96,7 +115,21 @@ def state_to_pinocchio(model: Model, q: Array, v: Array) -> tuple[Array, Array]:
 
 
 def state_from_pinocchio(model: Model, q: Array, v: Array) -> tuple[Array, Array]:
-    """Inverse of `state_to_pinocchio`."""
+    """An mbjax state from Pinocchio's layout: the inverse of `state_to_pinocchio`.
+
+    Args:
+        model: the mbjax model; its limits must be concrete.
+        q: Pinocchio's configuration, shape (nq_pin,).
+        v: Pinocchio's velocity, shape (nv,).
+
+    Returns:
+        q: mbjax configuration, shape (model.nq,).
+        v: mbjax velocity, shape (nv,).
+
+    Raises:
+        ValueError: the model has a universal joint, or q and v have the wrong sizes.
+        TypeError: the model's limits are traced.
+    """
     q, v = _check(model, q, v, "Pinocchio")
     lay = _pinocchio_layout(model.joint_types, _continuous(model))
     if q.shape != (lay["nq"],) or v.shape != (model.nv,):
@@ -142,13 +175,43 @@ def _mujoco_velocity(model: Model, q: Array, v: Array, to_world: bool) -> Array:
 
 
 def state_to_mujoco(model: Model, q: Array, v: Array) -> tuple[Array, Array]:
-    """(qpos, qvel) for the MuJoCo model of the same mechanism (`load_mjcf`/`from_mujoco`
-    numbering)."""
+    """A state as MuJoCo's (qpos, qvel), for the MuJoCo model of the same mechanism.
+
+    The joints are numbered as `load_mjcf` and `from_mujoco` number them. Configurations agree;
+    a free joint's velocity becomes MuJoCo's (v_origin in the world; omega in the body).
+
+    Args:
+        model: the mbjax model.
+        q: mbjax configuration, shape (nq,).
+        v: mbjax velocity, shape (nv,).
+
+    Returns:
+        qpos: MuJoCo's configuration, shape (nq,).
+        qvel: MuJoCo's velocity, shape (nv,).
+
+    Raises:
+        ValueError: the model has a universal joint, or a free joint on a body that does not
+            hang from the world (MuJoCo allows neither).
+    """
     q, v = _check(model, q, v, "MuJoCo")
     return q, _mujoco_velocity(model, q, v, to_world=True)
 
 
 def state_from_mujoco(model: Model, q: Array, v: Array) -> tuple[Array, Array]:
-    """Inverse of `state_to_mujoco`."""
+    """An mbjax state from MuJoCo's (qpos, qvel): the inverse of `state_to_mujoco`.
+
+    Args:
+        model: the mbjax model.
+        q: MuJoCo's qpos, shape (nq,).
+        v: MuJoCo's qvel, shape (nv,).
+
+    Returns:
+        q: mbjax configuration, shape (nq,).
+        v: mbjax velocity, shape (nv,).
+
+    Raises:
+        ValueError: the model has a universal joint, or a free joint on a body that does not
+            hang from the world.
+    """
     q, v = _check(model, q, v, "MuJoCo")
     return q, _mujoco_velocity(model, q, v, to_world=False)

@@ -312,10 +312,25 @@ def _chunk(model: Model, revolute: np.ndarray, q: Array, v: Array, tau: Array, s
     return u_dot
 
 
-def batched_forward_dynamics(model: Model, q: Array, q_dot: Array, tau: Array) -> Array:
-    """`forward_dynamics` of B states: q, q_dot, tau (B, nv) -> accelerations (B, nv), by
-    `batch_aba` (batch last inside). Agrees with `jax.vmap(forward_dynamics)` to rounding."""
+def batched_forward_dynamics(model: Model, q: Array, v: Array, tau: Array) -> Array:
+    """`forward_dynamics` of B states at once, in the throughput layout (batch last inside).
+
+    For trees of revolute and prismatic joints; agrees with `jax.vmap(forward_dynamics)` to
+    rounding.
+
+    Args:
+        model: the tree.
+        q: configurations, shape (B, nv).
+        v: velocities, shape (B, nv).
+        tau: generalized forces, shape (B, nv).
+
+    Returns:
+        The accelerations, shape (B, nv).
+
+    Raises:
+        ValueError: q is not (B, nv).
+    """
     q = jnp.asarray(q)
     if q.ndim != 2 or q.shape[1] != model.nv:
         raise ValueError(f"q must be (B, nv) = (B, {model.nv}), got shape {q.shape}")
-    return batch_aba(model, q.T, jnp.asarray(q_dot).T, jnp.asarray(tau).T).T
+    return batch_aba(model, q.T, jnp.asarray(v).T, jnp.asarray(tau).T).T

@@ -116,24 +116,49 @@ REFERENCE = (0.1581077119629904e2, -0.1575637105984298e2, 0.4082224013073101e-1,
 
 
 def to_testset(q: Array) -> Array:
-    """Tree coordinates (..., 7) to the test set's order (beta, Theta, gamma, Phi, delta, Omega,
-    epsilon)."""
+    """Tree coordinates to the test set's order (beta, Theta, gamma, Phi, delta, Omega, epsilon).
+
+    Args:
+        q: tree coordinates [rad], shape (..., 7).
+
+    Returns:
+        The test set's y, shape (..., 7).
+    """
     return q[..., jnp.array(TREE_ORDER)]
 
 
 def from_testset(y) -> Array:
-    """The test set's y(1..7) (..., 7) to tree coordinates."""
+    """The test set's y(1..7) to tree coordinates (the inverse of `to_testset`).
+
+    Args:
+        y: the test set's coordinates [rad], shape (..., 7).
+
+    Returns:
+        Tree coordinates, shape (..., 7).
+    """
     return jnp.asarray(y, dtype=float)[..., jnp.array(TREE_ORDER)]
 
 
 class PointSpring(AbstractControl):
-    """A linear spring from `point` (body `body`'s frame) to the fixed `anchor` (ground frame),
-    stiffness `stiffness` and rest length `rest_length`: energy V = stiffness (L - rest_length)^2
-    / 2 with L the length; force on the point F = -stiffness (L - rest_length) (x - anchor) / L,
-    generalized force J^T F with J = dx/dv (Hairer & Wanner II §VII.7, the test set's
-    fx, fy and ff(3); here for any tree, by a reverse-mode pass through the kinematics).
-    Call as force(t, q, v) -> (nv,), a control of the tree. All parameters are leaves:
-    differentiable and sweepable."""
+    """A linear spring from a point on a body to a fixed anchor, as a control of the tree.
+
+    Energy V = stiffness (L - rest_length)^2 / 2 with L the length; force on the point
+    F = -stiffness (L - rest_length) (x - anchor) / L, generalized force J^T F with J = dx/dv
+    (Hairer & Wanner II §VII.7, the test set's fx, fy and ff(3); here for any tree, by a
+    reverse-mode pass through the kinematics). Call as force(t, q, v) -> (nv,). All parameters
+    are leaves: differentiable and sweepable.
+
+    Args:
+        model: the tree the spring acts on.
+        body: the body carrying the spring's end.
+        point: the spring's end in the body's frame, shape (3,) [m].
+        anchor: the fixed end in the ground frame, shape (3,) [m].
+        stiffness: spring stiffness [N/m].
+        rest_length: rest length [m].
+
+    Raises:
+        ValueError: body is not a body of the model.
+    """
 
     model: Model
     body: int = eqx.field(static=True)
@@ -152,11 +177,26 @@ class PointSpring(AbstractControl):
         self.rest_length = jnp.asarray(rest_length, float)
 
     def position(self, q: Array) -> Array:
-        """The spring's end on the body, ground frame."""
+        """The spring's end on the body, in the ground frame.
+
+        Args:
+            q: tree configuration, shape (nq,).
+
+        Returns:
+            Its position [m], shape (3,).
+        """
         R, p = forward_kinematics(self.model, q)
         return p[self.body] + R[self.body] @ self.point
 
     def energy(self, q: Array) -> Array:
+        """The spring's potential energy.
+
+        Args:
+            q: tree configuration, shape (nq,).
+
+        Returns:
+            The energy [J], a scalar.
+        """
         length = jnp.linalg.norm(self.position(q) - self.anchor)
         return 0.5 * self.stiffness * (length - self.rest_length) ** 2
 
@@ -172,9 +212,16 @@ class PointSpring(AbstractControl):
 
 
 class Squeezer(NamedTuple):
-    """What `build` returns: the tree (driven by the motor torque `tau` plus the `spring`), its
-    cut joints, and the initial state (tree order). `system(method, **kw)` closes the tree:
-    `ClosedSystem(tree, closures, method, **kw)`."""
+    """What `build` returns: the driven tree, its cut joints and the initial state.
+
+    Args:
+        tree: the tree, driven by the motor torque `tau` plus the `spring`.
+        closures: the three `point_on_line` cut joints.
+        spring: the `PointSpring`.
+        tau: the constant motor torque, shape (7,) [N m].
+        q0: the test set's initial configuration in tree order [rad], shape (7,).
+        v0: the initial velocity (zeros), shape (7,).
+    """
 
     tree: TreeSystem
     closures: tuple
@@ -184,12 +231,25 @@ class Squeezer(NamedTuple):
     v0: Array
 
     def system(self, method=None, **kwargs) -> ClosedSystem:
+        """The closed mechanism: `ClosedSystem(tree, closures, method, **kwargs)`.
+
+        Args:
+            method: the closed-loop method (a strategy of `mbjax.loops`); None for the
+                default.
+            **kwargs: further `ClosedSystem` arguments.
+
+        Returns:
+            The `ClosedSystem`.
+        """
         return ClosedSystem(self.tree, self.closures, method, **kwargs)
 
 
 def build() -> Squeezer:
-    """Andrews' squeezer as a `Squeezer` (tree, closures, spring, tau, q0, v0); see the module
-    docstring."""
+    """Andrews' squeezing mechanism of the IVP test set (see the module).
+
+    Returns:
+        A `Squeezer` (tree, closures, spring, tau, q0, v0); `.system()` closes it.
+    """
     parents = (-1, 0, -1, -1, 3, -1, 5)
     mass = (m1, m2, m3, m5, m4, m7, m6)
     moments = np.array([i1, i2, i3, i5, i4, i7, i6])

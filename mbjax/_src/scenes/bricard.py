@@ -58,7 +58,14 @@ _ROT_Y = np.array([[0.0, 0.0, 1.0], [0.0, 1.0, 0.0], [-1.0, 0.0, 0.0]])   # its 
 
 
 def model(section=SECTION) -> Model:
-    """The open chain of the five bars from P1 (body k: bar k + 1, its joint at corner k)."""
+    """The open chain of the five bars from P1 (body k: bar k + 1, its joint at corner k).
+
+    Args:
+        section: the side of the bars' square cross-section [m].
+
+    Returns:
+        The tree's `Model`, five revolute joints, gravity -9.81 m/s^2 along y.
+    """
     directions = np.diff(CORNERS, axis=0) / LENGTH           # unit bar directions at q = 0
     transverse = MASS * (LENGTH**2 + section**2) / 12
     axial = MASS * section**2 / 6
@@ -71,19 +78,47 @@ def model(section=SECTION) -> Model:
 
 
 def joint_angles(phi):
-    """Tree coordinates on the mechanism's motion at parameter phi (closed form above)."""
+    """The tree coordinates on the mechanism's motion at parameter phi (closed form, see the module).
+
+    Args:
+        phi: the angle of the joints at P1, P3 and P5 [rad]; sin(phi) > -1/2.
+
+    Returns:
+        (phi, psi, phi, psi, phi) [rad], shape (5,).
+    """
     psi = -jnp.arcsin(jnp.sin(phi) / (1 + jnp.sin(phi)))
     return jnp.stack([phi, psi, phi, psi, phi])
 
 
 def point_p3(model: Model, q):
-    """The benchmark's output point P3, the joint between bars 2 and 3, ground frame."""
+    """The benchmark's output point P3, the joint between bars 2 and 3, in the ground frame.
+
+    Args:
+        model: the tree's model.
+        q: tree configuration [rad], shape (5,).
+
+    Returns:
+        P3's position [m], shape (3,).
+    """
     return forward_kinematics(model, q)[1][2]
 
 
 def build(phi0=0.0, phi_dot0=0.0, section=SECTION):
-    """(system, q0, v0): the mechanism (a `ClosedSystem`, coupled multipliers) at phi0 on its motion (0: the benchmark's start) with rate
-    phi_dot0 (0: at rest, as in the benchmark); the joint at P6 is a revolute cut joint."""
+    """The scene: Bricard's mechanism at a point of its motion.
+
+    The joint at P6 is a revolute cut joint (5 equations of rank 4, so the solvers report
+    `Status.REDUNDANT`); the `ClosedSystem` uses coupled multipliers.
+
+    Args:
+        phi0: the start on the motion [rad] (0: the benchmark's start).
+        phi_dot0: its rate [rad/s] (0: at rest, as in the benchmark).
+        section: the side of the bars' square cross-section [m].
+
+    Returns:
+        system: the `ClosedSystem`.
+        q0: the tree configuration, shape (5,).
+        v0: the tree velocity, shape (5,).
+    """
     phi0 = jnp.asarray(phi0, float)
     cut = CutJoint("revolute", 4, GROUND, origin_a=CORNERS[5] - CORNERS[4], origin_b=CORNERS[5],
                    rotation_a=_ROT_Y, rotation_b=_ROT_Y)

@@ -39,32 +39,69 @@ TORQUE_LIMIT = 1.8                           # [N m]: below the baseline's peak 
 
 
 def wrist(rotation_model: str = "physical", gravity: float = 9.81) -> CarpalWrist:
-    """The scene's wrist."""
+    """The scene's wrist: BASE_RADIUS, LINK_LENGTH and the tool (TOOL_MASS, TOOL_INERTIA, TOOL_COM).
+
+    Args:
+        rotation_model: "physical" (the mirror plate) or "chapter" (Canfield 1997's printed
+            rotation).
+        gravity: the acceleration of gravity [m/s^2].
+
+    Returns:
+        The `CarpalWrist`.
+    """
     return CarpalWrist(BASE_RADIUS, LINK_LENGTH, tool_mass=TOOL_MASS, tool_inertia=TOOL_INERTIA,
                        tool_com=TOOL_COM, gravity=gravity, rotation_model=rotation_model)
 
 
 def home(w: CarpalWrist | None = None) -> jnp.ndarray:
-    """theta at the home pose (beta = 0, plunge HOME_PLUNGE)."""
+    """The joint angles at the home pose (beta = 0, plunge HOME_PLUNGE).
+
+    Args:
+        w: the wrist; None for `wrist()`.
+
+    Returns:
+        theta [rad], shape (3,).
+    """
     w = wrist() if w is None else w
     return w.solve_inverse_kinematics(HOME_PLUNGE, jnp.zeros(2))[0]
 
 
 def free_motion(rotation_model: str = "physical"):
-    """(system, theta0, theta_dot0): torque-free, gravity-free motion from HOME."""
+    """The free-motion scenario: torque-free, gravity-free motion from HOME released with THETA_DOT0.
+
+    Args:
+        rotation_model: "physical" or "chapter" (see `wrist`).
+
+    Returns:
+        system: the `WristSystem`, no control.
+        theta0: the home pose [rad], shape (3,).
+        theta_dot0: THETA_DOT0 [rad/s], shape (3,).
+    """
     w = wrist(rotation_model, gravity=0.0)
     return WristSystem(w), home(w), jnp.asarray(THETA_DOT0)
 
 
 def servo():
-    """(system, theta0, theta_dot0): the servoed wrist under gravity, offset from HOME."""
+    """The servo scenario: a joint PD servo holding HOME under gravity, released from HOME + SERVO_OFFSET.
+
+    Returns:
+        system: the `WristSystem` with the servo (SERVO_K, SERVO_D, gravity feed-forward).
+        theta0: the offset start [rad], shape (3,).
+        theta_dot0: zeros, shape (3,).
+    """
     w = wrist()
     law = servo_law(w, home(w), SERVO_K, SERVO_D)
     return WristSystem(w, law), home(w) + jnp.asarray(SERVO_OFFSET), jnp.zeros(3)
 
 
 def build():
-    """The scene's default (system, theta0, theta_dot0): the free motion."""
+    """The scene's default: the free motion (`free_motion()`).
+
+    Returns:
+        system: the `WristSystem`.
+        theta0: the home pose [rad], shape (3,).
+        theta_dot0: THETA_DOT0 [rad/s], shape (3,).
+    """
     return free_motion()
 
 
@@ -79,10 +116,19 @@ def _synthesis_terminal(q, v, *, wrist, goal_plunge, goal_slope):
 
 
 def synthesis_problem(w: CarpalWrist | None = None, steps: int = 100):
-    """START -> GOAL at rest in DURATION, |tau_i| <= TORQUE_LIMIT, as a `mbjax.trajopt.Problem`
-    (RK4, `steps` knots of held torques): least-squares residuals, along the way the torques
+    """The move START -> GOAL at rest in DURATION, |tau_i| <= TORQUE_LIMIT, as a trajectory-optimisation problem.
+
+    RK4, `steps` knots of held torques; least-squares residuals: along the way the torques
     scaled by the limit (0.3) and a trace of the speed (1e-3), at the end the midplane chart's
-    miss (1e3 per link length in plunge, 1e3 in slope) and the speed (10)."""
+    miss (1e3 per link length in plunge, 1e3 in slope) and the speed (10).
+
+    Args:
+        w: the wrist; None for `wrist()`.
+        steps: the number of knots.
+
+    Returns:
+        The `mbjax.trajopt.Problem`, its controls the three joint torques.
+    """
     from mbjax._src.trajopt import Problem
 
     w = wrist() if w is None else w
@@ -96,8 +142,20 @@ def synthesis_problem(w: CarpalWrist | None = None, steps: int = 100):
 
 
 def synthesis_guess(problem) -> jnp.ndarray:
-    """The inverse-dynamics feed-forward along the minimum-jerk tool path (`mbjax.trajopt.
-    baseline`) at the middle of each step, clipped to the torque limit."""
+    """A first guess for `synthesis_problem`: the feed-forward torques along the minimum-jerk tool path.
+
+    The inverse dynamics along the path (`mbjax.wrist.feedforward_torques`) at the middle of
+    each step, clipped to the torque limit.
+
+    Args:
+        problem: the synthesis problem.
+
+    Returns:
+        The torques [N m], shape (horizon, 3).
+
+    Raises:
+        equinox.EquinoxRuntimeError: the tool path leaves the workspace.
+    """
     from mbjax._src.synthesis.baseline import ToolPath, feedforward_torques
 
     ts = (np.arange(problem.horizon) + 0.5) * problem.dt

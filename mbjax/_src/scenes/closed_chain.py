@@ -22,9 +22,22 @@ DURATION = 1.0
 
 
 def build(n: int):
-    """(system, q0, v0) for n tree degrees of freedom (n/2 bodies, n even, n >= 4); the system
-    is a `ClosedSystem` with the coupled multipliers (rebuild it from `system.tree` and
-    `system.closures` for another method)."""
+    """The scene: the chain of n/2 Hooke-jointed links with both ends fixed (Anderson 1993 Fig. 7A).
+
+    The system is a `ClosedSystem` with the coupled multipliers (rebuild it from `system.tree`
+    and `system.closures` for another method); the start is on the constraints.
+
+    Args:
+        n: the tree's degrees of freedom (n/2 bodies), even and at least 4.
+
+    Returns:
+        system: the `ClosedSystem`.
+        q0: the V-shaped chain projected onto the constraints [rad], shape (n,).
+        v0: a small velocity projected onto them [rad/s], shape (n,).
+
+    Raises:
+        ValueError: n is odd or below 4.
+    """
     if n < 4 or n % 2:
         raise ValueError(f"n must be an even number >= 4 (two dof per Hooke joint), got {n}")
     bodies = n // 2

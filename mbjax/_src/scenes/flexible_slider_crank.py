@@ -22,6 +22,7 @@ import jax.numpy as jnp
 import numpy as np
 
 from mbjax._src.flex import Beam, FlexibleModel, FlexibleSystem, beam_body, craig_bampton, shape_at
+from mbjax._src.flex.references import slider_crank_reference as reference  # noqa: F401 (the ANCF reference: mbjax.scenes.flexible_slider_crank.reference)
 from mbjax._src.integrate import RK4, simulate
 from mbjax._src.loops import GROUND, ClosedSystem, CutJoint, Prescribed, Stabilized
 from mbjax._src.model import Model
@@ -35,13 +36,34 @@ DURATION = 0.15
 
 
 def rod(n_elements: int) -> Beam:
+    """The connecting rod as a steel beam, 12 in long, 0.25 in diameter.
+
+    Args:
+        n_elements: the number of beam elements.
+
+    Returns:
+        The `mbjax.flex.Beam`.
+    """
     area = np.pi * DIAMETER**2 / 4
     return Beam.round(ROD, DIAMETER, E, MASS / (ROD * area), nu=0.3, n_elements=n_elements)
 
 
 def build(n_elements: int = 2, stiffening: bool = True):
-    """(system, q0, v0, midpoint shape (3, mu)); q = (crank angle, rod angle relative to the crank,
-    modal coordinates)."""
+    """The scene: the slider-crank with a flexible rod, the crank driven at OMEGA.
+
+    q = (crank angle, rod angle relative to the crank, modal coordinates).
+
+    Args:
+        n_elements: the rod's number of beam elements (3 in-plane modes each).
+        stiffening: include geometric stiffening.
+
+    Returns:
+        system: the `ClosedSystem` (Anderson 1993's route, projected after every step).
+        q0: the initial configuration, shape (nq,).
+        v0: the initial velocity, shape (nv,).
+        midpoint: the modal shape of the rod's midpoint, shape (3, mu), for
+            `midpoint_deflection`.
+    """
     structure = rod(n_elements)
     basis = craig_bampton(structure, n_modes=3 * n_elements, planar="xy")
     body = beam_body(structure, basis, nodes=(n_elements,), stiffening=stiffening)
@@ -64,7 +86,18 @@ def build(n_elements: int = 2, stiffening: bool = True):
 
 
 def midpoint_deflection(system, midpoint, qs):
-    """Signed distance [m] of the rod's midpoint from the chord PQ along a trajectory."""
+    """The signed distance of the rod's midpoint from the chord PQ along a trajectory.
+
+    Positive away from O at t = 0 (the rod frame's +y).
+
+    Args:
+        system: the scene's system (`build`).
+        midpoint: the midpoint's modal shape from `build`, shape (3, mu).
+        qs: saved configurations, shape (T, nq).
+
+    Returns:
+        The deflection [m], shape (T,).
+    """
     model = system.tree.model
     tip = model.bodies.node_phi[1, 0]
     _, qf = jax.vmap(model.split)(qs)
@@ -77,8 +110,22 @@ def midpoint_deflection(system, midpoint, qs):
 
 def run(n_elements: int = 2, stiffening: bool = True, dt: float = 1e-5, t1: float = DURATION,
         every: float = 5e-4, integrator=None, **tolerance):
-    """(ts, midpoint deflection [in], solution) of one run (RK4 unless `integrator` is given;
-    `tolerance`: simulate's rtol and atol)."""
+    """One run of the scene.
+
+    Args:
+        n_elements: the rod's number of beam elements.
+        stiffening: include geometric stiffening.
+        dt: the step [s].
+        t1: the final time [s].
+        every: the save interval [s].
+        integrator: the integrator; None for `RK4()`.
+        **tolerance: `simulate`'s rtol and atol.
+
+    Returns:
+        ts: the save times [s], shape (T,).
+        deflection: the rod's midpoint deflection [in], shape (T,).
+        solution: the `Solution`.
+    """
     system, q0, v0, midpoint = build(n_elements, stiffening)
     saveat = np.round(np.arange(0.0, t1 + every / 2, every), 12)
     sol = simulate(system, integrator or RK4(), q0, v0, dt=dt, t1=t1, saveat=saveat, **tolerance)

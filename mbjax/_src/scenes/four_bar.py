@@ -32,7 +32,15 @@ CLOSURES = ("point_on_line", "revolute")
 
 
 def model(gravity=(0.0, -GRAVITY, 0.0)) -> Model:
-    """The tree: crank and coupler from the ground origin, rocker from (D, 0, 0)."""
+    """The tree: crank and coupler from the ground origin, rocker from (D, 0, 0).
+
+    Args:
+        gravity: the acceleration of gravity, shape (3,) [m/s^2]; -y (in the linkage's plane)
+            by default.
+
+    Returns:
+        The tree's `Model`, three revolute joints about z.
+    """
     inertia = np.array([np.diag([1e-5, m * L**2 / 12, m * L**2 / 12])
                         for m, L in zip(MASSES, LENGTHS)])
     return Model([-1, 0, -1], "revolute", mass=MASSES, inertia=inertia,
@@ -42,8 +50,16 @@ def model(gravity=(0.0, -GRAVITY, 0.0)) -> Model:
 
 
 def joint_angles(theta):
-    """Tree coordinates (crank angle, coupler relative angle, rocker angle) of the closed
-    four-bar at crank angle theta: closed-form position analysis, elbow-up branch."""
+    """The tree coordinates of the closed four-bar at crank angle theta.
+
+    Closed-form position analysis (two circles' intersection), elbow-up branch.
+
+    Args:
+        theta: the crank angle [rad], a scalar.
+
+    Returns:
+        (crank angle, coupler angle relative to the crank, rocker angle) [rad], shape (3,).
+    """
     P = jnp.array([A_ * jnp.cos(theta), A_ * jnp.sin(theta)])        # crank tip
     e = jnp.array([D_, 0.0]) - P
     r = jnp.linalg.norm(e)
@@ -56,10 +72,25 @@ def joint_angles(theta):
 
 
 def build(closure: str = "point_on_line", theta0=THETA0, omega0=OMEGA0):
-    """(system, q0, v0): the four-bar closed by `closure` ("point_on_line": the planar pin, 2
-    equations; "revolute": the spatial revolute joint, 5 redundant equations) as a
-    `ClosedSystem` (coupled multipliers; rebuild it from `system.tree` and `system.closures`
-    for another method), started on the loop at crank angle theta0 with crank rate omega0."""
+    """The scene: the four-bar started on the loop.
+
+    A `ClosedSystem` with coupled multipliers (rebuild it from `system.tree` and
+    `system.closures` for another method).
+
+    Args:
+        closure: "point_on_line" (the planar pin, 2 equations) or "revolute" (the spatial
+            revolute joint, 5 redundant equations).
+        theta0: the initial crank angle [rad].
+        omega0: the initial crank rate [rad/s].
+
+    Returns:
+        system: the `ClosedSystem`.
+        q0: the tree configuration on the loop, shape (3,).
+        v0: the tree velocity on the loop, shape (3,).
+
+    Raises:
+        ValueError: closure is not one of `CLOSURES`.
+    """
     if closure not in CLOSURES:
         raise ValueError(f"closure must be one of {CLOSURES}, got {closure!r}")
     cut = CutJoint(closure, 1, 2, origin_a=(B_, 0.0, 0.0), origin_b=(C_, 0.0, 0.0))
@@ -82,12 +113,21 @@ def _crank_terminal(q, v, *, goal):
 
 
 def crank_problem(goal=CRANK_GOAL, steps: int = CRANK_STEPS):
-    """The four-bar lying on a table (gravity -z, normal to its plane; planar pin closure,
-    projection on) driven by a torque on its crank from
-    rest at crank angle THETA0 to rest at `goal` [rad] after `steps` steps of CRANK_DT (RK4),
-    with least effort: the running residual is the torque u (cost 1/2 u^2 dt), the terminal
-    residuals 100 (theta_N - goal) and 10 v_N. Each step ends on the loop by the projection, so
-    iLQR's linearization is that of the projected step."""
+    """The crank turned rest-to-rest with least effort, as a trajectory-optimisation problem.
+
+    The four-bar lies on a table (gravity -z, normal to its plane; planar pin closure,
+    projection on), driven by a torque on its crank from rest at crank angle THETA0 to rest at
+    `goal` after `steps` steps of CRANK_DT (RK4): the running residual is the torque u (cost
+    1/2 u^2 dt), the terminal residuals 100 (theta_N - goal) and 10 v_N. Each step ends on the
+    loop by the projection, so iLQR's linearization is that of the projected step.
+
+    Args:
+        goal: the final crank angle [rad].
+        steps: the horizon in steps of CRANK_DT.
+
+    Returns:
+        The `mbjax.trajopt.Problem`, its control the crank torque (nu = 1).
+    """
     from mbjax._src.rigid import TreeSystem
     from mbjax._src.trajopt import Problem
 

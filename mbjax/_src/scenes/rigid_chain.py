@@ -18,6 +18,12 @@ DURATION = 2.0
 
 
 def build():
-    """(model, q0, v0) of the scene."""
+    """The scene: the 7-link chain at rest in the bent configuration Q0.
+
+    Returns:
+        model: the chain's `Model` (wrap it in `TreeSystem(model)` to simulate).
+        q0: Q0 [rad], shape (7,).
+        v0: zeros, shape (7,).
+    """
     model = chain(N_LINKS, length=LINK_LENGTH, gravity=(0.0, 0.0, -GRAVITY))
     return model, jnp.asarray(Q0), jnp.zeros(N_LINKS)

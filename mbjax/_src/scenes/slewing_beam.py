@@ -38,6 +38,11 @@ COAST = 1.0                                        # [s] of coasting to measure 
 
 
 def beam() -> Beam:
+    """The aluminium strip (1 m, 50 x 3 mm) as N_ELEMENTS beam elements.
+
+    Returns:
+        The `mbjax.flex.Beam`, bending in the plane of motion about its thin axis.
+    """
     area = WIDTH * THICKNESS
     bending = WIDTH * THICKNESS**3 / 12            # in the plane of motion: about the thin axis
     return Beam(LENGTH, E, G, DENSITY, area, WIDTH**3 * THICKNESS / 12, bending,
@@ -45,7 +50,15 @@ def beam() -> Beam:
 
 
 def model(n_bending: int = 2) -> FlexibleModel:
-    """The hub and beam: a revolute joint about z carrying the flexible beam along x."""
+    """The hub and beam: a revolute joint about z carrying the flexible beam along x.
+
+    Args:
+        n_bending: the number of in-plane bending modes kept (Craig-Bampton, clamped at the
+            hub; no axial mode).
+
+    Returns:
+        The `mbjax.flex.FlexibleModel`, q = (hub angle, modal coordinates).
+    """
     structure = beam()
     mass = DENSITY * WIDTH * THICKNESS * LENGTH
     body = beam_body(structure, modes(structure, n_bending, 0), nodes=(N_ELEMENTS,))
@@ -59,20 +72,46 @@ def model(n_bending: int = 2) -> FlexibleModel:
 
 
 def frequencies(arm: FlexibleModel) -> Array:
-    """The modes' frequencies [rad/s] (K_r = diag(omega^2) for mass-normalized modes)."""
+    """The modes' frequencies (K_r = diag(omega^2) for mass-normalized modes).
+
+    Args:
+        arm: the model from `model`.
+
+    Returns:
+        The frequencies [rad/s], shape (n_bending,).
+    """
     return jnp.sqrt(jnp.diag(arm.bodies.stiffness[0]))
 
 
 def tip(arm: FlexibleModel, q: Array) -> Array:
-    """The tip's transverse deflection in the hub's rotating frame [m]."""
+    """The tip's transverse deflection in the hub's rotating frame.
+
+    Args:
+        arm: the model from `model`.
+        q: configuration, shape (nq,).
+
+    Returns:
+        The deflection [m], a scalar.
+    """
     _, qf = arm.split(q)
     return arm.bodies.node_phi[0, 0, 1] @ qf[0]
 
 
 def centreline(arm: FlexibleModel, qs, points: int = 11, magnification: float = 1.0) -> np.ndarray:
-    """World positions (T, points, 3) along the beam's centreline at the configurations qs (T, nq):
-    the modal deflection (times `magnification`, for a picture) in the hub frame
-    (`mbjax.flex.centreline`), turned by the hub angle."""
+    """World positions along the beam's centreline, for pictures and animations.
+
+    The modal deflection (times `magnification`) in the hub frame (`mbjax.flex.centreline`),
+    turned by the hub angle.
+
+    Args:
+        arm: the model from `model`.
+        qs: configurations, shape (T, nq).
+        points: the number of points along the beam.
+        magnification: the factor on the deflection.
+
+    Returns:
+        The positions [m], a NumPy array of shape (T, points, 3).
+    """
     structure = beam()
     basis = modes(structure, arm.bodies.stiffness.shape[-1], 0)     # the basis `model` was built on
     qs = np.asarray(qs)
@@ -92,10 +131,21 @@ def _slew_terminal(q, v, *, goal, omega):
 
 
 def slew_problem(n_bending: int = 2, slew=SLEW, duration: float = DURATION) -> Problem:
-    """The hub from rest turned by `slew` [rad] to rest in `duration` (RK4, DT, torque held over
-    each step), with least effort: the running residual is the hub torque (cost 1/2 u^2 dt); the
-    terminal residuals 100 (theta_N - slew), 10 theta'_N and 100 (omega_i eta_i, eta_i') of each
-    mode, so that the final cost holds 10^4 times the vibration energy left."""
+    """The rest-to-rest slew without residual vibration, as a trajectory-optimisation problem.
+
+    The hub from rest turned by `slew` to rest in `duration` (RK4, DT, torque held over each
+    step), with least effort: the running residual is the hub torque (cost 1/2 u^2 dt); the
+    terminal residuals 100 (theta_N - slew), 10 theta'_N and 100 (omega_i eta_i, eta_i') of
+    each mode, so that the final cost holds 10^4 times the vibration energy left.
+
+    Args:
+        n_bending: the number of bending modes.
+        slew: the hub's turn [rad].
+        duration: the manoeuvre's duration [s].
+
+    Returns:
+        The `mbjax.trajopt.Problem`, its control the hub torque (nu = 1).
+    """
     arm = model(n_bending)
     steps = round(duration / DT)
     terminal = eqx.Partial(_slew_terminal, goal=jnp.asarray(slew, float),
@@ -106,9 +156,18 @@ def slew_problem(n_bending: int = 2, slew=SLEW, duration: float = DURATION) -> P
 
 
 def rigid_guess(problem: Problem) -> Array:
-    """The least-effort rest-to-rest torque of the arm taken as rigid (a torque falling linearly
-    from 6 J slew / T^2 to its negative, J the hub's and beam's inertia about the axis): the
-    first guess, and the baseline whose residual vibration the optimum suppresses."""
+    """The least-effort rest-to-rest torque of the arm taken as rigid.
+
+    A torque falling linearly from 6 J slew / T^2 to its negative, J the hub's and beam's
+    inertia about the axis: the first guess, and the baseline whose residual vibration the
+    optimum suppresses.
+
+    Args:
+        problem: the slew problem.
+
+    Returns:
+        The torques [N m], shape (horizon, 1).
+    """
     arm = problem.system.model
     second = arm.bodies.second[0]                        # sum m (rho, phi) (rho, phi)^T
     J = arm.bodies.rotary[0, 2, 2] + second[0, 0, 0, 0] + second[1, 0, 1, 0]   # about z
@@ -120,8 +179,16 @@ def rigid_guess(problem: Problem) -> Array:
 
 @eqx.filter_jit
 def residual_vibration(problem: Problem, xN: Array, coast: float = COAST) -> Array:
-    """The tip's largest transverse deflection [m] while the arm coasts, torque off, for `coast`
-    seconds from the final state xN."""
+    """The residual vibration: the tip's largest transverse deflection while the arm coasts, torque off.
+
+    Args:
+        problem: the slew problem.
+        xN: the final state (q, v), shape (nq + nv,).
+        coast: how long the arm coasts [s].
+
+    Returns:
+        The largest deflection [m], a scalar.
+    """
     steps = round(coast / problem.dt)
 
     def step(x, k):

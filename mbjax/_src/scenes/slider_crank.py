@@ -47,7 +47,11 @@ def _bar(length):
 
 
 def model() -> Model:
-    """The tree: crank, rod on the crank, slider on the ground guide."""
+    """The tree: crank, rod on the crank, slider on the ground guide.
+
+    Returns:
+        The tree's `Model`: two revolute joints about z and a prismatic joint along x.
+    """
     a, b, c = BLOCK
     m_block = DENSITY * a * b * c
     block = (m_block, np.zeros(3), m_block / 12 * np.diag([b**2 + c**2, a**2 + c**2, a**2 + b**2]))
@@ -62,22 +66,49 @@ def model() -> Model:
 
 
 def slider_position(theta):
-    """x(theta) = R cos(theta) + sqrt(L^2 - (R sin(theta))^2)."""
+    """The slider's position x(theta) = R cos(theta) + sqrt(L^2 - (R sin(theta))^2).
+
+    Args:
+        theta: the crank angle [rad].
+
+    Returns:
+        x [m], theta's shape.
+    """
     return R_ * jnp.cos(theta) + jnp.sqrt(L_**2 - (R_ * jnp.sin(theta))**2)
 
 
 def joint_angles(theta):
-    """Tree coordinates (crank angle, rod angle relative to the crank, slider position) of the
-    closed mechanism at crank angle theta, in closed form."""
+    """The tree coordinates of the closed mechanism at crank angle theta, in closed form.
+
+    Args:
+        theta: the crank angle [rad], a scalar.
+
+    Returns:
+        (crank angle [rad], rod angle relative to the crank [rad], slider position [m]),
+        shape (3,).
+    """
     x = slider_position(theta)
     phi = jnp.arctan2(-R_ * jnp.sin(theta), x - R_ * jnp.cos(theta))   # rod's absolute angle
     return jnp.array([theta, phi - theta, x])
 
 
 def build(rate=RATE, theta0=THETA0, driven: bool = True):
-    """(system, q0, v0): the slider-crank (a `ClosedSystem`, coupled multipliers) at crank angle theta0 turning at `rate`, the crank
-    driven at that constant speed (`driven=True`, a `Prescribed` motion appended after the cut
-    joint) or free with that initial speed."""
+    """The scene: the slider-crank at crank angle theta0 turning at `rate`.
+
+    A `ClosedSystem` with coupled multipliers. Driven, the prescribed row's multiplier is the
+    motor torque on the crank (`ClosedSystem.loads(...)[-1]`).
+
+    Args:
+        rate: the crank speed [rad/s]: constant when driven, initial when free.
+        theta0: the initial crank angle [rad].
+        driven: drive the crank at constant speed (a `Prescribed` motion appended after the
+            cut joint) or leave it free.
+
+    Returns:
+        system: the `ClosedSystem`.
+        q0: the tree configuration on the loop, shape (3,).
+        v0: the tree velocity on the loop, shape (3,).
+    """
     theta0 = jnp.asarray(theta0, float)
     closures = [CutJoint("point_on_line", 1, 2, origin_a=(L_, 0.0, 0.0))]
     if driven:

@@ -20,7 +20,20 @@ DURATION = 6.0
 
 
 def build(rotation: AbstractRotation = Quaternion()):
-    """(body, q0, u0) of the scene, starting at R0 = I."""
+    """The scene: the torque-free symmetric body, starting at R0 = I with the angular velocity OMEGA0.
+
+    Args:
+        rotation: how the attitude is written in q, `mbjax.lie.Quaternion()` or
+            `mbjax.lie.RotationVector()`.
+
+    Returns:
+        body: the `mbjax.rigid.RigidBody` (rotation only, about its centre of mass).
+        q0: the initial attitude coordinates, shape (4,) or (3,).
+        u0: the initial body angular velocity [rad/s], shape (3,).
+
+    Raises:
+        TypeError: rotation is not a rotation strategy instance.
+    """
     body = RigidBody(1.0, np.diag([J_TRANSVERSE, J_TRANSVERSE, J_AXIAL]),
                      gravity=(0.0, 0.0, 0.0), fixed_point=True, rotation=rotation)
     q0, u0 = body.initial_state(np.eye(3), np.array(OMEGA0))
@@ -28,21 +41,54 @@ def build(rotation: AbstractRotation = Quaternion()):
 
 
 def exact_rotation(t):
-    """R(t) in closed form (Borri 1990 eqs 8.7-8.8)."""
+    """The exact rotation R(t) in closed form (Borri 1990 eqs 8.7-8.8).
+
+    Args:
+        t: time [s], a scalar.
+
+    Returns:
+        R(t), body to space, shape (3, 3).
+    """
     return torque_free_motion(J_AXIAL, J_TRANSVERSE, jnp.eye(3), jnp.array(OMEGA0), t)[0]
 
 
 def rotation_error_matrix(R, t):
-    """Angle in radians between a computed rotation R and the exact one (Borri 1990 Fig. 1's
-    error)."""
+    """The angle between a computed rotation and the exact one (Borri 1990 Fig. 1's error).
+
+    Args:
+        R: the computed rotation, shape (3, 3).
+        t: its time [s], a scalar.
+
+    Returns:
+        The angle [rad], a scalar.
+    """
     return jnp.linalg.norm(lie.log(R @ exact_rotation(t).T, check=False))
 
 
 def rotation_error(body: RigidBody, q, t):
-    """`rotation_error_matrix` of a state q of `body`."""
+    """The rotation error (`rotation_error_matrix`) of a state of the scene's body.
+
+    Args:
+        body: the body from `build`.
+        q: its configuration, shape (4,) or (3,).
+        t: the state's time [s], a scalar.
+
+    Returns:
+        The angle [rad], a scalar.
+    """
     return rotation_error_matrix(body.rotation_matrix(q), t)
 
 
 @jax.jit
 def rotation_errors(body: RigidBody, qs, ts):
+    """The rotation error along a trajectory.
+
+    Args:
+        body: the body from `build`.
+        qs: configurations, shape (T, 4) or (T, 3).
+        ts: their times [s], shape (T,).
+
+    Returns:
+        The angles [rad], shape (T,).
+    """
     return jax.vmap(lambda q, t: rotation_error(body, q, t))(qs, ts)

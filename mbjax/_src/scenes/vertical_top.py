@@ -24,19 +24,41 @@ CRITICAL_SPIN = 2.0 * J_TRANSVERSE * OMEGA / J_AXIAL
 
 
 def rigid_body(rotation: AbstractRotation = Quaternion()) -> RigidBody:
-    """The top as a `RigidBody` about its suspension point, centre of mass d above it."""
+    """The top as a `RigidBody` about its suspension point, centre of mass D above it.
+
+    Args:
+        rotation: how the attitude is written in q, `mbjax.lie.Quaternion()` or
+            `mbjax.lie.RotationVector()`.
+
+    Returns:
+        The `mbjax.rigid.RigidBody`.
+    """
     return RigidBody(MASS, jnp.diag(jnp.array([J_TRANSVERSE, J_TRANSVERSE, J_AXIAL])),
                      com=(0.0, 0.0, D), gravity=(0.0, 0.0, -GRAVITY), fixed_point=True,
                      rotation=rotation)
 
 
 def build() -> Body:
-    """The top as a `tfe.Body`."""
+    """The scene: the top as a `mbjax.tfe.Body` about its suspension point.
+
+    Returns:
+        The `Body` (fixed point, 3 dof).
+    """
     return Body.from_rigid(rigid_body())
 
 
 def exact_boundaries(dt):
-    """Spin rates at which the discriminant D of eq 7.10 vanishes for the two-node primal element:
-    (exact integration, reduced integration, physical)."""
+    """The stability boundaries of the two-node primal element (Borri 1990 eq 7.10).
+
+    The spin rates at which the discriminant D of eq 7.10 vanishes.
+
+    Args:
+        dt: the node spacing [s].
+
+    Returns:
+        exact: the boundary with exact integration [rad/s].
+        reduced: with reduced integration (the physical one) [rad/s].
+        physical: the critical spin CRITICAL_SPIN [rad/s].
+    """
     exact = CRITICAL_SPIN * jnp.sqrt(1.0 + (OMEGA * jnp.asarray(dt)) ** 2 / 12.0)
     return exact, jnp.full_like(exact, CRITICAL_SPIN), CRITICAL_SPIN

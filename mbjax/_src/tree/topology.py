@@ -15,7 +15,20 @@ from mbjax._src import runtime
 
 
 class Topology:
-    """Static, hashable description of a tree: `Topology(parents)` with parents[k] < k or -1."""
+    """The static, hashable topology of a tree of n bodies (Anderson 1993 §2.1; Jerkovsky 1978).
+
+    From the parent array follow the ancestor, distal and descendant sets of Anderson 1993
+    eqs 2-4, Jerkovsky 1978's path matrix pi (eq 1) and reference matrix rho (eq 2), and the
+    depth levels the tree passes are scheduled on. A `Model` holds one as its `topology`.
+
+    Args:
+        parents: each body's parent, shape (n,): parents[k] < k (every body numbered higher than
+            its parent, Anderson 1993 §2.1 rule (i)), or -1 for a base body.
+
+    Raises:
+        ValueError: parents is empty, not integers, out of range, or a body is numbered before
+            its parent (which also rules out cycles).
+    """
 
     def __init__(self, parents):
         raw = np.asarray(parents)
@@ -49,12 +62,20 @@ class Topology:
 
     @property
     def n(self) -> int:
+        """The number of bodies."""
         return len(self.parents)
 
     # -- the sets of Anderson 1993 eqs 2-4 ---------------------------------------------------------
 
     def ancestors(self, k: int) -> tuple[int, ...]:
-        """An[k] (eq 2): the bodies between body k and the ground, nearest first, k excluded."""
+        """An[k] (eq 2): the bodies between body k and the ground, nearest first, k excluded.
+
+        Args:
+            k: a body index.
+
+        Returns:
+            The ancestors' indices.
+        """
         out, p = [], self.parents[k]
         while p >= 0:
             out.append(p)
@@ -62,18 +83,38 @@ class Topology:
         return tuple(out)
 
     def distal(self, k: int) -> tuple[int, ...]:
-        """Dist[k] (eq 3): the bodies whose proximal body is k."""
+        """Dist[k] (eq 3): the bodies whose proximal body is k.
+
+        Args:
+            k: a body index.
+
+        Returns:
+            The children's indices, increasing.
+        """
         return tuple(j for j, p in enumerate(self.parents) if p == k)
 
     def descendants(self, k: int) -> tuple[int, ...]:
-        """Des[k] (eq 4): every body outboard of k, k excluded, in increasing order."""
+        """Des[k] (eq 4): every body outboard of k, k excluded, in increasing order.
+
+        Args:
+            k: a body index.
+
+        Returns:
+            The descendants' indices.
+        """
         return tuple(int(j) for j in np.flatnonzero(self.path_matrix()[:, k]) if j != k)
 
     # -- Jerkovsky 1978 eqs 1-3 ----------------------------------------------------------------------
 
     def path_matrix(self) -> np.ndarray:
-        """pi (Jerkovsky 1978 eq 1): pi[i, j] = 1 if body j lies on the path from the ground to body i
-        (j = i included). Row i is the inward set i^, column j the outward set j-bar."""
+        """The path matrix pi (Jerkovsky 1978 eq 1).
+
+        pi[i, j] = 1 if body j lies on the path from the ground to body i (j = i included). Row
+        i is the inward set i^, column j the outward set j-bar.
+
+        Returns:
+            pi, a NumPy int array of shape (n, n).
+        """
         pi = np.zeros((self.n, self.n), dtype=np.int64)
         for i, p in enumerate(self.parents):
             if p >= 0:
@@ -82,7 +123,12 @@ class Topology:
         return pi
 
     def reference_matrix(self) -> np.ndarray:
-        """rho (Jerkovsky 1978 eq 2): 1 on the diagonal and -1 at (i, parent of i); rho @ pi = I (eq 3)."""
+        """The reference matrix rho (Jerkovsky 1978 eq 2), with rho @ pi = I (eq 3).
+
+        Returns:
+            rho, 1 on the diagonal and -1 at (i, parent of i), a NumPy int array of shape
+            (n, n).
+        """
         rho = np.eye(self.n, dtype=np.int64)
         for i, p in enumerate(self.parents):
             if p >= 0:
@@ -129,11 +175,13 @@ class Topology:
 
 def levels_pay() -> bool:
     """Whether level steps beat one body per step: only where XLA runs each operation of a loop
-    body as a kernel of its own. Where it compiles a loop as one kernel (`mbjax._src.runtime`'s
-    default), a level step's scatters keep its loop out of that, and one body per step wins on
-    every tree measured (forward dynamics in a jitted rollout, us per evaluation, levels against
-    one by one: the G1 humanoid, 30 bodies in 11 levels, 30.8 against 10.6; stars of 10, 40, 100
-    and 300 bodies 7.6, 18.9, 39.0, 106 against 2.6, 10.1, 24.8, 74; a binary tree of 31 bodies
-    7.9 against 7.7). With kernels one by one (MBJAX_XLA_DEFAULTS=0), levels win on bushy trees:
-    the G1 31 against 47 us."""
+    body as a kernel of its own.
+
+    Where XLA compiles a loop as one kernel (`mbjax._src.runtime`'s default), a level step's
+    scatters keep its loop out of that, so one body per step is faster; with kernels one by one
+    (MBJAX_XLA_DEFAULTS=0), levels win on bushy trees. See benchmarks/README.md.
+
+    Returns:
+        True where level-by-level schedules pay (XLA's loop hoisting is off).
+    """
     return not runtime.HOISTING
