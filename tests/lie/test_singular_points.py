@@ -7,7 +7,7 @@ import jax.numpy as jnp
 import numpy as np
 import pytest
 
-from mbjax import lie
+from mbjax._src import lie
 
 X, Y, Z = np.eye(3)
 # exact half turns (entries 0 and +-1), the identity, and exact quaternions

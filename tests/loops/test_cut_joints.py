@@ -7,7 +7,7 @@ import numpy as np
 
 from mbjax import simulate
 from mbjax.integrate import RK4
-from mbjax.lie import quat_from_rotvec
+from mbjax._src.lie.quaternion import quat_from_rotvec
 from mbjax.loops import ClosedSystem, CutJoint, consistent_state
 from mbjax.model import Model
 from mbjax.rigid import TreeSystem

@@ -27,7 +27,7 @@ class ZeroOrderHold(AbstractControl):
         values: the samples, shape (K, m) (a 1-D history of K samples is taken as (K, 1)); a
             history of wrenches for `external=` is (K, n_bodies, 6).
         dt: the sample interval [s], positive (normally the simulation's step).
-        t0: the time of values[0] [s].
+        t0: the time [s] of the first sample, values[0].
 
     Raises:
         ValueError: values is empty or dt is not positive.

@@ -127,6 +127,19 @@ def flexible_aba_responses(model: FlexibleModel, q: Array, v: Array, tau: Array,
 
 def flexible_aba(model: FlexibleModel, q: Array, v: Array, tau: Array,
                  f_ext: Array | None = None) -> Array:
-    """v_dot (nv,) of the flexible tree at (q, v) under generalized forces tau (joint forces, then
-    modal forces), gravity and external wrenches f_ext: Anderson 1993's O(n) recursion."""
+    """Forward dynamics of a flexible tree by Anderson 1993's O(n) recursion (§2.3, eqs 48-86).
+
+    Args:
+        model: the flexible tree.
+        q: configuration (joint, then modal coordinates), shape (nq,).
+        v: generalized velocity (joint rates, then modal rates), shape (nv,).
+        tau: generalized forces (joint forces [N m or N], then modal forces), shape (nv,).
+        f_ext: external wrenches, one per body, world frame (torque about the body's frame
+            origin [N m]; force [N]), shape (n, 6), acting on the body's reference frame (its
+            joint grid); or None.
+
+    Returns:
+        v_dot under tau, gravity, velocity terms, elasticity (with geometric stiffening) and
+        f_ext, shape (nv,).
+    """
     return flexible_aba_responses(model, q, v, tau, jnp.zeros((0, model.nv), q.dtype), f_ext)[0]

@@ -26,7 +26,7 @@ Dynamics with prescribed coordinates (`simulate`): coordinates split into free f
 the slope's direction but not its length). No damping. Time stepping is classical RK4 in one
 jitted `lax.scan`, the step set by the highest frequency of the linearised system (`stable_step`,
 the axial modes: omega_max ~ 49 n sqrt(EA / rhoA) / L). The cost grows as n^2 (steps ~ n, work per
-step ~ n): the 20 s spin-up takes ~30 s at 4 elements, ~90 s at 8 on a shared 2-core CPU.
+step ~ n); run times of the spin-up reference are in benchmarks/README.md.
 """
 
 from collections.abc import Callable
@@ -53,8 +53,22 @@ def _hermite(xi, l):  # noqa: E741 (the element length, as in the ANCF papers)
 
 class AncfBeam(eqx.Module):
     """Uniform planar ANCF beam of `n_elements` equal elements (Berzeri & Shabana 2000; Gerstmayr
-    & Irschik 2008). Coordinates e: (4 * (n_elements + 1),), node n at e[4n : 4n + 4] =
-    (x, y, dx/ds, dy/ds). Material parameters are array leaves (differentiable)."""
+    & Irschik 2008), the geometrically exact reference of the module docstring.
+
+    Coordinates e: shape (4 * (n_elements + 1),), node n at e[4n : 4n + 4] =
+    (x, y, dx/ds, dy/ds). Material parameters are array leaves (differentiable).
+
+    Args:
+        length: length [m].
+        EA: axial stiffness [N].
+        EI: bending stiffness [N m^2].
+        rhoA: mass per length [kg/m].
+        n_elements: number of equal elements, >= 1; static.
+        n_gauss: Gauss points per element, >= 3; static.
+
+    Raises:
+        ValueError: n_elements < 1 or n_gauss < 3.
+    """
 
     length: Array
     EA: Array
@@ -71,10 +85,12 @@ class AncfBeam(eqx.Module):
 
     @property
     def n_coordinates(self) -> int:
+        """Number of coordinates, 4 per node."""
         return 4 * (self.n_elements + 1)
 
     @property
     def element_length(self) -> Array:
+        """Element length [m]."""
         return self.length / self.n_elements
 
     @property
@@ -88,7 +104,15 @@ class AncfBeam(eqx.Module):
 
     @eqx.filter_jit
     def initial_coordinates(self, origin=(0.0, 0.0), angle=0.0) -> Array:
-        """Straight, unstrained beam from `origin` along direction `angle` (rad)."""
+        """Coordinates of the straight, unstrained beam.
+
+        Args:
+            origin: position of node 0 [m], shape (2,).
+            angle: direction of the beam from the x axis [rad].
+
+        Returns:
+            e, shape (n_coordinates,).
+        """
         t = jnp.stack([jnp.cos(angle), jnp.sin(angle)])
         s = jnp.linspace(0.0, 1.0, self.n_elements + 1)[:, None] * self.length
         r = jnp.asarray(origin, float) + s * t
@@ -100,18 +124,20 @@ class AncfBeam(eqx.Module):
         return _hermite(s / self.element_length - k, self.element_length), ek
 
     def position(self, e, s) -> Array:
-        """r(s) = S(s) e at arc length s in [0, length] (reference configuration)."""
+        """r(s) = S(s) e: the position [m], shape (2,), of the point at arc length s in
+        [0, length] of the reference configuration, for coordinates e (n_coordinates,)."""
         (h, _, _), ek = self._interp(e, s)
         return h @ ek
 
     def slope(self, e, s) -> Array:
-        """r'(s) = dr/ds at arc length s."""
+        """r'(s) = dr/ds at arc length s, shape (2,), for coordinates e (n_coordinates,)."""
         (_, h_s, _), ek = self._interp(e, s)
         return h_s @ ek
 
     @eqx.filter_jit
     def mass_matrix(self) -> Array:
-        """Consistent mass M = sum_k int rhoA S^T S ds, scatter-added over elements (constant)."""
+        """Consistent mass M = sum_k int rhoA S^T S ds, scatter-added over elements (constant),
+        shape (n_coordinates, n_coordinates)."""
         xi, w = self._gauss()
         h, _, _ = _hermite(xi, self.element_length)
         Me = self.rhoA * self.element_length * jnp.kron(jnp.einsum("g,gi,gj->ij", w, h, h), jnp.eye(2))
@@ -129,21 +155,30 @@ class AncfBeam(eqx.Module):
         return n - 1, (rp[..., 0] * rpp[..., 1] - rp[..., 1] * rpp[..., 0]) / n**3
 
     def elastic_energy(self, e) -> Array:
-        """U(e) = 1/2 int (EA eps^2 + EI kappa^2) ds by Gauss quadrature (Gerstmayr & Irschik)."""
+        """U(e) = 1/2 int (EA eps^2 + EI kappa^2) ds by Gauss quadrature (Gerstmayr & Irschik),
+        a scalar [J], for coordinates e (n_coordinates,)."""
         _, w = self._gauss()
         eps, kappa = self.strains(e)
         return 0.5 * self.element_length * jnp.sum(w * (self.EA * eps**2 + self.EI * kappa**2))
 
     def elastic_force(self, e) -> Array:
-        """Q_e = -dU/de."""
+        """Q_e = -dU/de, shape (n_coordinates,)."""
         return -jax.grad(self.elastic_energy)(e)
 
     def kinetic_energy(self, e_dot) -> Array:
+        """T = e_dot^T M e_dot / 2 [J], a scalar."""
         return 0.5 * e_dot @ self.mass_matrix() @ e_dot
 
     def gravity_force(self, g) -> Array:
         """Q_g = int rhoA S^T g ds = M e_g with e_g the coordinates of the uniform field r(s) = g
-        (positions g, slopes 0), which the Hermite interpolation reproduces exactly."""
+        (positions g, slopes 0), which the Hermite interpolation reproduces exactly.
+
+        Args:
+            g: gravitational acceleration [m/s^2], shape (2,).
+
+        Returns:
+            Q_g, shape (n_coordinates,).
+        """
         eg = jnp.tile(jnp.concatenate([jnp.asarray(g, float), jnp.zeros(2)]), self.n_elements + 1)
         return self.mass_matrix() @ eg
 
@@ -260,10 +295,34 @@ def simulate_embedded(beam: AncfBeam, embed: Callable, q0, q_dot0, ts, *, dt: fl
 
 def simulate_ancf(beam: AncfBeam, e0, e_dot0, ts, *, prescribed=(), e_p: Callable | None = None,
              **kwargs) -> AncfSolution:
-    """M_ff e_f'' = -dU/de_f - M_fp e_p''(t) + Q_f from (e0, e_dot0) at ts[0]: `prescribed` static
-    global indices whose values the user's `e_p(t)` gives (positions only; velocities and
-    accelerations by jax.jvp), the rest free. The prescribed entries of e0, e_dot0 are ignored.
-    Keyword arguments (dt, safety, gravity, force, throw) as in `simulate_embedded`."""
+    """Simulate an ANCF beam with some coordinates prescribed: M_ff e_f'' = -dU/de_f -
+    M_fp e_p''(t) + Q_f from (e0, e_dot0) at ts[0].
+
+    Classical RK4 in one jitted `lax.scan` (see the module docstring); each interval of ts is
+    split into equal steps no longer than dt.
+
+    Args:
+        beam: the beam.
+        e0: initial coordinates, shape (n_coordinates,) (prescribed entries ignored).
+        e_dot0: initial rates, shape (n_coordinates,) (prescribed entries ignored).
+        ts: save times [s], concrete and increasing, shape (n_saves,); the run starts at ts[0].
+        prescribed: static global indices of the prescribed coordinates.
+        e_p: a differentiable callable t -> the prescribed coordinates' values, shape
+            (len(prescribed),) (positions only; velocities and accelerations by jax.jvp);
+            required when `prescribed` is not empty.
+        **kwargs: dt (the largest step [s], default `stable_step` at ts[0]), safety (the
+            factor on RK4's stability limit, 0.5), gravity (shape (2,) [m/s^2]), force (a
+            callable (t, e, e_dot) -> generalized forces, shape (n_coordinates,)) and throw, as
+            in `simulate_embedded`.
+
+    Returns:
+        An `AncfSolution`: ts, e and e_dot at the save times (shape (n_saves, n_coordinates)),
+        `status` (NONFINITE where the run blew up) and the step dt used.
+
+    Raises:
+        ValueError: prescribed indices repeated or outside the beam, or prescribed coordinates
+            without e_p; with throw=True, a failed run.
+    """
     f, p = _split(beam.n_coordinates, prescribed)
     if len(p) and e_p is None:
         raise ValueError("prescribed coordinates need e_p(t)")

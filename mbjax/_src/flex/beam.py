@@ -54,7 +54,26 @@ def _check_positive(name, value):
 class Beam(eqx.Module):
     """Uniform straight beam along the body x axis, n_elements equal 2-node, 12-dof elements.
 
-    Array fields are differentiable leaves (float64); `n_elements` and `timoshenko` are static.
+    The structural model M x_dd + K x = 0 of Anderson 1993 eq (9) (`matrices`), with the dof
+    conventions of the module docstring. Array fields are differentiable leaves (float64);
+    `n_elements` and `timoshenko` are static. `Beam.round` and `Beam.rectangle` build solid
+    sections.
+
+    Args:
+        L: length [m].
+        E: Young's modulus [Pa].
+        G: shear modulus [Pa].
+        rho: density [kg/m^3].
+        A: cross-section area [m^2].
+        Iy: second moment of area about the section's y axis [m^4] (bending in the xz plane).
+        Iz: second moment of area about the section's z axis [m^4] (bending in the xy plane).
+        J: torsion constant [m^4].
+        n_elements: number of equal elements, an integer >= 1; static.
+        timoshenko: shear-deformable (Timoshenko) elements instead of Euler-Bernoulli; static.
+        kappa: shear correction factor (used with `timoshenko`).
+
+    Raises:
+        ValueError: a parameter that is not positive and finite, or a bad n_elements.
     """
 
     L: jax.Array
@@ -80,9 +99,26 @@ class Beam(eqx.Module):
 
     @classmethod
     def round(cls, L, diameter, E, rho, nu=None, G=None, n_elements=10, *, timoshenko=False, kappa=5.0 / 6.0):
-        """Solid circular section: A = pi d^2/4, Iy = Iz = pi d^4/64, J = pi d^4/32. Give exactly one of
-        Poisson's ratio `nu` (G = E / (2 (1 + nu))) or the shear modulus `G`. kappa defaults to 5/6
-        (Cowper's 6 (1 + nu) / (7 + 6 nu) = 0.886 at nu = 0.3 may be passed instead)."""
+        """A beam of solid circular section: A = pi d^2/4, Iy = Iz = pi d^4/64, J = pi d^4/32.
+
+        Args:
+            L: length [m].
+            diameter: section diameter d [m].
+            E: Young's modulus [Pa].
+            rho: density [kg/m^3].
+            nu: Poisson's ratio, giving G = E / (2 (1 + nu)); give exactly one of nu and G.
+            G: shear modulus [Pa].
+            n_elements: number of equal elements.
+            timoshenko: shear-deformable elements.
+            kappa: shear correction factor, 5/6 by default (Cowper's 6 (1 + nu) / (7 + 6 nu) =
+                0.886 at nu = 0.3 may be passed instead).
+
+        Returns:
+            The `Beam`.
+
+        Raises:
+            ValueError: both or neither of nu and G, or a parameter that is not positive.
+        """
         if (nu is None) == (G is None):
             raise ValueError("Beam.round: give exactly one of nu or G")
         _check_positive("diameter", diameter)
@@ -95,8 +131,27 @@ class Beam(eqx.Module):
     @classmethod
     def rectangle(cls, L, width, height, E, rho, nu=None, G=None, n_elements=10, *, timoshenko=False,
                   kappa=5.0 / 6.0):
-        """Solid rectangle, `width` along y and `height` along z: Iy = w h^3/12, Iz = h w^3/12, and
-        Saint-Venant's J ~ a b^3 (1/3 - 0.21 (b/a) (1 - b^4 / (12 a^4))) with a >= b the sides."""
+        """A beam of solid rectangular section: Iy = w h^3/12, Iz = h w^3/12, and Saint-Venant's
+        J ~ a b^3 (1/3 - 0.21 (b/a) (1 - b^4 / (12 a^4))) with a >= b the sides.
+
+        Args:
+            L: length [m].
+            width: section width w along y [m].
+            height: section height h along z [m].
+            E: Young's modulus [Pa].
+            rho: density [kg/m^3].
+            nu: Poisson's ratio, giving G = E / (2 (1 + nu)); give exactly one of nu and G.
+            G: shear modulus [Pa].
+            n_elements: number of equal elements.
+            timoshenko: shear-deformable elements.
+            kappa: shear correction factor, 5/6 by default.
+
+        Returns:
+            The `Beam`.
+
+        Raises:
+            ValueError: both or neither of nu and G, or a parameter that is not positive.
+        """
         if (nu is None) == (G is None):
             raise ValueError("Beam.rectangle: give exactly one of nu or G")
         _check_positive("width", width)
@@ -110,14 +165,17 @@ class Beam(eqx.Module):
 
     @property
     def n_nodes(self) -> int:
+        """Number of nodes, n_elements + 1 (node 0 at the body-frame origin)."""
         return self.n_elements + 1
 
     @property
     def n_dofs(self) -> int:
+        """Number of dofs, 6 per node."""
         return 6 * self.n_nodes
 
     @property
     def Le(self):
+        """Element length [m]."""
         return self.L / self.n_elements
 
     @property
@@ -137,7 +195,11 @@ class Beam(eqx.Module):
         return 6 * np.arange(self.n_elements)[:, None] + np.arange(12)[None, :]
 
     def matrices(self):
-        """Assembled consistent mass and stiffness (M, K), each (6N, 6N), Anderson 1993 eq (9)."""
+        """Assembled consistent mass and stiffness of the free beam, Anderson 1993 eq (9).
+
+        Returns:
+            (M, K), each shape (6N, 6N) for N = n_nodes, dofs ordered as the module says.
+        """
         return _matrices(self)
 
 
@@ -270,9 +332,20 @@ def axial_forces(beam: Beam, u):
 
 
 def free_dofs(beam: Beam, clamped_nodes=(0,), planar=None) -> np.ndarray:
-    """Sorted global indices of the unconstrained dofs (static numpy): all dofs of `clamped_nodes`
-    are held; `planar="xy"` keeps only ux, uy, rz (axial + in-plane bending), `"xz"` keeps ux, uz, ry,
-    None keeps all six per node."""
+    """Sorted global indices of the unconstrained dofs (static numpy).
+
+    Args:
+        beam: the beam.
+        clamped_nodes: nodes whose six dofs are all held.
+        planar: "xy" keeps only ux, uy, rz (axial + in-plane bending), "xz" keeps ux, uz, ry,
+            None keeps all six per node.
+
+    Returns:
+        The free dof indices, a NumPy int array.
+
+    Raises:
+        ValueError: an unknown `planar` or a clamped node outside the beam.
+    """
     if planar not in _PLANAR:
         raise ValueError(f"free_dofs: planar must be None, 'xy' or 'xz', got {planar!r}")
     clamped = np.atleast_1d(np.asarray(clamped_nodes, dtype=int))

@@ -61,34 +61,69 @@ class ModalBody(eqx.Module):
     docstring), its modal stiffness and damping, the geometric-stiffening matrices, and the modal
     shapes at the grid points where other bodies or cut joints attach.
 
-    Build it with `ModalBody.from_points` (a `mbjax._src.flex.points.MassPoints` cloud and the reduced
-    stiffness) or `ModalBody.rigid` (mu = 0 padded: a rigid body in the same form).
+    Build it with `mbjax.flex.beam_body` (from a beam and its modal basis),
+    `ModalBody.from_points` (a `mbjax._src.flex.points.MassPoints` cloud and the reduced
+    stiffness) or `ModalBody.rigid` (a rigid body in the same form); the constructor takes the
+    fields below directly. Body-frame components throughout, the frame at the joint grid J^k.
+
+    Args:
+        mass: total mass m [kg], a scalar.
+        first: first mass moments S = sum_p m_p A_p, shape (3, 1 + mu).
+        second: second mass moments P = sum_p m_p A_p (x) A_p, shape (3, 1 + mu, 3, 1 + mu).
+        rotary: the points' summed rotary inertia I_0 [kg m^2], shape (3, 3).
+        rotary_psi: I_psi = sum_p I_p psi_p, shape (3, mu).
+        modal_mass: M_ff, shape (mu, mu).
+        stiffness: reduced modal stiffness K, shape (mu, mu).
+        damping: modal damping D, shape (mu, mu).
+        inertial_stiffening: eq 33's K_hat_Gq, one per temporal scalar of Table 1, shape
+            (21, mu, mu) (zero: stiffening off).
+        node_position: undeformed positions of the H attachment grid points [m], shape (H, 3).
+        node_phi: their translational shapes, shape (H, 3, mu).
+        node_psi: their rotational shapes, shape (H, 3, mu).
+        distal_stiffening: eq 33's K_check_Gh for loads at each attachment point, shape
+            (H, 6, mu, mu).
     """
 
-    mass: Array                 # ()
-    first: Array                # (3, 1 + mu)
-    second: Array               # (3, 1 + mu, 3, 1 + mu)
-    rotary: Array               # (3, 3)
-    rotary_psi: Array           # (3, mu)
-    modal_mass: Array           # (mu, mu)
-    stiffness: Array            # (mu, mu)
-    damping: Array              # (mu, mu)
-    inertial_stiffening: Array  # (21, mu, mu), eq 33's K_hat_Gq (zero: stiffening off)
-    node_position: Array        # (H, 3) undeformed positions of the attachment grid points
-    node_phi: Array             # (H, 3, mu) their translational shapes
-    node_psi: Array             # (H, 3, mu) their rotational shapes
-    distal_stiffening: Array    # (H, 6, mu, mu), eq 33's K_check_Gh for loads at each point
+    mass: Array
+    first: Array
+    second: Array
+    rotary: Array
+    rotary_psi: Array
+    modal_mass: Array
+    stiffness: Array
+    damping: Array
+    inertial_stiffening: Array
+    node_position: Array
+    node_phi: Array
+    node_psi: Array
+    distal_stiffening: Array
 
     @property
     def mu(self) -> int:
+        """Number of modal coordinates."""
         return self.modal_mass.shape[-1]
 
     @staticmethod
     def from_points(points, stiffness, *, damping=None, inertial_stiffening=None, nodes=None,
                     distal_stiffening=None) -> "ModalBody":
-        """Coefficients from a mass-point cloud (`mass` (P,), `position` (P, 3), `phi`, `psi`
-        (P, 3, mu), `inertia` (P, 3, 3)) and the reduced stiffness (mu, mu). `nodes` is an
-        optional (position (H, 3), phi (H, 3, mu), psi (H, 3, mu)) of attachment grid points."""
+        """The body's coefficients from a mass-point cloud (the sums of the module docstring).
+
+        Args:
+            points: the cloud, with `mass` (P,), `position` (P, 3), `phi`, `psi` (P, 3, mu)
+                and `inertia` (P, 3, 3) (a `MassPoints`).
+            stiffness: reduced modal stiffness, shape (mu, mu).
+            damping: modal damping, shape (mu, mu); None: zero.
+            inertial_stiffening: shape (21, mu, mu); None: zero (no stiffening).
+            nodes: attachment grid points (position (H, 3), phi (H, 3, mu), psi (H, 3, mu));
+                None: none.
+            distal_stiffening: shape (H, 6, mu, mu); None: zero.
+
+        Returns:
+            The `ModalBody`.
+
+        Raises:
+            ValueError: stiffness not of shape (mu, mu).
+        """
         m, rho, phi, psi, inertia = (jnp.asarray(points.mass, float), points.position,
                                      points.phi, points.psi, points.inertia)
         mu = phi.shape[-1]
@@ -118,9 +153,18 @@ class ModalBody(eqx.Module):
 
     @staticmethod
     def rigid(mass, com, inertia, mu: int) -> "ModalBody":
-        """A rigid body (mass, centre of mass in the body frame, inertia about the centre of mass)
-        in the same form, padded to mu modal columns that stay decoupled and at rest (unit modal
-        mass, no shapes, no stiffness)."""
+        """A rigid body in the same form, padded to mu modal columns that stay decoupled and at
+        rest (unit modal mass, no shapes, no stiffness).
+
+        Args:
+            mass: mass [kg].
+            com: centre of mass in the body frame [m], shape (3,).
+            inertia: inertia about the centre of mass [kg m^2], shape (3, 3).
+            mu: number of (idle) modal columns.
+
+        Returns:
+            The `ModalBody`, with no attachment points.
+        """
         mass, com = jnp.asarray(mass, float), jnp.asarray(com, float)
         first = jnp.zeros((3, 1 + mu)).at[:, 0].set(mass * com)
         second = jnp.zeros((3, 1 + mu, 3, 1 + mu)).at[:, 0, :, 0].set(mass * jnp.outer(com, com))

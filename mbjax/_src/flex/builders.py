@@ -20,9 +20,26 @@ from mbjax._src.flex.stiffening import distal_stiffening, inertial_stiffening
 @eqx.filter_jit
 def beam_body(beam: Beam, basis: ModalBasis, nodes=(), *, clamped_node: int = 0,
               stiffening: bool = True, damping=None) -> ModalBody:
-    """The modal body of `beam` in `basis` (clamped at `clamped_node`, the joint grid J^k), with
-    attachment points at the grid nodes `nodes` (for child bodies, cut joints and markers: index
-    i of `nodes` is attachment point i). stiffening=False leaves the geometric stiffness out."""
+    """The modal body of `beam` in `basis`, ready for a `FlexibleModel`.
+
+    Chains the structural side (see the module docstring): the reduced stiffness, the
+    mass-point cloud, the geometric-stiffening matrices (Anderson 1993 eq 33, Table 1) and the
+    shapes at the attachment points.
+
+    Args:
+        beam: the beam.
+        basis: its modal basis (e.g. `craig_bampton(beam, ...)`), clamped at `clamped_node`.
+        nodes: beam nodes where child bodies, cut joints and markers attach: index i of
+            `nodes` is attachment point i (what `FlexibleModel`'s `attach` and `markers`
+            refer to).
+        clamped_node: the node at the body frame's origin, the joint grid J^k.
+        stiffening: include geometric stiffening; False leaves it out (the prematurely
+            linearized model).
+        damping: modal damping, shape (mu, mu); None: none.
+
+    Returns:
+        The `ModalBody`.
+    """
     nodes = tuple(int(h) for h in nodes)
     _, K_r = reduced(beam, basis)
     index = np.asarray(nodes, dtype=int)

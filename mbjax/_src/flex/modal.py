@@ -31,10 +31,15 @@ __all__ = ["ModalBasis", "craig_bampton", "reduced"]
 
 
 class ModalBasis(eqx.Module):
-    """Modal shapes phi (6N, mu) in full beam dofs (zero on held dofs), Anderson 1993 eq (10).
+    """Modal shapes of a beam, x = phi q (Anderson 1993 eq (10)); built by `craig_bampton`.
 
-    `frequencies` (mu,) in rad/s; `kinds` (static) is "normal", "constraint", "static" or "reduced"
-    per column (see the module docstring)."""
+    Args:
+        shapes: phi in full beam dofs (zero on held dofs), shape (6N, mu).
+        frequencies: angular frequency of each column [rad/s], shape (mu,) (nan for constraint
+            and static columns that were not orthonormalized).
+        kinds: per column "normal", "constraint", "static" or "reduced" (see the module
+            docstring); static.
+    """
 
     shapes: jax.Array
     frequencies: jax.Array
@@ -42,6 +47,7 @@ class ModalBasis(eqx.Module):
 
     @property
     def mu(self) -> int:
+        """Number of modal coordinates (columns)."""
         return self.shapes.shape[1]
 
 
@@ -62,9 +68,31 @@ def craig_bampton(beam: Beam, *, clamped_node=0, interface_nodes=(), n_modes=Non
                   static_load_nodes=(), planar=None, orthonormalize=True) -> ModalBasis:
     """Craig-Bampton basis of `beam` clamped at `clamped_node` (Anderson 1993 sec. 2.2, eq (10)).
 
-    Exactly one of `n_modes` (count of fixed-interface normal modes, 0 allowed) or `cutoff` (keep
-    modes with omega <= cutoff, rad/s; needs concrete beam parameters, so use `n_modes` under
-    jit/grad) selects the normal modes. `planar` restricts the dofs as in `free_dofs`."""
+    The columns are the fixed-interface normal modes, then the constraint modes of the
+    interface nodes, then the static-correction modes of `static_load_nodes` (see the module
+    docstring).
+
+    Args:
+        beam: the beam.
+        clamped_node: the node held as the body frame's joint grid J^k.
+        interface_nodes: nodes whose dofs get constraint modes (where other bodies or cut
+            joints attach).
+        n_modes: number of fixed-interface normal modes (0 allowed); give exactly one of
+            n_modes and cutoff.
+        cutoff: keep the normal modes with angular frequency <= cutoff [rad/s]; needs concrete
+            beam parameters, so use `n_modes` under jit/grad.
+        static_load_nodes: nodes whose free dofs get static-correction modes.
+        planar: None, "xy" or "xz": restrict the dofs as in `free_dofs`.
+        orthonormalize: rotate the assembled basis so that M_r = I and K_r =
+            diag(frequencies^2), ascending (kinds then all "reduced").
+
+    Returns:
+        The `ModalBasis`.
+
+    Raises:
+        ValueError: both or neither of n_modes and cutoff, nodes outside the beam or repeated,
+            an empty basis, no interior dofs, or (orthonormalized) linearly dependent columns.
+    """
     if (n_modes is None) == (cutoff is None):
         raise ValueError("craig_bampton: give exactly one of n_modes or cutoff")
     clamped = _nodes("clamped_node", clamped_node, beam)

@@ -28,16 +28,29 @@ from mbjax._src.model import Model
 class FlexibleModel(eqx.Module):
     """A rigid `model` with some bodies made flexible.
 
-    flexible: {body index: ModalBody}; attach: {child body: grid point index of its (flexible)
-    parent's ModalBody nodes} for every child of a flexible body; markers: ((body, node), ...)
-    extra frames at grid points for cut joints (frame index n + i), or ((body, -1), ...) for a
-    body's own frame.
+    q = (the rigid model's joint coordinates, the flexible bodies' modal coordinates in body
+    order), v likewise (see the module docstring). A flexible body's mass, centre of mass and
+    inertia are its ModalBody's (its rigid-body terms); the rigid `model`'s values for that body
+    are not used. A rigid part that moves with the body (a hub at the clamp) goes into the
+    ModalBody (`rotary`, as `mbjax._src.scenes.slewing_beam` does); a rigid mass that differs
+    from the ModalBody's by more than `MASS_MISMATCH` (relative) gets a warning, so that such a
+    part is not dropped unseen.
 
-    A flexible body's mass, centre of mass and inertia are its ModalBody's (its rigid-body
-    terms); the rigid `model`'s values for that body are not used. A rigid part that moves with
-    the body (a hub at the clamp) goes into the ModalBody (`rotary`, as
-    `mbjax._src.scenes.slewing_beam` does); a rigid mass that differs from the ModalBody's by more
-    than `MASS_MISMATCH` (relative) gets a warning, so that such a part is not dropped unseen.
+    Args:
+        model: the tree, its joints, placements and rigid bodies' inertia (a `mbjax.Model`).
+        flexible: {body index: `ModalBody`} for the bodies made flexible (at least one, with
+            at least one mode).
+        attach: {child body: attachment-point index of its flexible parent's ModalBody} for
+            every child of a flexible body.
+        markers: extra frames for cut joints and loads, ((body, point), ...): frame index
+            n + i is marker i, at attachment point `point` of flexible body `body`, or at the
+            body's own frame with point -1.
+
+    Raises:
+        TypeError: `model` not a `mbjax.Model`, or a flexible entry not a `ModalBody`.
+        ValueError: no flexible body or no modes, a body or attachment point that does not
+            exist, a child of a flexible body without `attach`, or an `attach` for a child of a
+            rigid body.
     """
 
     model: Model
@@ -95,6 +108,7 @@ class FlexibleModel(eqx.Module):
 
     @property
     def n(self) -> int:
+        """Number of bodies."""
         return self.model.n
 
     @property
@@ -104,14 +118,17 @@ class FlexibleModel(eqx.Module):
 
     @property
     def n_modal(self) -> int:
+        """Number of modal coordinates, over all bodies (unpadded)."""
         return sum(self.modes)
 
     @property
     def nq(self) -> int:
+        """Number of configuration coordinates: joint, then modal."""
         return self.model.nq + self.n_modal
 
     @property
     def nv(self) -> int:
+        """Number of velocity coordinates: joint, then modal."""
         return self.model.nv + self.n_modal
 
     @property
@@ -128,7 +145,14 @@ class FlexibleModel(eqx.Module):
         return index, mask
 
     def split(self, x: Array) -> tuple[Array, Array]:
-        """(joint part, per-body modal part (n, mu) zero-padded) of a q or v vector."""
+        """The joint part and the per-body modal part of a q or v vector.
+
+        Args:
+            x: a q vector, shape (nq,), or a v vector, shape (nv,).
+
+        Returns:
+            (joint part, modal part), the modal part per body zero-padded, shape (n, mu).
+        """
         index, mask = self._modal_index
         joint, modal = x[:-self.n_modal], x[-self.n_modal:]
         return joint, jnp.where(mask, modal[index], 0.0)
@@ -138,28 +162,42 @@ class FlexibleModel(eqx.Module):
         return jnp.concatenate([joint, modal[self._modal_index[1]]])
 
     def modal_slice(self, body: int) -> slice:
-        """Where body's modal coordinates sit in q (and v)."""
+        """Where body's modal coordinates sit in q (in v they sit model.nq - model.nv places
+        earlier: the same place where every joint coordinate is its own rate).
+
+        Args:
+            body: a body index.
+
+        Returns:
+            The slice of q holding that body's modal coordinates (empty for a rigid body).
+        """
         start = self.model.nq + sum(self.modes[:body])
         return slice(start, start + self.modes[body])
 
     def neutral(self) -> Array:
+        """The reference configuration, shape (nq,): the rigid model's, undeformed."""
         return jnp.concatenate([self.model.neutral(), jnp.zeros(self.n_modal)])
 
     # -- the coordinates' kinematics (modal coordinates are Euclidean, eq 19) --------------------
 
     def q_dot(self, q: Array, v: Array) -> Array:
+        """dq/dt, shape (nq,), for velocity v (nv,): the rigid model's, and u for the modes."""
         nq, nv = self.model.nq, self.model.nv
         return jnp.concatenate([self.model.q_dot(q[:nq], v[:nv]), v[nv:]])
 
     def retract(self, q0: Array, xi: Array) -> Array:
+        """The configuration at chart point xi (nv,) about q0 (nq,): the rigid model's chart,
+        q0 + xi for the modes."""
         nq, nv = self.model.nq, self.model.nv
         return jnp.concatenate([self.model.retract(q0[:nq], xi[:nv]), q0[nq:] + xi[nv:]])
 
     def local_rate(self, q0: Array, xi: Array, v: Array) -> Array:
+        """xi_dot, shape (nv,), at chart point xi about q0 for velocity v."""
         nq, nv = self.model.nq, self.model.nv
         return jnp.concatenate([self.model.local_rate(q0[:nq], xi[:nv], v[:nv]), v[nv:]])
 
     def normalize(self, q: Array) -> Array:
+        """q, shape (nq,), with every quaternion scaled to unit length."""
         nq = self.model.nq
         return jnp.concatenate([self.model.normalize(q[:nq]), q[nq:]])
 

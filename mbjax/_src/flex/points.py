@@ -76,9 +76,18 @@ def shape_at(beam: Beam, basis: ModalBasis, s):
 
 
 def centreline(beam: Beam, basis: ModalBasis, q, points: int = 21, magnification: float = 1.0):
-    """Positions (..., points, 3) of `points` points evenly spaced on the beam's axis (x, from its
-    root) in the body frame, deformed by the modal coordinates q (..., mu), the deflection times
-    `magnification` (for a picture)."""
+    """The deformed beam axis in the body frame, for a picture.
+
+    Args:
+        beam: the beam (along the body x axis, from its root).
+        basis: its modal basis.
+        q: modal coordinates, shape (..., mu).
+        points: number of points, evenly spaced along the axis.
+        magnification: factor on the deflection.
+
+    Returns:
+        Positions [m], shape (..., points, 3).
+    """
     s = jnp.linspace(0.0, beam.L, points)
     phi = jax.vmap(lambda si: shape_at(beam, basis, si)[0])(s)          # (points, 3, mu)
     axis = s[:, None] * jnp.array([1.0, 0.0, 0.0])

@@ -1,8 +1,8 @@
 """Flexible trees as systems for `mbjax.simulate` and `mbjax.loops.ClosedSystem`.
 
 `FlexibleSystem` integrates (q, v) = (joint and modal coordinates, their rates) with Anderson 1993's
-O(n) recursion ("recursive", `mbjax._src.flex.aba`) or the dense Lagrangian route ("dense",
-`mbjax._src.flex.lagrange`). Closed loops and prescribed motions wrap it in
+O(n) recursion (`method=Recursive()`, `mbjax._src.flex.aba`) or the dense Lagrangian route
+(`method=Dense()`, `mbjax._src.flex.lagrange`). Closed loops and prescribed motions wrap it in
 `mbjax.loops.ClosedSystem(..., method=Stabilized())`, with cut joints at the model's markers.
 """
 
@@ -25,21 +25,40 @@ from mbjax._src.system.tree_system import AbstractTreeSystem
 
 
 class FlexibleSystem(AbstractTreeSystem):
-    """u = v; v_dot from the flexible tree's forward dynamics under gravity, elasticity, the
-    control and the external wrenches. The control drives joint and modal coordinates alike
-    (`actuation` picks some).
+    """A flexible tree as a system for `mbjax.simulate`: u = v; v_dot from the tree's forward
+    dynamics under gravity, elasticity, the control and the external wrenches.
 
-    `external` (t, q, v) returns world-frame wrenches (torque; force): one per body, shape
-    (n, 6), acting on the body's reference frame (the joint grid where its modes are clamped, or
-    `external_point`, a point fixed in that frame), as in `mbjax.rigid.TreeSystem`; or one per
-    frame, shape (n + markers, 6), the rows past n acting at the model's markers (torque about
-    the marker's origin, the force applied there). A load at a marker on a grid point bends the
-    body and stiffens it (Anderson 1993 eq 33, `mbjax._src.flex.kinematics.grid_point`), as a cut joint's
-    constraint load there does.
+    The state is (q, v) = (joint and modal coordinates, their rates), shapes (nq,) and (nv,).
+    The control drives joint and modal coordinates alike (`actuation` picks some). A load at a
+    marker on a grid point bends the body and stiffens it (Anderson 1993 eq 33,
+    `mbjax._src.flex.kinematics.grid_point`), as a cut joint's constraint load there does.
 
     Geometric stiffening adds acceleration-dependent loads, so the equations are not
     M v_dot + bias = 0 with a symmetric M (`symmetric_dynamics` is False): closed loops go
-    through `mbjax.loops.Stabilized`, on either route."""
+    through `mbjax.loops.Stabilized`, on either route.
+
+    Args:
+        model: the flexible tree, a `FlexibleModel`.
+        control: a callable (t, q, v) -> generalized forces on the actuated coordinates (joint
+            forces, then modal forces), an `mbjax.control` module, a constant array, or None.
+        external: a callable (t, q, v) -> world-frame wrenches (torque [N m]; force [N]): one
+            per body, shape (n, 6), acting on the body's reference frame (the joint grid where
+            its modes are clamped, or `external_point`, a point fixed in that frame), as in
+            `mbjax.rigid.TreeSystem`; or one per frame, shape (n + markers, 6), the rows past n
+            acting at the model's markers (torque about the marker's origin, the force applied
+            there); or None.
+        external_point: body-frame points where the bodies' external forces act [m], shape
+            (n, 3) or (3,); None: the bodies' frame origins.
+        actuation: the indices of the velocity coordinates the control drives (or a boolean
+            mask of length nv); None: all of them.
+        method: `mbjax.Recursive()` (Anderson 1993's O(n) recursion), `mbjax.Dense()` (the
+            Lagrangian, O(n^3); joints whose q is their own rate only) or `mbjax.Auto()` (the
+            default); static.
+
+    Raises:
+        TypeError: `model` is not a `FlexibleModel`, or `method` is not a strategy instance.
+        ValueError: malformed control, external, external_point or actuation.
+    """
 
     model: FlexibleModel
     control: AbstractControl | None
@@ -59,12 +78,22 @@ class FlexibleSystem(AbstractTreeSystem):
         self.method = as_dynamics(method)
 
     def frames(self, q):
-        """Body frames (joint grids), then the markers at grid points, deformation included."""
+        """World poses of the body frames (joint grids), then of the markers at grid points,
+        deformation included.
+
+        Args:
+            q: configuration, shape (nq,).
+
+        Returns:
+            (R, p): rotations, shape (n + markers, 3, 3), and origins [m], shape
+            (n + markers, 3).
+        """
         R, p, R_markers, p_markers = body_and_marker_poses(self.model, q)
         return jnp.concatenate([R, R_markers]), jnp.concatenate([p, p_markers])
 
     def kinetic_energy(self, q, v):
-        """T = sum_k w_k^T M_k(q_k) w_k / 2 (Anderson 1993 eq 34), w from the recursion's velocities."""
+        """T = sum_k w_k^T M_k(q_k) w_k / 2 (Anderson 1993 eq 34), w from the recursion's
+        velocities; a scalar [J]."""
         w = body_velocities(self.model, q, v)
         qf = self.model.split(q)[1]
         return jnp.sum(jax.vmap(body_kinetic_energy)(self.model.bodies, qf, w))
@@ -74,11 +103,12 @@ class FlexibleSystem(AbstractTreeSystem):
         return jnp.any(self.model.model.damping != 0) | jnp.any(self.model.bodies.damping != 0)
 
     def energy(self, q, v):
-        """Kinetic, gravitational and modal strain energy."""
+        """Kinetic, gravitational and modal strain energy [J], a scalar; the work of the applied
+        forces is not included."""
         return self.kinetic_energy(q, v) + potential_energy(self.model, q)
 
     def mass_matrix(self, q):
-        """d^2 T / dv^2: symmetric; the equations of motion add stiffening to it."""
+        """d^2 T / dv^2, symmetric, shape (nv, nv); the equations of motion add stiffening to it."""
         zero = jnp.zeros(self.nv, q.dtype)
         return jax.jacfwd(jax.grad(self.kinetic_energy, argnums=1), argnums=1)(q, zero)
 
@@ -88,7 +118,7 @@ class FlexibleSystem(AbstractTreeSystem):
         return self._loads(t, q, v)[1]
 
     def applied(self, t, q, v):
-        """The control's generalized forces, plus those of the wrenches at markers."""
+        """The control's generalized forces, plus those of the wrenches at markers, shape (nv,)."""
         return self._loads(t, q, v)[0]
 
     def _loads(self, t, q, v):
@@ -106,6 +136,7 @@ class FlexibleSystem(AbstractTreeSystem):
         return tau, about_origins(f[:self.n], self.frames(q)[0][:self.n], self.external_point)
 
     def responses(self, t, q, v, loads):
+        """As `AbstractTreeSystem.responses`, by the route `method` resolves to."""
         tau, f = self._loads(t, q, v)
         if isinstance(self.method.resolve(self.nv), Recursive):
             return flexible_aba_responses(self.model, q, v, tau, loads, f)

@@ -18,8 +18,19 @@ from mbjax._src.model.closures import GROUND, Coupling, CutJoint, Prescribed
 
 
 class Loops(eqx.Module):
-    """A tree (any `AbstractTreeSystem`: rigid, or flexible with markers as frames n, n + 1, ...)
-    closed by cut joints and driven by prescribed motions."""
+    """A tree closed by cut joints and couplings and driven by prescribed motions: the
+    constraints Phi(q, t) = 0 at position, velocity and acceleration level (see the module
+    docstring). `ClosedSystem` holds one; the loop algorithms are functions of it.
+
+    Args:
+        tree: any `AbstractTreeSystem`: rigid, or flexible with markers as frames n, n + 1, ...
+        closures: `CutJoint`s, `Coupling`s and `Prescribed` motions, at least one.
+
+    Raises:
+        TypeError: `tree` is not a tree system, or a closure of another type.
+        ValueError: no closures, or one that names a body or coordinate the tree lacks (a
+            `Prescribed` motion also needs nq == nv).
+    """
 
     tree: AbstractTreeSystem
     closures: tuple
@@ -59,7 +70,7 @@ class Loops(eqx.Module):
         return sum(c.size for c in self.closures)
 
     def phi(self, q: Array, t=0.0) -> Array:
-        """Phi(q, t), (m,)."""
+        """The residual Phi(q, t), shape (m,), for q of shape (nq,) at time t [s]."""
         if any(isinstance(c, CutJoint) for c in self.closures):
             R, p = self.tree.frames(q)
         else:                         # prescribed motions only: no kinematics to trace
@@ -67,16 +78,18 @@ class Loops(eqx.Module):
         return jnp.concatenate([c.residual(R, p, q, t) for c in self.closures])
 
     def rate(self, q: Array, v: Array, t=0.0) -> Array:
-        """A v + B = dPhi/dt along the motion."""
+        """A v + B = dPhi/dt along the motion, shape (m,), for v of shape (nv,)."""
         return jax.jvp(self.phi, (q, jnp.asarray(t, q.dtype)),
                        (self.tree.q_dot(q, v), jnp.ones((), q.dtype)))[1]
 
     def jacobian(self, q: Array, t=0.0) -> Array:
-        """A (m, nv): the rate is linear in v, A v + B. Reverse mode, one pass per constraint
-        row, so O(m n) rather than O(n^2) for long chains."""
+        """The velocity constraint operator A, shape (m, nv): the rate is linear in v, A v + B.
+        Reverse mode, one pass per constraint row, so O(m n) rather than O(n^2) for long
+        chains."""
         return jax.jacrev(lambda v: self.rate(q, v, t))(jnp.zeros(self.tree.nv, q.dtype))
 
     def acceleration_bias(self, q: Array, v: Array, t=0.0) -> Array:
-        """b = d/dt (A v + B) at fixed v, so that A v_dot + b is the second derivative of Phi."""
+        """b = d/dt (A v + B) at fixed v, shape (m,), so that A v_dot + b is the second
+        derivative of Phi."""
         return jax.jvp(lambda q_, t_: self.rate(q_, v, t_), (q, jnp.asarray(t, q.dtype)),
                        (self.tree.q_dot(q, v), jnp.ones((), q.dtype)))[1]

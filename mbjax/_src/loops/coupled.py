@@ -38,8 +38,17 @@ def coupled_acceleration(loops: Loops, q: Array, v: Array, t=0.0,
 
 
 class Coupled(AbstractLoopMethod):
-    """u = v; v_dot from the coupled Lagrange-multiplier equations (Jerkovsky 1978 eqs 89-93), with
-    Baumgarte gains (alpha, beta) ((0, 0): none). Needs a tree with a symmetric mass matrix."""
+    """u = v; v_dot from the coupled Lagrange-multiplier equations (Jerkovsky 1978 eqs 89-93),
+    with optional Baumgarte stabilization (see the module docstring). Dense, O(n^3); needs a
+    tree with a symmetric mass matrix (rigid trees).
+
+    Args:
+        baumgarte: the gains (alpha [1/s], beta [1/s]), both >= 0: the constraint errors obey
+            e_ddot + 2 alpha e_dot + beta^2 e = 0; (0, 0), the default, for none. Static.
+
+    Raises:
+        ValueError: not two non-negative gains.
+    """
 
     baumgarte: tuple = eqx.field(static=True, default=(0.0, 0.0),
                                  converter=lambda g: tuple(float(x) for x in g))

@@ -12,30 +12,47 @@ from jax import Array
 
 
 class AbstractLoopMethod(eqx.Module):
-    """A loop-closure method (`Coupled`, `Momentum`, `Stabilized`)."""
+    """A loop-closure method (`Coupled`, `Momentum`, `Stabilized`), passed to `ClosedSystem` as
+    `method=`.
+
+    A subclass chooses the velocity state u (the defaults: u = v) and implements `acceleration`
+    and `loads`; `ClosedSystem` calls these with its `Loops` (the tree and its closures).
+    """
 
     def validate(self, tree) -> None:
-        """Raise if this method cannot close loops on `tree`."""
+        """Raise if this method cannot close loops on `tree` (nothing by default).
+
+        Raises:
+            TypeError: the method needs what the tree lacks (a symmetric mass matrix).
+        """
 
     def velocity(self, loops, q: Array, u: Array) -> Array:
-        """The joint velocities v in the state u."""
+        """The joint velocities v, shape (nv,), in the state u (u itself by default)."""
         return u
 
     def with_velocity(self, loops, q: Array, u: Array, v: Array) -> Array:
-        """u with its velocity part replaced by v."""
+        """u with its velocity part replaced by v, shape (nv,) (v by default)."""
         return v
 
     def initial_state(self, loops, q: Array, v: Array, t, consistent: bool) -> Array:
-        """The state u for joint velocities v."""
+        """The state u for joint velocities v, shape (nv,) (v by default)."""
         return v
 
     @abc.abstractmethod
     def acceleration(self, loops, t: Array, q: Array, u: Array) -> Array:
-        """u_dot."""
+        """u_dot, the shape of u.
+
+        Args:
+            loops: the tree and its closures.
+            t: time [s], a scalar.
+            q: configuration, shape (nq,).
+            u: the method's velocity state.
+        """
 
     @abc.abstractmethod
     def loads(self, loops, t: Array, q: Array, u: Array) -> Array:
-        """The constraint loads on the rows of A at (t, q, u)."""
+        """The constraint loads on the rows of A at (t, q, u), shape (m,) (arguments as
+        `acceleration`)."""
 
 
 def require_symmetric(method: str, tree) -> None:

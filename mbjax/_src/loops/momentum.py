@@ -32,7 +32,10 @@ def loop_momentum_rate(loops: Loops, q: Array, G: Array, t=0.0) -> tuple[Array, 
 
 class Momentum(AbstractLoopMethod):
     """u = G = mu v, the generalized momenta; G_dot = K^a - X + A^t K_c with the multipliers of
-    Jerkovsky 1978 eq 98. Needs a tree with a symmetric mass matrix."""
+    Jerkovsky 1978 eq 98. Needs a tree with a symmetric mass matrix (rigid trees).
+
+    Takes no arguments: `method=Momentum()`.
+    """
 
     def validate(self, tree):
         require_symmetric("Momentum", tree)

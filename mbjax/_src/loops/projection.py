@@ -35,7 +35,22 @@ NEUMANN = 3             # tangent solves with the Jacobian I + O(|xi|)
 
 def project_configuration(loops: Loops, q: Array, t=0.0, *,
                           iterations: int = ITERATIONS) -> tuple[Array, Array]:
-    """(q on Phi = 0 along the normals at q, |Phi| there); see the module docstring."""
+    """Project a configuration onto Phi(q, t) = 0 along the constraint normals at q.
+
+    A fixed number of chord iterations; gradients by the implicit function theorem (see the
+    module docstring). Meant for the small drift of one step; far from the constraints use
+    `consistent_state`.
+
+    Args:
+        loops: the tree and its closures (`ClosedSystem.loops`).
+        q: configuration, shape (nq,).
+        t: time [s], a scalar.
+        iterations: number of chord iterations; static.
+
+    Returns:
+        (q on the constraints, shape (nq,), with its quaternions normalized; |Phi| there, a
+        scalar).
+    """
     tree = loops.tree
     A = loops.jacobian(q, t)
     solve_W = solver(A @ A.T)
@@ -72,7 +87,21 @@ def gauss_newton(loops: Loops, q: Array, t=0.0, *, iterations: int = 30) -> Arra
 
 @eqx.filter_jit
 def project_velocity(loops: Loops, q: Array, v: Array, t=0.0, mass=None) -> Array:
-    """v with A v + B = 0, the smallest correction (in the metric of `mass` when given)."""
+    """Project a velocity onto the velocity constraints A v + B = 0 by the smallest correction.
+
+    Redundant constraints are fine (a regularized pseudo-inverse).
+
+    Args:
+        loops: the tree and its closures (`ClosedSystem.loops`).
+        q: configuration, shape (nq,).
+        v: joint velocities, shape (nv,).
+        t: time [s], a scalar.
+        mass: a symmetric positive-definite metric, shape (nv, nv) (the mass matrix: the
+            kinetic-energy-optimal correction); None: the Euclidean one.
+
+    Returns:
+        The corrected v, shape (nv,).
+    """
     A = loops.jacobian(q, t)
     if mass is None:
         y, _ = multipliers(A @ A.T, loops.rate(q, v, t))
@@ -92,15 +121,32 @@ def _project(loops, q, v, t, iterations):
 
 def consistent_state(system, q, v, t=0.0, *, project: bool = True, tol: float = 1e-10,
                      iterations: int = 30):
-    """Initial conditions (q, v) on the loop closures of `system` (a `ClosedSystem` or `Loops`),
-    checked (concrete values, outside jit).
+    """Initial conditions (q, v) on the loop closures of `system`, checked.
 
-    project=True: (q, v) projected onto Phi = 0 (`iterations` Gauss-Newton steps) and
-    A v + B = 0 (the kinetic-energy-optimal velocity correction); a ValueError says so when the
-    positions cannot be brought within tol (the loop cannot close near q: an unreachable closure
-    or a wrong branch). project=False: (q, v) returned unchanged if they meet the constraints to
-    tol, else a ValueError with the residuals. Make the method's state with
-    `ClosedSystem.initial_state(q, v)`."""
+    Needs concrete values (call it outside jit). Make the method's state from the result with
+    `ClosedSystem.initial_state(q, v)`.
+
+    Args:
+        system: a `ClosedSystem` or `Loops`.
+        q: configuration, shape (nq,).
+        v: joint velocities, shape (nv,).
+        t: time [s], a scalar.
+        project: True: project q onto Phi = 0 (`iterations` full Gauss-Newton steps, then the
+            chord projection) and v onto A v + B = 0 (the kinetic-energy-optimal correction);
+            False: only check that (q, v) meet the constraints.
+        tol: the largest |Phi| (and, with project=False, |A v + B|) accepted.
+        iterations: Gauss-Newton steps of the projection.
+
+    Returns:
+        (q, v): projected, or unchanged with project=False.
+
+    Raises:
+        TypeError: `system` is neither a `ClosedSystem` nor `Loops`.
+        ValueError: q or v of the wrong shape or non-finite; with project=True, positions that
+            cannot be brought within tol (the loop cannot close near q: an unreachable closure
+            or a wrong branch); with project=False, a state that violates the constraints (the
+            message gives the residuals).
+    """
     loops = getattr(system, "loops", system)
     if not isinstance(loops, Loops):
         raise TypeError(f"system must be a ClosedSystem or Loops, got {type(system).__name__}")

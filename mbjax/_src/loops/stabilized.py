@@ -62,13 +62,22 @@ def stabilized_acceleration(loops: Loops, q: Array, v: Array, t=0.0, f_c=None, e
 
 
 class Stabilized(AbstractLoopMethod):
-    """Anderson 1993's O(n + m^3) route, for rigid and flexible trees. epsilon = 0: u = v and
-    algebraic loads; epsilon > 0: u = (v, f_c), the loads integrated by eq 93, so that
-    A v + B - epsilon f_c keeps its initial value all along: the velocity constraint holds to
-    O(epsilon |f_c|), at the price of a stiff load equation (time constant epsilon /
-    eig(A Gamma): explicit steps need dt < 2.8 epsilon / max eig(A Gamma), an A-stable implicit
-    integrator such as `ImplicitMidpoint` takes any epsilon). kappa > 0 adds position feedback
-    (module docstring)."""
+    """Anderson 1993's O(n + m^3) route, for rigid and flexible trees.
+
+    epsilon = 0: u = v and algebraic loads. epsilon > 0: u = (v, f_c), the loads integrated by
+    eq 93, so that A v + B - epsilon f_c keeps its initial value all along: the velocity
+    constraint holds to O(epsilon |f_c|), at the price of a stiff load equation (time constant
+    epsilon / eig(A Gamma): explicit steps need dt < 2.8 epsilon / max eig(A Gamma), an
+    A-stable implicit integrator such as `ImplicitMidpoint` takes any epsilon).
+
+    Args:
+        epsilon: the epsilon-dynamics' parameter (>= 0; 0: algebraic loads); static.
+        kappa: position feedback (>= 0, needs epsilon > 0): the position error then stays
+            below epsilon |f_c| / kappa (see the module docstring); static.
+
+    Raises:
+        ValueError: a negative epsilon or kappa, or kappa without epsilon.
+    """
 
     epsilon: float = eqx.field(static=True, default=0.0)
     kappa: float = eqx.field(static=True, default=0.0)

@@ -1,4 +1,4 @@
-"""Closed mechanisms as systems for `mbjax.simulate`: any tree closed by cut joints and
+"""Closed mechanisms as systems for `mbjax.simulate`: any tree closed by cut joints, couplings and
 prescribed motions, solved by a loop method passed in (diffrax-style strategies).
 
     ClosedSystem(tree, closures, method=Coupled(baumgarte=...) | Momentum() | Stabilized(...),
@@ -50,12 +50,38 @@ def _with_forces(tree: AbstractTreeSystem, control, external, external_point) ->
 
 
 class ClosedSystem(AbstractSystem):
-    """A tree closed by `closures` (`CutJoint`s and `Prescribed` motions), solved by `method`
-    (default: `Coupled()` for trees with a symmetric mass matrix, `Stabilized()` otherwise).
+    """A tree closed by `closures`, solved by a loop method, as a system for `mbjax.simulate`.
 
-    The velocity state u is the method's: the joint velocities v (`Coupled`, `Stabilized()`),
-    the momenta M v (`Momentum`), or v and the loads (`Stabilized(epsilon > 0)`); make it with
-    `initial_state(q, v)` and read v back with `velocity(q, u)`."""
+    The configuration is the tree's q, shape (nq,). The velocity state u is the method's: the
+    joint velocities v (`Coupled`, `Stabilized()`), the momenta M v (`Momentum`), or v and the
+    loads (`Stabilized(epsilon > 0)`, shape (nv + m,)); make it with `initial_state(q, v)` and
+    read v back with `velocity(q, u)`. Put initial conditions on the constraints first with
+    `consistent_state`.
+
+    Args:
+        tree: the open tree (`mbjax.rigid.TreeSystem`, `mbjax.flex.FlexibleSystem`); it
+            carries the applied forces.
+        closures: `CutJoint`s, `Coupling`s and `Prescribed` motions (at least one), e.g. a
+            loaded model's `model.closures`.
+        method: an `AbstractLoopMethod` instance; None: `Coupled()` for trees with a symmetric
+            mass matrix, `Stabilized()` otherwise.
+        projection: after every step, project (q, v) onto Phi = 0 and A v + B = 0
+            (differentiably; `mbjax._src.loops.projection`); static.
+        tolerance: the residual |Phi| past which `check` reports
+            `Status.CONSTRAINT_VIOLATED`; static.
+        control: the tree's control, if not given to the tree (as in `TreeSystem`).
+        external: the tree's external wrenches, if not given to the tree.
+        external_point: where the external forces act, if not given to the tree.
+        iterations: chord iterations of each projection; static.
+
+    Raises:
+        TypeError: `tree` is not a tree system, `method` is a class or not a loop method, the
+            method cannot close loops on this tree (`Coupled`, `Momentum` on a flexible tree),
+            or a closure of another type.
+        ValueError: no closures, a closure that names a body or coordinate the tree lacks,
+            a control or external load given both here and to the tree, tolerance <= 0 or
+            iterations < 1.
+    """
 
     loops: Loops
     method: AbstractLoopMethod
@@ -89,27 +115,57 @@ class ClosedSystem(AbstractSystem):
 
     @property
     def tree(self) -> AbstractTreeSystem:
+        """The open tree, with the applied forces."""
         return self.loops.tree
 
     @property
     def closures(self) -> tuple:
+        """The closures, a tuple."""
         return self.loops.closures
 
     # -- the method's state -----------------------------------------------------------------------
 
     def velocity(self, q: Array, u: Array) -> Array:
-        """The joint velocities v in the state u."""
+        """The joint velocities v in the state u.
+
+        Args:
+            q: configuration, shape (nq,).
+            u: the method's velocity state.
+
+        Returns:
+            v, shape (nv,).
+        """
         return self.method.velocity(self.loops, q, u)
 
     def initial_state(self, q: Array, v: Array, t=0.0, *, consistent: bool = True) -> Array:
-        """The state u for joint velocities v (`Stabilized(epsilon > 0)`: with the algebraic
-        loads when consistent, else eq 89's)."""
+        """The method's velocity state u for joint velocities v.
+
+        Args:
+            q: configuration, shape (nq,).
+            v: joint velocities, shape (nv,).
+            t: time [s], a scalar.
+            consistent: for `Stabilized(epsilon > 0)`, start the load state from the algebraic
+                loads (True) or from Anderson 1993 eq 89 (False).
+
+        Returns:
+            u: v (`Coupled`, `Stabilized()`), M(q) v (`Momentum`), or (v, f_c), shape
+            (nv + m,) (`Stabilized(epsilon > 0)`).
+        """
         q, v = jnp.asarray(q, float), jnp.asarray(v, float)
         return self.method.initial_state(self.loops, q, v, jnp.asarray(t, q.dtype), consistent)
 
     def loads(self, t, q: Array, u: Array) -> Array:
-        """The constraint loads on the rows of A (`Coupled`, `Momentum`: the multipliers K_c,
-        A^t K_c the generalized constraint force; `Stabilized`: f_c = -K_c)."""
+        """The constraint loads on the rows of A at a state.
+
+        Args:
+            t: time [s], a scalar.
+            q: configuration, shape (nq,).
+            u: the method's velocity state.
+
+        Returns:
+            Shape (m,): `Coupled`, `Momentum`: the multipliers K_c, A^t K_c the generalized
+            constraint force; `Stabilized`: f_c = -K_c.
+        """
         return self.method.loads(self.loops, t, q, u)
 
     # -- AbstractSystem ---------------------------------------------------------------------------
@@ -135,6 +191,7 @@ class ClosedSystem(AbstractSystem):
 
     @property
     def n_controls(self) -> int:
+        """The number of forces the tree's control returns."""
         return self.tree.n_controls
 
     def with_control(self, control) -> "ClosedSystem":
@@ -153,6 +210,8 @@ class ClosedSystem(AbstractSystem):
         return q, self.method.with_velocity(self.loops, q, u, v)
 
     def check(self, t, q, u):
+        """`Status.CONSTRAINT_VIOLATED` where |Phi| > tolerance, `Status.REDUNDANT` where the
+        constraint Jacobian has lost rank, and the tree's own flags; an int32 scalar."""
         violated = jnp.linalg.norm(self.loops.phi(q, t)) > self.tolerance
         A = self.loops.jacobian(q, t)
         redundant = numerical_rank(A @ A.T) < self.loops.m
@@ -163,8 +222,8 @@ class ClosedSystem(AbstractSystem):
     # -- invariants -------------------------------------------------------------------------------
 
     def energy(self, q, u):
-        """The tree's energy (kinetic, gravitational, strain) at the state's velocities; the work
-        of the applied forces and prescribed motions is not included."""
+        """The tree's energy (kinetic, gravitational, strain) at the state's velocities [J], a
+        scalar; the work of the applied forces and prescribed motions is not included."""
         return self.tree.energy(q, self.velocity(q, u))
 
     def invariants(self, t, q, u):

@@ -15,7 +15,9 @@ axis is the frame's z axis. Its residual, from the poses of the two frames (grou
     point_on_plane (p_A - p_B) . z_B                     (p_A on the plane z_B)  1
 
 A `Coupling` ties one configuration coordinate to another, q_a = multiplier q_b + offset (URDF's
-mimic joints, MJCF's joint equality). A `Prescribed` motion drives one velocity coordinate, q_j = q0 + rate t (a rheonomic constraint,
+mimic joints, which `load_urdf` returns in `Model.closures`; the form of MJCF's joint equality,
+which `load_mjcf` does not map). A `Prescribed` motion drives one velocity coordinate,
+q_j = q0 + rate t (a rheonomic constraint,
 e.g. a crank turning at constant speed), or q_j = motion(t) for any differentiable motion (a
 spin-up profile): its velocity and acceleration terms come from autodiff in t.
 
@@ -30,7 +32,7 @@ import jax.numpy as jnp
 import numpy as np
 from jax import Array
 
-GROUND = -1
+GROUND = -1             # the ground as a body index (`CutJoint`'s body_b)
 SIZES = {"spherical": 3, "revolute": 5, "universal": 4, "weld": 6, "prismatic": 5,
          "point_on_line": 2, "point_on_plane": 1}
 
@@ -42,7 +44,25 @@ def _vee_antisym(R: Array) -> Array:
 
 class CutJoint(eqx.Module):
     """A joint between frame A in body `body_a` and frame B in body `body_b` (-1: the ground),
-    cut to make the mechanism a tree; see the module docstring for the residual of each kind."""
+    cut to make the mechanism a tree; see the module docstring for the residual of each kind.
+
+    Each frame is a placement in its body's frame; the joint's axis is the frame's z axis. For a
+    flexible tree, `body_a` and `body_b` may also be marker frames (n, n + 1, ...).
+
+    Args:
+        kind: "spherical", "revolute", "universal", "weld", "prismatic", "point_on_line" or
+            "point_on_plane"; static.
+        body_a: the body (frame index) of frame A, >= 0; static.
+        body_b: the body of frame B, or `GROUND` (-1); static.
+        origin_a: origin of frame A in body_a's frame [m], shape (3,).
+        origin_b: origin of frame B in body_b's frame (or the world) [m], shape (3,).
+        rotation_a: rotation of frame A in body_a's frame, shape (3, 3); None: the identity.
+        rotation_b: rotation of frame B in body_b's frame, shape (3, 3); None: the identity.
+
+    Raises:
+        ValueError: an unknown kind, the same body twice, or the ground as body_a.
+        TypeError: body indices that are not ints.
+    """
 
     kind: str = eqx.field(static=True)
     body_a: int = eqx.field(static=True)
@@ -70,10 +90,21 @@ class CutJoint(eqx.Module):
 
     @property
     def size(self) -> int:
+        """Number of scalar constraint equations."""
         return SIZES[self.kind]
 
     def residual(self, R: Array, p: Array, q: Array, t) -> Array:
-        """Phi of this joint from the body poses R (n, 3, 3), p (n, 3)."""
+        """Phi of this joint from the frames' world poses.
+
+        Args:
+            R: rotations of the tree's frames, shape (n_frames, 3, 3).
+            p: origins of the tree's frames [m], shape (n_frames, 3).
+            q: configuration (unused).
+            t: time (unused).
+
+        Returns:
+            The residual, shape (size,).
+        """
         RA = R[self.body_a] @ self.rotation_a
         pA = p[self.body_a] + R[self.body_a] @ self.origin_a
         if self.body_b == GROUND:
@@ -102,8 +133,20 @@ class CutJoint(eqx.Module):
 
 
 class Prescribed(eqx.Module):
-    """Velocity coordinate `dof` (a 1-dof joint's angle or slide) driven as q0 + rate t, or as
-    motion(t) (a differentiable callable of time) when `motion` is given."""
+    """Coordinate `dof` (a 1-dof joint's angle or slide) driven as q0 + rate t, or as motion(t)
+    when `motion` is given: a rheonomic constraint q[dof] - motion(t) = 0.
+
+    Args:
+        dof: the coordinate's index (in q, which must equal v's layout: nq == nv); static.
+        q0: its value at t = 0 [rad or m].
+        rate: its constant rate [rad/s or m/s].
+        motion: a differentiable callable t -> the coordinate's value, replacing q0 + rate t;
+            its velocity and acceleration terms come from autodiff in t.
+
+    Raises:
+        ValueError: a negative or non-int dof.
+        TypeError: a motion that is not callable.
+    """
 
     dof: int = eqx.field(static=True)
     q0: Array
@@ -122,9 +165,11 @@ class Prescribed(eqx.Module):
 
     @property
     def size(self) -> int:
+        """One equation."""
         return 1
 
     def residual(self, R: Array, p: Array, q: Array, t) -> Array:
+        """q[dof] - motion(t), shape (1,) (R and p unused)."""
         if self.motion is not None:
             return (q[self.dof] - self.motion(t))[None]
         return (q[self.dof] - self.q0 - self.rate * t)[None]
@@ -132,7 +177,17 @@ class Prescribed(eqx.Module):
 
 class Coupling(eqx.Module):
     """Configuration coordinate `coordinate` tied to `reference`: q_a = multiplier q_b + offset
-    (a URDF mimic joint or an MJCF joint equality; indices into q)."""
+    (a URDF mimic joint, as `load_urdf` returns it in `Model.closures`; indices into q).
+
+    Args:
+        coordinate: the index a of the coupled coordinate in q; static.
+        reference: the index b of the coordinate it follows in q; static.
+        multiplier: the factor on q_b.
+        offset: the offset [rad or m].
+
+    Raises:
+        ValueError: negative or non-int indices, or a coordinate coupled to itself.
+    """
 
     coordinate: int = eqx.field(static=True)
     reference: int = eqx.field(static=True)
@@ -151,7 +206,9 @@ class Coupling(eqx.Module):
 
     @property
     def size(self) -> int:
+        """One equation."""
         return 1
 
     def residual(self, R: Array, p: Array, q: Array, t) -> Array:
+        """q_a - multiplier q_b - offset, shape (1,) (R, p and t unused)."""
         return (q[self.coordinate] - self.multiplier * q[self.reference] - self.offset)[None]

@@ -13,11 +13,11 @@ The mapping (MuJoCo body frames, joints and names to mbjax):
       body's frame is put at its joint's anchor (jnt_pos; same orientation as MuJoCo's) and the
       centre of mass, child placements and frames are shifted by -anchor. A hinge or slide joint
       with a ref position is offset so that q is MuJoCo's qpos. q and v follow qpos and qvel
-      (`mbjax.state_from_mujoco` converts the free joints' velocities).
+      (`mbjax.model.state_from_mujoco` converts the free joints' velocities).
     - A body without joints is welded to its parent: its mass merges into the parent (parallel
       axes; a body welded to the world is part of the ground) and its name becomes a named frame.
       Sites become named frames, and so does a body whose last joint is off its origin, so that
-      `mbjax.frame_pose(model, q, name)` is MuJoCo's xpos/xmat for every body and
+      `mbjax.rigid.frame_pose(model, q, name)` is MuJoCo's xpos/xmat for every body and
       site_xpos/site_xmat for every site (a site named like a body is "site/NAME").
     - hinge -> revolute, slide -> prismatic, ball -> spherical, free -> free.
     - Joint data: jnt_range of limited hinges and slides as lower/upper, dof_armature plus the
@@ -34,9 +34,8 @@ The mapping (MuJoCo body frames, joints and names to mbjax):
 
 What mbjax does not model (contacts, actuator forces, tendons, springs, polynomial damping,
 gravity compensation, fluid forces, flexes, plugins, ball joint limits, other equality
-constraints, free joints' translational
-armature) is named in one `ModelWarning`; `strict=True` makes it an error, as it does for
-implausible inertias.
+constraints, free joints' translational armature) is named in one `ModelWarning`, also with
+`strict=True`, which makes only implausible inertias errors.
 """
 
 import os
@@ -179,8 +178,21 @@ def from_mujoco(mjmodel, *, strict: bool = False) -> Model:
 
     The active connect and weld equality constraints are the model's `closures`
     (`mbjax.loops.CutJoint`s), for `mbjax.loops.ClosedSystem(TreeSystem(model), model.closures)`.
-    What mbjax does not model is named in one `ModelWarning`; strict=True makes implausible
-    inertias errors (`mbjax._src.model.checks`), not the features mbjax leaves out."""
+    What mbjax does not model is named in one `ModelWarning`.
+
+    Args:
+        mjmodel: the compiled `mujoco.MjModel`.
+        strict: make implausible inertias errors (`mbjax._src.model.checks`), not the features
+            mbjax leaves out.
+
+    Returns:
+        The `Model`; q and v follow MuJoCo's qpos and qvel (free joints' velocities convert
+        with `mbjax.model.state_from_mujoco`).
+
+    Raises:
+        ImportError: MuJoCo is not installed.
+        ValueError: a model without joints, or (strict=True) implausible inertial data.
+    """
     mujoco = _mujoco()
     m = mjmodel
     if m.nv == 0:
@@ -329,8 +341,23 @@ def _cut_joints(m, mujoco, where) -> tuple[list, int]:
 
 
 def load_mjcf(source: str | os.PathLike, *, strict: bool = False) -> Model:
-    """A `Model` from an MJCF file path or XML string (one starting with '<'), compiled by MuJoCo
-    (`pip install mujoco`); see `from_mujoco` for the result and the options."""
+    """A `Model` from an MJCF file, compiled by MuJoCo (`pip install mujoco`).
+
+    See the module docstring for the mapping and `from_mujoco` for the result: the connect and
+    weld equality constraints are the model's `closures`.
+
+    Args:
+        source: a file path, or an XML string (one starting with '<').
+        strict: make implausible inertias errors (not the features mbjax leaves out).
+
+    Returns:
+        The `Model`.
+
+    Raises:
+        ImportError: MuJoCo is not installed.
+        ValueError: MuJoCo's compiler rejects the file, a model without joints, or
+            (strict=True) implausible inertial data.
+    """
     mujoco = _mujoco()
     text = str(source)
     if not isinstance(source, os.PathLike) and text.lstrip().startswith("<"):

@@ -1,4 +1,4 @@
-"""`Model`: a tree of rigid bodies connected by joints (DESIGN.md "Data model").
+"""`Model`: a tree of rigid bodies connected by joints.
 
 Topology, joint types and names are static (hashable; changing them recompiles). Placements, axes,
 masses, centres of mass, inertias and gravity are array leaves with a leading body axis, so they can

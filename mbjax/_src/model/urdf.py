@@ -3,7 +3,7 @@
 Links with <inertial> become bodies; revolute and continuous joints become revolute joints,
 prismatic joints prismatic ones and floating joints free joints; a fixed joint merges its child
 link (mass, centre of mass and inertia, and the placements of the joints beyond it) into the
-parent body, and keeps the link and the joint as named frames (`mbjax.frame_pose`). The root link
+parent body, and keeps the link and the joint as named frames (`mbjax.rigid.frame_pose`). The root link
 is welded to the ground unless `floating_base=True` adds a free joint. Bodies are numbered
 depth-first from the root, as Pinocchio numbers its joints, so q and v line up with Pinocchio's.
 Pinocchio (through urdfdom, which keeps joints in a name-sorted map) visits the children of a link
@@ -19,8 +19,9 @@ an error; `mbjax._src.model.checks`); non-finite or unparsable numbers are error
 Joint data: <limit> gives position (revolute, prismatic), effort and velocity limits, <dynamics>
 damping (used by the dynamics) and friction (kept as data); `armature=` adds rotor inertia to
 every joint (URDF has no field for it). <mimic> joints load as independent joints, as Pinocchio
-and MuJoCo load them, with a warning; `closures=True` also returns their couplings as
-`mbjax.loops.Coupling` closures for `mbjax.loops.ClosedSystem`.
+and MuJoCo load them, with a warning; their couplings are the model's `closures`
+(`mbjax.loops.Coupling`s), which `mbjax.loops.ClosedSystem(TreeSystem(model), model.closures)`
+enforces.
 """
 
 import os
@@ -129,14 +130,34 @@ def _read(text: str):
 def load_urdf(source: str | os.PathLike, *, floating_base: bool = False,
               gravity=(0.0, 0.0, -9.81), sibling_order: str = "name", armature=0.0,
               min_mass: float = 0.0, min_inertia: float = 0.0, strict: bool = False) -> Model:
-    """A Model from a URDF path or XML string (a string starting with '<' is read as XML).
+    """A `Model` from a URDF file or XML string (see the module docstring for the mapping).
 
-    sibling_order: "name" (Pinocchio's numbering) or "document" (MuJoCo's; see the module).
-    armature: rotor inertia on every joint coordinate (a number or an (nv,) array).
-    min_mass, min_inertia: lower bounds on the mass and the principal moments of every body (like
-        MuJoCo's boundmass and boundinertia), a remedy for massless leaves on moving joints.
-    strict: turn the warnings on implausible data into errors (not the note on mimic joints).
-    The mimic joints' couplings are the model's `closures` (`mbjax.loops.Coupling`s).
+    The mimic joints' couplings are the model's `closures` (`mbjax.loops.Coupling`s), empty
+    without mimic joints.
+
+    Args:
+        source: a path, or an XML string (a string starting with '<' is read as XML).
+        floating_base: add a free joint above the root link (else it is welded to the ground).
+        gravity: gravitational acceleration in the world frame [m/s^2], shape (3,).
+        sibling_order: "name" (Pinocchio's numbering) or "document" (MuJoCo's; see the
+            module).
+        armature: rotor inertia on every joint coordinate [kg m^2 or kg], a number or an
+            (nv,) array.
+        min_mass: lower bound on every body's mass [kg] (MuJoCo's boundmass), a remedy for
+            massless leaves on moving joints.
+        min_inertia: lower bound on every body's principal moments [kg m^2] (MuJoCo's
+            boundinertia).
+        strict: turn the warnings on implausible data into errors (not the note on mimic
+            joints).
+
+    Returns:
+        The `Model`, bodies numbered depth-first from the root.
+
+    Raises:
+        FileNotFoundError: a path that is not a file.
+        ValueError: malformed XML or numbers, an unsupported joint type, a graph that is not a
+            tree, no movable joint, an unknown sibling_order, or (strict=True) implausible
+            inertial data.
     """
     if sibling_order not in ("name", "document"):
         raise ValueError(f"sibling_order must be 'name' or 'document', got {sibling_order!r}")
@@ -306,10 +327,23 @@ def matrix_rpy(R: np.ndarray) -> np.ndarray:
 
 def to_urdf(model: Model, name: str = "mbjax") -> str:
     """The URDF of a revolute/prismatic/free tree (for loading the same model into Pinocchio or
-    MuJoCo). Link k is `model.names[k]`; the ground link is `base`. Limits, damping and friction
-    are written; a joint without limits gets wide ones (+-1e3), so that the peers keep one angle
-    per revolute joint (a URDF continuous joint is (cos, sin) in Pinocchio). Armature and named
-    frames have no URDF field and are not written."""
+    MuJoCo).
+
+    Link k is `model.names[k]`; the ground link is `base`. Limits, damping and friction are
+    written; a joint without limits gets wide ones (+-1e3), so that the peers keep one angle
+    per revolute joint (a URDF continuous joint is (cos, sin) in Pinocchio). Armature, named
+    frames and closures have no URDF field and are not written.
+
+    Args:
+        model: the tree.
+        name: the robot's name.
+
+    Returns:
+        The URDF document, a string.
+
+    Raises:
+        ValueError: a joint other than revolute, prismatic or free.
+    """
     kinds = {"revolute": "revolute", "prismatic": "prismatic", "free": "floating"}
     for kind in model.joint_types:
         if kind not in kinds:

@@ -17,7 +17,8 @@ origin (see `kinematics`), so no quantity changes frame on its way along the tre
 P may have several columns for multi-DOF joints; D is then a small symmetric positive-definite
 block solved by Cholesky. The passes run at one width for every body, so a floating base (a free
 joint under revolute ones) is eliminated on its own, outside the passes, with 6 x 6 blocks, and
-the revolute bodies keep their division (`_wide_root`; the Unitree G1's evaluation 138 -> 32 us).
+the revolute bodies keep their division instead of a 6 x 6 Cholesky factorization each
+(`_wide_root`; the effect on a humanoid is in benchmarks/README.md).
 
 Step (ii) eliminates M(q) itself: (S, U, D) per body (`Factor`, from `aba_factored`) is a sparse
 L D L^T factorization of the mass matrix, with which `solve` applies M^-1 in two vector passes

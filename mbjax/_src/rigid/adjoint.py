@@ -19,12 +19,11 @@ is written out (`rnea_derivatives`: two vector passes, which reverse mode runs t
 for universal joints, for the model's parameters and for the external wrenches it is JAX's own
 derivative of the RNEA. Either is recomputed in the reverse pass (`jax.checkpoint`), so
 `jax.grad` through a rollout keeps per step only (q, v, u_dot) and the factor, not every
-intermediate of the recursion (storing them is slower: 4.8x against 3.0x in one A/B script).
-7-link chain, 1000 steps of semi-implicit Euler, each loop compiled as one kernel
-(`mbjax._src.runtime`; the rule's passes hold no gather or scatter in either direction,
-`mbjax._src.tree.take`): the gradient costs 2.7x the rollout (3.2 us a step; 3.4x with JAX's
-derivative of the RNEA, 6.0x differentiating the recursion itself); 30 links, 2.7-2.9x (was
-3.4x); the Unitree G1 (a free base) 3.2x (was 3.9x).
+intermediate of the recursion: recomputing them costs less than storing them. With each loop
+compiled as one kernel (`mbjax._src.runtime`; the rule's passes hold no gather or scatter in
+either direction, `mbjax._src.tree.take`), reverse mode through the adjoint rule costs about 3x
+the forward pass, about half of what differentiating the recursion itself costs; see
+benchmarks/README.md.
 
 `with_adjoint(fd)` gives `fd` (any function computing the forward dynamics of a tree: `aba`, or
 its vmappable form) this rule as a `jax.custom_jvp`. Forward mode, reverse mode (JAX transposes

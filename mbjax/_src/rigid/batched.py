@@ -24,9 +24,7 @@ CPU's vector units and XLA's fusion:
   `lie.sincos` (XLA calls the C library's for `jnp.sin` element by element, slowest inside a
   loop compiled as one kernel).
 
-Together the last two took `jit(vmap(forward_dynamics))` of the 7-link chain at B = 4096 (angles
-uniform in [-pi, pi)) from 1.63 to 0.60 us per state, against 0.70 for Pinocchio's
-`abaInParallel` on two threads (one A/B script, `mbjax bench throughput`'s forward records).
+The last two are the largest single gains (the timings are in benchmarks/README.md).
 
 The passes, per body k with parent p (Anderson 1993 eqs 20-31, 48-50, 80-84):
 
@@ -50,10 +48,9 @@ from mbjax._src.tree import backward_pass, forward_pass
 
 JOINTS = ("revolute", "prismatic")
 # Where XLA compiles a loop as one kernel (`mbjax._src.runtime.hoisting`), a batch runs as a loop over
-# chunks of CHUNK states, so that each chunk's intermediates stay in cache: us per state, one
-# kernel for the whole batch against chunks of 64 (7-link chain; 30-link): 2.03 against 1.53
-# (7.27 against 6.52) at B = 1024, 1.98 against 1.58 (9.10 against 6.14) at B = 4096; chunks of
-# 256: 1.63 (7.24). With kernels launched one by one, the whole batch at once is faster.
+# chunks of CHUNK states, so that each chunk's intermediates stay in cache (faster than one kernel
+# for the whole batch and than larger chunks; benchmarks/README.md). With kernels launched one by
+# one, the whole batch at once is faster.
 CHUNK = 64
 
 # -- structure-of-arrays algebra: a 3-vector is a tuple of 3 arrays, a 3x3 matrix a tuple of rows,
@@ -239,7 +236,7 @@ def batch_aba(model: Model, q: Array, v: Array, tau: Array) -> Array:
     v = jnp.broadcast_to(jnp.asarray(v, dtype), q.shape)
     tau = jnp.broadcast_to(jnp.reshape(jnp.asarray(tau, dtype), (n, -1)), q.shape)
     # outside the chunk loop, vectorized (`lie.sincos`): inside it XLA calls the C library's sin
-    # and cos element by element, 0.5-0.9 us a state (7-link chain)
+    # and cos element by element, a large part of a state's cost (benchmarks/README.md)
     sin, cos = lie.sincos(jnp.where(jnp.asarray(revolute)[:, None], q, 0.0))
     if not runtime.HOISTING or batch <= CHUNK:
         return _chunk(model, revolute, q, v, tau, sin, cos)
@@ -313,22 +310,24 @@ def _chunk(model: Model, revolute: np.ndarray, q: Array, v: Array, tau: Array, s
 
 
 def batched_forward_dynamics(model: Model, q: Array, v: Array, tau: Array) -> Array:
-    """`forward_dynamics` of B states at once, in the throughput layout (batch last inside).
+    """`mbjax.forward_dynamics` of B states at once, in the throughput layout (batch last inside).
 
-    For trees of revolute and prismatic joints; agrees with `jax.vmap(forward_dynamics)` to
-    rounding.
+    Anderson 1993's recursion with every scalar an array over the batch (`batch_aba`, see the
+    module docstring); agrees with `jax.vmap(mbjax.forward_dynamics)` to rounding, which takes
+    this route by itself for large batches. Gravity comes from the model; no external wrenches.
+    The arithmetic follows q's dtype.
 
     Args:
-        model: the tree.
+        model: a tree of revolute and prismatic joints only (nq = nv).
         q: configurations, shape (B, nv).
-        v: velocities, shape (B, nv).
-        tau: generalized forces, shape (B, nv).
+        v: joint velocities, shape (B, nv).
+        tau: joint forces [N m or N], shape (B, nv).
 
     Returns:
-        The accelerations, shape (B, nv).
+        The joint accelerations, shape (B, nv).
 
     Raises:
-        ValueError: q is not (B, nv).
+        ValueError: q is not (B, nv), or the model has a joint other than revolute or prismatic.
     """
     q = jnp.asarray(q)
     if q.ndim != 2 or q.shape[1] != model.nv:

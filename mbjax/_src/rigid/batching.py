@@ -3,9 +3,8 @@
 A user batches with `jax.vmap(mbjax.forward_dynamics)`. Left to itself, vmap puts the batch axis
 in front of every 6x6 block of `aba` (mbjax._src.rigid.aba), many small batched matrix products per
 body; `batch_aba` (mbjax._src.rigid.batched) runs the same recursion of Anderson 1993 §2.3 with the batch
-last, as straight-line elementwise code: 7.2 -> 1.4 us per state for the 7-link chain at
-B = 4096, 0.65 since its vectorized sines and symmetric blocks (`mbjax bench speed`,
-benchmarks/README.md). `aba_vmappable` is `aba` whose vmap rule
+last, as straight-line elementwise code, several times cheaper per state at large batches
+(`mbjax bench speed`; the timings are in benchmarks/README.md). `aba_vmappable` is `aba` whose vmap rule
 (`jax.custom_batching.custom_vmap`) takes that route when it can:
 
 - the model itself is not batched (a sweep over model parameters keeps the plain vmap), its
@@ -13,8 +12,8 @@ benchmarks/README.md). `aba_vmappable` is `aba` whose vmap rule
   that one vmapped call costs less one state after another, see BATCH_CROSSOVER);
 - anything else (free, spherical or universal joints, a batched model, a small batch) runs one
   state after another where XLA compiles loops as one kernel (`mbjax._src.runtime.hoisting`): a
-  `lax.map` of `aba`, each state costing what an evaluation costs in a rollout (the G1
-  humanoid's free base, B = 1024: 11.5 us per state against 37 for the plain vmap), and the
+  `lax.map` of `aba`, each state costing what an evaluation costs in a rollout (for a free base
+  such as the G1 humanoid's, a fraction of the plain vmap's cost; benchmarks/README.md), and the
   plain vmap of `aba` otherwise. The answer never depends on the route (the routes agree to
   rounding: tests/rigid/test_batching.py).
 
@@ -34,11 +33,9 @@ from mbjax._src.model import Model
 from mbjax._src.rigid.aba import aba
 from mbjax._src.rigid.batched import JOINTS, batch_aba
 
-# Batch size from which jax.vmap runs batch_aba. 7-link chain, batch_aba against one state
-# after another (one A/B script, 2-core CPU, since batch_aba's vectorized sines and symmetric
-# blocks): one jitted vmap call, 4.7 against 2.3 us per state at B = 16, 1.9 against 1.8 at 32,
-# 1.6 against 2.0 at 64; inside a 1000-step rollout, 3.5e5 against 1.9e5 steps/s at B = 16 and
-# 4.1e5 against 1.9e5 at 32 (a call's fixed cost is paid once per loop there).
+# Batch size from which jax.vmap runs batch_aba: below it one jitted vmapped call costs less one
+# state after another (inside a rollout, where a call's fixed cost is paid once per loop,
+# batch_aba wins at smaller batches too). The timings behind it are in benchmarks/README.md.
 BATCH_CROSSOVER = 32
 
 

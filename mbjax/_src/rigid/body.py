@@ -5,8 +5,8 @@ everywhere in mbjax; Omega is the body-frame angular velocity (R_dot = R (Omega 
 velocity of the centre of mass. A body about a fixed point (a heavy top, or a torque-free body
 turning about its centre of mass) has no translational part.
 
-Rotation coordinates are either unit quaternions (w, x, y, z), q_dot = q * (0, Omega) / 2, or
-rotation vectors r with r_dot = Gamma(r)^-T Omega (Borri 1990 eqs 2.8, A.21: omega = R Omega =
+Rotation coordinates are either unit quaternions (w, x, y, z), q_dot = q * (0, Omega) / 2
+(`mbjax.lie.Quaternion()`), or rotation vectors r (`mbjax.lie.RotationVector()`) with r_dot = Gamma(r)^-T Omega (Borri 1990 eqs 2.8, A.21: omega = R Omega =
 Gamma r_dot and Gamma^-1 R = Gamma^-T by eq A.24), rescaled to |r| <= pi after each step
 (eq A.29).
 """
@@ -26,17 +26,39 @@ from mbjax._src.spatial import check_inertia
 
 
 class RigidBody(AbstractDrivenSystem):
-    """A rigid body of `mass` and body-frame `inertia` under uniform `gravity`.
+    """A rigid body of `mass` and body-frame `inertia` under uniform `gravity`, free or turning
+    about a fixed point, as a system for `mbjax.simulate`.
 
-    fixed_point=False: a free body; `inertia` is about the centre of mass and q = (rot, x).
-    fixed_point=True: the body turns about a fixed point at the origin; `inertia` is about that
-    point, `com` is the centre of mass in the body frame, and q = rot.
+    fixed_point=False: a free body; q = (rot, x), u = (Omega, v) (nv = 6), `inertia` is about
+    the centre of mass. fixed_point=True: the body turns about a fixed point at the origin;
+    q = rot, u = Omega (nv = 3), `inertia` is about that point and `com` is the centre of mass
+    in the body frame. rot has 4 entries (quaternion) or 3 (rotation vector).
 
-    control: a callable (t, q, u) -> generalized forces on u = (Omega, v): a body-frame torque
-    (and, for a free body, a world-frame force), or on the `actuation` coordinates only; a
-    constant array is a constant control. external: a callable (t, q, u) -> (1, 6), a world-frame
-    wrench (torque; force) at the body's origin (its centre of mass; the fixed point) or at
-    external_point (body frame, from that origin).
+    Args:
+        mass: mass [kg], a positive scalar.
+        inertia: inertia in the body frame [kg m^2], shape (3, 3), symmetric positive-definite:
+            about the centre of mass (free body) or about the fixed point.
+        com: centre of mass in the body frame [m], shape (3,); must be 0 for a free body.
+        gravity: gravitational acceleration in the world frame [m/s^2], shape (3,).
+        fixed_point: whether the body turns about a fixed point at the origin; static.
+        rotation: the rotation coordinates, `mbjax.lie.Quaternion()` (the default) or
+            `mbjax.lie.RotationVector()`; static.
+        control: a callable (t, q, u) -> generalized forces on u = (Omega, v): a body-frame
+            torque [N m] (and, for a free body, a world-frame force [N]), or on the `actuation`
+            coordinates only; an `mbjax.control` module; a constant array (a constant control);
+            or None.
+        external: a callable (t, q, u) -> a world-frame wrench (torque [N m]; force [N]), shape
+            (1, 6), acting at the body's origin (its centre of mass; the fixed point) or at
+            `external_point`; or None.
+        external_point: where the external force acts, body-frame coordinates from that origin
+            [m], shape (1, 3) or (3,); None: the origin.
+        actuation: the indices of the velocity coordinates the control drives (or a boolean
+            mask of length nv); None: all of them.
+
+    Raises:
+        TypeError: `rotation` is not a rotation-coordinates instance.
+        ValueError: a non-positive mass, an invalid inertia, a free body with com != 0, or
+            malformed control, external or actuation arguments.
     """
 
     mass: Array
@@ -84,21 +106,47 @@ class RigidBody(AbstractDrivenSystem):
 
     @property
     def n_rot(self) -> int:
+        """The number of rotation coordinates at the start of q (4 or 3)."""
         return self.rotation.size
 
     def rotation_matrix(self, q: Array) -> Array:
-        """R, body to space."""
+        """R, body to space.
+
+        Args:
+            q: configuration, shape (nq,).
+
+        Returns:
+            R, shape (3, 3).
+        """
         rot = q[: self.n_rot]
         return self.rotation.to_matrix(rot)
 
     def position(self, q: Array) -> Array:
-        """Centre of mass in space."""
+        """Centre of mass in space.
+
+        Args:
+            q: configuration, shape (nq,).
+
+        Returns:
+            The centre of mass in the world frame [m], shape (3,).
+        """
         if self.fixed_point:
             return self.rotation_matrix(q) @ self.com
         return q[self.n_rot:]
 
     def initial_state(self, R0, Omega0, x0=(0.0, 0.0, 0.0), v0=(0.0, 0.0, 0.0)):
-        """(q0, u0) from a rotation matrix, body angular velocity and (free body) COM motion."""
+        """(q0, u0) from a rotation matrix, body angular velocity and (free body) COM motion.
+
+        Args:
+            R0: rotation, body to world, shape (3, 3).
+            Omega0: body-frame angular velocity [rad/s], shape (3,).
+            x0: centre-of-mass position [m], shape (3,); free body only.
+            v0: centre-of-mass velocity [m/s], shape (3,); free body only.
+
+        Returns:
+            (q0, u0): q0 = rot (fixed point) or (rot, x0) (free body) in the body's rotation
+            coordinates, and u0 = Omega0 or (Omega0, v0).
+        """
         R0 = jnp.asarray(R0, dtype=float)
         rot = self.rotation.from_matrix(R0)
         Omega0 = jnp.asarray(Omega0, dtype=float)
@@ -115,9 +163,19 @@ class RigidBody(AbstractDrivenSystem):
         return rot_dot if self.fixed_point else jnp.concatenate([rot_dot, u[3:]])
 
     def acceleration(self, t, q, u):
-        """Euler's equations J Omega_dot = tau - Omega x J Omega, solved by Cholesky; the COM
-        falls freely (free body) or gravity gives tau = com x (m R^T g) (fixed point). The
-        control and the external wrench add to tau (and to the force on the COM)."""
+        """Euler's equations J Omega_dot = tau - Omega x J Omega, solved by Cholesky.
+
+        The COM falls freely (free body) or gravity gives tau = com x (m R^T g) (fixed point).
+        The control and the external wrench add to tau (and to the force on the COM).
+
+        Args:
+            t: time [s], a scalar.
+            q: configuration, shape (nq,).
+            u: velocity (Omega; v), shape (nv,).
+
+        Returns:
+            u_dot = (Omega_dot; v_dot), shape (nv,).
+        """
         Omega = u[:3]
         R = self.rotation_matrix(q)
         tau = jnp.cross(self.com, self.mass * (R.T @ self.gravity))
@@ -152,18 +210,34 @@ class RigidBody(AbstractDrivenSystem):
     # -- invariants ----------------------------------------------------------------------------
 
     def kinetic_energy(self, q, u):
+        """T = Omega . J Omega / 2 (+ m |v|^2 / 2 for a free body) [J], a scalar."""
         Omega = u[:3]
         T = 0.5 * Omega @ self.inertia @ Omega
         return T if self.fixed_point else T + 0.5 * self.mass * u[3:] @ u[3:]
 
     def potential_energy(self, q):
+        """V = -m g . x_com [J], a scalar."""
         return -self.mass * self.gravity @ self.position(q)
 
     def energy(self, q, u):
+        """T + V [J], a scalar; the work of the control and external load is not included.
+
+        Args:
+            q: configuration, shape (nq,).
+            u: velocity, shape (nv,).
+        """
         return self.kinetic_energy(q, u) + self.potential_energy(q)
 
     def angular_momentum(self, q, u):
-        """Spatial angular momentum about the origin (the fixed point, if any)."""
+        """Angular momentum about the world origin (the fixed point, if any), world frame.
+
+        Args:
+            q: configuration, shape (nq,).
+            u: velocity, shape (nv,).
+
+        Returns:
+            H [kg m^2/s], shape (3,).
+        """
         h = self.rotation_matrix(q) @ (self.inertia @ u[:3])
         return h if self.fixed_point else h + self.mass * jnp.cross(q[self.n_rot:], u[3:])
 

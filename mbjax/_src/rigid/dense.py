@@ -11,7 +11,7 @@ and the constraint forces of eq 76 at each joint,
 
 A^T (mu sigma_dot + Y - K) is, joint by joint, the wrench (torque about the hinge h_j; force) the
 joint transmits to its outward system j-bar (eqs 20, 35); its free components are tau and its
-constrained ones K_hat_c. Cost O(n^2) to build and O(n^3) to factor: `method="dense"` of
+constrained ones K_hat_c. Cost O(n^2) to build and O(n^3) to factor: `method=Dense()` of
 `mbjax.forward_dynamics`.
 """
 
@@ -63,9 +63,24 @@ def joint_reactions(model: Model, q: Array, v: Array, a: Array) -> Array:
 
 
 def constraint_forces(model: Model, q: Array, v: Array, a: Array) -> Array:
-    """K_hat_c (eq 76): each joint's reaction wrench (n, 6, ground frame, about the hinge) with
-    its free components removed, i.e. its components on the constrained axes Gamma_c, Delta_c
-    (orthonormal complements of the joint axes, so this is an orthogonal projection)."""
+    """The joints' constraint forces K_hat_c of Jerkovsky 1978 eq 76.
+
+    Each joint's reaction wrench, A^T (mu sigma_dot + Y - K) (eqs 20, 35: what the joint
+    transmits to its outward system), with its free components removed: its components on the
+    constrained axes Gamma_c, Delta_c, the orthonormal complements of the joint axes, so this
+    is an orthogonal projection. Gravity counts as an applied force; the joint forces tau are
+    the free components that are removed.
+
+    Args:
+        model: the tree.
+        q: configuration, shape (nq,).
+        v: generalized velocity, shape (nv,).
+        a: generalized acceleration, shape (nv,) (e.g. from `mbjax.forward_dynamics`).
+
+    Returns:
+        One wrench per joint, shape (n, 6): (torque about the hinge [N m]; force [N]), ground
+        (world) frame components.
+    """
     terms = operator_terms(model, q, v)
     W = _reactions(terms, v, a)
     pad = (~model.v_mask).astype(q.dtype)

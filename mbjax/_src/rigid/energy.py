@@ -17,14 +17,33 @@ from mbjax._src.rigid.kinematics import body_kinematics, forward_kinematics
 
 @jax.jit
 def kinetic_energy(model: Model, q: Array, v: Array) -> Array:
-    """1/2 sum_k V_k^T I_k V_k (eq 10), plus the rotors' 1/2 armature v^2."""
+    """The tree's kinetic energy, 1/2 sum_k V_k^T I_k V_k (Jerkovsky 1978 eq 10), plus the
+    rotors' 1/2 armature v^2.
+
+    Args:
+        model: the tree.
+        q: configuration, shape (nq,).
+        v: generalized velocity, shape (nv,).
+
+    Returns:
+        T [J], a scalar.
+    """
     kin = body_kinematics(model, q, v)
     return 0.5 * (jnp.einsum("ki,kij,kj->", kin.V, kin.I, kin.V) + model.armature @ (v * v))
 
 
 @jax.jit
 def potential_energy(model: Model, q: Array) -> Array:
-    """Gravity's potential, zero at the ground origin."""
+    """Gravity's potential, V = -sum_k M_k g . c_k, zero with every centre of mass at the ground
+    origin.
+
+    Args:
+        model: the tree (its `gravity`, shape (3,) [m/s^2]).
+        q: configuration, shape (nq,).
+
+    Returns:
+        V [J], a scalar.
+    """
     R, p = forward_kinematics(model, q)
     c = p + jnp.einsum("kij,kj->ki", R, model.com)
     return -jnp.sum(model.mass * (c @ model.gravity))
@@ -32,6 +51,7 @@ def potential_energy(model: Model, q: Array) -> Array:
 
 @jax.jit
 def energy(model: Model, q: Array, v: Array) -> Array:
+    """Kinetic plus gravitational energy, T + V, a scalar [J]."""
     return kinetic_energy(model, q, v) + potential_energy(model, q)
 
 

@@ -38,7 +38,20 @@ def frame_placement(model: Model, name: str) -> tuple[int, Array, Array]:
 
 @partial(jax.jit, static_argnames="name")
 def frame_pose(model: Model, q: Array, name: str) -> tuple[Array, Array]:
-    """World orientation (3, 3) and origin (3,) of the frame, body or joint called `name`."""
+    """World pose of the frame, body or joint called `name` (looked up as the module says).
+
+    Args:
+        model: the tree.
+        q: configuration, shape (nq,).
+        name: a named frame (URDF link or fixed joint, MJCF site), a body or a joint; static.
+
+    Returns:
+        (R, p): the frame's rotation (frame to world), shape (3, 3), and its origin in the
+        world [m], shape (3,).
+
+    Raises:
+        KeyError: no frame, body or joint of that name (the message lists the model's names).
+    """
     body, R_f, p_f = frame_placement(model, name)
     if body < 0:
         return R_f, p_f
@@ -48,8 +61,23 @@ def frame_pose(model: Model, q: Array, name: str) -> tuple[Array, Array]:
 
 @partial(jax.jit, static_argnames="name")
 def frame_jacobian(model: Model, q: Array, name: str) -> Array:
-    """J (6, nv) with (omega; v) = J v: the frame's angular velocity and the velocity of its
-    origin, world components (Pinocchio's LOCAL_WORLD_ALIGNED, in (angular; linear) order)."""
+    """The Jacobian J with (omega; v) = J v of the frame, body or joint called `name`.
+
+    omega is the frame's angular velocity and v the velocity of its origin, both in world
+    components: Pinocchio's LOCAL_WORLD_ALIGNED, in (angular; linear) order. A frame on the
+    ground has J = 0.
+
+    Args:
+        model: the tree.
+        q: configuration, shape (nq,).
+        name: a named frame, a body or a joint (as `frame_pose`); static.
+
+    Returns:
+        J, shape (6, nv): rows (omega; v), columns the velocity coordinates.
+
+    Raises:
+        KeyError: no frame, body or joint of that name.
+    """
     body, R_f, p_f = frame_placement(model, name)
     if body < 0:
         return jnp.zeros((6, model.nv), q.dtype)

@@ -42,16 +42,25 @@ class Kinematics(NamedTuple):
 
 @jax.jit
 def forward_kinematics(model: Model, q: Array) -> tuple[Array, Array]:
-    """World orientation (n, 3, 3) and origin (n, 3) of every body frame.
+    """World orientation and origin of every body frame.
 
     Its derivative in q is written out (for the joints `fixed_in_body` accepts): moving the
     coordinates along dq moves body k rigidly by the twist xi_k, the sum of the joints' twists
     S_j e_j over k's path from the ground (ground frame at the ground origin; e_j the joint's
     increments along its columns, dq_j itself for a hinge), xi = pi (S e) with Jerkovsky 1978's path
     matrix pi (eq 1); then dR_k = xi_k,w x R_k and dp_k = xi_k,w x p_k + xi_k,v. One product of
-    6-vectors per direction instead of the derivative of the products of rotations: the 7-dof
-    arm's flange Jacobian at 100 poses under `jax.jacfwd` 0.25 against 0.66 ms. The derivative
-    in the model's parameters is JAX's own."""
+    6-vectors per direction instead of the derivative of the products of rotations, so
+    `jax.jacfwd` of a pose is cheaper (benchmarks/README.md). The derivative in the model's
+    parameters is JAX's own.
+
+    Args:
+        model: the tree.
+        q: configuration, shape (nq,).
+
+    Returns:
+        (R, p): each body's rotation (body to world), shape (n, 3, 3), and the origin of its
+        frame (its joint) in the world [m], shape (n, 3).
+    """
     if fixed_in_body(model):
         return _poses(model, q)
     return _poses.fun(model, q)

@@ -80,8 +80,22 @@ def _free_columns(model: Model) -> np.ndarray:
 
 
 def transformation_operator(model: Model, q: Array) -> tuple[Array, Array]:
-    """A (6n x 6n, eq 17) and A_hat_f (6n x nv, eq 47) as explicit matrices, body-major rows
-    (omega_1, v_c1, omega_2, ...). For display and checks: the dynamics use the block form."""
+    """Jerkovsky 1978's transformation operator A (eq 17) and free-axis matrix A_hat_f (eq 47) as
+    explicit matrices.
+
+    sigma = A sigma_bar maps the relative velocities at the hinges to the bodies' primitive
+    velocities (omega; v_c), and sigma_bar = A_hat_f v the joint rates to the relative
+    velocities (see the module docstring). For display and checks: the dynamics use the block
+    form (`operator_terms`).
+
+    Args:
+        model: the tree.
+        q: configuration, shape (nq,).
+
+    Returns:
+        (A, A_hat_f): shapes (6n, 6n) and (6n, nv), rows body-major (omega_1, v_c1, omega_2,
+        ...), world-frame components.
+    """
     terms = operator_terms(model, q, jnp.zeros(model.nv, q.dtype))
     n, w = model.n, model.width
     A = terms.A.transpose(0, 2, 1, 3).reshape(6 * n, 6 * n)

@@ -44,15 +44,31 @@ def _model(model) -> Model:
 
 
 class TreeSystem(AbstractTreeSystem):
-    """A rigid tree: u = v, v_dot = forward dynamics under gravity, the control and the external
-    wrenches, by Anderson 1993's O(n) recursion or Jerkovsky 1978 eq 74 (`method`, as in
-    `mbjax.forward_dynamics`).
+    """A rigid tree as a system for `mbjax.simulate`: u = v, v_dot the forward dynamics under
+    gravity, the control and the external wrenches, by Anderson 1993's O(n) recursion or
+    Jerkovsky 1978 eq 74 (`method`, as in `mbjax.forward_dynamics`).
 
-    control: a callable (t, q, v) -> forces on the actuated coordinates (a `mbjax.control`
-        module, any function, or a constant array: a constant tau); actuation: the indices of
-        the velocity coordinates it drives (all by default);
-    external: a callable (t, q, v) -> (n, 6) world-frame wrenches (torque; force) on the bodies,
-        at their origins or at external_point (n, 3), body-frame points."""
+    The state is (q, v), shapes (nq,) and (nv,). Its derivatives, of any order, come from the
+    adjoint rule of `mbjax._src.rigid.adjoint`.
+
+    Args:
+        model: the tree, a `mbjax.Model`.
+        control: a callable (t, q, v) -> forces on the actuated coordinates, shape
+            (n_controls,) (an `mbjax.control` module or any function), a constant array (a
+            constant tau [N m or N]), or None.
+        external: a callable (t, q, v) -> world-frame wrenches (torque [N m]; force [N]) on the
+            bodies, shape (n, 6), acting at their origins or at `external_point`; or None.
+        external_point: body-frame points where the external forces act [m], shape (n, 3) or
+            (3,) (the same for every body); None: the bodies' origins.
+        actuation: the indices of the velocity coordinates the control drives (or a boolean
+            mask of length nv); None: all of them.
+        method: `mbjax.Recursive()`, `mbjax.Dense()` or `mbjax.Auto()` (the default); static.
+
+    Raises:
+        TypeError: `model` is not a `mbjax.Model` (a flexible tree goes in
+            `mbjax.flex.FlexibleSystem`), or `method` is not a strategy instance.
+        ValueError: malformed control, external, external_point or actuation.
+    """
 
     model: Model
     control: AbstractControl | None
@@ -70,21 +86,36 @@ class TreeSystem(AbstractTreeSystem):
         self.method = as_dynamics(method)
 
     def frames(self, q):
+        """The bodies' world poses: `mbjax.rigid.forward_kinematics` (the model's named frames
+        are in `mbjax.rigid.frame_pose`)."""
         return forward_kinematics(self.model, q)
 
     def check(self, t, q, u):
         """`Status.LIMIT_EXCEEDED` where the state or the control is beyond the model's joint
-        limits (`mbjax._src.model.limits`); limits are data here, not contact forces."""
+        limits (`mbjax._src.model.limits`); limits are data here, not contact forces.
+
+        Args:
+            t: time [s], a scalar.
+            q: configuration, shape (nq,).
+            u: generalized velocity, shape (nv,).
+
+        Returns:
+            An int32 scalar of `Status` flags.
+        """
         over = exceeded(self.model, q, u, self.applied(t, q, u))
         return jnp.where(over, int(Status.LIMIT_EXCEEDED), 0).astype(jnp.int32)
 
     def energy(self, q, v):
+        """Kinetic plus gravitational energy [J], a scalar (`mbjax.rigid.kinetic_energy` plus
+        `potential_energy`); the work of the control and external load is not included."""
         return energy(self.model, q, v)
 
     def kinetic_energy(self, q, v):
+        """The kinetic energy [J], a scalar (`mbjax.rigid.kinetic_energy`)."""
         return kinetic_energy(self.model, q, v)
 
     def dissipative(self):
+        """Whether any joint is damped."""
         return jnp.any(self.model.damping != 0)
 
     def invariants(self, t, q, u):
@@ -96,32 +127,55 @@ class TreeSystem(AbstractTreeSystem):
         return join(energy_part, free_momenta(self.model, t, q, u))
 
     def mass_matrix(self, q):
+        """M(q), shape (nv, nv) (`mbjax.mass_matrix`)."""
         return mass_matrix(self.model, q)
 
     def responses(self, t, q, v, loads):
+        """As `AbstractTreeSystem.responses`, by the route `method` resolves to."""
         tau, f = self.applied(t, q, v), self.wrenches(t, q, v)
         recursive = isinstance(self.method.resolve(self.model.nv), Recursive)
         route = aba_responses if recursive else dense_responses
         return route(self.model, q, v, tau, loads, f)
 
     def acceleration(self, t, q, u):
-        """`forward_dynamics` under the control and the external wrenches (its derivatives by the
-        adjoint rule of `mbjax._src.rigid.adjoint`)."""
+        """`mbjax.forward_dynamics` under the control and the external wrenches (its derivatives
+        by the adjoint rule of `mbjax._src.rigid.adjoint`).
+
+        Args:
+            t: time [s], a scalar.
+            q: configuration, shape (nq,).
+            u: generalized velocity v, shape (nv,).
+
+        Returns:
+            v_dot, shape (nv,).
+        """
         return forward_dynamics(self.model, q, u, self.applied(t, q, u), self.method,
                                 self.wrenches(t, q, u))
 
     def bias(self, t, q, v):
         """The RNEA at zero acceleration (velocity terms, gravity, external wrenches) less the
-        control: M v_dot + bias = 0."""
+        control: M v_dot + bias = 0; shape (nv,)."""
         return (inverse_dynamics(self.model, q, v, jnp.zeros_like(v), self.wrenches(t, q, v))
                 - self.applied(t, q, v))
 
 
 class BatchTreeSystem(AbstractSystem):
-    """B copies of a tree of revolute and prismatic joints in one system, batch last: q and u are
-    (nv, B) and u_dot = `batch_aba(model, q, u, tau)`. `simulate` integrates all of them in one
-    scan, with the throughput layout of `mbjax._src.rigid.batched` (the same trajectories as
-    `jax.vmap` of a `TreeSystem` simulation). tau is (nv,) for every copy or (nv, B)."""
+    """B copies of a tree of revolute and prismatic joints in one system, batch last.
+
+    q and u are (nv, B) and u_dot = `batch_aba(model, q, u, tau)`. `simulate` integrates all of
+    them in one scan, with the throughput layout of `mbjax._src.rigid.batched` (the same
+    trajectories as `jax.vmap` of a `TreeSystem` simulation). Gravity comes from the model; no
+    control or external load; no invariants.
+
+    Args:
+        model: a tree of revolute and prismatic joints only.
+        tau: constant joint forces [N m or N], shape (nv,) (the same for every copy) or
+            (nv, B); None: zero.
+
+    Raises:
+        ValueError: (when simulated) a joint that is not revolute or prismatic, or q not of
+            shape (nv, B).
+    """
 
     model: Model
     tau: Array
@@ -134,12 +188,32 @@ class BatchTreeSystem(AbstractSystem):
         return u
 
     def acceleration(self, t, q, u):
+        """The joint accelerations of every copy, shape (nv, B), from q and u of shape (nv, B)."""
         return batch_aba(self.model, q, u, self.tau)
 
 
 class MomentumSystem(AbstractDrivenSystem):
-    """u = p = M(q) v, the free momenta (Jerkovsky 1978 eq 73); u_dot from eq 72. Controls and
-    external wrenches as for `TreeSystem`."""
+    """A rigid tree integrated in Jerkovsky 1978's momentum form: u = p = M(q) v, the free
+    momenta (eq 73), and u_dot from eq 72, which needs no mass-matrix solve (only v = M^-1 p
+    does).
+
+    The state is (q, p), shapes (nq,) and (nv,); make p from joint velocities as
+    `mbjax.mass_matrix(model, q) @ v` and read v back with `velocity(q, p)`.
+
+    Args:
+        model: the tree, a `mbjax.Model`.
+        control: as for `TreeSystem`: a callable (t, q, v) -> forces on the actuated
+            coordinates (called with the velocities v, not the momenta), a constant array, or
+            None.
+        external: a callable (t, q, v) -> world-frame wrenches, shape (n, 6), or None.
+        external_point: body-frame points where the external forces act [m], shape (n, 3) or
+            (3,); None: the bodies' origins.
+        actuation: the indices of the velocity coordinates the control drives; None: all.
+
+    Raises:
+        TypeError: `model` is not a `mbjax.Model`.
+        ValueError: malformed control, external, external_point or actuation.
+    """
 
     model: Model
     control: AbstractControl | None
@@ -155,13 +229,24 @@ class MomentumSystem(AbstractDrivenSystem):
 
     @property
     def n(self) -> int:
+        """Number of bodies."""
         return self.model.n
 
     @property
     def nv(self) -> int:
+        """Number of velocity coordinates (and of momenta)."""
         return self.model.nv
 
     def velocity(self, q, p):
+        """The joint velocities of the momenta, v = M(q)^-1 p, by Cholesky.
+
+        Args:
+            q: configuration, shape (nq,).
+            p: free momenta, shape (nv,).
+
+        Returns:
+            v, shape (nv,).
+        """
         return velocity_from_momentum(self.model, q, p)
 
     def kinematics(self, q, u):
@@ -187,6 +272,7 @@ class MomentumSystem(AbstractDrivenSystem):
         return held(self, t, q, self.velocity(q, u))
 
     def energy(self, q, u):
+        """Kinetic plus gravitational energy [J] at the momenta u, a scalar."""
         return energy(self.model, q, self.velocity(q, u))
 
     def invariants(self, t, q, u):

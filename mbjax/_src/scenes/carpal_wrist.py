@@ -116,7 +116,7 @@ def _synthesis_terminal(q, v, *, wrist, goal_plunge, goal_slope):
 
 
 def synthesis_problem(w: CarpalWrist | None = None, steps: int = 100):
-    """The move START -> GOAL at rest in DURATION, |tau_i| <= TORQUE_LIMIT, as a trajectory-optimisation problem.
+    """The move START -> GOAL at rest in DURATION, |tau_i| <= TORQUE_LIMIT, as a trajopt problem.
 
     RK4, `steps` knots of held torques; least-squares residuals: along the way the torques
     scaled by the limit (0.3) and a trace of the speed (1e-3), at the end the midplane chart's

@@ -22,7 +22,14 @@ def min_jerk(s: Array) -> Array:
 
 
 class ToolPath(eqx.Module):
-    """Plunge and slope blended from `start` to `goal` (each (plunge, slope)) over `duration`."""
+    """A tool path in the midplane chart: plunge and slope blended from `start` to `goal` by the
+    quintic (minimum-jerk) profile, at rest at both ends.
+
+    Args:
+        start: (plunge [m], slope shape (2,)) at t = 0.
+        goal: (plunge [m], slope shape (2,)) at t = duration.
+        duration: the blend's duration [s]; static.
+    """
 
     start_plunge: Array
     start_slope: Array
@@ -36,12 +43,22 @@ class ToolPath(eqx.Module):
         self.duration = float(duration)
 
     def chart(self, t: Array) -> tuple[Array, Array]:
+        """(plunge [m], slope shape (2,)) at time t [s] (held at the ends outside [0, duration])."""
         s = min_jerk(t / self.duration)
         return (self.start_plunge + s * (self.goal_plunge - self.start_plunge),
                 self.start_slope + s * (self.goal_slope - self.start_slope))
 
     def joint_motion(self, wrist, t: Array) -> tuple[Array, Array, Array, Array]:
-        """(theta, theta_dot, theta_ddot, reachable) at time t, derivatives in t by autodiff."""
+        """The joint motion along the path, its derivatives in t by autodiff.
+
+        Args:
+            wrist: the `CarpalWrist`.
+            t: time [s], a scalar.
+
+        Returns:
+            (theta [rad], theta_dot [rad/s], theta_ddot [rad/s^2], each shape (3,);
+            reachable, a boolean scalar).
+        """
         def theta(time):
             return kinematics.solve_inverse_kinematics(wrist, *self.chart(time))[0]
 
@@ -63,7 +80,20 @@ class FeedForward(eqx.Module):
 
 @eqx.filter_jit
 def feedforward_torques(wrist, path: ToolPath, ts: Array) -> Array:
-    """tau_ff at times ts, shape (len(ts), 3); raises if the path leaves the workspace."""
+    """The feed-forward motor torques along a tool path: inverse kinematics, then the
+    inverse dynamics of eq 6.16.
+
+    Args:
+        wrist: the `CarpalWrist`.
+        path: the `ToolPath`.
+        ts: times [s], shape (k,).
+
+    Returns:
+        tau_ff [N m], shape (k, 3).
+
+    Raises:
+        equinox.EquinoxRuntimeError: the path leaves the workspace.
+    """
     q, q_dot, q_ddot, ok = jax.vmap(lambda t: path.joint_motion(wrist, t))(jnp.asarray(ts, dtype=float))
     tau = jax.vmap(wrist.inverse_dynamics)(q, q_dot, q_ddot)
     return eqx.error_if(tau, ~jnp.all(ok), "the tool path leaves the Carpal Wrist's workspace")

@@ -17,9 +17,8 @@ tracking cost
 y = (p / l, g) the pose in the midplane chart, t_k the saved times, weighted towards the end by
 (t_k / T)^e, e = end_power = 2 (the start is far from the target by construction). The logarithm
 keeps a few far-off episodes from dominating the mean, which otherwise trades the many near misses
-for them: on 64 held-out targets, 150 iterations on 32 episodes left the median final pose error
-at 0.035 with the plain mean (learning rate 3e-3) and at 0.025 with the logarithm (1e-2); servo
-alone 0.040. The gradient is reverse mode through the rollouts by default (`jax.value_and_grad`:
+for them (training results in benchmarks/README.md). The gradient is reverse mode through the
+rollouts by default (`jax.value_and_grad`:
 a few forward passes for the network's hundred-odd weights, where `jax.jacfwd` would carry one
 tangent per weight), one jitted `lax.scan` over the iterations. Success on held-out targets: the
 final pose within `kinematics.pose_error` < `success_tolerance`.
@@ -39,11 +38,28 @@ from mbjax._src.wrist import WristSystem, kinematics
 
 
 class NeuralController(AbstractControl):
-    """tau = limit tanh((kp (theta* - theta) - kd theta_dot + C(theta*)
-                         + limit MLP(theta - theta*, theta_dot / omega_scale, theta* - theta_centre)) / limit).
+    """A servo plus a small MLP, saturated at the torque limit, steering the wrist to a target:
 
-    With `neural=False` the MLP term is left out: the servo alone, the baseline the training
-    is measured against."""
+        tau = limit tanh((kp (theta* - theta) - kd theta_dot + C(theta*)
+                          + limit MLP(theta - theta*, theta_dot / omega_scale,
+                                      theta* - theta_centre)) / limit).
+
+    The MLP's output layer starts at zero, so the untrained controller is the servo. Aim it with
+    `aimed_at`; train it with `train_controller`. A control for `WristSystem`.
+
+    Args:
+        key: a `jax.random` key for the MLP's initial weights.
+        limit: the torque limit [N m].
+        theta_centre: the workspace's centre in input angles [rad], shape (3,) (also the
+            initial target).
+        width: the MLP's hidden width.
+        depth: the MLP's number of hidden layers.
+        kp: proportional gain [N m/rad].
+        kd: derivative gain [N m s/rad].
+        omega_scale: the scale of theta_dot at the MLP's input [rad/s]; static.
+        neural: False leaves the MLP term out: the servo alone, the baseline the training is
+            compared with; static.
+    """
 
     mlp: eqx.nn.MLP
     limit: Array
@@ -69,8 +85,16 @@ class NeuralController(AbstractControl):
         self.neural = neural
 
     def aimed_at(self, wrist, target: Array, gravity_torque: Array | None = None) -> "NeuralController":
-        """The same controller steering to joint target theta*, with the gravity torque C(theta*)
-        (computed here unless given)."""
+        """The same controller steering to joint target theta*.
+
+        Args:
+            wrist: the `CarpalWrist`.
+            target: theta* [rad], shape (3,).
+            gravity_torque: C(theta*) [N m], shape (3,); None: computed here.
+
+        Returns:
+            The aimed `NeuralController`.
+        """
         target = jnp.asarray(target, dtype=float)
         if gravity_torque is None:
             gravity_torque = wrist.eom_terms(target, jnp.zeros_like(target))[2]
@@ -95,7 +119,15 @@ def sample_poses(key, n: int, plunge_range, max_slope: float) -> tuple[Array, Ar
 
 
 class Episodes(eqx.Module):
-    """A batch of (start theta, target theta, target plunge, target slope, C(target theta))."""
+    """A batch of k training or evaluation episodes, from `make_episodes`.
+
+    Attributes:
+        start: start input angles [rad], shape (k, 3).
+        target: target input angles [rad], shape (k, 3).
+        target_plunge: the targets' plunge [m], shape (k,).
+        target_slope: the targets' slope, shape (k, 2).
+        gravity_torque: C(target) [N m], shape (k, 3).
+    """
 
     start: Array
     target: Array
@@ -105,7 +137,23 @@ class Episodes(eqx.Module):
 
 
 def make_episodes(wrist, key, n: int, plunge_range=(0.068, 0.082), max_slope: float = 0.3) -> Episodes:
-    """Random start and target poses in the workspace (knees-out inverse kinematics)."""
+    """Random start and target poses in the workspace (knees-out inverse kinematics).
+
+    Poses are uniform in plunge and in the slope disk |g| <= max_slope.
+
+    Args:
+        wrist: the `CarpalWrist`.
+        key: a `jax.random` key.
+        n: number of episodes.
+        plunge_range: (lowest, highest) plunge [m].
+        max_slope: the largest slope |g|.
+
+    Returns:
+        The `Episodes`.
+
+    Raises:
+        ValueError: a sampled pose is outside the workspace (narrow plunge_range or max_slope).
+    """
     k1, k2 = jax.random.split(key)
     ik = jax.jit(jax.vmap(lambda p, g: kinematics.solve_inverse_kinematics(wrist, p, g)))
     (p0, g0), (p1, g1) = sample_poses(k1, n, plunge_range, max_slope), sample_poses(k2, n, plunge_range, max_slope)
@@ -146,9 +194,35 @@ def train_controller(controller: NeuralController, wrist, episodes: Episodes, *,
                      pose_tolerance: float = 0.02, speed_tolerance: float = 1.0,
                      effort_weight: float = 0.1, gradient: str = "reverse", end_power: float = 2.0,
                      robust: bool = True):
-    """(trained controller, loss per iteration): Adam on the batch-mean episode cost, with
-    reverse-mode gradients by default (the network's weights outnumber what forward mode does
-    cheaply; see `adam_descent`)."""
+    """Train the controller's MLP through the simulator: Adam on the batch mean of the episode
+    cost J (see the module docstring).
+
+    Reverse-mode gradients by default: the network's weights outnumber what forward mode does
+    cheaply (see `mbjax._src.trajopt.descent.adam_descent`). The whole descent is one jitted
+    `lax.scan`.
+
+    Args:
+        controller: the `NeuralController` to train (its MLP's weights vary).
+        wrist: the `CarpalWrist`.
+        episodes: the training `Episodes`.
+        iterations: Adam steps.
+        learning_rate: Adam's learning rate.
+        duration: each episode's duration T [s].
+        steps: RK4 steps per episode.
+        saves: saved times per episode that the tracking cost sums over.
+        pose_tolerance: tol, the scale of the pose miss.
+        speed_tolerance: omega_tol, the scale of the final speed [rad/s].
+        effort_weight: w, the weight of the effort term.
+        gradient: "reverse" or "forward" mode, as `adam_descent` takes it.
+        end_power: e, the weight (t_k / T)^e towards the end.
+        robust: descend on the mean of log(1 + J) (True) or of J (False).
+
+    Returns:
+        (the trained controller, the loss at each iteration, shape (iterations,)).
+
+    Raises:
+        ValueError: gradient is neither "forward" nor "reverse".
+    """
     weights, rebuild = jax.flatten_util.ravel_pytree(eqx.filter(controller.mlp, eqx.is_inexact_array))
     static_mlp = eqx.filter(controller.mlp, eqx.is_inexact_array, inverse=True)
     cost_kw = dict(duration=duration, steps=steps, saves=saves, pose_tolerance=pose_tolerance,
@@ -170,7 +244,19 @@ def train_controller(controller: NeuralController, wrist, episodes: Episodes, *,
 @eqx.filter_jit
 def evaluate_controller(controller: NeuralController, wrist, episodes: Episodes, *, duration: float = 0.6,
                         steps: int = 30, success_tolerance: float = 0.02) -> tuple[Array, Array]:
-    """(final pose errors, success rate) over `episodes` (held-out targets)."""
+    """Run the controller on held-out episodes and score the final poses.
+
+    Args:
+        controller: the `NeuralController`.
+        wrist: the `CarpalWrist`.
+        episodes: the evaluation `Episodes` (k of them).
+        duration: each episode's duration [s].
+        steps: RK4 steps per episode.
+        success_tolerance: the `pose_error` below which an episode succeeds.
+
+    Returns:
+        (final pose errors, shape (k,); success rate, the fraction below success_tolerance).
+    """
     def one(*e):
         return episode_cost(controller, wrist, *e, duration=duration, steps=steps, saves=1,
                             pose_tolerance=1.0, speed_tolerance=1.0, effort_weight=0.0)[1]

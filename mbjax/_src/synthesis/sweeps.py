@@ -31,8 +31,20 @@ def batch(base: CarpalWrist, **values) -> CarpalWrist:
 
 
 def grid(base: CarpalWrist, **axes) -> tuple[CarpalWrist, tuple[int, ...]]:
-    """The Cartesian product of per-field value lists (each a sequence of values of that field's
-    shape), as one batch in C order, and the grid's shape."""
+    """A grid of wrists for `mbjax.trajopt.sweep`: the Cartesian product of per-field values.
+
+    Args:
+        base: the wrist whose other fields every variant keeps.
+        **axes: field name (base_radius, link_length, phi0, tool_mass, tool_inertia,
+            tool_com, gravity) -> a sequence of values of that field's shape.
+
+    Returns:
+        (wrists, shape): one batched `CarpalWrist` whose leaves have a leading axis of
+        prod(shape) variants in C order, and the grid's shape (one length per field).
+
+    Raises:
+        ValueError: an unknown field.
+    """
     names = list(axes)
     rows = list(itertools.product(*(list(axes[k]) for k in names)))
     values = {k: np.stack([np.asarray(r[i], dtype=float) for r in rows]) for i, k in enumerate(names)}
@@ -40,8 +52,17 @@ def grid(base: CarpalWrist, **axes) -> tuple[CarpalWrist, tuple[int, ...]]:
 
 
 def peak_torque(wrist: CarpalWrist, path: ToolPath, samples: int = 64):
-    """The largest |motor torque| (inverse dynamics) along a tool path, and where (time index):
-    the actuator-sizing number of Canfield 1997 eq 6.16."""
+    """The largest |motor torque| (inverse dynamics) along a tool path: the actuator-sizing
+    number of Canfield 1997 eq 6.16.
+
+    Args:
+        wrist: the `CarpalWrist`.
+        path: the `ToolPath`.
+        samples: number of evenly spaced times in [0, duration].
+
+    Returns:
+        max over the samples and motors of |tau| [N m], a scalar.
+    """
     ts = jnp.linspace(0.0, path.duration, samples)
     q, q_dot, q_ddot, _ = jax.vmap(lambda t: path.joint_motion(wrist, t))(ts)
     tau = jax.vmap(wrist.inverse_dynamics)(q, q_dot, q_ddot)

@@ -28,9 +28,18 @@ from mbjax._src.wrist import WristSystem, kinematics
 
 
 class Synthesis(WithStatus):
-    """The result of `synthesize`: the torque spline, the objective at each iteration, the final
-    state and the figures of merit (`kinematics.pose_error` of the final pose against the goal,
-    the effort int |tau|^2 dt in N^2 m^2 s, the peak |tau_i| in N m)."""
+    """The result of `synthesize`.
+
+    Attributes:
+        spline: the torque `mbjax.control.CubicSpline`, a control for `WristSystem`.
+        losses: the objective at each iteration, shape (iterations,).
+        theta_final: the final input angles [rad], shape (3,).
+        theta_dot_final: their final rates [rad/s], shape (3,).
+        final_pose_error: `pose_error` of the final pose against the goal.
+        effort: int |tau|^2 dt [N^2 m^2 s].
+        peak_torque: the peak |tau_i| [N m].
+        status: the final rollout's `Status` flags.
+    """
 
     spline: CubicSpline
     losses: Array
@@ -70,16 +79,38 @@ def synthesize(wrist, theta0: Array, goal, *, duration: float, torque_limit: flo
     """Torque splines that move the wrist from rest at theta0 to rest at goal = (plunge, slope)
     in `duration` with least effort, |tau_i| <= torque_limit; see the module docstring.
 
-    `init` defaults to the constant torque that holds theta0 against gravity; the feed-forward
-    baseline fitted to the spline (`CubicSpline.fit`, clipped to the limit) is a far better start
-    for this open-loop unstable robot. Each rollout takes `steps` steps of `integrator`;
-    `iterations` Adam steps at `learning_rate` (cosine-decayed to a tenth).
     The gradient is forward mode (`jax.jacfwd` over the 3 n_knots spline values): for a few dozen
     parameters it compiles several times faster than reverse mode through the rollout's scan.
     The result's figures come from the same discrete rollout; re-simulate `spline` with a finer
     or higher-order integrator to see the continuous-time miss (`mbjax reproduce carpal-wrist`).
-    The status is the final rollout's (a non-finite state, a singular configuration); throw=True
-    raises on a failure instead (as `mbjax.simulate`)."""
+
+    Args:
+        wrist: the `CarpalWrist`.
+        theta0: the input angles at rest at t = 0 [rad], shape (3,).
+        goal: (plunge [m], slope shape (2,)), the pose to reach at rest.
+        duration: the manoeuvre's duration T [s]; static.
+        torque_limit: the motors' saturation |tau_i| [N m].
+        n_knots: spline knots per motor.
+        steps: steps of `integrator` per rollout.
+        iterations: Adam steps.
+        learning_rate: Adam's initial learning rate (cosine-decayed to a tenth).
+        pose_tolerance: tol, the scale of the final pose miss in the objective.
+        speed_tolerance: omega_tol, the scale of the final speed [rad/s].
+        effort_weight: w, the weight of the effort term.
+        integrator: the rollouts' integrator (`mbjax.integrate.RK4()` by default).
+        init: the starting spline; None: the constant torque that holds theta0 against
+            gravity. The feed-forward baseline fitted to a spline (`CubicSpline.fit`, clipped to
+            the limit) is a far better start for this open-loop unstable robot.
+        throw: raise on a failed final rollout instead of reporting it in `status`, as
+            `mbjax.simulate` does.
+
+    Returns:
+        A `Synthesis`: the spline, the losses, the final state, the figures of merit and the
+        final rollout's status (a non-finite state, a singular configuration).
+
+    Raises:
+        equinox.EquinoxRuntimeError: with throw=True, the final rollout failed.
+    """
     theta0 = jnp.asarray(theta0, dtype=float)
     goal_p, goal_g = (jnp.asarray(x, dtype=float) for x in goal)
     if init is None:
@@ -109,4 +140,4 @@ def synthesize(wrist, theta0: Array, goal, *, duration: float, torque_limit: flo
     return raise_on_failure(
         Synthesis(spline=spline, losses=losses, theta_final=theta, theta_dot_final=theta_dot,
                   final_pose_error=error, effort=work, peak_torque=peak, status=status),
-        throw, "mbjax.trajopt.synthesize")
+        throw, "mbjax.wrist.synthesize")

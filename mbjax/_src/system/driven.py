@@ -46,9 +46,19 @@ class AbstractDrivenSystem(AbstractSystem):
 
     @property
     def n_controls(self) -> int:
+        """The number of forces the control returns: len(actuation), or nv if all are actuated."""
         return self.nv if self.actuation is None else len(self.actuation)
 
     def with_control(self, control) -> "AbstractDrivenSystem":
+        """The system driven by `control` instead of its own (what trajectory optimisation varies).
+
+        Args:
+            control: a callable (t, q, v) -> forces, shape (n_controls,); an
+                `mbjax.control` module; a constant array; or None (no control).
+
+        Returns:
+            A copy of the system with the new control; the actuation is unchanged.
+        """
         return eqx.tree_at(lambda s: s.control, self, as_control(control),
                            is_leaf=lambda x: x is None)
 
@@ -56,12 +66,15 @@ class AbstractDrivenSystem(AbstractSystem):
         """The control's forces on all nv velocity coordinates (zero where unactuated).
 
         Args:
-            t: time, scalar.
-            q: configuration.
+            t: time [s], a scalar.
+            q: configuration, shape (nq,).
             v: velocity, shape (nv,).
 
         Returns:
             Generalized forces, shape (nv,).
+
+        Raises:
+            ValueError: the control returned a shape other than (n_controls,).
         """
         if self.control is None:
             return jnp.zeros(self.nv, v.dtype)
@@ -76,8 +89,20 @@ class AbstractDrivenSystem(AbstractSystem):
         return jnp.zeros(self.nv, v.dtype).at[jnp.array(self.actuation)].set(tau)
 
     def external_wrenches(self, t: Array, q: Array, v: Array) -> Array | None:
-        """The external wrenches as `external` returns them, checked: shape (n, 6), world frame,
-        at the bodies' origins or at `external_point`; None without an external load."""
+        """The external wrenches as `external` returns them, checked.
+
+        Args:
+            t: time [s], a scalar.
+            q: configuration, shape (nq,).
+            v: velocity, shape (nv,).
+
+        Returns:
+            World-frame wrenches (torque [N m]; force [N]), shape (n, 6), acting at the bodies'
+            origins or at `external_point`; None without an external load.
+
+        Raises:
+            ValueError: `external` returned a shape other than (n, 6).
+        """
         if self.external is None:
             return None
         f = jnp.asarray(self.external(t, q, v), v.dtype)

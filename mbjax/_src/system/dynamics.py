@@ -15,7 +15,12 @@ from mbjax._src import runtime
 
 
 class AbstractForwardDynamics(eqx.Module):
-    """A route to the accelerations of a tree; `resolve(nv)` names the concrete one."""
+    """A route to the accelerations of a tree; `resolve(nv)` names the concrete one.
+
+    Pass an instance (`Recursive()`, `Dense()`, `Auto()`) as `method=` to
+    `mbjax.forward_dynamics`, `mbjax.rigid.TreeSystem` or `mbjax.flex.FlexibleSystem`; strings
+    and classes are refused with a TypeError.
+    """
 
     @abc.abstractmethod
     def resolve(self, nv: int) -> "Recursive | Dense":
@@ -31,7 +36,10 @@ class AbstractForwardDynamics(eqx.Module):
 
 class Recursive(AbstractForwardDynamics):
     """Anderson 1993's O(n) recursion: one inward pass that triangularizes the mass matrix body
-    by body and one outward pass for the accelerations (§2.3, eqs 51-86)."""
+    by body and one outward pass for the accelerations (§2.3, eqs 51-86).
+
+    Takes no arguments: `method=Recursive()`.
+    """
 
     def resolve(self, nv: int) -> "Recursive":
         return self
@@ -39,7 +47,10 @@ class Recursive(AbstractForwardDynamics):
 
 class Dense(AbstractForwardDynamics):
     """The generalized mass matrix formed and factored by Cholesky (Jerkovsky 1978 eq 74 for rigid
-    trees; the Lagrangian route of Anderson 1993 §2.2 for flexible ones), O(n^3)."""
+    trees; the Lagrangian route of Anderson 1993 §2.2 for flexible ones), O(n^3).
+
+    Takes no arguments: `method=Dense()`.
+    """
 
     def resolve(self, nv: int) -> "Dense":
         return self
@@ -59,10 +70,12 @@ def _default_crossover() -> int:
 class Auto(AbstractForwardDynamics):
     """`Dense()` below `crossover_nv` velocity coordinates, `Recursive()` from there on.
 
+    The choice is made once, when the program is traced, from the model's static size.
+
     Args:
         crossover_nv: the smallest tree, in velocity coordinates, run by the recursion. By default
-            0 where XLA compiles loops as one kernel (what `import mbjax` sets up), else 5: the
-            crossover measured by `mbjax bench rigid`.
+            0 where XLA compiles loops as one kernel (what `import mbjax` sets up), else 5
+            (`CROSSOVER_NV`, the crossover found by `mbjax bench rigid`).
     """
 
     crossover_nv: int = eqx.field(static=True, default_factory=_default_crossover)

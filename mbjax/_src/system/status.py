@@ -10,26 +10,44 @@ from jax import Array
 
 
 class Status(enum.IntFlag):
-    """Flags OR-ed into `Solution.status`; 0 means success without remarks."""
+    """Flags OR-ed into a result's integer `status` (`Solution.status`, one per run; batched
+    under vmap); 0 means success without remarks. Test a flag with `status & Status.X`, and a
+    run with `result.ok`; `result.messages()` spells the flags out.
+
+    Attributes:
+        SUCCESS: 0, no flag set.
+        NONFINITE: a state became inf or NaN (the step is beyond the method's stability).
+        NOT_CONVERGED: an implicit step's Newton iteration missed its tolerance.
+        SOLVER_FAILED: the adaptive reference solver stopped (step-size underflow, max_steps).
+        CONSTRAINT_VIOLATED: a closed loop's residual |Phi| grew past the system's tolerance.
+        REDUNDANT: a note, not a failure: the constraint Jacobian lost rank (redundant closures
+            or a singular configuration); least-squares loads were used.
+        LIMIT_EXCEEDED: a note: a saved state or control is beyond the model's joint limits
+            (position, velocity or effort; `mbjax._src.model.limits`).
+        INACCURATE: the estimated error exceeds the tolerance asked for (`simulate`'s rtol and
+            atol; `Solution.error`).
+        SINGULAR: a saved state at (or within the system's tolerance of) a singular
+            configuration, where the dynamics are not defined (the Carpal Wrist's inverse or
+            direct singularity: `WristSystem.check`).
+    """
 
     SUCCESS = 0
-    NONFINITE = 1          # a state became inf or NaN (the step is beyond the method's stability)
-    NOT_CONVERGED = 2      # an implicit step's Newton iteration missed its tolerance
-    SOLVER_FAILED = 4      # the adaptive reference solver stopped (step-size underflow, max_steps)
-    CONSTRAINT_VIOLATED = 8  # a closed loop's residual |Phi| grew past the system's tolerance
-    REDUNDANT = 16         # a note, not a failure: the constraint Jacobian lost rank (redundant
-                           # closures or a singular configuration); least-squares loads were used
-    LIMIT_EXCEEDED = 32    # a note: a saved state or control is beyond the model's joint limits
-                           # (position, velocity or effort; `mbjax._src.model.limits`)
-    INACCURATE = 64        # the estimated error exceeds the tolerance asked for (`simulate`'s
-                           # rtol and atol; `Solution.error`)
-    SINGULAR = 128         # a saved state at (or within the system's tolerance of) a singular
-                           # configuration, where the dynamics are not defined (the Carpal
-                           # Wrist's inverse or direct singularity: `WristSystem.check`)
+    NONFINITE = 1
+    NOT_CONVERGED = 2
+    SOLVER_FAILED = 4
+    CONSTRAINT_VIOLATED = 8
+    REDUNDANT = 16
+    LIMIT_EXCEEDED = 32
+    INACCURATE = 64
+    SINGULAR = 128
 
     @classmethod
     def failures(cls) -> int:
-        """The flags that make a run fail (`REDUNDANT` and `LIMIT_EXCEEDED` only inform)."""
+        """The flags that make a run fail (`REDUNDANT` and `LIMIT_EXCEEDED` only inform).
+
+        Returns:
+            The failure flags OR-ed into one int mask.
+        """
         return (cls.NONFINITE | cls.NOT_CONVERGED | cls.SOLVER_FAILED | cls.CONSTRAINT_VIOLATED
                 | cls.INACCURATE | cls.SINGULAR)
 
@@ -55,11 +73,17 @@ class WithStatus(eqx.Module):
 
     @property
     def ok(self) -> Array:
-        """True where the run succeeded (no failure flag; the notes only inform)."""
+        """True where the run succeeded (no failure flag; the notes only inform); the shape of
+        `status`."""
         return (self.status & Status.failures()) == 0
 
     def messages(self) -> list[str]:
-        """Human-readable status for each (possibly batched) run; needs concrete values."""
+        """Human-readable status for each (possibly batched) run; needs concrete values.
+
+        Returns:
+            One string per run ("success", or the flags' names joined by commas), in the
+            order of `status` flattened.
+        """
         out = []
         for code in np.atleast_1d(np.asarray(self.status)).ravel():
             flags = [f.name.lower().replace("_", " ") for f in Status if f and Status(int(code)) & f]

@@ -22,70 +22,187 @@ from mbjax._src.system.invariants import Invariants
 
 
 class AbstractSystem(eqx.Module):
-    """A first-order mechanical system in (q, u); see the module docstring."""
+    """A first-order mechanical system in (q, u): what `mbjax.simulate` and every integrator
+    integrate.
+
+    Subclasses implement `kinematics` (q_dot) and `acceleration` (u_dot); a system whose
+    configuration lives on a manifold also overrides the chart (`retract`, `local_rate`) and
+    `project` (see the module docstring). The other methods have defaults that suit an
+    unconstrained, uncontrolled system. The abstract class takes no constructor arguments.
+    """
 
     @abc.abstractmethod
     def kinematics(self, q: Array, u: Array) -> Array:
-        """q_dot as a function of the configuration and the velocity."""
+        """q_dot as a function of the configuration and the velocity.
+
+        Args:
+            q: configuration, shape (nq,).
+            u: velocity state, shape (nu,).
+
+        Returns:
+            dq/dt, shape (nq,).
+        """
 
     @abc.abstractmethod
     def acceleration(self, t: Array, q: Array, u: Array) -> Array:
-        """u_dot, the equations of motion solved for the accelerations."""
+        """u_dot: the equations of motion solved for the accelerations.
+
+        Args:
+            t: time [s], a scalar.
+            q: configuration, shape (nq,).
+            u: velocity state, shape (nu,).
+
+        Returns:
+            du/dt, shape (nu,).
+        """
 
     def retract(self, q0: Array, xi: Array) -> Array:
-        """The configuration at chart point xi about q0."""
+        """The configuration at chart point xi about q0 (q0 + xi by default).
+
+        Args:
+            q0: the chart's base configuration, shape (nq,).
+            xi: chart coordinates, shape (nu,); xi = 0 is q0.
+
+        Returns:
+            The configuration, shape (nq,).
+        """
         return q0 + xi
 
     def local_rate(self, q0: Array, xi: Array, u: Array) -> Array:
-        """xi_dot at chart point xi about q0 for velocity u."""
+        """xi_dot at chart point xi about q0 for velocity u.
+
+        Args:
+            q0: the chart's base configuration, shape (nq,).
+            xi: chart coordinates, shape (nu,).
+            u: velocity state, shape (nu,).
+
+        Returns:
+            dxi/dt, shape (nu,) (for rotations, Borri 1990's Gamma(xi)^-T Omega).
+        """
         return self.kinematics(self.retract(q0, xi), u)
 
     def project(self, q: Array) -> Array:
-        """Map coordinates back to their canonical form (unit quaternion, principal rotation vector)."""
+        """Map coordinates back to their canonical form (unit quaternion, principal rotation vector).
+
+        Args:
+            q: configuration, shape (nq,).
+
+        Returns:
+            The same configuration in canonical coordinates, shape (nq,); q itself by default.
+        """
         return q
 
     def hold(self, t: Array, q: Array, u: Array) -> "AbstractSystem":
-        """The system as it acts over one step of `simulate` that starts at (t, q, u): sampled
-        controls (`mbjax.control.ZeroOrderHold`, `SampleAndHold`) frozen at their values there.
-        The system itself here."""
+        """The system as it acts over one step of `simulate` that starts at (t, q, u).
+
+        Sampled controls (`mbjax.control.ZeroOrderHold`, `SampleAndHold`) are frozen at their
+        values there.
+
+        Args:
+            t: time at the step's start [s], a scalar.
+            q: configuration at the step's start, shape (nq,).
+            u: velocity state at the step's start, shape (nu,).
+
+        Returns:
+            The system with its sampled controls held; the system itself by default.
+        """
         return self
 
     def constrain(self, t: Array, q: Array, u: Array) -> tuple[Array, Array]:
-        """After each step of `simulate`: put (q, u) back on the system's constraints (a closed
-        loop's projection, `mbjax.loops`). The identity here."""
+        """After each step of `simulate`: put (q, u) back on the system's constraints.
+
+        A closed loop projects onto its closures here (`mbjax.loops`).
+
+        Args:
+            t: time [s], a scalar.
+            q: configuration, shape (nq,).
+            u: velocity state, shape (nu,).
+
+        Returns:
+            (q, u) on the constraints; unchanged by default.
+        """
         return q, u
 
     def check(self, t: Array, q: Array, u: Array) -> Array:
-        """`Status` flags for a state `simulate` saves (a violated or redundant constraint,
-        `mbjax.loops`); 0 here."""
+        """`Status` flags for a state `simulate` saves.
+
+        A closed loop reports a violated or redundant constraint here (`mbjax.loops`), a tree a
+        joint limit exceeded, the Carpal Wrist a singular configuration.
+
+        Args:
+            t: time [s], a scalar.
+            q: configuration, shape (nq,).
+            u: velocity state, shape (nu,).
+
+        Returns:
+            An int32 scalar of OR-ed `Status` flags; 0 by default.
+        """
         return jnp.array(0, jnp.int32)
 
     def invariants(self, t: Array, q: Array, u: Array) -> Invariants | None:
-        """The quantities the exact motion conserves at a state (`mbjax._src.system.invariants`:
-        the energy of a passive system, a free tree's momentum), whose drift `simulate(...,
-        rtol=)` holds to rtol; None here: none known."""
+        """The quantities the exact motion conserves at a state.
+
+        The energy of a passive system, a free tree's momentum (`mbjax._src.system.invariants`):
+        their drift is what `simulate(..., rtol=)` holds to rtol.
+
+        Args:
+            t: time [s], a scalar.
+            q: configuration, shape (nq,).
+            u: velocity state, shape (nu,).
+
+        Returns:
+            The invariants at the state, or None where none is known (the default).
+        """
         return None
 
     def state_sizes(self) -> tuple[int | None, int | None]:
-        """The lengths of q and u a state of this system must have, None where the system does
-        not say (`simulate` and `mbjax.trajopt.Problem` check states against them)."""
+        """The lengths of q and u a state of this system must have.
+
+        `simulate` and `mbjax.trajopt.Problem` check states against them.
+
+        Returns:
+            (nq, nu), each None where the system does not say; (None, None) by default.
+        """
         return None, None
 
     @property
     def n_controls(self) -> int:
-        """The number of forces its control returns (its actuated coordinates)."""
+        """The number of forces its control returns (its actuated coordinates).
+
+        Raises:
+            TypeError: the system has no control.
+        """
         raise TypeError(f"{type(self).__name__} has no control")
 
     def with_control(self, control) -> "AbstractSystem":
-        """The system driven by `control` instead of its own (what trajectory optimisation
-        varies); systems without a control raise TypeError."""
+        """The system driven by `control` instead of its own (what trajectory optimisation varies).
+
+        Args:
+            control: a callable (t, q, u) -> forces, an `mbjax.control` module or a constant
+                array.
+
+        Returns:
+            A copy of the system with the new control.
+
+        Raises:
+            TypeError: the system has no control.
+        """
         raise TypeError(f"{type(self).__name__} has no control to optimise: a problem needs a "
                         "system with a `control` (TreeSystem, FlexibleSystem, WristSystem, "
                         "RigidBody, a ClosedSystem of a tree, ...)")
 
     @eqx.filter_jit
     def relative_energy_error(self, qs: Array, us: Array) -> Array:
-        """(E(t) - E(0)) / |E(0)| along a saved trajectory, for systems with an `energy(q, u)`
-        (one compiled program, not one per array operation when called outside `jit`)."""
+        """(E(t) - E(0)) / |E(0)| along a saved trajectory, for systems with an `energy(q, u)`.
+
+        One compiled program, not one per array operation when called outside `jit`.
+
+        Args:
+            qs: saved configurations, shape (n_saves, nq).
+            us: saved velocity states, shape (n_saves, nu).
+
+        Returns:
+            The relative energy error at every saved state, shape (n_saves,).
+        """
         E = jax.vmap(self.energy)(qs, us)
         return (E - E[0]) / jnp.abs(E[0])

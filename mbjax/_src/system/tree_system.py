@@ -27,8 +27,14 @@ from mbjax._src.system.invariants import energy_invariant
 
 
 class AbstractTreeSystem(AbstractDrivenSystem):
-    """An open tree of bodies as a system for `simulate` and `mbjax.loops.ClosedSystem`. Its
-    `model` (a `mbjax.Model` or a `mbjax.flex.FlexibleModel`) gives the coordinates."""
+    """An open tree of bodies as a system for `simulate` and `mbjax.loops.ClosedSystem`.
+
+    Its `model` (a `mbjax.Model` or a `mbjax.flex.FlexibleModel`) gives the coordinates; the
+    state is (q, v), q of shape (nq,) and v of shape (nv,). Final subclasses
+    (`mbjax.rigid.TreeSystem`, `mbjax.flex.FlexibleSystem`) take the model, the control, the
+    external load and the forward-dynamics method in their constructors; see the module
+    docstring for what they must provide.
+    """
 
     model: eqx.AbstractVar[object]
     symmetric_dynamics: eqx.AbstractClassVar[bool]
@@ -56,11 +62,23 @@ class AbstractTreeSystem(AbstractDrivenSystem):
         return self.model.n_frames
 
     def neutral(self) -> Array:
-        """The reference configuration (zero angles, identity quaternions, undeformed)."""
+        """The reference configuration (zero angles, identity quaternions, undeformed).
+
+        Returns:
+            q, shape (nq,).
+        """
         return self.model.neutral()
 
     def q_dot(self, q: Array, v: Array) -> Array:
-        """dq/dt for velocity v."""
+        """dq/dt for velocity v.
+
+        Args:
+            q: configuration, shape (nq,).
+            v: generalized velocity, shape (nv,).
+
+        Returns:
+            dq/dt, shape (nq,).
+        """
         return self.model.q_dot(q, v)
 
     def retract(self, q0: Array, xi: Array) -> Array:
@@ -70,55 +88,134 @@ class AbstractTreeSystem(AbstractDrivenSystem):
         return self.model.local_rate(q0, xi, u)
 
     def normalize(self, q: Array) -> Array:
-        """q with every quaternion scaled to unit length."""
+        """q with every quaternion scaled to unit length.
+
+        Args:
+            q: configuration, shape (nq,).
+
+        Returns:
+            The normalized configuration, shape (nq,).
+        """
         return self.model.normalize(q)
 
     # -- kinematics, energy, dynamics -------------------------------------------------------------
 
     @abc.abstractmethod
     def frames(self, q: Array) -> tuple[Array, Array]:
-        """World rotation (n_frames, 3, 3) and origin (n_frames, 3) of every frame."""
+        """World poses of every frame: the bodies, then any markers.
+
+        Args:
+            q: configuration, shape (nq,).
+
+        Returns:
+            (R, p): rotations (body to world), shape (n_frames, 3, 3), and origins [m], shape
+            (n_frames, 3).
+        """
 
     @abc.abstractmethod
     def energy(self, q: Array, v: Array) -> Array:
-        """Kinetic plus gravitational (plus strain) energy; the work of the applied forces is
-        not included."""
+        """Kinetic plus gravitational (plus strain) energy.
+
+        The work of the applied forces is not included.
+
+        Args:
+            q: configuration, shape (nq,).
+            v: generalized velocity, shape (nv,).
+
+        Returns:
+            The energy [J], a scalar.
+        """
 
     @abc.abstractmethod
     def kinetic_energy(self, q: Array, v: Array) -> Array:
-        """The kinetic energy."""
+        """The kinetic energy.
+
+        Args:
+            q: configuration, shape (nq,).
+            v: generalized velocity, shape (nv,).
+
+        Returns:
+            T [J], a scalar.
+        """
 
     @abc.abstractmethod
     def dissipative(self) -> Array:
-        """True where the tree has damping (joint or modal), so that its energy can only fall."""
+        """Whether the tree has damping (joint or modal), so that its energy can only fall.
+
+        Returns:
+            A boolean scalar.
+        """
 
     def invariants(self, t, q, u):
-        """The energy of a passive tree (measured against its kinetic energy); None otherwise."""
+        """The energy of a passive tree (its drift relative to the kinetic energy); None otherwise."""
         if not self.passive:
             return None
         return energy_invariant(self.energy(q, u), self.kinetic_energy(q, u), self.dissipative())
 
     @abc.abstractmethod
     def mass_matrix(self, q: Array) -> Array:
-        """M(q) = d^2 T / dv^2, symmetric positive-definite (nv, nv)."""
+        """M(q) = d^2 T / dv^2.
+
+        Args:
+            q: configuration, shape (nq,).
+
+        Returns:
+            M, symmetric positive-definite, shape (nv, nv).
+        """
 
     @abc.abstractmethod
     def responses(self, t: Array, q: Array, v: Array, loads: Array) -> tuple[Array, Array]:
-        """(v_dot (nv,), responses (m, nv)): the accelerations under every force (gravity,
-        velocity terms, elasticity, control, external wrenches), and those each row of `loads`
-        (m, nv) alone produces (no gravity, velocity or applied force): the unit constraint-load
-        responses of Anderson 1993 eqs 101-107, from one triangularization."""
+        """The accelerations under every force, and those each of m unit loads alone produces.
+
+        The second output is the unit constraint-load responses of Anderson 1993 eqs 101-107
+        (no gravity, velocity or applied force), from the same triangularization as the first.
+
+        Args:
+            t: time [s], a scalar.
+            q: configuration, shape (nq,).
+            v: generalized velocity, shape (nv,).
+            loads: generalized loads, one per row, shape (m, nv).
+
+        Returns:
+            (v_dot, responses): the accelerations under gravity, velocity terms, elasticity,
+            the control and the external wrenches, shape (nv,); and the accelerations of each
+            row of `loads`, shape (m, nv).
+        """
 
     def bias(self, t: Array, q: Array, v: Array) -> Array:
-        """The equations of motion as M(q) v_dot + bias(t, q, v) = 0 (`symmetric_dynamics`
-        trees only): velocity terms and gravity less the applied forces."""
+        """The equations of motion as M(q) v_dot + bias(t, q, v) = 0.
+
+        Only for trees with `symmetric_dynamics`: velocity terms and gravity less the applied
+        forces.
+
+        Args:
+            t: time [s], a scalar.
+            q: configuration, shape (nq,).
+            v: generalized velocity, shape (nv,).
+
+        Returns:
+            bias, shape (nv,).
+
+        Raises:
+            TypeError: the tree's equations have no symmetric mass matrix (a flexible tree).
+        """
         raise TypeError(f"{type(self).__name__} has no equations of the form M(q) v_dot + bias = 0 "
                         "with a symmetric M (symmetric_dynamics is False)")
 
     # -- applied forces -------------------------------------------------------------------------
 
     def wrenches(self, t: Array, q: Array, v: Array) -> Array | None:
-        """The external wrenches (n, 6), world frame, torque about each body's origin; or None."""
+        """The external wrenches moved to the bodies' origins.
+
+        Args:
+            t: time [s], a scalar.
+            q: configuration, shape (nq,).
+            v: generalized velocity, shape (nv,).
+
+        Returns:
+            World-frame wrenches (torque about each body's origin [N m]; force [N]), shape
+            (n, 6); or None without an external load.
+        """
         f = self.external_wrenches(t, q, v)
         if f is None or self.external_point is None:
             return f

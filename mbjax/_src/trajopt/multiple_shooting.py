@@ -40,12 +40,12 @@ STEPS = tuple(0.5**k for k in range(10))
 
 
 class MultipleShooting(AbstractSolver):
-    """Multiple shooting: knot states and controls as unknowns, the dynamics enforced by an augmented Lagrangian.
+    """Multiple shooting: knot states and controls as unknowns, the dynamics as constraints.
 
-    A solver strategy for `mbjax.trajopt.solve`; the method is described in the module. Needs
-    a state with as many coordinates as velocities (no quaternions; use `Shooting` there).
-    Success when the largest defect is below `defect_tolerance` and the last inner solve
-    settled.
+    The defects are enforced by an augmented Lagrangian, the steps taken by Gauss-Newton (see
+    the module). A solver strategy for `mbjax.trajopt.solve`. Needs a state with as many
+    coordinates as velocities (no quaternions; use `Shooting` there). Success when the largest
+    defect is below `defect_tolerance` and the last inner solve settled.
 
     Args:
         iterations: the most Gauss-Newton steps in all (static).

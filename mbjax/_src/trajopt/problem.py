@@ -38,9 +38,26 @@ from mbjax._src.system.system import AbstractSystem
 
 
 class Problem(eqx.Module):
-    """See the module. `q0`, `v0`: the initial state; `running(q, v, u)` a cost rate and
-    `terminal(q, v)` the final cost, each a scalar or a vector of residuals; `lower`, `upper`:
-    bounds on each actuated force (scalars or one per actuated coordinate; None for none)."""
+    """A discrete optimal-control problem over a system's controls (see the module).
+
+    Args:
+        system: any mbjax system with a control (`TreeSystem`, `FlexibleSystem`, `WristSystem`,
+            `RigidBody`, a `ClosedSystem` of a tree, ...); its control is replaced by the
+            unknowns u_k.
+        q0: initial configuration, shape (nq,).
+        v0: initial velocity, shape (nv,).
+        dt: the step and control interval, seconds.
+        horizon: the number of steps N.
+        running: cost rate running(q, v, u), a scalar or a vector of residuals.
+        terminal: final cost terminal(q, v), a scalar or a vector of residuals.
+        lower: lower bound on each actuated force, a scalar or shape (nu,); None for none.
+        upper: upper bound, likewise.
+        integrator: the step's integrator (`RK4()` by default).
+
+    Raises:
+        TypeError, ValueError: naming the malformed argument (a system without a control, a
+            state of the wrong shape, a non-positive dt or horizon, lower above upper).
+    """
 
     system: AbstractSystem
     q0: Array
@@ -95,22 +112,27 @@ class Problem(eqx.Module):
 
     @property
     def nq(self) -> int:
+        """Length of q."""
         return self.q0.shape[0]
 
     @property
     def nv(self) -> int:
+        """Length of v."""
         return self.v0.shape[0]
 
     @property
     def nx(self) -> int:
+        """Length of the state x = (q, v)."""
         return self.nq + self.nv
 
     @property
     def nu(self) -> int:
+        """Number of controls per step (the system's actuated coordinates)."""
         return self.system.n_controls
 
     @property
     def x0(self) -> Array:
+        """The initial state (q0, v0), shape (nx,)."""
         return jnp.concatenate([self.q0, self.v0])
 
     def split(self, x: Array) -> tuple[Array, Array]:
@@ -127,10 +149,9 @@ class Problem(eqx.Module):
         return jnp.concatenate([q1, v1])
 
     def step_jacobians(self, x: Array, u: Array, k) -> tuple[Array, Array]:
-        """(A, B) = (d step/dx, d step/du) at (x, u), one forward-mode pass for both. (One pass
-        per argument skips the dynamics' derivative in the state for the control's directions,
-        0.2 ms less a linearization of the arm's 100 semi-implicit Euler steps, but traces the
-        step twice: with RK4, 2.5 s more compilation and a slower solve, 0.26 against 0.19 s.)"""
+        """(A, B) = (d step/dx, d step/du) at (x, u), one forward-mode pass for both: one pass per
+        argument would trace the step twice, which costs more compilation than it saves (see
+        benchmarks/README.md)."""
         return jax.jacfwd(self.step, argnums=(0, 1))(x, u, k)
 
     def stage_cost(self, x: Array, u: Array) -> Array:
@@ -160,7 +181,14 @@ class Problem(eqx.Module):
         return jax.grad(self.final_cost)(x), jax.hessian(self.final_cost)(x)
 
     def rollout(self, us: Array) -> Array:
-        """The states x_0 ... x_N (N + 1, nx) under the controls us (N, nu)."""
+        """The states under a control sequence.
+
+        Args:
+            us: controls, shape (N, nu).
+
+        Returns:
+            The states x_0 ... x_N, shape (N + 1, nx).
+        """
         def f(x, uk):
             u, k = uk
             x1 = self.step(x, u, k)
@@ -173,7 +201,14 @@ class Problem(eqx.Module):
         return jnp.sum(jax.vmap(self.stage_cost)(xs[:-1], us)) + self.final_cost(xs[-1])
 
     def objective(self, us: Array) -> Array:
-        """The objective as a function of the controls alone (single shooting)."""
+        """The objective as a function of the controls alone (single shooting).
+
+        Args:
+            us: controls, shape (N, nu).
+
+        Returns:
+            The cost, a scalar.
+        """
         return self.cost(self.rollout(us), us)
 
     def initial_controls(self, us0=None) -> Array:

@@ -99,7 +99,8 @@ def eom_terms(wrist, theta: Array, theta_dot: Array) -> tuple[Array, Array, Arra
     dA/dtheta: A_dot = dA/dtheta . theta_dot and dT/dtheta_k = 1/2 theta_dot^T dA/dtheta_k
     theta_dot; C = dV/dtheta = m g (J_G)_3. Second derivatives of the kinematics, where
     differentiating T itself (A = d^2T/dtheta_dot^2, B's mixed term) nests three: the same
-    numbers (tests/wrist/test_dynamics.py) from a graph that compiles about twice as fast."""
+    numbers (tests/wrist/test_dynamics.py) from a smaller graph, which compiles faster
+    (benchmarks/README.md)."""
     theta, theta_dot = jnp.asarray(theta), jnp.asarray(theta_dot)
 
     def inertia(th):

@@ -19,12 +19,18 @@ from jax import Array
 
 
 class Pose(eqx.Module):
-    """The tool's pose in the base frame B (batched under vmap).
+    """The tool's pose in the base frame B (batched under vmap), as
+    `CarpalWrist.forward_kinematics` returns it.
 
-    alpha, beta: azimuth and bend of the tool axis (alpha = 0 by convention at beta = 0);
-    plunge: distance from the base centre along e3 to the midplane; slope: (gx, gy), the
-    midplane's nonsingular chart (tan(beta / 2) = |slope|); normal: the midplane's unit normal N;
-    rotation: R, B to D; centre: the distal-plate centre c_D; com: the tool's centre of mass.
+    Args:
+        alpha: azimuth of the tool axis [rad], a scalar (0 by convention at beta = 0).
+        beta: bend of the tool axis [rad], a scalar.
+        plunge: distance from the base centre along e3 to the midplane [m], a scalar.
+        slope: (gx, gy), the midplane's nonsingular chart (tan(beta / 2) = |slope|), shape (2,).
+        normal: the midplane's unit normal N, shape (3,).
+        rotation: R, B to D, shape (3, 3).
+        centre: the distal-plate centre c_D [m], shape (3,).
+        com: the tool's centre of mass [m], shape (3,).
     """
 
     alpha: Array
@@ -284,7 +290,15 @@ def reachable(wrist, alpha, beta, plunge) -> Array:
 
 
 def rotation_angle(Ra: Array, Rb: Array) -> Array:
-    """The geodesic angle between two rotations (rad), accurate near 0."""
+    """The geodesic angle between two rotations, accurate near 0.
+
+    Args:
+        Ra: a rotation matrix, shape (3, 3).
+        Rb: a rotation matrix, shape (3, 3).
+
+    Returns:
+        The angle of Ra^T Rb [rad], a scalar in [0, pi].
+    """
     D = Ra.T @ Rb
     s = 0.5 * _safe_norm(jnp.array([D[2, 1] - D[1, 2], D[0, 2] - D[2, 0], D[1, 0] - D[0, 1]]))
     c = 0.5 * (jnp.trace(D) - 1.0)
@@ -292,7 +306,16 @@ def rotation_angle(Ra: Array, Rb: Array) -> Array:
 
 
 def pose_error(wrist, a: Pose, b: Pose) -> Array:
-    """max(rotation angle between a and b (rad), |centre_a - centre_b| / link_length): one
-    dimensionless number for 'did the tool arrive'."""
+    """One dimensionless number for 'did the tool arrive': max(rotation angle between a and b
+    [rad], |centre_a - centre_b| / link_length).
+
+    Args:
+        wrist: the `CarpalWrist` (its link_length scales the distance).
+        a: a tool pose.
+        b: another tool pose.
+
+    Returns:
+        The error, a non-negative scalar.
+    """
     return jnp.maximum(rotation_angle(a.rotation, b.rotation),
                        _safe_norm(a.centre - b.centre) / wrist.link_length)

@@ -18,12 +18,28 @@ SINGULAR_TOLERANCE = 1e-3
 
 
 class WristSystem(AbstractDrivenSystem):
-    """q = theta, u = theta_dot; theta_ddot from eq 6.21 under the motor torques of `control`
-    (t, theta, theta_dot) -> (3,) (a `mbjax.control` module such as a torque spline or a servo,
-    a controller from `mbjax.trajopt`, any callable or a constant; none: unpowered motors; on
-    the `actuation` motors only if given) and an `external` (t, theta, theta_dot) -> (1, 6)
-    world-frame wrench (torque; force) on the tool at the distal-plate centre, or at
-    `external_point` (tool frame D, shape (1, 3)). With `ExplicitEuler` this is the chapter's eq 6.45."""
+    """The Carpal Wrist as a system for `mbjax.simulate` (Canfield 1997 §6.4): q = theta,
+    u = theta_dot, each shape (3,); theta_ddot from eq 6.21 under the motor torques and an
+    external wrench on the tool. With `ExplicitEuler` this is the chapter's eq 6.45.
+
+    Args:
+        model: the wrist, a `CarpalWrist`.
+        control: the motor torques [N m], a callable (t, theta, theta_dot) -> shape (3,) (or
+            (n_controls,) with `actuation`): a `mbjax.control` module such as a torque spline or
+            a servo (`mbjax.wrist.servo`), a controller from `mbjax.trajopt`, any callable, or a
+            constant array; None: unpowered motors.
+        external: a callable (t, theta, theta_dot) -> a world-frame wrench (torque [N m];
+            force [N]) on the tool, shape (1, 6), its force acting at the distal-plate centre or
+            at `external_point`; or None.
+        external_point: where the external force acts, in the tool frame D [m], shape (1, 3)
+            or (3,); None: the distal-plate centre.
+        actuation: the indices of the driven motors (or a boolean mask of length 3); None: all
+            three.
+
+    Raises:
+        TypeError: `model` is not a `CarpalWrist`.
+        ValueError: malformed control, external, external_point or actuation.
+    """
 
     model: CarpalWrist
     control: AbstractControl | None
@@ -53,7 +69,16 @@ class WristSystem(AbstractDrivenSystem):
         return 3, 3
 
     def torques(self, t: Array, q: Array, u: Array) -> Array:
-        """The motor torques of the control plus the torques equivalent to the external wrench."""
+        """The motor torques of the control plus the torques equivalent to the external wrench.
+
+        Args:
+            t: time [s], a scalar.
+            q: input angles theta [rad], shape (3,).
+            u: their rates [rad/s], shape (3,).
+
+        Returns:
+            tau [N m], shape (3,).
+        """
         tau = self.applied(t, q, u)
         f = self.external_wrenches(t, q, u)
         if f is None:
@@ -68,15 +93,21 @@ class WristSystem(AbstractDrivenSystem):
         return dynamics.forward_dynamics(self.model, q, u, self.torques(t, q, u))
 
     def check(self, t: Array, q: Array, u: Array) -> Array:
-        """SINGULAR where the wrist is within SINGULAR_TOLERANCE of an inverse or a direct
-        singularity (`kinematics.singularity_measures`): there the accelerations of eq 6.21
-        are not defined (1e17 rad/s^2 at the knees' tangency, measured)."""
+        """`Status.SINGULAR` where the wrist is within SINGULAR_TOLERANCE of an inverse or a
+        direct singularity (`kinematics.singularity_measures`): there the accelerations of
+        eq 6.21 are not defined (A of eq 6.16 is singular, and they grow without bound on the
+        way; see benchmarks/README.md).
+
+        Returns:
+            An int32 scalar of `Status` flags.
+        """
         m = kinematics.singularity_measures(self.model, q)
         near = jnp.minimum(jnp.abs(m.inverse), jnp.abs(m.direct)) < SINGULAR_TOLERANCE
         return jnp.where(near, int(Status.SINGULAR), 0).astype(jnp.int32)
 
     def energy(self, q: Array, u: Array) -> Array:
-        """T + V of the tool; the work of the motors and the external wrench is not included."""
+        """T + V of the tool [J], a scalar; the work of the motors and the external wrench is not
+        included."""
         return dynamics.energy(self.model, q, u)
 
     def invariants(self, t, q, u):
