@@ -399,6 +399,7 @@ def test_momentum_and_velocity_forms_agree():
     assert np.abs(q_v[-1] - q_v[0]).max() > 0.3                       # it did move
 
 
+@pytest.mark.slow     # 51 s; tests/integrate/test_accuracy checks a floating tree's momentum
 def test_floating_base_conserves_momentum():
     """A free-floating tree without gravity or torques: RKMK4 keeps the spatial momentum about
     the ground origin, the energy and the unit quaternions."""

@@ -16,6 +16,7 @@ from mbjax.scenes import vertical_top as vt
 from mbjax.tfe import Element, Mixed, PrimalUnsymmetric, initial_state, solve_tfe
 
 
+@pytest.mark.slow     # 50 s; tests/integrate/test_accuracy checks the estimate
 def test_the_estimate_follows_the_closed_form_error():
     body, state0 = tft.scene()
     element, spacing = Element(2), 0.015

@@ -98,6 +98,7 @@ def test_the_arm_reaches_its_target_at_a_stationary_point():
                                np.asarray(result.qs), atol=1e-12)
 
 
+@pytest.mark.slow     # 45 s; tests/trajopt/test_sweep vmaps solves
 def test_many_targets_in_one_vmapped_solve():
     offsets = jnp.array([[0.0, 0.2, 0.0], [0.1, 0.0, 0.1], [0.0, -0.15, 0.05]])
 
@@ -136,6 +137,7 @@ def test_bad_problems_are_refused_with_the_argument_named():
         solve(floating, ILQR())
 
 
+@pytest.mark.slow     # 41 s; test_multiple_shooting keeps the LQR optimum
 def test_single_shooting_reaches_the_lqr_optimum_and_adam_descends():
     from mbjax.trajopt import Shooting
 

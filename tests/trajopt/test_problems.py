@@ -7,6 +7,7 @@ beam's optimal torque re-simulated on a finer model (twice the modes, a tenth of
 import jax
 import jax.numpy as jnp
 import numpy as np
+import pytest
 from scipy.optimize import least_squares
 
 from mbjax.scenes import four_bar as fb
@@ -14,6 +15,7 @@ from mbjax.scenes import slewing_beam as sb
 from mbjax.trajopt import ILQR, Problem, solve
 
 
+@pytest.mark.slow     # 70 s; a closed loop in a Problem: test_crocoddyl and test_ilqr keep the trees
 def test_four_bar_matches_its_minimal_coordinate_optimum():
     """The crank's least-effort quarter turn through the closed loop (3 tree coordinates, the
     pin closure projected after each step) against the one-coordinate problem: the crank's
@@ -70,6 +72,7 @@ def test_four_bar_matches_its_minimal_coordinate_optimum():
     np.testing.assert_allclose(result.us[:, 0], reference.x, atol=1e-6 * np.abs(reference.x).max())
 
 
+@pytest.mark.slow     # 36 s
 def test_slewing_beam_suppresses_residual_vibration():
     """The flexible arm's quarter-turn slew: iLQR from the rigid arm's least-effort torque
     arrives at rest with the vibration gone. Re-simulated on a finer model (4 bending modes,

@@ -163,7 +163,10 @@ def test_tour_in_workers(tmp_path):
     assert summary["scenes"]["torque-free-body"]["integrators"]["rkmk4"]["final_error_rad"] < 1e-4
 
 
-@pytest.mark.parametrize("group", list(TOUR_GROUPS))
+# the rigid group in the default suite; the others (over a minute each on 2 cores) are slow: their
+# scenes' physics is tested in tests/tfe, tests/flex, tests/wrist, tests/trajopt and tests/model
+@pytest.mark.parametrize("group", [group if group == "rigid" else pytest.param(group, marks=pytest.mark.slow)
+                                   for group in TOUR_GROUPS])
 def test_tour_quick(tmp_path, group):
     scenes = TOUR_GROUPS[group]        # one after another here: xdist runs the groups side by side
     assert main(["tour", "--quick", "--out", str(tmp_path), "--jobs", "1",
@@ -257,6 +260,7 @@ TOUR_CHECKS = {"rigid": _check_rigid, "time-elements": _check_time_elements,
                "carpal-wrist": _check_carpal_wrist}
 
 
+@pytest.mark.slow     # a benchmark script: the library is tested in tests/wrist
 def test_bench_wrist_quick(tmp_path):
     """`mbjax bench wrist --quick` (a README claim; about 15 s): RK4's error falls at fourth
     order, the Lagrange and Newton-Euler inverse dynamics agree, the sweep covers every variant
@@ -276,6 +280,7 @@ def test_bench_wrist_quick(tmp_path):
     assert (tmp_path / "wrist.png").stat().st_size > 10_000
 
 
+@pytest.mark.slow     # a benchmark script: the integrators are tested in tests/integrate
 def test_bench_integrators_quick(tmp_path):
     assert main(["bench", "integrators", "--quick", "--out", str(tmp_path)]) == 0
     records = [json.loads(line) for line in (tmp_path / "integrators.jsonl").read_text().split("\n")
@@ -649,6 +654,7 @@ def test_bench_compile(tmp_path):
     assert (tmp_path / "compile.png").stat().st_size > 10_000
 
 
+@pytest.mark.slow     # every solver on every problem: tests/trajopt checks each
 def test_reproduce_trajopt(tmp_path):
     """`mbjax reproduce trajopt --quick`: each problem by iLQR and the arm by multiple shooting
     too (the first-order baselines and the other problems' shooting are the full run's), the
