@@ -10,8 +10,9 @@ import numpy as np
 import pytest
 
 from mbjax import Recursive, Dense
-from mbjax.flex import Beam, FlexibleModel, FlexibleSystem, ModalBody, beam_body, craig_bampton, flexible_aba
-from mbjax._src.flex import lagrangian_forward_dynamics, energy
+from mbjax.flex import (Beam, FlexibleModel, FlexibleSystem, ModalBody, beam_body, craig_bampton,
+                        forward_dynamics)
+from mbjax._src.flex import energy, flexible_aba, lagrangian_forward_dynamics
 from mbjax._src.flex.body import mass_matrix
 from mbjax.integrate import RK4, simulate
 from mbjax.lie import exp
@@ -94,9 +95,12 @@ def test_recursion_matches_the_lagrangian_route(stiffening):
     rng = np.random.default_rng(1)
     q = jnp.asarray(rng.normal(size=model.nq)) * 0.5
     v, tau = jnp.asarray(rng.normal(size=model.nv)), jnp.asarray(rng.normal(size=model.nv))
-    recursive = jax.jit(flexible_aba)(model, q, v, tau)
-    dense = jax.jit(lagrangian_forward_dynamics)(model, q, v, tau)
+    recursive = forward_dynamics(model, q, v, tau, method=Recursive())
+    dense = forward_dynamics(model, q, v, tau, method=Dense())
     np.testing.assert_allclose(recursive, dense, rtol=1e-11, atol=1e-11)
+    np.testing.assert_allclose(recursive, jax.jit(flexible_aba)(model, q, v, tau), rtol=1e-14, atol=1e-14)
+    np.testing.assert_allclose(dense, jax.jit(lagrangian_forward_dynamics)(model, q, v, tau),
+                               rtol=1e-14, atol=1e-14)
 
 
 def test_energy_is_conserved_without_stiffening():
