@@ -10,6 +10,7 @@ import jax.numpy as jnp
 import numpy as np
 
 import mbjax
+from mbjax._src.model.joints import JOINT_TYPES
 
 MUJOCO_INTEGRATORS = ("Euler", "RK4", "implicit", "implicitfast")
 
@@ -326,10 +327,10 @@ def pinocchio_maps(model, pin_model):
         assert jid < pin_model.njoints, model.joint_names[k]
         iv, iq, nq = pin_model.idx_vs[jid], pin_model.idx_qs[jid], pin_model.nqs[jid]
         v_index += [iv + j for j in ((3, 4, 5, 0, 1, 2) if kind == "free"
-                                      else range(mbjax.model.JOINT_TYPES[kind].nv))]
+                                      else range(JOINT_TYPES[kind].nv))]
         q_parts.append((iq, nq, kind))
 
-    q_start = np.cumsum([0] + [mbjax.model.JOINT_TYPES[k].nq for k in model.joint_types])
+    q_start = np.cumsum([0] + [JOINT_TYPES[k].nq for k in model.joint_types])
 
     def to_pin(q):
         q = np.asarray(q)

@@ -411,7 +411,7 @@ def models_tour(out: Path, quick: bool) -> dict:
     """A URDF arm as a user brings it (`mbjax.data.ARM7`): its links and fixed joints as named
     frames, the flange's pose and Jacobian by name, its joint limits as data that `simulate`'s
     status checks (the unpowered arm falls through them), and the same arm through MuJoCo's
-    compiler (`mbjax.from_mujoco`) and Pinocchio, when installed, against their dynamics."""
+    compiler (`mbjax.model.from_mujoco`) and Pinocchio, when installed, against their dynamics."""
     from mbjax._src.model.limits import excess
     from mbjax_harness.plot.scenes import models_figure
     from mbjax._src.rigid import TreeSystem, frame_jacobian, frame_pose

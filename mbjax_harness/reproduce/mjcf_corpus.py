@@ -1,7 +1,7 @@
 """The MJCF corpus: every MuJoCo model shipped by the installed packages (dm_control's suite,
 locomotion walkers, third-party arms and test models, gymnasium's and gymnasium_robotics' MuJoCo
 assets, the mujoco package's own), loaded with
-`mbjax.from_mujoco` and checked against MuJoCo's forward dynamics and kinematics.
+`mbjax.model.from_mujoco` and checked against MuJoCo's forward dynamics and kinematics.
 
 A file is a model when MuJoCo compiles it on its own and it has joints; the others (include
 fragments, files that need a parent's assets, jointless scenes) are listed as skipped with

@@ -148,7 +148,7 @@ def test_wrist_external_wrench_through_the_newton_euler_jacobians():
     closed-form Jacobians of the Newton-Euler route: tau = J_v^T F + J_omega^T n at the centre
     of mass; a wrench at another point adds the moment of its force."""
     system, theta, _ = cw.servo()
-    wrist = system.wrist
+    wrist = system.model
     F, n = jnp.array([1.0, -2.0, 3.0]), jnp.array([0.1, 0.2, -0.3])
     J_v, J_omega = jax.jacfwd(newton_euler.tool_velocity, argnums=2)(wrist, theta, jnp.zeros(3))
     expected = J_v.T @ F + J_omega.T @ n

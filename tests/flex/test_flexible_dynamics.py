@@ -229,7 +229,7 @@ def test_bad_input_is_a_clear_error():
             ClosedSystem(FlexibleSystem(model), [Prescribed(0)], method)
     closed = ClosedSystem(FlexibleSystem(model), [Prescribed(0)])
     assert isinstance(closed.method, Stabilized)
-    with pytest.raises(ValueError, match="method"):
+    with pytest.raises(TypeError, match="method must be mbjax.Recursive"):
         FlexibleSystem(model, method="fast")
 
 

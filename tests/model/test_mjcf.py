@@ -5,7 +5,7 @@ the ignored-features warning, and the corpus of MJCF models shipped by the insta
 Every dynamic comparison runs `mbjax_harness.reproduce.mjcf_corpus.compare`: MuJoCo with contacts,
 constraints, actuators and springs disabled (joint damping and armature kept) at a random state
 (qpos, qvel, qfrc_applied), mbjax's `forward_dynamics` mapped to MuJoCo's qacc by `jax.jvp` of
-`state_to_mujoco`, relative difference below 1e-8; poses are `mbjax.frame_pose` of every body
+`state_to_mujoco`, relative difference below 1e-8; poses are `mbjax.rigid.frame_pose` of every body
 and site against xpos/xmat and site_xpos/site_xmat.
 """
 
@@ -42,7 +42,7 @@ def _load(xml: str, **kwargs):
     mjmodel = mujoco.MjModel.from_xml_string(xml)
     with warnings.catch_warnings():
         warnings.simplefilter("error", ModelWarning)
-        return mjmodel, mbjax.from_mujoco(mjmodel, **kwargs)
+        return mjmodel, mbjax.model.from_mujoco(mjmodel, **kwargs)
 
 
 def _check(mjmodel, model, seeds=(0, 1)):
@@ -52,12 +52,12 @@ def _check(mjmodel, model, seeds=(0, 1)):
         assert errors["qacc"] < TOLERANCE, errors
         assert errors["poses"] < 1e-12, errors
     m, d = random_state(mjmodel, seeds[0])
-    q, _ = mbjax.state_from_mujoco(model, jnp.asarray(d.qpos), jnp.asarray(d.qvel))
+    q, _ = mbjax.model.state_from_mujoco(model, jnp.asarray(d.qpos), jnp.asarray(d.qvel))
     named = [(object_name(m, "body", b), d.xmat[b], d.xpos[b]) for b in range(1, m.nbody)]
     named += [(site_frame_name(model, object_name(m, "site", s)), d.site_xmat[s], d.site_xpos[s])
               for s in range(m.nsite)]
     for name, xmat, xpos in named:
-        R, p = mbjax.frame_pose(model, q, name)
+        R, p = mbjax.rigid.frame_pose(model, q, name)
         np.testing.assert_allclose(np.asarray(R).reshape(9), xmat, atol=1e-12, err_msg=name)
         np.testing.assert_allclose(p, xpos, atol=1e-12, err_msg=name)
 
@@ -116,7 +116,7 @@ def test_orientation_by_hand():
     xml = f"""<mujoco>{NO_CONTACT}<worldbody><body name="b" pos="1 2 3" axisangle="0 0 1 90">
               <joint name="j" axis="1 0 0"/><geom size="0.1"/></body></worldbody></mujoco>"""
     _, model = _load(xml)
-    R, p = mbjax.frame_pose(model, model.neutral(), "b")
+    R, p = mbjax.rigid.frame_pose(model, model.neutral(), "b")
     np.testing.assert_allclose(R, [[0, -1, 0], [1, 0, 0], [0, 0, 1]], atol=1e-12)
     np.testing.assert_allclose(p, [1, 2, 3], atol=1e-12)
 
@@ -196,9 +196,9 @@ def test_several_joints_per_body_and_anchors():
     assert {"link", "child", "tip"} <= set(model.frame_names)
     _check(mjmodel, model)
     m, d = random_state(mjmodel, 3)
-    q, _ = mbjax.state_from_mujoco(model, jnp.asarray(d.qpos), jnp.asarray(d.qvel))
+    q, _ = mbjax.model.state_from_mujoco(model, jnp.asarray(d.qpos), jnp.asarray(d.qvel))
     for j, name in enumerate(model.joint_names):
-        np.testing.assert_allclose(mbjax.frame_pose(model, q, name)[1], d.xanchor[j], atol=1e-12)
+        np.testing.assert_allclose(mbjax.rigid.frame_pose(model, q, name)[1], d.xanchor[j], atol=1e-12)
 
 
 BALL_AND_FREE = f"""
@@ -222,7 +222,7 @@ def test_ball_and_free_joints():
     translational armature (MuJoCo's, on the world-frame velocity) is left out with a warning."""
     mjmodel = mujoco.MjModel.from_xml_string(BALL_AND_FREE)
     with pytest.warns(ModelWarning, match=r"armature on free joints' translation \(1\)"):
-        model = mbjax.from_mujoco(mjmodel)
+        model = mbjax.model.from_mujoco(mjmodel)
     np.testing.assert_allclose(model.armature[:6], [0.05] * 3 + [0.0] * 3)
     assert model.joint_types == ("free", "spherical", "revolute", "spherical", "free")
     assert (model.nq, model.nv) == (mjmodel.nq, mjmodel.nv)
@@ -279,7 +279,7 @@ def test_joint_data():
 <actuator><motor joint="j2" gear="3"{extra}/></actuator></mujoco>"""
     mjmodel = mujoco.MjModel.from_xml_string(xml)
     with pytest.warns(ModelWarning, match="actuator forces"):
-        model = mbjax.from_mujoco(mjmodel)
+        model = mbjax.model.from_mujoco(mjmodel)
     np.testing.assert_allclose(model.lower, [-1, -0.1])
     np.testing.assert_allclose(model.upper, [1, 0.2])
     np.testing.assert_allclose(model.friction, [0.3, 0])
@@ -352,7 +352,7 @@ def _check_closure(xml, kind, assembled=True):
     loop's acceleration is MuJoCo's with the constraint hard."""
     mjmodel = mujoco.MjModel.from_xml_string(xml)
     with pytest.warns(ModelWarning, match="model.closures"):
-        model = mbjax.from_mujoco(mjmodel)
+        model = mbjax.model.from_mujoco(mjmodel)
     cuts = model.closures
     assert len(cuts) == 1 and isinstance(cuts[0], CutJoint) and cuts[0].kind == kind
     loops = Loops(TreeSystem(model), cuts)
@@ -437,7 +437,7 @@ def test_ignored_features_are_named_in_one_warning():
     mjmodel = mujoco.MjModel.from_xml_string(IGNORED)
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
-        model = mbjax.from_mujoco(mjmodel)
+        model = mbjax.model.from_mujoco(mjmodel)
     assert len(caught) == 1 and issubclass(caught[0].category, ModelWarning)
     message = str(caught[0].message)
     for what in ("contacts (2 geom pairs", "actuator forces (1", "tendons (1)", "joint springs (1)",
@@ -453,13 +453,13 @@ def test_ignored_features_are_named_in_one_warning():
 def test_strict():
     """strict=True refuses implausible inertias, not the features mbjax leaves out."""
     with pytest.warns(ModelWarning, match="contacts"):
-        mbjax.from_mujoco(mujoco.MjModel.from_xml_string(IGNORED), strict=True)
+        mbjax.model.from_mujoco(mujoco.MjModel.from_xml_string(IGNORED), strict=True)
     mjmodel, _ = _load(DEFAULTS, strict=True)
     mjmodel.body_inertia[1] = [0.01, 0.01, 0.05]            # J1 + J2 < J3: passed on to Model
     with pytest.warns(ModelWarning, match="triangle inequality"):
-        mbjax.from_mujoco(mjmodel)
+        mbjax.model.from_mujoco(mjmodel)
     with pytest.raises(ValueError, match="triangle inequality"):
-        mbjax.from_mujoco(mjmodel, strict=True)
+        mbjax.model.from_mujoco(mjmodel, strict=True)
 
 
 def test_errors(monkeypatch):

@@ -21,7 +21,7 @@ pin = pytest.importorskip("pinocchio")
 
 
 def _pin_state(model, q, v):
-    return tuple(np.asarray(x) for x in mbjax.state_to_pinocchio(model, q, v))
+    return tuple(np.asarray(x) for x in mbjax.model.state_to_pinocchio(model, q, v))
 
 
 def _random_state(model, seed):
@@ -77,7 +77,7 @@ def test_unusual_links_merge_and_keep_their_frames():
     np.testing.assert_allclose(mbjax.mass_matrix(model, q), M_pin, rtol=1e-12, atol=1e-14)
     pin.framesForwardKinematics(pm, pd, q_pin)
     for frame in model.frame_names + model.names:
-        R, p = mbjax.frame_pose(model, q, frame)
+        R, p = mbjax.rigid.frame_pose(model, q, frame)
         pose = pd.oMf[pm.getFrameId(frame)]
         np.testing.assert_allclose(R, pose.rotation, atol=1e-14)
         np.testing.assert_allclose(p, pose.translation, atol=1e-14)
@@ -87,9 +87,9 @@ def test_frame_jacobian_against_pinocchio_and_the_pose_rate():
     model = mbjax.load_urdf(ROBOT, floating_base=True)
     q, v, _ = _random_state(model, 1)
     for frame in ("foot_contact", "imu", "upper"):
-        J = mbjax.frame_jacobian(model, q, frame)
+        J = mbjax.rigid.frame_jacobian(model, q, frame)
         # identity: the pose's rate along q_dot(q, v) is (omega x R, v_origin) = J v
-        (R, p), (R_dot, p_dot) = jax.jvp(lambda q_: mbjax.frame_pose(model, q_, frame), (q,),
+        (R, p), (R_dot, p_dot) = jax.jvp(lambda q_: mbjax.rigid.frame_pose(model, q_, frame), (q,),
                                          (model.q_dot(q, v),))
         W = R_dot @ R.T
         np.testing.assert_allclose(J @ v, jnp.concatenate([jnp.array([W[2, 1], W[0, 2], W[1, 0]]),
@@ -99,10 +99,10 @@ def test_frame_jacobian_against_pinocchio_and_the_pose_rate():
         q_pin, _ = _pin_state(model, q, v)
         J_pin = pin.computeFrameJacobian(pm, pd, q_pin, pm.getFrameId(frame),
                                          pin.ReferenceFrame.LOCAL_WORLD_ALIGNED)
-        P = np.asarray(jax.jacfwd(lambda v_: mbjax.state_to_pinocchio(model, q, v_)[1])(v))
+        P = np.asarray(jax.jacfwd(lambda v_: mbjax.model.state_to_pinocchio(model, q, v_)[1])(v))
         np.testing.assert_allclose(np.concatenate([J_pin[3:], J_pin[:3]]) @ P, J, atol=1e-13)
     with pytest.raises(KeyError, match="no frame, body or joint named 'nope'"):
-        mbjax.frame_pose(model, q, "nope")
+        mbjax.rigid.frame_pose(model, q, "nope")
 
 
 def test_joint_data_is_read():
@@ -218,17 +218,17 @@ def test_mimic_joints_load_independent_with_their_couplings():
 def test_state_converters_round_trip_and_layout():
     model = mbjax.load_urdf(ROBOT, floating_base=True)
     q, v, _ = _random_state(model, 5)
-    q_pin, v_pin = mbjax.state_to_pinocchio(model, q, v)
+    q_pin, v_pin = mbjax.model.state_to_pinocchio(model, q, v)
     assert q_pin.shape == (model.nq + 1,)                         # continuous: cos, sin
     np.testing.assert_allclose(q_pin[3:7], jnp.concatenate([q[4:7], q[3:4]]))   # xyzw
     np.testing.assert_allclose(v_pin[:6], jnp.concatenate([v[3:6], v[:3]]))     # (v; omega)
-    for to, back in ((mbjax.state_to_pinocchio, mbjax.state_from_pinocchio),
-                     (mbjax.state_to_mujoco, mbjax.state_from_mujoco)):
+    for to, back in ((mbjax.model.state_to_pinocchio, mbjax.model.state_from_pinocchio),
+                     (mbjax.model.state_to_mujoco, mbjax.model.state_from_mujoco)):
         q2, v2 = back(model, *to(model, q, v))
         np.testing.assert_allclose(q2, q, atol=1e-15)
         np.testing.assert_allclose(v2, v, atol=1e-15)
     with pytest.raises(ValueError, match="must have 10 and 8 entries for this model, got 9 and 8"):
-        mbjax.state_from_pinocchio(model, q, v)
+        mbjax.model.state_from_pinocchio(model, q, v)
 
 
 def test_floating_base_against_mujoco_free_joint_layout():
@@ -242,12 +242,12 @@ def test_floating_base_against_mujoco_free_joint_layout():
     mj.opt.disableflags |= mujoco.mjtDisableBit.mjDSBL_CONSTRAINT
     data = mujoco.MjData(mj)
     q, v, tau = _random_state(model, 6)
-    data.qpos[:], data.qvel[:] = (np.asarray(x) for x in mbjax.state_to_mujoco(model, q, v))
+    data.qpos[:], data.qvel[:] = (np.asarray(x) for x in mbjax.model.state_to_mujoco(model, q, v))
     mujoco.mj_forward(mj, data)
     a_mj = data.qacc.copy()
     data.qfrc_applied[:] = 0
     a = mbjax.forward_dynamics(model, q, v, jnp.zeros(model.nv))
-    _, a_as_mj = jax.jvp(lambda q_, v_: mbjax.state_to_mujoco(model, q_, v_)[1], (q, v),
+    _, a_as_mj = jax.jvp(lambda q_, v_: mbjax.model.state_to_mujoco(model, q_, v_)[1], (q, v),
                          (model.q_dot(q, v), a))
     np.testing.assert_allclose(a_as_mj, a_mj, rtol=1e-9, atol=1e-9)
 
@@ -298,7 +298,7 @@ def test_converters_match_the_name_matched_map():
     model = mbjax.load_urdf(FIXED_URDF, floating_base=True)
     to_pin, vi = pinocchio_maps(model, pin.buildModelFromXML(FIXED_URDF, pin.JointModelFreeFlyer()))
     q, v, _ = random_state(model, 7)
-    q_pin, v_pin = mbjax.state_to_pinocchio(model, jnp.asarray(q), jnp.asarray(v))
+    q_pin, v_pin = mbjax.model.state_to_pinocchio(model, jnp.asarray(q), jnp.asarray(v))
     expected_v = np.zeros(model.nv)
     expected_v[vi] = v
     np.testing.assert_allclose(q_pin, to_pin(q), atol=1e-15)

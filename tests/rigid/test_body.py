@@ -141,7 +141,7 @@ def test_bad_bodies_are_rejected():
         RigidBody(1.0, jnp.eye(2))
     with pytest.raises(ValueError, match="mass"):
         RigidBody(0.0, jnp.eye(3))
-    with pytest.raises(ValueError, match="rotation"):
+    with pytest.raises(TypeError, match="rotation must be mbjax.lie.Quaternion"):
         RigidBody(1.0, jnp.eye(3), rotation="euler")
     with pytest.raises(ValueError, match="centre of mass"):
         RigidBody(1.0, jnp.eye(3), com=(0.0, 0.0, 1.0))

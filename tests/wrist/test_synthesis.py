@@ -138,7 +138,7 @@ def test_trajopt_solve_throws_when_not_converged():
 
 
 @pytest.mark.parametrize(("change", "error", "message"), [
-    (dict(q0=jnp.zeros(3)), ValueError, r"q0 and v0 must have shapes \(2,\) and \(2,\)"),
+    (dict(q0=jnp.zeros(3)), ValueError, r"q0 must have shape \(2,\) for this system"),
     (dict(dt="0.01"), ValueError, "dt must be a positive number"),
     (dict(dt=0.0), ValueError, "dt must be a positive number"),
     (dict(horizon=20.0), ValueError, "horizon must be a positive int"),

@@ -16,7 +16,7 @@ def test_explicit_euler_is_the_chapters_eq_6_45():
     system, q0, u0 = cw.servo()
     dt = 0.01
     q1, u1, _ = ExplicitEuler().step(system, 0.0, q0, u0 + 0.3, dt)
-    a = system.wrist.forward_dynamics(q0, u0 + 0.3, system.torques(0.0, q0, u0 + 0.3))
+    a = system.model.forward_dynamics(q0, u0 + 0.3, system.torques(0.0, q0, u0 + 0.3))
     np.testing.assert_allclose(q1, q0 + (u0 + 0.3) * dt, rtol=0, atol=1e-15)
     np.testing.assert_allclose(u1, u0 + 0.3 + a * dt, rtol=0, atol=1e-13)
 
@@ -24,12 +24,12 @@ def test_explicit_euler_is_the_chapters_eq_6_45():
 def test_energy_is_conserved_and_rk4_converges_at_order_four():
     system, q0, u0 = cw.free_motion()
     T = cw.FREE_DURATION
-    E0 = system.wrist.energy(q0, u0)
+    E0 = system.model.energy(q0, u0)
     ends, drifts = [], []
     for dt in (0.02, 0.01, 0.005):
         sol = simulate(system, RK4(), q0, u0, dt=dt, t1=T, saveat=np.linspace(0, T, 11))
         assert sol.messages() == ["success"]
-        E = jax.jit(jax.vmap(system.wrist.energy))(sol.qs, sol.us)
+        E = jax.jit(jax.vmap(system.model.energy))(sol.qs, sol.us)
         drifts.append(float(jnp.max(jnp.abs(E - E0)) / E0))
         ends.append(np.asarray(sol.qs[-1]))
     ref = np.asarray(simulate(system, RK4(), q0, u0, dt=1e-3, t1=T, saveat=[T]).qs[-1])
@@ -38,7 +38,7 @@ def test_energy_is_conserved_and_rk4_converges_at_order_four():
     assert np.all(np.abs(orders - 4) < 0.3), orders
     assert drifts[-1] < 1e-10 and drifts[0] / drifts[-1] > 100
     # the motion stays well inside the workspace (the study is not near a singularity)
-    m = jax.jit(jax.vmap(system.wrist.singularity_measures))(sol.qs)
+    m = jax.jit(jax.vmap(system.model.singularity_measures))(sol.qs)
     assert float(m.inverse.min()) > 0.5 and float(m.direct.min()) > 0.9
 
 
@@ -58,7 +58,7 @@ def test_stability_boundaries_match_the_linearization():
 
     def servo_energy(q, u):
         e = q - law.q_ref
-        return 0.5 * law.kp * e @ e + 0.5 * u @ system.wrist.mass_matrix(q) @ u
+        return 0.5 * law.kp * e @ e + 0.5 * u @ system.model.mass_matrix(q) @ u
 
     energies = jax.jit(jax.vmap(servo_energy))
     E0 = float(jax.jit(servo_energy)(q0, u0))
