@@ -163,10 +163,11 @@ def test_tour_in_workers(tmp_path):
     assert summary["scenes"]["torque-free-body"]["integrators"]["rkmk4"]["final_error_rad"] < 1e-4
 
 
-# the rigid group in the default suite; the others (over a minute each on 2 cores) are slow: their
-# scenes' physics is tested in tests/tfe, tests/flex, tests/wrist, tests/trajopt and tests/model
-@pytest.mark.parametrize("group", [group if group == "rigid" else pytest.param(group, marks=pytest.mark.slow)
-                                   for group in TOUR_GROUPS])
+# about a minute each on 2 cores: slow. The default suite runs two scenes of the tour in
+# test_tour_in_workers; the scenes' physics is tested through the library (tests/rigid, tfe, flex,
+# loops, wrist, trajopt, model).
+@pytest.mark.slow
+@pytest.mark.parametrize("group", list(TOUR_GROUPS))
 def test_tour_quick(tmp_path, group):
     scenes = TOUR_GROUPS[group]        # one after another here: xdist runs the groups side by side
     assert main(["tour", "--quick", "--out", str(tmp_path), "--jobs", "1",

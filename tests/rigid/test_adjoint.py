@@ -62,7 +62,9 @@ def test_solve_with_the_factor_is_the_inverse_mass_matrix():
     assert _relative(ours, reference) < 1e-12
 
 
-@pytest.mark.parametrize(("model", "wrenches"), [(MODEL, True), (HINGES, False), (BALLS, False)],
+# the spherical joints' variant is slow: "every joint" has spherical joints too
+@pytest.mark.parametrize(("model", "wrenches"), [(MODEL, True), (HINGES, False),
+                                                 pytest.param(BALLS, False, marks=pytest.mark.slow)],
                          ids=["every joint, f_ext", "hinges", "balls"])
 def test_first_derivatives_are_the_recursions(model, wrenches):
     """jacfwd and jacrev in q, v, tau (and the external wrenches), at a random state and at
@@ -91,7 +93,8 @@ def test_first_derivatives_are_the_recursions(model, wrenches):
                 assert _relative(g, w) < 1e-11
 
 
-@pytest.mark.parametrize("model", [MODEL, BALLS], ids=["every joint", "balls"])
+@pytest.mark.parametrize("model", [MODEL, pytest.param(BALLS, marks=pytest.mark.slow)],
+                         ids=["every joint", "balls"])
 def test_model_gradient_is_the_recursions(model):
     """Reverse mode in every model leaf (masses, inertias, placements, axes, gravity, damping,
     armature) and q together against the recursion's, and forward mode along one random model
