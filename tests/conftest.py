@@ -31,9 +31,9 @@ def _free_compiled_code():
     jax.clear_caches()
 
 
-# The longest tests (the notebooks, then the CLI's reproductions and tour) go first, so the two
-# xdist workers (`-n 2 --maxschedchunk 1` in pyproject.toml) start on them and fill in with the
-# short ones, instead of finishing on one long notebook while the other worker idles.
+# The longest modules (the notebooks, then the CLI's tour) go first, so the two xdist workers
+# (`-n 2 --dist loadfile` in pyproject.toml: a module's tests in one worker) start on them and
+# fill in with the short ones, instead of finishing on a long module while the other idles.
 _LONG_FIRST = ("test_notebooks.py", "test_cli.py")
 
 
