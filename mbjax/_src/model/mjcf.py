@@ -44,6 +44,7 @@ import warnings
 import numpy as np
 
 from mbjax._src.model.checks import ModelWarning, combine
+from mbjax._src.model.closures import CutJoint
 from mbjax._src.model.joints import JOINT_TYPES
 from mbjax._src.model.model import Model
 
@@ -305,8 +306,6 @@ def _equality_on(m, mujoco) -> bool:
 def _cut_joints(m, mujoco, where) -> tuple[list, int]:
     """The active connect and weld constraints as CutJoints, and how many there are (constraints
     within one rigid body, always satisfied or never, are left out)."""
-    from mbjax._src.model.closures import CutJoint
-
     cuts, count = [], 0
     if not _equality_on(m, mujoco):
         return cuts, count

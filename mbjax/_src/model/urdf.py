@@ -32,6 +32,7 @@ import equinox as eqx
 import numpy as np
 
 from mbjax._src.model.checks import combine, warn
+from mbjax._src.model.closures import Coupling
 from mbjax._src.model.joints import JOINT_TYPES
 from mbjax._src.model.model import Model
 
@@ -289,8 +290,6 @@ def load_urdf(source: str | os.PathLike, *, floating_base: bool = False,
 
 def _mimics(model: Model, bodies: list) -> list:
     """The mimic joints' couplings q = multiplier q_reference + offset."""
-    from mbjax._src.model.closures import Coupling
-
     q_start = dict(zip(model.joint_names, _q_starts(model), strict=True))
     out, names = [], []
     for b in bodies:
