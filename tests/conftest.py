@@ -32,8 +32,11 @@ def _free_compiled_code():
 
 
 # The longest modules (the notebooks, then the CLI's tour) go first, so the two xdist workers
-# (`-n 2 --dist loadfile` in pyproject.toml: a module's tests in one worker) start on them and
-# fill in with the short ones, instead of finishing on a long module while the other idles.
+# (`-n 2 --dist loadgroup` in pyproject.toml) start on them and fill in with the short ones,
+# instead of finishing on a long module while the other idles. Each module is one xdist group (its
+# compiled programs shared by its tests), except the notebooks and the README's blocks, whose
+# every test runs in a process of its own and may go to either worker.
+_SHARED_OUT = ("test_notebooks.py", "test_readme.py")
 _LONG_FIRST = ("test_notebooks.py", "test_cli.py")
 
 
@@ -43,6 +46,9 @@ def pytest_collection_modifyitems(config, items):
         return _LONG_FIRST.index(name) if name in _LONG_FIRST else len(_LONG_FIRST)
 
     items.sort(key=rank)          # stable: the order within each group is kept
+    for item in items:
+        if item.path.name not in _SHARED_OUT:
+            item.add_marker(pytest.mark.xdist_group(str(item.path.relative_to(config.rootpath))))
     for item in items:            # the slow tests (full-length runs) get an hour, not the default
         if item.get_closest_marker("slow") and not item.get_closest_marker("timeout"):
             item.add_marker(pytest.mark.timeout(3600))
