@@ -90,7 +90,7 @@ class Problem(eqx.Module):
         if self.q0.ndim != 1 or self.v0.ndim != 1:
             raise ValueError(f"q0 and v0 must be vectors, got shapes {self.q0.shape} and "
                              f"{self.v0.shape}")
-        system.n_controls                           # raises for a system without a control
+        system.with_control(None)                   # raises for a system without a control
         for name, x, size in zip(("q0", "v0"), (self.q0, self.v0), system.state_sizes(), strict=True):
             if size is not None and x.shape != (size,):
                 raise ValueError(f"{name} must have shape ({size},) for this system, got {x.shape}")
