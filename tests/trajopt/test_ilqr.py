@@ -98,7 +98,7 @@ def test_the_arm_reaches_its_target_at_a_stationary_point():
                                np.asarray(result.qs), atol=1e-12)
 
 
-@pytest.mark.slow     # 45 s; tests/trajopt/test_sweep vmaps solves
+@pytest.mark.slow     # 45 s; notebook 11's smoke run solves several targets in one vmapped solve
 def test_many_targets_in_one_vmapped_solve():
     offsets = jnp.array([[0.0, 0.2, 0.0], [0.1, 0.0, 0.1], [0.0, -0.15, 0.05]])
 
