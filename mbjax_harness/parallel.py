@@ -80,9 +80,12 @@ def run(task: Callable, keys: Sequence[Hashable], jobs: int | None = None,
     board = Board(desc, len(keys))
     results = {}
     context = multiprocessing.get_context("spawn")      # JAX's threads do not survive a fork
-    events = context.Queue()
-    with ProcessPoolExecutor(jobs, context, initializer=_start_worker,
-                             initargs=(_settings(), events)) as pool:
+    # a manager's queue: a worker's put returns once the notice is here, so a task's notices
+    # arrive before its result (a plain Queue's feeder thread could deliver a step after it)
+    manager = context.Manager()
+    events = manager.Queue()
+    with manager, ProcessPoolExecutor(jobs, context, initializer=_start_worker,
+                                      initargs=(_settings(), events)) as pool:
         pending = {pool.submit(_run, task, key): key for key in keys}
         try:
             while pending:
