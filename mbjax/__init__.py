@@ -14,8 +14,18 @@ The names below are the everyday ones; each topic has its namespace: `mbjax.lie`
 
 from mbjax._src import runtime as _runtime  # first: it sets XLA_FLAGS before JAX starts its backend
 
-from mbjax import (control, data, flex, integrate, lie, loops, model, rigid, scenes, tfe, trajopt,
-                   wrist)
+from mbjax import control as control
+from mbjax import data as data
+from mbjax import flex as flex
+from mbjax import integrate as integrate
+from mbjax import lie as lie
+from mbjax import loops as loops
+from mbjax import model as model
+from mbjax import rigid as rigid
+from mbjax import scenes as scenes
+from mbjax import tfe as tfe
+from mbjax import trajopt as trajopt
+from mbjax import wrist as wrist
 from mbjax._src.cache import use_compilation_cache as use_compilation_cache
 from mbjax._src.integrate.simulate import simulate as simulate
 from mbjax._src.model.mjcf import load_mjcf as load_mjcf

@@ -9,7 +9,6 @@ import importlib.util
 import jax.numpy as jnp
 import numpy as np
 
-import mbjax
 from mbjax._src.model.joints import JOINT_TYPES
 
 MUJOCO_INTEGRATORS = ("Euler", "RK4", "implicit", "implicitfast")

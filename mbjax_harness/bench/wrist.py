@@ -27,7 +27,8 @@ from mbjax_harness.timing import measure, write_jsonl
 from mbjax._src.integrate import RK4, simulate
 from mbjax._src.scenes import carpal_wrist as cw
 from mbjax._src.synthesis import sweeps
-from mbjax._src.trajopt.sweep import size, sweep
+from mbjax._src.trajopt.sweep import size
+from mbjax.trajopt import sweep as sweep_variants
 from mbjax._src.synthesis.baseline import ToolPath
 
 NAME = "wrist"
@@ -86,7 +87,7 @@ def sweep(variants_per_axis: int, repeats, common) -> list[dict]:
     if len(jax.devices()) > 1:
         layouts[f"sharded, {len(jax.devices())} devices"] = jax.devices()
     for name, devices in layouts.items():
-        out, timing = measure(partial(sweep, fn, wrists, devices=devices), repeats=repeats)
+        out, timing = measure(partial(sweep_variants, fn, wrists, devices=devices), repeats=repeats)
         peaks[name] = np.asarray(out)
         records.append({**common, "kind": "sweep", "layout": name, "variants": size(wrists),
                         "compile_s": timing.compile_s, "run_s": timing.run_s,

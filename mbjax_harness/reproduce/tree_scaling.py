@@ -30,7 +30,6 @@ from pathlib import Path
 import jax.numpy as jnp
 import numpy as np
 
-from mbjax import Recursive
 from mbjax_harness import peers
 from mbjax_harness.bench.rigid import loop_length, looped_fn, states, timed
 from mbjax._src.model import chain

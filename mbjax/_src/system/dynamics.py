@@ -89,7 +89,7 @@ def as_dynamics(method) -> AbstractForwardDynamics:
     if isinstance(method, AbstractForwardDynamics):
         return method
     hint = (f"; pass an instance, {method.__name__}()" if isinstance(method, type) else
-            f"; strings are gone: pass Recursive(), Dense() or Auto()" if isinstance(method, str)
+            "; strings are gone: pass Recursive(), Dense() or Auto()" if isinstance(method, str)
             else "")
     raise TypeError(f"method must be mbjax.Recursive(), mbjax.Dense() or mbjax.Auto(), got "
                     f"{method!r}{hint}")
