@@ -19,6 +19,7 @@ from matplotlib.animation import FuncAnimation, PillowWriter
 from matplotlib.figure import Figure
 from matplotlib.ticker import MaxNLocator
 
+from mbjax.wrist import WristSystem
 from mbjax_harness.progress import step
 
 __all__ = ["animate", "frames_along", "stick_animation", "wrist_animation"]
@@ -114,7 +115,7 @@ def animate(path: Path, system, ts, qs, *, title: str = "", frames: int = 60) ->
     the Carpal Wrist's legs and plates (`wrist_animation`), a closed loop's spanning tree with a
     stick from each body of a cut joint to the joint's frame on it (so the loop is seen closed),
     or a tree system's bodies (`stick_animation` of its `frames`)."""
-    if hasattr(system, "wrist"):
+    if isinstance(system, WristSystem):
         return wrist_animation(path, system.model, ts, qs, title=title, frames=frames)
     tree = getattr(system, "tree", system)          # a ClosedSystem draws its tree
     R, p = frames_along(tree, qs)
