@@ -11,7 +11,7 @@ from scipy.optimize import minimize
 from mbjax.model import Model
 from mbjax.rigid import TreeSystem
 from mbjax.scenes import arm as scene
-from mbjax.trajopt import ILQR, Problem, solve
+from mbjax.trajopt import ILQR, MultipleShooting, Problem, solve
 
 # a 2 kg slider without gravity: x = (q, v), q_ddot = u / m; RK4 with u held over the step is
 # exact for it, x_{k+1} = F x_k + G u_k
@@ -130,11 +130,10 @@ def test_bad_problems_are_refused_with_the_argument_named():
         solve(problem, ILQR(), jnp.zeros((4, 1)))
     with pytest.raises(TypeError, match="solver"):
         solve(problem, ILQR)
-    free = TreeSystem(Model([-1], "free", mass=[1.0], inertia=[np.eye(3)]))      # a quaternion
-    floating = Problem(free, np.r_[0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0], np.zeros(6), dt=0.1,
-                       horizon=5, running=lambda q, v, u: u @ u, terminal=lambda q, v: v @ v)
-    with pytest.raises(ValueError, match="nq = 7, nv = 6"):
-        solve(floating, ILQR())
+    with pytest.raises(ValueError, match="states0: ILQR starts from the rollout"):
+        solve(problem, ILQR(), states0=jnp.zeros((6, 2)))
+    with pytest.raises(ValueError, match=r"states0 must be \(horizon \+ 1, nq \+ nv\)"):
+        solve(problem, MultipleShooting(), states0=jnp.zeros((5, 2)))
 
 
 @pytest.mark.slow     # 41 s; test_multiple_shooting keeps the LQR optimum

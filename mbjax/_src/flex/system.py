@@ -50,7 +50,8 @@ class FlexibleSystem(AbstractTreeSystem):
         external_point: body-frame points where the bodies' external forces act [m], shape
             (n, 3) or (3,); None: the bodies' frame origins.
         actuation: the indices of the velocity coordinates the control drives (or a boolean
-            mask of length nv); None: all of them.
+            mask of length nv), or an (nv, nu) actuation matrix S of rank nu (generalized
+            force S u: thrusters, tendons); None: all of them. Stored as the matrix.
         method: `mbjax.Recursive()` (Anderson 1993's O(n) recursion), `mbjax.Dense()` (the
             Lagrangian, O(n^3); joints whose q is their own rate only) or `mbjax.Auto()` (the
             default); static.
@@ -64,7 +65,7 @@ class FlexibleSystem(AbstractTreeSystem):
     control: AbstractControl | None
     external: AbstractControl | None
     external_point: Array | None
-    actuation: tuple[int, ...] | None = eqx.field(static=True)
+    actuation: Array | None
     method: AbstractForwardDynamics = eqx.field(static=True)
     symmetric_dynamics: ClassVar[bool] = False
 

@@ -6,10 +6,12 @@ from mbjax._src.integrate.base import AbstractIntegrator
 
 
 class SemiImplicitEuler(AbstractIntegrator):
-    """Semi-implicit (symplectic) Euler: u1 = u0 + dt u_dot(t0, q0, u0), then q1 = q0 + dt q_dot(q0, u1).
+    """Semi-implicit (symplectic) Euler: u1 = u0 + dt u_dot(t0, q0, u0), then q1 = q0 (+) dt u1.
 
-    Order 1; symplectic for separable Hamiltonians, so energy errors stay bounded instead of
-    growing. Takes no arguments.
+    The configuration steps on its group (`retract` along `tangent`: q0 + dt q_dot(q0, u1) for
+    Euclidean coordinates, Pinocchio's `integrate` for a tree's quaternion joints), so on a
+    tree it is Crocoddyl's `IntegratedActionModelEuler`. Order 1; symplectic for separable
+    Hamiltonians, so energy errors stay bounded instead of growing. Takes no arguments.
     """
 
     order = 1
@@ -17,5 +19,5 @@ class SemiImplicitEuler(AbstractIntegrator):
 
     def step(self, system, t, q, u, dt):
         u1 = u + dt * system.acceleration(t, q, u)
-        q1 = system.project(q + dt * system.kinematics(q, u1))
+        q1 = system.project(system.retract(q, dt * system.tangent(q, u1)))
         return q1, u1, jnp.array(True)

@@ -72,6 +72,19 @@ class AbstractRotation(eqx.Module):
             The coordinates of R0 exp(xi), shape (size,).
         """
 
+    def difference(self, rot0: Array, rot1: Array) -> Array:
+        """The body-frame rotation vector xi with R1 = R0 exp(xi), |xi| <= pi (`retract`'s inverse).
+
+        Args:
+            rot0: the coordinates of R0, shape (size,).
+            rot1: the coordinates of R1, shape (size,).
+
+        Returns:
+            xi, shape (3,).
+        """
+        q0, q1 = (quat.quat_from_matrix(self.to_matrix(r)) for r in (rot0, rot1))
+        return quat.rotvec_from_quat(quat.quat_multiply(quat.quat_conjugate(q0), q1))
+
     @abc.abstractmethod
     def normalize(self, rot: Array) -> Array:
         """The canonical coordinates of the same rotation (unit length, principal angle).
@@ -104,6 +117,10 @@ class Quaternion(AbstractRotation):
     def retract(self, rot0, xi):
         return quat.quat_multiply(rot0, quat.quat_from_rotvec(xi))
 
+    def difference(self, rot0, rot1):
+        return quat.rotvec_from_quat(quat.quat_multiply(quat.quat_conjugate(quat.quat_normalize(rot0)),
+                                                        quat.quat_normalize(rot1)))
+
     def normalize(self, rot):
         return quat.quat_normalize(rot)
 
@@ -129,6 +146,10 @@ class RotationVector(AbstractRotation):
     def retract(self, rot0, xi):
         return quat.rotvec_from_quat(quat.quat_multiply(quat.quat_from_rotvec(rot0),
                                                         quat.quat_from_rotvec(xi)))
+
+    def difference(self, rot0, rot1):
+        return quat.rotvec_from_quat(quat.quat_multiply(
+            quat.quat_conjugate(quat.quat_from_rotvec(rot0)), quat.quat_from_rotvec(rot1)))
 
     def normalize(self, rot):
         return rv.rescale(rot)

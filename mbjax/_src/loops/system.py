@@ -182,6 +182,12 @@ class ClosedSystem(AbstractSystem):
     def local_rate(self, q0, xi, u):
         return self.tree.local_rate(q0, xi, self.velocity(self.retract(q0, xi), u))
 
+    def tangent(self, q, u):
+        return self.tree.tangent(q, self.velocity(q, u))
+
+    def difference(self, q0, q1):
+        return self.tree.difference(q0, q1)
+
     def project(self, q):
         return self.tree.normalize(q)
 

@@ -25,10 +25,19 @@ Quaternions are normalized where they are read, so a drifted state still gives a
 
 from typing import NamedTuple
 
+import jax
 import jax.numpy as jnp
 from jax import Array
 
-from mbjax._src.lie import gamma_inv, quat_from_rotvec, quat_multiply, quat_to_matrix
+from mbjax._src.lie import (
+    gamma,
+    gamma_inv,
+    quat_conjugate,
+    quat_from_rotvec,
+    quat_multiply,
+    quat_to_matrix,
+    rotvec_from_quat,
+)
 from mbjax._src.spatial import skew
 
 
@@ -147,34 +156,71 @@ def joint_rate(kind: str, q: Array, v: Array) -> Array:
     return v[: JOINT_TYPES[kind].nq]
 
 
-def joint_retract(kind: str, q0: Array, xi: Array) -> Array:
-    """One joint's configuration at chart point xi about q0.
+def joint_integrate(kind: str, q0: Array, v: Array) -> Array:
+    """One joint's configuration q0 (+) v: moved along v for one unit of time on its group.
 
-    q0 + xi for Euclidean joints; a body-frame rotation increment quat0 * exp(xi) (Borri 1990
-    §2) for quaternions, and for a free joint also the origin moved by xi's ground-frame part.
+    q0 + v for revolute, prismatic and universal joints; the body-frame rotation increment
+    quat0 * exp(omega) (Borri 1990 §2) for a spherical joint; for a free joint the exponential of
+    the body twist v = (omega; u) on SE(3): R0 exp(omega), p0 + R0 Gamma(omega) u, with Gamma the
+    tangent map of Borri 1990 eq A.17 (Pinocchio's `integrate`, its exp6).
 
     Args:
         kind: the joint type.
-        q0: the chart's base configuration, shape (nq,).
-        xi: the chart point, shape (nv,).
+        q0: the joint's configuration, shape (nq,).
+        v: a tangent vector (a velocity times a time), shape (nv,).
 
     Returns:
         The configuration, shape (nq,).
     """
     if kind == "spherical":
-        return quat_multiply(_unit(q0[:4]), quat_from_rotvec(xi[:3]))
+        return quat_multiply(_unit(q0[:4]), quat_from_rotvec(v[:3]))
     if kind == "free":
-        return jnp.concatenate([q0[:3] + xi[3:6],
-                                quat_multiply(_unit(q0[3:7]), quat_from_rotvec(xi[:3]))])
+        quat0 = _unit(q0[3:7])
+        return jnp.concatenate([q0[:3] + quat_to_matrix(quat0) @ (gamma(v[:3]) @ v[3:6]),
+                                quat_multiply(quat0, quat_from_rotvec(v[:3]))])
     n = JOINT_TYPES[kind].nq
-    return q0[:n] + xi[:n]
+    return q0[:n] + v[:n]
+
+
+def joint_difference(kind: str, q0: Array, q1: Array, continuous: Array) -> Array:
+    """One joint's tangent vector v with q0 (+) v = q1 (`joint_integrate`'s inverse).
+
+    q1 - q0 for prismatic and universal joints and for a revolute joint with limits; the angle
+    wrapped to [-pi, pi) for a revolute joint without (continuous, as Pinocchio's); the body-frame
+    rotation vector log(quat0^-1 quat1) for a spherical joint, with |omega| <= pi; and the
+    SE(3) logarithm (omega; Gamma(omega)^-1 R0^T (p1 - p0)) for a free joint.
+
+    Args:
+        kind: the joint type.
+        q0: the first configuration, shape (nq,).
+        q1: the second configuration, shape (nq,).
+        continuous: a boolean scalar, whether a revolute joint has no limits.
+
+    Returns:
+        v, shape (nv,).
+    """
+    if kind in ("spherical", "free"):
+        quat0, quat1 = _unit(q0[-4:]), _unit(q1[-4:])
+        omega = rotvec_from_quat(quat_multiply(quat_conjugate(quat0), quat1))
+        if kind == "spherical":
+            return omega
+        u = gamma_inv(omega) @ (quat_to_matrix(quat0).T @ (q1[:3] - q0[:3]))
+        return jnp.concatenate([omega, u])
+    n = JOINT_TYPES[kind].nq
+    d = q1[:n] - q0[:n]
+    if kind == "revolute":
+        wrapped = d - 2 * jnp.pi * jnp.floor((d + jnp.pi) / (2 * jnp.pi))
+        d = jnp.where(continuous, wrapped, d)
+    return d
 
 
 def joint_local_rate(kind: str, q0: Array, xi: Array, v: Array) -> Array:
     """One joint's chart rate xi_dot at chart point xi about q0 for velocity v.
 
-    Gamma(xi)^-T omega for the rotation increment (Borri 1990 eq 2.8) and R v_origin for a free
-    joint's origin; v itself for Euclidean joints.
+    The chart is `joint_integrate`: q = q0 (+) xi. Its rate is v itself for Euclidean joints;
+    Gamma(xi)^-T omega for the rotation increment (Borri 1990 eq 2.8); and for a free joint's
+    translation, from d/dt (Gamma(xi_omega) xi_u) = exp(xi_omega) u,
+    xi_u_dot = Gamma^-1 (exp(xi_omega) u - (d Gamma / dt) xi_u).
 
     Args:
         kind: the joint type.
@@ -185,9 +231,12 @@ def joint_local_rate(kind: str, q0: Array, xi: Array, v: Array) -> Array:
     Returns:
         xi_dot, shape (nv,).
     """
-    if kind == "spherical":
-        return gamma_inv(xi[:3]).T @ v[:3]
-    if kind == "free":
-        R = quat_to_matrix(joint_retract(kind, q0, xi)[3:7])
-        return jnp.concatenate([gamma_inv(xi[:3]).T @ v[:3], R @ v[3:6]])
+    if kind in ("spherical", "free"):
+        omega_rate = gamma_inv(xi[:3]).T @ v[:3]
+        if kind == "spherical":
+            return omega_rate
+        _, gamma_rate = jax.jvp(lambda w: gamma(w) @ xi[3:6], (xi[:3],), (omega_rate,))
+        u_rate = gamma_inv(xi[:3]) @ (quat_to_matrix(quat_from_rotvec(xi[:3])) @ v[3:6]
+                                      - gamma_rate)
+        return jnp.concatenate([omega_rate, u_rate])
     return v[: JOINT_TYPES[kind].nv]

@@ -23,7 +23,8 @@ from mbjax._src.model.joints import (
     joint_calc,
     joint_local_rate,
     joint_rate,
-    joint_retract,
+    joint_difference,
+    joint_integrate,
 )
 from mbjax._src.model.checks import check_body
 from mbjax._src.tree.take import take
@@ -441,10 +442,62 @@ class Model(eqx.Module):
         q_dot = v and retract(q0, xi) = q0 + xi, with no per-joint-type gathers and scatters."""
         return all(JOINT_TYPES[kind].nq == JOINT_TYPES[kind].nv for kind in self.joint_types)
 
-    def retract(self, q0: Array, xi: Array) -> Array:
-        """The configuration at chart point xi about q0 (see `mbjax._src.model.joints.joint_retract`).
+    def integrate(self, q: Array, v: Array) -> Array:
+        """q (+) v: the configuration reached from q by the velocity v in one unit of time.
 
-        q0 + xi for Euclidean joints; a body-frame rotation increment for quaternions.
+        q + v for revolute, prismatic and universal joints; on the rotation group for spherical
+        joints and on SE(3) for free joints (the body twist's exponential), equal to
+        Pinocchio's `integrate` after `mbjax.model.state_to_pinocchio` (see
+        `mbjax._src.model.joints.joint_integrate`). Differentiable, with finite derivatives at
+        zero and half turns.
+
+        Args:
+            q: configuration, shape (nq,).
+            v: tangent vector (a velocity times a time), shape (nv,).
+
+        Returns:
+            The configuration, shape (nq,).
+        """
+        if self.euclidean:
+            return q + v
+        return self._flat_q(self._per_type(
+            lambda kind, qk, vk, a, a2: self._pad_q(kind, joint_integrate(kind, qk, vk)), q, v))
+
+    def difference(self, q0: Array, q1: Array) -> Array:
+        """The tangent vector v with q0 (+) v = q1: `integrate`'s inverse.
+
+        q1 - q0, with a revolute joint without limits (URDF continuous) wrapped to [-pi, pi);
+        the body-frame rotation vector (|omega| <= pi) for quaternions and the SE(3)
+        logarithm for free joints. Equal to Pinocchio's `difference` after the state
+        converters.
+
+        Args:
+            q0: configuration, shape (nq,).
+            q1: configuration, shape (nq,).
+
+        Returns:
+            v, shape (nv,).
+        """
+        layout, width = _layout(self.joint_types), self.width
+        continuous = jnp.isinf(self.lower) & jnp.isinf(self.upper)
+        if self.euclidean:                       # q1 - q0, continuous angles wrapped
+            revolute = np.zeros(self.nq, bool)
+            for k in layout["groups"].get("revolute", ()):
+                revolute[layout["q_start"][k]] = True
+            d = q1 - q0
+            return jnp.where(revolute & continuous,
+                             d - 2 * jnp.pi * jnp.floor((d + jnp.pi) / (2 * jnp.pi)), d)
+        pieces = []
+        for kind, idx in layout["groups"].items():
+            own = layout["q_own"][kind]
+            d = jax.vmap(lambda a, b, c, kind=kind: joint_difference(kind, a, b, c))(
+                take(q0, own), take(q1, own), take(continuous, own[:, 0]))
+            pieces.append(jnp.pad(d, ((0, 0), (0, width - d.shape[1]))))
+        return self.flat_v(_by_body(layout, pieces))
+
+    def retract(self, q0: Array, xi: Array) -> Array:
+        """The configuration at chart point xi about q0: `integrate(q0, xi)`, the chart that
+        `local_rate` differentiates (what RKMK4 and the closed loops' projections step in).
 
         Args:
             q0: the chart's base configuration, shape (nq,).
@@ -453,10 +506,7 @@ class Model(eqx.Module):
         Returns:
             The configuration, shape (nq,).
         """
-        if self.euclidean:
-            return q0 + xi
-        return self._flat_q(self._per_type(
-            lambda kind, qk, xk, a, a2: self._pad_q(kind, joint_retract(kind, qk, xk)), q0, xi))
+        return self.integrate(q0, xi)
 
     def local_rate(self, q0: Array, xi: Array, v: Array) -> Array:
         """The chart coordinates' rate xi_dot at chart point xi about q0 for velocity v.
@@ -505,6 +555,29 @@ class Model(eqx.Module):
         source = np.arange(q.shape[0])
         source[idx.ravel()] = q.shape[0] + np.arange(idx.size)
         return take(jnp.concatenate([q, units.ravel()]), source)
+
+    def locked(self, joint_names, q: Array) -> "Model":
+        """The model with some joints fixed at q's values (Pinocchio's `buildReducedModel`).
+
+        Each locked joint's body is merged into its parent (mass, centre of mass and inertia
+        combined at the locked configuration, as a URDF's fixed joints are merged); the body
+        and its frames stay as frames, its children hang from the parent, and the remaining
+        joints keep their order, limits, damping and armature.
+
+        Args:
+            joint_names: names of the joints to lock, a sequence of strings.
+            q: a configuration of this model, shape (nq,); the locked joints' values are read
+                from it.
+
+        Returns:
+            The reduced `Model`.
+
+        Raises:
+            ValueError: an unknown joint name, a joint named twice, every joint locked, or q of
+                the wrong shape.
+        """
+        from mbjax._src.model.locked import lock_joints
+        return lock_joints(self, joint_names, q)
 
     def spatial_inertia(self) -> Array:
         """The spatial inertias about each body's origin, in body coordinates.

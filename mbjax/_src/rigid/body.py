@@ -53,7 +53,8 @@ class RigidBody(AbstractDrivenSystem):
         external_point: where the external force acts, body-frame coordinates from that origin
             [m], shape (1, 3) or (3,); None: the origin.
         actuation: the indices of the velocity coordinates the control drives (or a boolean
-            mask of length nv); None: all of them.
+            mask of length nv), or an (nv, nu) actuation matrix S of rank nu (generalized
+            force S u: thrusters, tendons); None: all of them. Stored as the matrix.
 
     Raises:
         TypeError: `rotation` is not a rotation-coordinates instance.
@@ -68,7 +69,7 @@ class RigidBody(AbstractDrivenSystem):
     control: AbstractControl | None
     external: AbstractControl | None
     external_point: Array | None
-    actuation: tuple[int, ...] | None = eqx.field(static=True)
+    actuation: Array | None
     fixed_point: bool = eqx.field(static=True)
     rotation: AbstractRotation = eqx.field(static=True)
 
@@ -201,6 +202,15 @@ class RigidBody(AbstractDrivenSystem):
         """xi_dot = Gamma(xi)^-T Omega, the body-frame dexp^-1 (Borri 1990 eq 2.8)."""
         xi_dot = lie.gamma_inv(xi[:3]).T @ u[:3]
         return xi_dot if self.fixed_point else jnp.concatenate([xi_dot, u[3:]])
+
+    def tangent(self, q, u):
+        """(Omega; v): the chart's rate at xi = 0."""
+        return u[:3] if self.fixed_point else u
+
+    def difference(self, q0, q1):
+        """(log(R0^T R1); x1 - x0)."""
+        rot = self.rotation.difference(q0[: self.n_rot], q1[: self.n_rot])
+        return rot if self.fixed_point else jnp.concatenate([rot, q1[self.n_rot:] - q0[self.n_rot:]])
 
     def project(self, q):
         rot = q[: self.n_rot]

@@ -61,7 +61,8 @@ class TreeSystem(AbstractTreeSystem):
         external_point: body-frame points where the external forces act [m], shape (n, 3) or
             (3,) (the same for every body); None: the bodies' origins.
         actuation: the indices of the velocity coordinates the control drives (or a boolean
-            mask of length nv); None: all of them.
+            mask of length nv), or an (nv, nu) actuation matrix S of rank nu (generalized
+            force S u: thrusters, tendons); None: all of them. Stored as the matrix.
         method: `mbjax.Recursive()`, `mbjax.Dense()` or `mbjax.Auto()` (the default); static.
 
     Raises:
@@ -74,7 +75,7 @@ class TreeSystem(AbstractTreeSystem):
     control: AbstractControl | None
     external: AbstractControl | None
     external_point: Array | None
-    actuation: tuple[int, ...] | None = eqx.field(static=True)
+    actuation: Array | None
     method: AbstractForwardDynamics = eqx.field(static=True)
     symmetric_dynamics: ClassVar[bool] = True
 
@@ -208,7 +209,8 @@ class MomentumSystem(AbstractDrivenSystem):
         external: a callable (t, q, v) -> world-frame wrenches, shape (n, 6), or None.
         external_point: body-frame points where the external forces act [m], shape (n, 3) or
             (3,); None: the bodies' origins.
-        actuation: the indices of the velocity coordinates the control drives; None: all.
+        actuation: the indices of the velocity coordinates the control drives, or an
+            (nv, nu) actuation matrix; None: all. Stored as the matrix.
 
     Raises:
         TypeError: `model` is not a `mbjax.Model`.
@@ -219,7 +221,7 @@ class MomentumSystem(AbstractDrivenSystem):
     control: AbstractControl | None
     external: AbstractControl | None
     external_point: Array | None
-    actuation: tuple[int, ...] | None = eqx.field(static=True)
+    actuation: Array | None
 
     def __init__(self, model: Model, control=None, *, external=None, external_point=None,
                  actuation=None):
@@ -264,6 +266,12 @@ class MomentumSystem(AbstractDrivenSystem):
 
     def local_rate(self, q0, xi, u):
         return self.model.local_rate(q0, xi, self.velocity(self.model.retract(q0, xi), u))
+
+    def tangent(self, q, u):
+        return self.velocity(q, u)
+
+    def difference(self, q0, q1):
+        return self.model.difference(q0, q1)
 
     def project(self, q):
         return self.model.normalize(q)

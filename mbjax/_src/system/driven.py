@@ -1,8 +1,11 @@
 """What every driven system shares: a control on its actuated velocity coordinates and external
 wrenches on its bodies, with their checks written once.
 
-A control returns one generalized force per actuated coordinate (`actuation`: their indices, all
-of them by default). An external load returns one world-frame wrench (torque; force) per body,
+A control returns one force per actuator. `actuation` says where they act: on the velocity
+coordinates it lists (indices, all of them by default), or through an (nv, nu) actuation matrix S
+whose columns are each actuator's generalized force per unit control, tau = S u (thrusters on a
+floating base, tendons, differential drives; Crocoddyl's `ActuationModelAbstract` with a constant
+d tau / d u). An external load returns one world-frame wrench (torque; force) per body,
 shape (n, 6), acting at the body's origin, or at a point fixed in the body (`external_point`,
 body-frame coordinates, shape (n, 3)).
 """
@@ -10,6 +13,7 @@ body-frame coordinates, shape (n, 3)).
 import abc
 
 import equinox as eqx
+import jax
 import jax.numpy as jnp
 import numpy as np
 from jax import Array
@@ -27,7 +31,7 @@ class AbstractDrivenSystem(AbstractSystem):
     control: eqx.AbstractVar[AbstractControl | None]
     external: eqx.AbstractVar[AbstractControl | None]
     external_point: eqx.AbstractVar[Array | None]
-    actuation: eqx.AbstractVar[tuple[int, ...] | None]
+    actuation: eqx.AbstractVar[Array | None]
 
     @property
     @abc.abstractmethod
@@ -46,8 +50,9 @@ class AbstractDrivenSystem(AbstractSystem):
 
     @property
     def n_controls(self) -> int:
-        """The number of forces the control returns: len(actuation), or nv if all are actuated."""
-        return self.nv if self.actuation is None else len(self.actuation)
+        """The number of forces the control returns: len(actuation), the actuation matrix's
+        columns, or nv if all coordinates are actuated."""
+        return self.nv if self.actuation is None else self.actuation.shape[1]
 
     def with_control(self, control) -> "AbstractDrivenSystem":
         """The system driven by `control` instead of its own (what trajectory optimisation varies).
@@ -83,10 +88,8 @@ class AbstractDrivenSystem(AbstractSystem):
             raise ValueError(f"the control returned shape {tau.shape}; this system expects "
                              f"({self.n_controls},): " + (
                                  "one force per velocity coordinate" if self.actuation is None
-                                 else f"one per actuated coordinate, actuation={self.actuation}"))
-        if self.actuation is None:
-            return tau
-        return jnp.zeros(self.nv, v.dtype).at[jnp.array(self.actuation)].set(tau)
+                                 else "one per actuator (column of the actuation matrix)"))
+        return tau if self.actuation is None else self.actuation @ tau
 
     def external_wrenches(self, t: Array, q: Array, v: Array) -> Array | None:
         """The external wrenches as `external` returns them, checked.
@@ -135,41 +138,63 @@ def drive(control, external, external_point, actuation, *, nv: int, n: int) -> t
         external_point: body-frame points where the external forces act, shape (n, 3) or (3,)
             (the same point for every body), or None (the bodies' origins).
         actuation: indices of the actuated velocity coordinates, a boolean mask of length nv,
-            or None (all of them).
+            an (nv, nu) actuation matrix of rank nu (generalized force S u), or None (all
+            coordinates).
         nv: the system's number of velocity coordinates.
         n: the system's number of bodies.
 
     Returns:
-        (control, external, external_point, actuation), as the system stores them.
+        (control, external, external_point, actuation), as the system stores them: the
+        actuation as its (nv, nu) matrix (the identity's columns for indices), or None.
 
     Raises:
         TypeError, ValueError: naming the argument that is malformed.
     """
     actuation = check_actuation(actuation, nv)
     control = as_control(control)
-    n_act = nv if actuation is None else len(actuation)
+    n_act = nv if actuation is None else actuation.shape[1]
     value = getattr(control, "value", None)
     if value is not None and value.shape != (n_act,):
         raise ValueError(f"the constant control (tau) must have shape ({n_act},), got {value.shape}")
     return control, as_control(external), check_points(external_point, n), actuation
 
 
-def check_actuation(actuation, nv: int) -> tuple[int, ...] | None:
-    """The actuated velocity coordinates as a tuple of distinct indices (in the order of the
-    control's outputs), or None (all of them)."""
+def check_actuation(actuation, nv: int) -> Array | None:
+    """The (nv, nu) actuation matrix: given, checked to be of full column rank, or the columns
+    of the identity at the actuated velocity coordinates (distinct indices, in the order of the
+    control's outputs, or a boolean mask); None where all coordinates are actuated."""
     if actuation is None:
         return None
+    if isinstance(actuation, jax.core.Tracer) or (np.ndim(actuation) == 2):
+        return _actuation_matrix(actuation, nv)
     index = np.atleast_1d(np.asarray(actuation))
     if index.dtype == bool:
         if index.shape != (nv,):
             raise ValueError(f"actuation as a mask must have {nv} entries, got {index.shape}")
         index = np.flatnonzero(index)
     if not np.issubdtype(index.dtype, np.integer) or index.ndim != 1:
-        raise TypeError(f"actuation must be velocity-coordinate indices (ints) or a boolean mask, "
-                        f"got {actuation!r}")
+        raise TypeError(f"actuation must be velocity-coordinate indices (ints), a boolean mask or "
+                        f"an (nv, nu) actuation matrix, got {actuation!r}")
     if len(set(index.tolist())) != len(index) or np.any(index < 0) or np.any(index >= nv):
         raise ValueError(f"actuation must be distinct indices in 0 ... {nv - 1}, got {index.tolist()}")
-    return tuple(int(i) for i in index)
+    return jnp.asarray(np.eye(nv)[:, index])
+
+
+def _actuation_matrix(S, nv: int) -> Array:
+    """An (nv, nu) actuation matrix, checked where concrete: real, finite, of rank nu."""
+    S = jnp.asarray(S, dtype=float)
+    if S.ndim != 2 or S.shape[0] != nv or S.shape[1] < 1:
+        raise ValueError(f"actuation as a matrix must have shape (nv, nu) = ({nv}, nu) with "
+                         f"nu >= 1, got {S.shape}")
+    if not isinstance(S, jax.core.Tracer):
+        values = np.asarray(S)
+        if not np.isfinite(values).all():
+            raise ValueError("actuation matrix must be finite")
+        rank = np.linalg.matrix_rank(values)
+        if rank < S.shape[1]:
+            raise ValueError(f"actuation matrix has rank {rank} < nu = {S.shape[1]}: some "
+                             "controls act alike (or not at all); give independent columns")
+    return S
 
 
 def check_points(point, n: int) -> Array | None:

@@ -8,7 +8,8 @@ q may live on a manifold (a quaternion, a rotation vector), so a system also giv
 about any configuration q0: q = retract(q0, xi) with xi in R^dim(u), xi = 0 at q0, and the rate
 xi_dot = local_rate(q0, xi, u). For rotations this is Borri 1990's incremental rotation vector about a
 reference configuration (§2): R = R0 exp(xi), xi_dot = Gamma(xi)^-T Omega. Euclidean systems keep the
-defaults (retract(q0, xi) = q0 + xi).
+defaults (retract(q0, xi) = q0 + xi). `difference` is the chart's inverse and `tangent` its rate at
+xi = 0, along which the Euler methods step.
 """
 
 import abc
@@ -80,6 +81,37 @@ class AbstractSystem(eqx.Module):
             dxi/dt, shape (nu,) (for rotations, Borri 1990's Gamma(xi)^-T Omega).
         """
         return self.kinematics(self.retract(q0, xi), u)
+
+    def tangent(self, q: Array, u: Array) -> Array:
+        """The configuration's rate in the chart about q itself: local_rate(q, 0, u).
+
+        What the Euler methods step along: q1 = retract(q, dt tangent(q, u)), on the group for
+        quaternion joints (Crocoddyl's and Pinocchio's `integrate`).
+
+        Args:
+            q: configuration, shape (nq,).
+            u: velocity state, shape (nu,).
+
+        Returns:
+            xi_dot at xi = 0, shape of the chart (the velocity's for a tree); kinematics(q, u)
+            by default.
+        """
+        return self.kinematics(q, u)
+
+    def difference(self, q0: Array, q1: Array) -> Array:
+        """The chart point xi about q0 at which retract(q0, xi) = q1 (q1 - q0 by default).
+
+        What trajectory optimisation measures deviations with (Pinocchio's `difference` for a
+        tree).
+
+        Args:
+            q0: the chart's base configuration, shape (nq,).
+            q1: a configuration, shape (nq,).
+
+        Returns:
+            xi, shape of the chart.
+        """
+        return q1 - q0
 
     def project(self, q: Array) -> Array:
         """Map coordinates back to their canonical form (unit quaternion, principal rotation vector).

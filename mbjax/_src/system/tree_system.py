@@ -87,6 +87,12 @@ class AbstractTreeSystem(AbstractDrivenSystem):
     def local_rate(self, q0: Array, xi: Array, u: Array) -> Array:
         return self.model.local_rate(q0, xi, u)
 
+    def tangent(self, q: Array, u: Array) -> Array:
+        return u
+
+    def difference(self, q0: Array, q1: Array) -> Array:
+        return self.model.difference(q0, q1)
+
     def normalize(self, q: Array) -> Array:
         """q with every quaternion scaled to unit length.
 

@@ -3,9 +3,11 @@
 Each iteration (Li and Todorov 2004; Tassa, Erez and Todorov 2012; the control bounds as in
 Tassa, Mansard and Todorov 2014):
 
-1. linearize about the current trajectory: A_k = df/dx, B_k = df/du by `jax.jacfwd` of the
-   problem's integrator step (`Problem.step_jacobians`), and the costs' gradients and Hessians
-   (Gauss-Newton for residual costs, `Problem`), all vmapped over time;
+1. linearize about the current trajectory in the state's tangent space (deviations
+   dx = difference(x_k, x), so a floating base's quaternion needs nothing special):
+   A_k = df/dx, B_k = df/du by `jax.jacfwd` of the problem's integrator step
+   (`Problem.step_jacobians`), and the costs' gradients and Hessians (Gauss-Newton for
+   residual costs, `Problem`), all vmapped over time;
 2. a backward Riccati pass (`lax.scan`, reversed) from V = the terminal cost's expansion:
 
        Q_x = l_x + A^T V_x,        Q_u = l_u + B^T V_x,
@@ -15,7 +17,7 @@ Tassa, Mansard and Todorov 2014):
    (a projected Newton method on the box, a fixed number of iterations), and the feedback
    K_k = -Q_uu_ff^-1 Q_ux on the controls it leaves free (zero rows on the clamped ones); the
    value function is carried back through the closed loop;
-3. a forward pass u = clip(u_k + alpha k_k + K_k (x - x_k)), the step length alpha backtracking
+3. a forward pass u = clip(u_k + alpha k_k + K_k difference(x_k, x)), the step length alpha backtracking
    through `steps` until the cost decrease is at least a fraction of the model's prediction;
 4. mu, the regularization of Q_uu, shrinks tenfold after an accepted step longer than
    `shrink_above`, grows tenfold after one of `grow_below` or shorter and after a failure (a
@@ -43,7 +45,7 @@ from jax import Array
 from mbjax._src.system.status import Status
 from mbjax._src.linalg import spd_solve
 from mbjax._src.trajopt.problem import Problem
-from mbjax._src.trajopt.result import AbstractSolver, Result, history, require_vector_state
+from mbjax._src.trajopt.result import AbstractSolver, Result, history, no_states
 
 MU_MIN, MU_MAX, MU_FACTOR = 1e-9, 1e10, 10.0
 CROCODDYL_SCHEDULE = {"steps": tuple(0.5**k for k in range(10)), "acceptance": 0.1,
@@ -114,9 +116,9 @@ class ILQR(AbstractSolver):
     """Iterative LQR (DDP with the dynamics' first derivatives) with box-constrained controls.
 
     A solver strategy for `mbjax.trajopt.solve`; the algorithm and its schedule are described
-    in the module. Needs a state with as many coordinates as velocities (no quaternions; use
-    `Shooting` there). The result's `feedback` holds the gains of the last accepted
-    iteration.
+    in the module. It steps in the state's tangent space, so floating bases and continuous
+    joints need nothing special. The result's `feedback` holds the gains of the last
+    accepted iteration, acting on deviations `Problem.difference(x_k, x)`.
 
     Args:
         iterations: the most iterations (static).
@@ -140,25 +142,27 @@ class ILQR(AbstractSolver):
     grow_below: float = 0.0
     qp_iterations: int = eqx.field(static=True, default=8)
 
-    def solve(self, problem: Problem, us: Array) -> Result:
+    def solve(self, problem: Problem, us: Array, states: Array | None = None) -> Result:
         """Optimise the controls of `problem` from `us` (normally through `mbjax.trajopt.solve`).
 
         Args:
             problem: the trajectory-optimisation problem.
             us: the first guess, inside the bounds, shape (horizon, nu).
+            states: must be None: iLQR starts from the rollout of us (a state trajectory as
+                first guess is `MultipleShooting`'s).
 
         Returns:
             The `Result`, its status NOT_CONVERGED where the iterations ran out or mu passed
             its ceiling.
 
         Raises:
-            ValueError: the problem's configuration has more coordinates than velocities.
+            ValueError: states were given.
         """
-        require_vector_state(problem, "ILQR")
+        no_states(states, "ILQR")
         xs = problem.rollout(us)
         cost = problem.cost(xs, us)
         alphas = jnp.asarray(self.steps, cost.dtype)
-        N, nx, nu = problem.horizon, problem.nx, problem.nu
+        N, nx, nu = problem.horizon, problem.ndx, problem.nu
         state = dict(xs=xs, us=us, cost=cost, mu=jnp.asarray(self.regularization, cost.dtype),
                      iteration=jnp.array(0), done=jnp.array(False), stalled=jnp.array(False),
                      costs=history(self.iterations + 1, cost),
@@ -221,7 +225,7 @@ class ILQR(AbstractSolver):
         """The dynamics' and costs' expansion about (xs, us): (A, B, l_x, l_u, l_xx, l_ux, l_uu)
         per step and the terminal (V_x, V_xx)."""
         steps = jnp.arange(problem.horizon)
-        A, B = jax.vmap(problem.step_jacobians)(xs[:-1], us, steps)
+        A, B, _ = jax.vmap(problem.step_jacobians)(xs[:-1], us, steps, xs[1:])
         return (A, B, *jax.vmap(problem.stage_expansion)(xs[:-1], us)), problem.final_expansion(xs[-1])
 
     def _backward(self, problem: Problem, expansion: tuple, us: Array, mu: Array):
@@ -245,7 +249,8 @@ class ILQR(AbstractSolver):
         """(xs, us, cost) of the closed-loop rollout with step length alpha."""
         def f(x, inputs):
             x_ref, u_ref, k_, K_, i = inputs
-            u = jnp.clip(u_ref + alpha * k_ + K_ @ (x - x_ref), problem.lower, problem.upper)
+            u = jnp.clip(u_ref + alpha * k_ + K_ @ problem.difference(x_ref, x), problem.lower,
+                         problem.upper)
             return problem.step(x, u, i), (x, u)
 
         x_end, (x_seq, u_seq) = jax.lax.scan(f, xs[0], (xs[:-1], us, k, K,

@@ -1,6 +1,7 @@
 """Multiple shooting: the states at the knots are unknowns beside the controls, and the
 dynamics are constraints, the defects e_k = f(x_k, u_k) - x_{k+1} = 0 (Bock and Plitt 1984),
-enforced by an augmented Lagrangian (Hestenes 1969; Powell 1969):
+measured in the state's tangent space (e_k = difference(x_{k+1}, f(x_k, u_k)), steps taken by
+x (+) dx, as `ILQR`'s), enforced by an augmented Lagrangian (Hestenes 1969; Powell 1969):
 
     M(xs, us) = sum_k l(x_k, u_k) dt + l_N(x_N) + sum_k lambda_k^T e_k + rho / 2 sum_k |e_k|^2.
 
@@ -19,7 +20,9 @@ along the knots (no nonlinear rollout), with a backtracking line search on M: ea
 vmapped evaluation of all the knots at once. After an inner solve the multipliers take
 lambda_k += rho e_k, and rho grows tenfold when the largest defect has not fallen to a quarter.
 
-The first guess's states are the rollout of its controls. The trajectory returned is the
+The first guess's states are the rollout of its controls, or a given state trajectory (an
+infeasible start, as Crocoddyl's FDDP takes one: the knots need not be connected by the
+dynamics; the first is the problem's x0). The trajectory returned is the
 rollout of the final controls (its `cost` the problem's objective of it), which the knots match
 to the defect tolerance; `costs` holds the merit M after each inner iteration. Success when the
 largest defect is below `defect_tolerance` and the last inner solve's relative decrease fell
@@ -31,10 +34,9 @@ import jax
 import jax.numpy as jnp
 from jax import Array
 
-from mbjax._src.trajopt.ilqr import ILQR, riccati_step
+from mbjax._src.trajopt.ilqr import riccati_step
 from mbjax._src.trajopt.problem import Problem
-from mbjax._src.trajopt.result import (AbstractSolver, Result, history, require_vector_state,
-                                  rollout_result)
+from mbjax._src.trajopt.result import AbstractSolver, Result, history, rollout_result
 
 STEPS = tuple(0.5**k for k in range(10))
 
@@ -43,9 +45,10 @@ class MultipleShooting(AbstractSolver):
     """Multiple shooting: knot states and controls as unknowns, the dynamics as constraints.
 
     The defects are enforced by an augmented Lagrangian, the steps taken by Gauss-Newton (see
-    the module). A solver strategy for `mbjax.trajopt.solve`. Needs a state with as many
-    coordinates as velocities (no quaternions; use `Shooting` there). Success when the largest
-    defect is below `defect_tolerance` and the last inner solve settled.
+    the module). A solver strategy for `mbjax.trajopt.solve`; it steps in the state's tangent
+    space, so floating bases need nothing special, and takes a state trajectory as first
+    guess. Success when the largest defect is below `defect_tolerance` and the last inner
+    solve settled.
 
     Args:
         iterations: the most Gauss-Newton steps in all (static).
@@ -66,27 +69,26 @@ class MultipleShooting(AbstractSolver):
     regularization: float = 1e-6
     qp_iterations: int = eqx.field(static=True, default=8)
 
-    def solve(self, problem: Problem, us: Array) -> Result:
+    def solve(self, problem: Problem, us: Array, states: Array | None = None) -> Result:
         """Optimise the controls of `problem` from `us` (normally through `mbjax.trajopt.solve`).
 
         Args:
             problem: the trajectory-optimisation problem.
-            us: the first guess, inside the bounds, shape (horizon, nu); the knots' states
-                start as its rollout.
+            us: the first guess, inside the bounds, shape (horizon, nu).
+            states: the knots' first states, shape (horizon + 1, nx) (the first replaced by
+                the problem's x0); None for the rollout of us.
 
         Returns:
             The `Result`: the rollout of the final controls, `costs` the merit after each
             inner iteration.
-
-        Raises:
-            ValueError: the problem's configuration has more coordinates than velocities.
         """
-        require_vector_state(problem, "MultipleShooting")
         steps = jnp.arange(problem.horizon)
         alphas = jnp.asarray(STEPS, us.dtype)
+        nx = problem.ndx
 
         def defects(xs, us):
-            return jax.vmap(problem.step)(xs[:-1], us, steps) - xs[1:]
+            return jax.vmap(lambda x, u, k, y: problem.difference(y, problem.step(x, u, k)))(
+                xs[:-1], us, steps, xs[1:])
 
         def merit(xs, us, lam, rho):
             e = defects(xs, us)
@@ -94,9 +96,10 @@ class MultipleShooting(AbstractSolver):
 
         def direction(xs, us, lam, rho, mu):
             """The Gauss-Newton step (dxs, dus) of the merit, and whether it is finite."""
-            (A, B, lx, lu, lxx, lux, luu), (vx, Vxx) = ILQR._linearize(problem, xs, us)
-            e = defects(xs, us)
-            eye_x = jnp.eye(problem.nx, dtype=us.dtype)
+            A, B, e = jax.vmap(problem.step_jacobians)(xs[:-1], us, steps, xs[1:])
+            lx, lu, lxx, lux, luu = jax.vmap(problem.stage_expansion)(xs[:-1], us)
+            vx, Vxx = problem.final_expansion(xs[-1])
+            eye_x = jnp.eye(nx, dtype=us.dtype)
 
             def back(carry, inputs):
                 v, V = carry
@@ -121,9 +124,9 @@ class MultipleShooting(AbstractSolver):
                 y = S @ (rho * w + lam - v)
                 return y, (du, y)
 
-            _, (dus, dys) = jax.lax.scan(forward, jnp.zeros(problem.nx, us.dtype),
+            _, (dus, dys) = jax.lax.scan(forward, jnp.zeros(nx, us.dtype),
                                          (A, B, k, K, S, v_next, e, lam))
-            dxs = jnp.concatenate([jnp.zeros((1, problem.nx), us.dtype), dys])
+            dxs = jnp.concatenate([jnp.zeros((1, nx), us.dtype), dys])
             ok = jnp.all(jnp.isfinite(dxs)) & jnp.all(jnp.isfinite(dus))
             return dxs, dus, ok
 
@@ -133,7 +136,7 @@ class MultipleShooting(AbstractSolver):
 
             def trial(j):
                 u = jnp.clip(us + alphas[j] * dus, problem.lower, problem.upper)
-                x = xs + alphas[j] * dxs
+                x = jax.vmap(problem.integrate)(xs, alphas[j] * dxs)
                 return x, u, merit(x, u, lam, rho)
 
             def worse(t):
@@ -173,8 +176,8 @@ class MultipleShooting(AbstractSolver):
             done = settled & (defect <= self.defect_tolerance)
             return ~done & (i < self.iterations) & (mu < 1e10)
 
-        xs = problem.rollout(us)
-        lam = jnp.zeros((problem.horizon, problem.nx), us.dtype)
+        xs = problem.initial_states(states, us)
+        lam = jnp.zeros((problem.horizon, nx), us.dtype)
         rho = jnp.asarray(self.penalty, us.dtype)
         value = merit(xs, us, lam, rho)
         s = (xs, us, lam, rho, jnp.asarray(self.regularization, us.dtype), value,

@@ -16,11 +16,19 @@ weighted by dt as in Crocoddyl's integrated action models, so a problem's optimu
 depend on how finely its horizon is cut. Costs are any JAX functions: weights held in an
 equinox module are differentiable like the model's parameters.
 
+States live on the system's configuration manifold (a floating base's quaternion, a continuous
+joint's angle): second-order solvers linearize in its tangent space, a deviation being
+dx = difference(x_ref, x) = (system.difference(q_ref, q), v - v_ref), of length ndx = 2 nv for a
+tree (Crocoddyl's `StateMultibody`), and move along it with integrate(x, dx) = (retract(q, dq),
+v + dv). On Euclidean coordinates both are plain subtraction and addition.
+
 A cost function returns either a scalar, taken as it is, or a vector of residuals r, meaning the
 least-squares cost 1/2 |r|^2 (weights folded into r). The second form is what second-order
 solvers want: its Hessian is taken as J^T J with J = dr/d(x, u) (Gauss-Newton, as Crocoddyl's
 residual models do), positive semidefinite wherever the trajectory is, where a scalar cost's
-exact Hessian (an end-effector distance, say) can be indefinite far from the optimum.
+exact Hessian (an end-effector distance, say) can be indefinite far from the optimum. A tuple
+of cost functions is their sum (the residuals stacked). `mbjax.trajopt.state_residual`,
+`frame_residual` and `control_residual` write Crocoddyl's common costs.
 """
 
 from collections.abc import Callable
@@ -48,8 +56,9 @@ class Problem(eqx.Module):
         v0: initial velocity, shape (nv,).
         dt: the step and control interval, seconds.
         horizon: the number of steps N.
-        running: cost rate running(q, v, u), a scalar or a vector of residuals.
-        terminal: final cost terminal(q, v), a scalar or a vector of residuals.
+        running: cost rate running(q, v, u), a scalar or a vector of residuals; or a tuple of
+            such functions, their sum.
+        terminal: final cost terminal(q, v), likewise.
         lower: lower bound on each actuated force, a scalar or shape (nu,); None for none.
         upper: upper bound, likewise.
         integrator: the step's integrator (`RK4()` by default).
@@ -82,6 +91,8 @@ class Problem(eqx.Module):
             raise ValueError(f"horizon must be a positive int (the number of steps), got {horizon!r}")
         if isinstance(dt, str | bytes) or not (np.ndim(dt) == 0 and float(dt) > 0):
             raise ValueError(f"dt must be a positive number, got {dt!r}")
+        running, terminal = (Sum(tuple(c)) if isinstance(c, list | tuple) else c
+                             for c in (running, terminal))
         if not (callable(running) and callable(terminal)):
             raise TypeError("running(q, v, u) and terminal(q, v) must be callables returning "
                             "a scalar cost or a vector of residuals")
@@ -148,11 +159,58 @@ class Problem(eqx.Module):
         q1, v1 = system.constrain(t + self.dt, q1, v1)
         return jnp.concatenate([q1, v1])
 
-    def step_jacobians(self, x: Array, u: Array, k) -> tuple[Array, Array]:
-        """(A, B) = (d step/dx, d step/du) at (x, u), one forward-mode pass for both: one pass per
-        argument would trace the step twice, which costs more compilation than it saves (see
-        benchmarks/README.md)."""
-        return jax.jacfwd(self.step, argnums=(0, 1))(x, u, k)
+    @property
+    def ndq(self) -> int:
+        """Length of a configuration deviation (the tangent space's: nv for a tree)."""
+        return jax.eval_shape(self.system.difference, self.q0, self.q0).shape[0]
+
+    @property
+    def ndx(self) -> int:
+        """Length of a state deviation dx = difference(x_ref, x): ndq + nv."""
+        return self.ndq + self.nv
+
+    def integrate(self, x: Array, dx: Array) -> Array:
+        """The state x (+) dx: the configuration moved along dq on its manifold, v + dv.
+
+        Args:
+            x: a state, shape (nx,).
+            dx: a deviation, shape (ndx,).
+
+        Returns:
+            The state, shape (nx,).
+        """
+        q, v = self.split(x)
+        q1 = self.system.project(self.system.retract(q, dx[:self.ndq]))
+        return jnp.concatenate([q1, v + dx[self.ndq:]])
+
+    def difference(self, x0: Array, x1: Array) -> Array:
+        """The deviation dx with x0 (+) dx = x1.
+
+        Args:
+            x0: the reference state, shape (nx,).
+            x1: a state, shape (nx,).
+
+        Returns:
+            dx, shape (ndx,).
+        """
+        (q0, v0), (q1, v1) = self.split(x0), self.split(x1)
+        return jnp.concatenate([self.system.difference(q0, q1), v1 - v0])
+
+    def step_jacobians(self, x: Array, u: Array, k, x_next: Array):
+        """(A, B, e): the step's Jacobians in the tangent spaces, and its gap.
+
+        With F(dx, u) = difference(x_next, step(x (+) dx, u)), A = dF/ddx and B = dF/du at
+        dx = 0 and e = F(0, u), the step's defect against the knot x_next (zero along a
+        rollout). One forward-mode pass for both: one pass per argument would trace the step
+        twice, which costs more compilation than it saves (see benchmarks/README.md).
+        """
+        def gap(dx, u):
+            out = self.difference(x_next, self.step(self.integrate(x, dx), u, k))
+            return out, out
+
+        (A, B), e = jax.jacfwd(gap, argnums=(0, 1), has_aux=True)(
+            jnp.zeros(self.ndx, x.dtype), u)
+        return A, B, e
 
     def stage_cost(self, x: Array, u: Array) -> Array:
         """running(q, v, u) dt (1/2 |r|^2 dt for residuals r)."""
@@ -161,24 +219,43 @@ class Problem(eqx.Module):
     def final_cost(self, x: Array) -> Array:
         return _value(self.terminal(*self.split(x)))
 
+    def _about(self, x: Array, fn: Callable) -> Callable:
+        """fn(q, v, ...) as a function of the deviation (dq, dv, ...) about x."""
+        q, v = self.split(x)
+        return lambda dq, dv, *rest: fn(self.system.retract(q, dq), v + dv, *rest)
+
     def stage_expansion(self, x: Array, u: Array):
-        """(l_x, l_u, l_xx, l_ux, l_uu) of the stage cost at (x, u): exact, or Gauss-Newton for
-        residuals (see the module)."""
-        if _is_residual(self.running, *self.split(x), u):
-            (Jq, Jv, Ju), r = _jacobian_and_value(self.running, *self.split(x), u)
+        """(l_x, l_u, l_xx, l_ux, l_uu) of the stage cost at (x, u) in the tangent space:
+        exact, or Gauss-Newton for residuals (see the module)."""
+        zero_q, zero_v = jnp.zeros(self.ndq, x.dtype), jnp.zeros(self.nv, x.dtype)
+        running = self._about(x, self.running)
+        if _is_residual(running, zero_q, zero_v, u):
+            (Jq, Jv, Ju), r = _jacobian_and_value(running, zero_q, zero_v, u)
             Jx, dt = jnp.concatenate([Jq, Jv], axis=1), self.dt
             return (Jx.T @ r * dt, Ju.T @ r * dt, Jx.T @ Jx * dt, Ju.T @ Jx * dt, Ju.T @ Ju * dt)
-        (lx, lu), ((lxx, _), (lux, luu)) = (jax.grad(self.stage_cost, argnums=(0, 1))(x, u),
-                                            jax.hessian(self.stage_cost, argnums=(0, 1))(x, u))
+
+        def cost(dx, u):
+            return _value(running(dx[:self.ndq], dx[self.ndq:], u)) * self.dt
+
+        dx = jnp.zeros(self.ndx, x.dtype)
+        (lx, lu), ((lxx, _), (lux, luu)) = (jax.grad(cost, argnums=(0, 1))(dx, u),
+                                            jax.hessian(cost, argnums=(0, 1))(dx, u))
         return lx, lu, lxx, lux, luu
 
     def final_expansion(self, x: Array):
-        """(V_x, V_xx) of the terminal cost at x, as `stage_expansion`."""
-        if _is_residual(self.terminal, *self.split(x)):
-            (Jq, Jv), r = _jacobian_and_value(self.terminal, *self.split(x))
+        """(V_x, V_xx) of the terminal cost at x in the tangent space, as `stage_expansion`."""
+        zero_q, zero_v = jnp.zeros(self.ndq, x.dtype), jnp.zeros(self.nv, x.dtype)
+        terminal = self._about(x, self.terminal)
+        if _is_residual(terminal, zero_q, zero_v):
+            (Jq, Jv), r = _jacobian_and_value(terminal, zero_q, zero_v)
             J = jnp.concatenate([Jq, Jv], axis=1)
             return J.T @ r, J.T @ J
-        return jax.grad(self.final_cost)(x), jax.hessian(self.final_cost)(x)
+
+        def cost(dx):
+            return _value(terminal(dx[:self.ndq], dx[self.ndq:]))
+
+        dx = jnp.zeros(self.ndx, x.dtype)
+        return jax.grad(cost)(dx), jax.hessian(cost)(dx)
 
     def rollout(self, us: Array) -> Array:
         """The states under a control sequence.
@@ -220,6 +297,19 @@ class Problem(eqx.Module):
                              f"shape {us.shape}")
         return jnp.clip(us, self.lower, self.upper)
 
+    def initial_states(self, states, us: Array) -> Array:
+        """The knots' first states: `states` (N + 1, nx) with its first replaced by x0 and its
+        configurations projected (unit quaternions), or the rollout of us where None."""
+        if states is None:
+            return self.rollout(us)
+        xs = jnp.asarray(states, dtype=float)
+        if xs.shape != (self.horizon + 1, self.nx):
+            raise ValueError(f"states0 must be (horizon + 1, nq + nv) = ({self.horizon + 1}, "
+                             f"{self.nx}), got shape {xs.shape}")
+        q, v = self.split(xs)
+        xs = jnp.concatenate([jax.vmap(self.system.project)(q), v], axis=1)
+        return xs.at[0].set(self.x0)
+
 
 def _value(c: Array) -> Array:
     """A cost function's output as a cost: itself, or 1/2 |r|^2 for residuals r."""
@@ -244,3 +334,16 @@ def _jacobian_and_value(fn: Callable, *args):
         return jax.jacfwd(partial, has_aux=True)(args[i])
     jacobians, values = zip(*(with_value(i) for i in range(len(args))), strict=True)
     return jacobians, values[0]
+
+
+class Sum(eqx.Module):
+    """A sum of cost functions: their residuals stacked where each returns residuals, else the
+    sum of their values (a residual vector r counting 1/2 |r|^2)."""
+
+    terms: tuple
+
+    def __call__(self, *args) -> Array:
+        values = [jnp.asarray(term(*args)) for term in self.terms]
+        if all(v.ndim == 1 for v in values):
+            return jnp.concatenate(values)
+        return sum(_value(v) for v in values)

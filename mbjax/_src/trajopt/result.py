@@ -25,8 +25,8 @@ class Result(WithStatus):
         costs: the cost after each iteration, shape (iterations + 1,) of the solver's
             maximum; the entries past the iterations taken are NaN.
         iterations: the iterations taken.
-        feedback: the time-varying gains K_k of u = u_k + K_k (x - x_k), shape (N, nu, nx),
-            where the solver has them (DDP: from its last accepted iteration's backward pass,
+        feedback: the time-varying gains K_k of u = u_k + K_k dx on the deviation
+            dx = `Problem.difference`(x_k, x), shape (N, nu, ndx), where the solver has them (DDP: from its last accepted iteration's backward pass,
             about the trajectory before that step, the same at convergence), else zeros.
         status: the `Status` flags.
     """
@@ -44,16 +44,18 @@ class Result(WithStatus):
 class AbstractSolver(eqx.Module):
     """A trajectory-optimisation method, a strategy passed to `mbjax.trajopt.solve`.
 
-    Subclasses implement `solve(problem, us)`.
+    Subclasses implement `solve(problem, us, states)`.
     """
 
     @abc.abstractmethod
-    def solve(self, problem: Problem, us: Array) -> Result:
+    def solve(self, problem: Problem, us: Array, states: Array | None = None) -> Result:
         """Optimise the controls of `problem` starting from `us`.
 
         Args:
             problem: the trajectory-optimisation problem.
             us: the first guess, inside the bounds, shape (horizon, nu).
+            states: a state trajectory as first guess, shape (horizon + 1, nx), for a solver
+                that can use one; None for the rollout of us.
 
         Returns:
             The `Result`.
@@ -65,13 +67,11 @@ def history(length: int, first: Array) -> Array:
     return jnp.full(length, jnp.nan, first.dtype).at[0].set(first)
 
 
-def require_vector_state(problem: Problem, solver: str) -> None:
-    """Refuse a problem whose configuration has more coordinates than velocities: `solver`
-    steps in the coordinates (q, v)."""
-    if problem.nq != problem.nv:
-        raise ValueError(f"{solver} steps in the coordinates (q, v), which needs as many "
-                         f"configuration coordinates as velocities; this system has "
-                         f"nq = {problem.nq}, nv = {problem.nv} (quaternions): use Shooting")
+def no_states(states, solver: str) -> None:
+    """Refuse a state trajectory as first guess for a solver that starts from a rollout."""
+    if states is not None:
+        raise ValueError(f"states0: {solver} starts from the rollout of us0 and takes no state "
+                         "trajectory; MultipleShooting takes one (an infeasible start)")
 
 
 def rollout_result(problem: Problem, us: Array, costs: Array, iterations: Array,
@@ -85,5 +85,5 @@ def rollout_result(problem: Problem, us: Array, costs: Array, iterations: Array,
               | jnp.where(finite, 0, int(Status.NONFINITE)))
     q, v = problem.split(xs)
     return Result(qs=q, vs=v, us=us, cost=cost, costs=costs, iterations=iterations,
-                  feedback=jnp.zeros((problem.horizon, problem.nu, problem.nx), us.dtype),
+                  feedback=jnp.zeros((problem.horizon, problem.nu, problem.ndx), us.dtype),
                   status=status)

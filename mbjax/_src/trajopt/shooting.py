@@ -26,7 +26,7 @@ from jax import Array
 
 from mbjax._src.trajopt.descent import cosine_adam
 from mbjax._src.trajopt.problem import Problem
-from mbjax._src.trajopt.result import AbstractSolver, Result, history, rollout_result
+from mbjax._src.trajopt.result import AbstractSolver, Result, history, no_states, rollout_result
 
 METHODS = ("lbfgs", "adam")
 
@@ -59,16 +59,21 @@ class Shooting(AbstractSolver):
         if self.method not in METHODS:
             raise ValueError(f"method must be one of {METHODS}, got {self.method!r}")
 
-    def solve(self, problem: Problem, us: Array) -> Result:
+    def solve(self, problem: Problem, us: Array, states: Array | None = None) -> Result:
         """Optimise the controls of `problem` from `us` (normally through `mbjax.trajopt.solve`).
 
         Args:
             problem: the trajectory-optimisation problem.
             us: the first guess, inside the bounds, shape (horizon, nu).
+            states: must be None (the unknowns are the controls alone).
 
         Returns:
             The `Result` (no feedback gains: `feedback` is zeros).
+
+        Raises:
+            ValueError: states were given.
         """
+        no_states(states, "Shooting")
         shape = us.shape
 
         def objective(flat):

@@ -12,7 +12,7 @@ from mbjax._src.trajopt.result import AbstractSolver, Result
 
 @eqx.filter_jit
 def solve(problem: Problem, solver: AbstractSolver = ILQR(), us0: Array | None = None,
-          throw: bool = False) -> Result:
+          states0: Array | None = None, throw: bool = False) -> Result:
     """Optimise a problem's controls with a solver strategy.
 
     One compiled program: the solver's iterations run inside it, and `jax.vmap` solves many
@@ -26,6 +26,9 @@ def solve(problem: Problem, solver: AbstractSolver = ILQR(), us0: Array | None =
         solver: the method, an `AbstractSolver` instance (`ILQR()`, `MultipleShooting()`,
             `Shooting()`).
         us0: the first guess, shape (horizon, nu), clipped to the bounds; None for zeros.
+        states0: a state trajectory as first guess, shape (horizon + 1, nq + nv), for
+            `MultipleShooting` (an infeasible start: the knots need not follow the dynamics);
+            None for the rollout of us0.
         throw: raise an error naming the failure (not converged, non-finite) instead of
             returning the result with its status.
 
@@ -34,13 +37,13 @@ def solve(problem: Problem, solver: AbstractSolver = ILQR(), us0: Array | None =
 
     Raises:
         TypeError: problem is not a `Problem` or solver not a solver instance.
-        ValueError: us0 has the wrong shape, or the solver cannot take the problem (`ILQR` and
-            `MultipleShooting` on quaternion coordinates).
+        ValueError: us0 or states0 has the wrong shape, or states0 was given to a solver that
+            starts from a rollout (`ILQR`, `Shooting`).
         equinox.EquinoxRuntimeError: with throw=True, the solve failed.
     """
     if not isinstance(problem, Problem):
         raise TypeError(f"problem must be a mbjax.trajopt.Problem, got {type(problem).__name__}")
     if not isinstance(solver, AbstractSolver):
         raise TypeError(f"solver must be a solver instance such as ILQR(), got {solver!r}")
-    return raise_on_failure(solver.solve(problem, problem.initial_controls(us0)), throw,
+    return raise_on_failure(solver.solve(problem, problem.initial_controls(us0), states0), throw,
                             "mbjax._src.trajopt.solve")

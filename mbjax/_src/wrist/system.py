@@ -33,8 +33,8 @@ class WristSystem(AbstractDrivenSystem):
             at `external_point`; or None.
         external_point: where the external force acts, in the tool frame D [m], shape (1, 3)
             or (3,); None: the distal-plate centre.
-        actuation: the indices of the driven motors (or a boolean mask of length 3); None: all
-            three.
+        actuation: the indices of the driven motors (or a boolean mask of length 3, or a
+            (3, nu) actuation matrix); None: all three. Stored as the matrix.
 
     Raises:
         TypeError: `model` is not a `CarpalWrist`.
@@ -45,7 +45,7 @@ class WristSystem(AbstractDrivenSystem):
     control: AbstractControl | None
     external: AbstractControl | None
     external_point: Array | None
-    actuation: tuple[int, ...] | None = eqx.field(static=True)
+    actuation: Array | None
 
     def __init__(self, model: CarpalWrist, control=None, *, external=None, external_point=None,
                  actuation=None):
