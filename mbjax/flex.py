@@ -10,12 +10,11 @@ from mbjax._src.flex.builders import beam_body as beam_body
 from mbjax._src.flex.model import FlexibleModel as FlexibleModel
 from mbjax._src.flex.system import FlexibleSystem as FlexibleSystem
 from mbjax._src.flex.dynamics import forward_dynamics as forward_dynamics
-from mbjax._src.flex.points import centreline as centreline
 from mbjax._src.flex.ancf import AncfBeam as AncfBeam
 from mbjax._src.flex.ancf import simulate_ancf as simulate_ancf
 
 __all__ = [
     "Beam", "ModalBasis", "craig_bampton", "ModalBody", "beam_body", "FlexibleModel",
-    "FlexibleSystem", "forward_dynamics", "centreline", "AncfBeam",
+    "FlexibleSystem", "forward_dynamics", "AncfBeam",
     "simulate_ancf"
 ]

@@ -12,7 +12,6 @@ from mbjax._src.loops.stabilized import Stabilized as Stabilized
 from mbjax._src.model.closures import CutJoint as CutJoint
 from mbjax._src.model.closures import Coupling as Coupling
 from mbjax._src.model.closures import Prescribed as Prescribed
-from mbjax._src.model.closures import GROUND as GROUND
 from mbjax._src.loops.constraints import Loops as Loops
 from mbjax._src.loops.projection import consistent_state as consistent_state
 from mbjax._src.loops.projection import project_configuration as project_configuration
@@ -20,6 +19,6 @@ from mbjax._src.loops.projection import project_velocity as project_velocity
 
 __all__ = [
     "ClosedSystem", "AbstractLoopMethod", "Coupled", "Momentum", "Stabilized", "CutJoint",
-    "Coupling", "Prescribed", "GROUND", "Loops", "consistent_state", "project_configuration",
+    "Coupling", "Prescribed", "Loops", "consistent_state", "project_configuration",
     "project_velocity"
 ]

@@ -14,9 +14,8 @@ from mbjax._src.tfe.mixed import MixedUnsymmetric as MixedUnsymmetric
 from mbjax._src.tfe.three_field import ThreeField as ThreeField
 from mbjax._src.tfe.solve import solve_tfe as solve_tfe
 from mbjax._src.tfe.solve import initial_state as initial_state
-from mbjax._src.tfe.solve import TFESolution as TFESolution
 
 __all__ = [
     "Body", "Element", "Reference", "AbstractForm", "PrimalUnsymmetric", "PrimalSymmetric", "Mixed",
-    "MixedUnsymmetric", "ThreeField", "solve_tfe", "initial_state", "TFESolution", "stability"
+    "MixedUnsymmetric", "ThreeField", "solve_tfe", "initial_state", "stability"
 ]

@@ -1,6 +1,6 @@
 """Trajectory optimisation for any system: a `Problem`, `solve` with a solver strategy (`ILQR`,
-`MultipleShooting`, `Shooting`), its `Result`, `optimal_cost` for co-design, and `sweep` for
-batches of problems or parameters."""
+`MultipleShooting`, `Shooting`), its `Result`, residuals for the common costs, `optimal_cost` for
+co-design, and `sweep` for batches of problems or parameters."""
 
 from mbjax._src.trajopt.problem import Problem as Problem
 from mbjax._src.trajopt.solve import solve as solve
@@ -11,8 +11,11 @@ from mbjax._src.trajopt.multiple_shooting import MultipleShooting as MultipleSho
 from mbjax._src.trajopt.shooting import Shooting as Shooting
 from mbjax._src.trajopt.codesign import optimal_cost as optimal_cost
 from mbjax._src.trajopt.sweep import sweep as sweep
+from mbjax._src.trajopt.residuals import state_residual as state_residual
+from mbjax._src.trajopt.residuals import frame_residual as frame_residual
+from mbjax._src.trajopt.residuals import control_residual as control_residual
 
 __all__ = [
     "Problem", "solve", "AbstractSolver", "Result", "ILQR", "MultipleShooting", "Shooting",
-    "optimal_cost", "sweep"
+    "optimal_cost", "sweep", "state_residual", "frame_residual", "control_residual"
 ]

@@ -1,14 +1,18 @@
 """`mbjax bench trajopt`: trajectory optimisation, mbjax's iLQR against Crocoddyl's FDDP on
 identical problems, one at a time and 64 at once.
 
-Problems (`mbjax.scenes`): `arm-reach`, the 7-dof arm's flange moved 0.4 m, and
-`acrobot-swingup`, the double pendulum driven at its elbow to upright; each built twice, as an
-`mbjax.trajopt.Problem` and as a Crocoddyl shooting problem (`mbjax_harness.peers`: Pinocchio
-models of the same URDF, the same residuals and weights, the same horizon and step), both with
-semi-implicit Euler steps (Crocoddyl's `IntegratedActionModelEuler`), both from the same first
-guess (the arm: the torque that holds its start; the acrobot: zero) and its rollout. The run
-checks that the two are one problem: the guess's rollouts agree (`dynamics_agreement`, largest
-state difference) and so do their costs (`cost_agreement`, relative).
+Problems: `arm-reach`, the shipped 7-dof arm's flange moved 0.4 m, and `acrobot-swingup`, the
+double pendulum driven at its elbow to upright (`mbjax.scenes`); and Crocoddyl's own
+contact-free examples (`mbjax_harness.crocoddyl_examples`): `kinova-reach`, `double-pendulum`,
+`quadrotor` (a free base driven by four thrusters through an actuation matrix) and
+`quadrotor-bounded` (thrusts in [0.1, 5] N, Crocoddyl's BoxDDP). Each is built twice, as an
+`mbjax.trajopt.Problem` and as a Crocoddyl shooting problem (Pinocchio models of the same URDF,
+the same residuals and weights, the same horizon and step), both with semi-implicit Euler steps
+(Crocoddyl's `IntegratedActionModelEuler`), both from the same first guess and its rollout. The
+run checks that the two are one problem: Crocoddyl's step from each state of the guess's mbjax
+rollout lands on mbjax's next state (`one_step_agreement`, largest difference in Crocoddyl's
+layout) and the guess costs the same (`cost_agreement`, relative); and it prices each engine's
+solution in the other (`cost_in_other_engine`: the rollout of its controls).
 
 mbjax's iLQR runs with Crocoddyl's globalization (`ILQR(**CROCODDYL_SCHEDULE)`: the same
 step lengths, acceptance test and regularization schedule), so the two differ in their
@@ -41,6 +45,7 @@ import jax.numpy as jnp
 import numpy as np
 
 from mbjax_harness import peers
+from mbjax_harness.crocoddyl_examples import EXAMPLES, Example
 from mbjax._src.integrate import SemiImplicitEuler
 from mbjax_harness.timing import measure, write_jsonl
 from mbjax._src.trajopt import ILQR, solve
@@ -82,7 +87,17 @@ def arm_reach():
             lambda q: float(jnp.linalg.norm(arm.flange(model, q) - target)), crocoddyl)
 
 
-def acrobot_swingup():
+def _identity(xs):
+    return np.asarray(xs)
+
+
+def arm_example() -> Example:
+    problem, us0, final_error, build = arm_reach()
+    return Example(problem, np.asarray(us0), lambda: build()[0], "SolverFDDP", _identity,
+                   final_error)
+
+
+def acrobot_example() -> Example:
     from mbjax._src.model.urdf import to_urdf
     from mbjax._src.scenes import acrobot
 
@@ -91,15 +106,14 @@ def acrobot_swingup():
     goal = jnp.array([0.0, 0.0, 2 * acrobot.LENGTH])
 
     def crocoddyl():
-        problem_ = peers.crocoddyl_swingup(to_urdf(model), problem.q0, goal, acrobot.LENGTH,
-                                           problem.dt, problem.horizon)
-        return problem_, None
+        return peers.crocoddyl_swingup(to_urdf(model), problem.q0, goal, acrobot.LENGTH,
+                                       problem.dt, problem.horizon)
 
-    return (problem, jnp.zeros((problem.horizon, problem.nu)),
-            lambda q: float(jnp.linalg.norm(acrobot.tip(model, q) - goal)), crocoddyl)
+    return Example(problem, np.zeros((problem.horizon, problem.nu)), crocoddyl, "SolverFDDP",
+                   _identity, lambda q: float(jnp.linalg.norm(acrobot.tip(model, q) - goal)))
 
 
-PROBLEMS = {"arm-reach": arm_reach, "acrobot-swingup": acrobot_swingup}
+PROBLEMS = {"arm-reach": arm_example, "acrobot-swingup": acrobot_example, **EXAMPLES}
 
 
 def _to_tolerance(costs, best: float) -> int:
@@ -110,13 +124,14 @@ def _to_tolerance(costs, best: float) -> int:
 
 
 class CrocoddylSolver:
-    """One Crocoddyl problem's FDDP solver, from a fixed first guess and its rollout."""
+    """One Crocoddyl problem's solver (FDDP, or BoxDDP for bounded controls), from a fixed first
+    guess and its rollout."""
 
-    def __init__(self, problem, us0):
+    def __init__(self, problem, us0, solver: str = "SolverFDDP"):
         import crocoddyl
 
         self.problem, self.us0 = problem, [np.asarray(u, float) for u in us0]
-        self.solver = crocoddyl.SolverFDDP(problem)
+        self.solver = getattr(crocoddyl, solver)(problem)
 
     def solve(self, iterations: int) -> bool:
         xs0 = self.problem.rollout(self.us0)
@@ -144,9 +159,30 @@ class CrocoddylSolver:
         return measure(self.solve, iterations, repeats=repeats)[1].run_s
 
 
+def agreement(example: Example, croc_problem) -> dict:
+    """That the two are one problem: the first guess's one-step states (each of Crocoddyl's
+    knots stepped from mbjax's state, largest difference in Crocoddyl's layout) and the guess's
+    cost in both (relative)."""
+    problem, us0 = example.problem, np.asarray(example.us0, float)
+    xs = problem.rollout(jnp.asarray(us0))
+    xs_croc = example.to_crocoddyl(xs)
+    step = 0.0
+    for k, model in enumerate(croc_problem.runningModels):
+        data = model.createData()
+        model.calc(data, xs_croc[k], us0[k])
+        step = max(step, float(np.max(np.abs(np.asarray(data.xnext) - xs_croc[k + 1]))))
+    cost_mbjax = float(problem.cost(xs, jnp.asarray(us0)))
+    cost_croc = croc_problem.calc(list(xs_croc), list(us0))
+    return {"one_step_agreement": step,
+            "cost_agreement": abs(cost_croc - cost_mbjax) / abs(cost_mbjax)}
+
+
 def single(name: str, repeats: int, common: dict) -> list[dict]:
-    """Both engines on one problem: cost histories, times to convergence and to TOLERANCE."""
-    problem, us0, final_error, build = PROBLEMS[name]()
+    """Both engines on one problem: cost histories, times to convergence and to TOLERANCE, and
+    each engine's solution priced by the other."""
+    example = PROBLEMS[name]()
+    problem, us0 = example.problem, jnp.asarray(example.us0)
+    final_error = example.final_error or (lambda q: None)
     ilqr = ILQR(iterations=ITERATIONS, **CROCODDYL_SCHEDULE)
     result, timing = measure(solve, problem, ilqr, us0, repeats=repeats)
     iterations = int(result.iterations)
@@ -162,23 +198,23 @@ def single(name: str, repeats: int, common: dict) -> list[dict]:
                         "skipped": why})
         best = mbjax["cost"]
     else:
-        croc_problem, _ = build()
-        croc = CrocoddylSolver(croc_problem, us0)
-        xs_mbjax = np.asarray(problem.rollout(jnp.asarray(us0)))
-        xs_croc = np.array(croc_problem.rollout(croc.us0))
-        cost_mbjax = float(problem.cost(jnp.asarray(xs_mbjax), jnp.asarray(us0)))
-        cost_croc = croc_problem.calc(list(xs_croc), croc.us0)
+        croc_problem = example.crocoddyl()
+        croc = CrocoddylSolver(croc_problem, example.us0, example.solver)
+        checks = agreement(example, croc_problem)
         history = croc.history()
         converged = croc.solve(ITERATIONS)
-        q_end = np.asarray(croc.solver.xs[-1])[:problem.nq]
+        us_croc = np.array(croc.solver.us)
+        q_end = problem.split(problem.rollout(jnp.asarray(us_croc))[-1])[0]
+        us_mbjax = [np.asarray(u) for u in result.us]
+        mbjax["cost_in_other_engine"] = croc_problem.calc(croc_problem.rollout(us_mbjax),
+                                                          us_mbjax)
         records.append({
             **common, "kind": "single", "problem": name, "engine": "crocoddyl",
-            "solver": "SolverFDDP", "iterations": int(croc.solver.iter),
+            "solver": example.solver, "iterations": int(croc.solver.iter),
             "seconds": croc.timed(ITERATIONS, repeats), "cost": float(croc.solver.cost),
-            "final_error": final_error(jnp.asarray(q_end)),
+            "final_error": final_error(q_end),
             "status": "success" if converged else "not converged", "history": history,
-            "dynamics_agreement": float(np.max(np.abs(xs_croc - xs_mbjax))),
-            "cost_agreement": abs(cost_croc - cost_mbjax) / abs(cost_mbjax)})
+            "cost_in_other_engine": float(problem.objective(jnp.asarray(us_croc))), **checks})
         best = min(mbjax["cost"], records[-1]["cost"])
         k = _to_tolerance(history, best)
         records[-1].update(iterations_to_tolerance=k, seconds_to_tolerance=min(
@@ -191,6 +227,7 @@ def single(name: str, repeats: int, common: dict) -> list[dict]:
     mbjax.update(iterations_to_tolerance=k, seconds_to_tolerance=truncated)
     for r in records:
         r["best_cost"] = best
+        r["relative_to_best"] = (r["cost"] - best) / abs(best) if "cost" in r else None
     return records
 
 
@@ -266,6 +303,22 @@ def summarize(records: list[dict], common: dict) -> dict:
     return out
 
 
+def table(records: list[dict]) -> str:
+    """The single problems as a Markdown table: problem | engine | iterations | wall time to
+    1e-6 | cost | status, with the agreement checks."""
+    lines = ["| problem | engine | iterations (to 1e-6) | wall time to 1e-6 [ms] | cost | "
+             "status | one step, guess cost agree |", "|---|---|---|---|---|---|---|"]
+    for r in records:
+        if r["kind"] != "single" or "skipped" in r:
+            continue
+        checks = (f"{r['one_step_agreement']:.1e}, {r['cost_agreement']:.1e}"
+                  if "one_step_agreement" in r else "")
+        lines.append(f"| {r['problem']} | {r['engine']} {r['solver']} | {r['iterations']} "
+                     f"({r['iterations_to_tolerance']}) | {r['seconds_to_tolerance'] * 1e3:.1f} | "
+                     f"{r['cost']:.10g} | {r['status']} | {checks} |")
+    return "\n".join(lines)
+
+
 def run(out: Path, quick: bool = False) -> list[dict]:
     common = {"machine": platform.machine(), "jax": jax.__version__,
               "device": jax.devices()[0].device_kind, "backend": jax.default_backend()}
@@ -287,19 +340,15 @@ def run(out: Path, quick: bool = False) -> list[dict]:
     trajopt_bench_figure(records).savefig(out / f"{NAME}.png", dpi=120)
     for r in records:
         if "skipped" in r:
-            print(f"{r['kind']:6s} {r['problem']:16s} {r['engine']:9s} skipped: {r['skipped']}")
-        elif r["kind"] == "single":
-            print(f"single {r['problem']:16s} {r['engine']:9s} {r['iterations']:4d} iterations "
-                  f"{r['seconds'] * 1e3:8.1f} ms, to 1e-6: {r['iterations_to_tolerance']:4d} "
-                  f"iterations {r['seconds_to_tolerance'] * 1e3:8.1f} ms, cost {r['cost']:.9g}, "
-                  f"final error {r['final_error']:.2e} ({r['status']})")
+            print(f"{r['kind']:6s} {r['problem']:18s} {r['engine']:9s} skipped: {r['skipped']}")
         elif r["kind"] == "many":
             print(f"many   {r['targets']} targets {r['engine']:9s} {r['how']:24s} "
                   f"{r['seconds']:7.2f} s, iterations mean {r['mean_iterations']:.0f} max "
                   f"{r['max_iterations']}, converged {r['converged']}/{r['targets']}")
-        else:
+        elif r["kind"] == "summary":
             print(f"targets: one problem within 2x Crocoddyl: {r['single_met']} "
                   f"({r['single_ratio']}); many targets ahead: {r['many_met']} "
                   f"(ratio {r['many_ratio']})")
+    print(table(records))
     print(f"wrote {out / (NAME + '.jsonl')} and {out / (NAME + '.png')}")
     return records

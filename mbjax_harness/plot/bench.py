@@ -280,8 +280,12 @@ def trajopt_bench_figure(records: list[dict]) -> Figure:
     the iteration's share of its solve time; then the many-targets times."""
     singles = [r for r in records if r["kind"] == "single" and "skipped" not in r]
     problems = list(dict.fromkeys(r["problem"] for r in singles))
-    fig = Figure(figsize=(5.2 * (len(problems) + 1), 4.2), layout="constrained")
-    axes = fig.subplots(1, len(problems) + 1, squeeze=False)[0]
+    ncols = min(len(problems) + 1, 4)
+    nrows = -(-(len(problems) + 1) // ncols)
+    fig = Figure(figsize=(5.2 * ncols, 4.2 * nrows), layout="constrained")
+    axes = fig.subplots(nrows, ncols, squeeze=False).ravel()
+    for ax in axes[len(problems) + 1:]:
+        ax.set_axis_off()
     style = {"mbjax": ("#1f77b4", "o"), "crocoddyl": ("#d62728", "s")}
     for ax, problem in zip(axes, problems, strict=False):
         for r in (r for r in singles if r["problem"] == problem):
@@ -298,7 +302,7 @@ def trajopt_bench_figure(records: list[dict]) -> Figure:
         ax.set(xlabel="time [s] (each iteration its share of the solve)",
                ylabel="(cost - best) / best", title=problem)
         ax.legend(fontsize=7)
-    ax = axes[-1]
+    ax = axes[len(problems)]
     many = [r for r in records if r["kind"] == "many" and "skipped" not in r]
     labels = [f"{r['engine']}\n{r['how']}" for r in many]
     ax.bar(range(len(many)), [r["seconds"] for r in many],

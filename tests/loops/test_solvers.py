@@ -11,7 +11,8 @@ import pytest
 from mbjax import Dense
 from mbjax.integrate import RK4, simulate
 from mbjax._src.integrate import Status
-from mbjax.loops import GROUND, ClosedSystem, Coupled, CutJoint, Loops, Momentum, Prescribed, Stabilized, consistent_state
+from mbjax._src.model.closures import GROUND
+from mbjax.loops import ClosedSystem, Coupled, CutJoint, Loops, Momentum, Prescribed, Stabilized, consistent_state
 from mbjax._src.loops import coupled_acceleration, eta_and_gamma, loop_momentum_rate
 from mbjax.rigid import TreeSystem
 from mbjax._src.rigid.dynamics import forward_dynamics, mass_matrix

@@ -39,3 +39,35 @@ def test_arm_reach_matches_crocoddyl(schedule):
     # redundant arm's self-motion, which only the 1e-4 state regularization prices
     assert final_error(result.qs[-1]) < 1e-5
     assert final_error(jnp.asarray(croc.solver.xs[-1])[:problem.nq]) < 1e-5
+
+
+# -- Crocoddyl's own contact-free examples (`mbjax_harness.crocoddyl_examples`) --------------------
+
+@pytest.mark.parametrize("name", [
+    "double-pendulum", "quadrotor",
+    pytest.param("kinova-reach", marks=pytest.mark.slow),
+    pytest.param("quadrotor-bounded", marks=pytest.mark.slow)])
+def test_crocoddyls_examples_reach_fddps_optimum(name):
+    """The same problem in both libraries (each of Crocoddyl's steps from the guess's mbjax
+    rollout lands on mbjax's next state: semi-implicit Euler on SE(3) for the quadrotor's free
+    base; the guess costs the same), and iLQR from the same first guess ends within 1e-6
+    (relative) of FDDP's optimum or below it, each engine pricing the other's solution as it
+    does."""
+    from mbjax_harness.bench.trajopt import agreement
+    from mbjax_harness.crocoddyl_examples import EXAMPLES
+
+    example = EXAMPLES[name]()
+    croc_problem = example.crocoddyl()
+    checks = agreement(example, croc_problem)
+    assert checks["one_step_agreement"] < 1e-12 and checks["cost_agreement"] < 1e-12, checks
+    result = solve(example.problem, ILQR(), jnp.asarray(example.us0))
+    assert result.messages() == ["success"]
+    croc = CrocoddylSolver(croc_problem, example.us0, example.solver)
+    croc.solve(200)
+    assert float(result.cost) <= croc.solver.cost * (1 + 1e-6), (float(result.cost),
+                                                                 croc.solver.cost)
+    us = [np.asarray(u) for u in result.us]
+    np.testing.assert_allclose(croc_problem.calc(croc_problem.rollout(us), us), result.cost,
+                               rtol=1e-10)
+    np.testing.assert_allclose(example.problem.objective(jnp.asarray(np.array(croc.solver.us))),
+                               croc.solver.cost, rtol=1e-8)

@@ -194,7 +194,7 @@ class FlexibleModel(eqx.Module):
     def difference(self, q0: Array, q1: Array) -> Array:
         """The chart point xi (nv,) about q0 at which `retract` gives q1: the rigid model's
         difference, q1 - q0 for the modes."""
-        nq, nv = self.model.nq, self.model.nv
+        nq = self.model.nq
         return jnp.concatenate([self.model.difference(q0[:nq], q1[:nq]), q1[nq:] - q0[nq:]])
 
     def local_rate(self, q0: Array, xi: Array, v: Array) -> Array:

@@ -9,6 +9,7 @@ from mbjax._src.trajopt.result import AbstractSolver, Result
 from mbjax._src.trajopt.shooting import Shooting
 from mbjax._src.trajopt.solve import solve
 from mbjax._src.trajopt.sweep import sweep
+from mbjax._src.trajopt.residuals import control_residual, frame_residual, state_residual
 
-__all__ = ["AbstractSolver", "ILQR", "MultipleShooting", "Problem", "Result", "Shooting", 
-           "optimal_cost", "solve", "sweep"]
+__all__ = ["AbstractSolver", "ILQR", "MultipleShooting", "Problem", "Result", "Shooting",
+           "optimal_cost", "solve", "sweep", "control_residual", "frame_residual", "state_residual"]

@@ -1,6 +1,5 @@
 """The Carpal Wrist as a system for `simulate` (Canfield 1997 §6.4)."""
 
-import equinox as eqx
 import jax.numpy as jnp
 from jax import Array
 

@@ -1,0 +1,105 @@
+"""Configurations on their Lie group: `Model.integrate` and `Model.difference` against Pinocchio's
+`integrate` and `difference` (after the state converters) on floating robots of
+example-robot-data and on a spherical joint, their inverse relation, and finite derivatives at
+zero and half turns."""
+
+import jax
+import jax.numpy as jnp
+import numpy as np
+import pytest
+
+import mbjax
+from mbjax.model import Model, state_to_pinocchio
+from mbjax_harness.peers import random_state
+
+pin = pytest.importorskip("pinocchio")
+
+QUICK_ROBOTS = ("hector/quadrotor_base", "solo/solo12", "kinova/kinova")
+
+
+def _against_pinocchio(model, pin_model, seed: int) -> float:
+    """max |mbjax - Pinocchio| of integrate and difference at random states (Pinocchio's layout)."""
+    q0, v, _ = random_state(model, seed)
+    q1, _, _ = random_state(model, seed + 1)
+    q0, q1, v = jnp.asarray(q0), jnp.asarray(q1), jnp.asarray(v)
+    pq0, pv = (np.asarray(x) for x in state_to_pinocchio(model, q0, v))
+    pq1 = np.asarray(state_to_pinocchio(model, q1, v)[0])
+    integrated = np.asarray(state_to_pinocchio(model, model.integrate(q0, v), v)[0])
+    difference = np.asarray(state_to_pinocchio(model, q0, model.difference(q0, q1))[1])
+    return max(np.abs(integrated - pin.integrate(pin_model, pq0, pv)).max(),
+               np.abs(difference - pin.difference(pin_model, pq0, pq1)).max())
+
+
+def _corpus(names=None):
+    from mbjax_harness.reproduce import urdf_corpus
+    try:
+        paths = urdf_corpus.corpus_paths()
+    except Exception as err:          # PackageNotFoundError
+        pytest.skip(f"example-robot-data is not installed ({err})")
+    return [p for p in paths if names is None or urdf_corpus.name(p) in names]
+
+
+def _floating_difference(path) -> float | None:
+    try:
+        model = mbjax.load_urdf(path, floating_base=True)
+    except ValueError:               # a file that is not a robot
+        return None
+    pin_model = pin.buildModelFromUrdf(str(path), pin.JointModelFreeFlyer())
+    return max(_against_pinocchio(model, pin_model, seed) for seed in (0, 2))
+
+
+def test_integrate_and_difference_equal_pinocchios():
+    """A quadrotor, a quadruped and an arm with continuous joints, on free bases."""
+    paths = _corpus(QUICK_ROBOTS)
+    assert len(paths) == len(QUICK_ROBOTS)
+    for path in paths:
+        assert _floating_difference(path) < 1e-12, path
+
+
+@pytest.mark.slow
+def test_integrate_and_difference_on_every_floating_robot():
+    worst = {path.stem: _floating_difference(path) for path in _corpus()}
+    worst = {name: d for name, d in worst.items() if d is not None}
+    assert len(worst) > 60 and max(worst.values()) < 1e-12, worst
+
+
+def test_spherical_joint_equals_pinocchios():
+    """A ball joint carrying a hinge (no URDF has one): Pinocchio's JointModelSpherical."""
+    model = Model([-1, 0], ["spherical", "revolute"], mass=[1.0, 1.0],
+                  inertia=[np.eye(3), np.eye(3)], axis=[[0, 0, 1], [0, 1, 0]],
+                  placement_translation=[[0, 0, 0], [0, 0, -0.5]], lower=[-1, -1, -1, -1, -2],
+                  upper=[1, 1, 1, 1, 2])
+    pm = pin.Model()
+    ball = pm.addJoint(0, pin.JointModelSpherical(), pin.SE3.Identity(), "joint0")
+    pm.addJoint(ball, pin.JointModelRY(), pin.SE3(np.eye(3), np.array([0, 0, -0.5])), "joint1")
+    assert max(_against_pinocchio(model, pm, seed) for seed in (0, 3)) < 1e-13
+
+
+def test_difference_inverts_integrate_with_finite_derivatives_at_zero_and_half_turns():
+    """difference(q, integrate(q, v)) = v; its Jacobian in v is the identity at v = 0 and
+    finite (and equal to central differences) at a half turn of the free and ball joints."""
+    model = Model([-1, 0, 1], ["free", "spherical", "revolute"], mass=[1.0] * 3,
+                  inertia=[np.eye(3)] * 3)
+    q, _, _ = random_state(model, 5)
+    q = jnp.asarray(q)
+    rng = np.random.default_rng(1)
+    for v in (jnp.zeros(model.nv), jnp.asarray(rng.normal(size=model.nv)),
+              jnp.r_[jnp.pi, 0, 0, 0.3, 0.2, 0.1, 0, jnp.pi - 1e-9, 0, 0.5]):
+        np.testing.assert_allclose(model.difference(q, model.integrate(q, v)), v, atol=1e-8)
+        J = jax.jacfwd(lambda w: model.difference(q, model.integrate(q, w)))(v)
+        assert np.isfinite(J).all()
+        if not jnp.any(v):
+            np.testing.assert_allclose(J, np.eye(model.nv), atol=1e-12)
+    half = jnp.r_[0, 0, jnp.pi, 0.3, 0.2, 0.1, 0, 0, jnp.pi, 0.5]
+    J = jax.jacfwd(model.integrate, argnums=1)(q, half)
+    h = 1e-6
+    fd = np.stack([(model.integrate(q, half + h * e) - model.integrate(q, half - h * e)) / (2 * h)
+                   for e in np.eye(model.nv)], 1)
+    np.testing.assert_allclose(J, fd, atol=1e-7)
+
+
+def test_continuous_angles_wrap_and_limited_ones_do_not():
+    model = Model([-1, 0], "revolute", mass=[1.0, 1.0], inertia=[np.eye(3)] * 2,
+                  lower=[-np.inf, -4.0], upper=[np.inf, 4.0])
+    d = model.difference(jnp.array([3.0, 3.0]), jnp.array([-3.0, -3.0]))
+    np.testing.assert_allclose(d, [2 * np.pi - 6.0, -6.0], atol=1e-15)
