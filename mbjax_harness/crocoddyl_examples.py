@@ -27,6 +27,7 @@ import jax.numpy as jnp
 import numpy as np
 
 from mbjax import load_urdf
+from mbjax._src.model.model import Model
 from mbjax._src.integrate import SemiImplicitEuler
 from mbjax._src.model.states import state_from_pinocchio, state_to_pinocchio
 from mbjax._src.rigid import TreeSystem, inverse_dynamics
@@ -170,11 +171,18 @@ def thruster_matrix() -> np.ndarray:
     return np.stack(columns, 1)
 
 
-def quadrotor(bounded: bool = False) -> Example:
-    robot = _robot("hector")
-    model = _load(robot, floating_base=True)
+def hector() -> Model:
+    """The hector quadrotor as a free body, from its URDF's inertial data (example-robot-data's
+    `hector_description`: 1.477 kg, inertia diag(0.01152, 0.01152, 0.0218) kg m^2), for where
+    example-robot-data is not installed."""
+    return Model([-1], "free", mass=[1.477], inertia=[np.diag([0.01152, 0.01152, 0.0218])],
+                 names=["base_link"], joint_names=["root_joint"])
+
+
+def quadrotor_problem(model: Model, bounded: bool = False) -> tuple[Problem, np.ndarray]:
+    """Crocoddyl's quadrotor problem in mbjax for a free-floating `model` (its body
+    "base_link"), and its first guess, the hover thrust."""
     dt, horizon = 3e-2, 33
-    q0, v0 = state_from_pinocchio(model, robot.q0, np.zeros(6))
     # Crocoddyl's state weights, (v, omega) of the configuration's tangent then of the velocity,
     # in mbjax's (omega, v) order
     weights = np.r_[[1000.0] * 3, [0.1] * 3, [1000.0] * 6]
@@ -183,12 +191,18 @@ def quadrotor(bounded: bool = False) -> Example:
                frame_residual(model, "base_link", TARGET, np.eye(3), weight=1e-2))
     terminal = frame_residual(model, "base_link", TARGET, np.eye(3), weight=3.0)
     lower, upper = (0.1, 5.0) if bounded else (None, None)
-    problem = Problem(TreeSystem(model, actuation=thruster_matrix()), q0, v0, dt=dt,
-                      horizon=horizon, running=running, terminal=terminal, lower=lower,
-                      upper=upper, integrator=SemiImplicitEuler())
-    # the first guess: hover thrust (the weight shared by the four)
+    problem = Problem(TreeSystem(model, actuation=thruster_matrix()), model.neutral(),
+                      jnp.zeros(6), dt=dt, horizon=horizon, running=running, terminal=terminal,
+                      lower=lower, upper=upper, integrator=SemiImplicitEuler())
     hover = float(-model.gravity[2] * np.sum(np.asarray(model.mass))) / 4
-    us0 = np.full((horizon, 4), hover)
+    return problem, np.full((horizon, 4), hover)
+
+
+def quadrotor(bounded: bool = False) -> Example:
+    robot = _robot("hector")
+    model = _load(robot, floating_base=True)
+    problem, us0 = quadrotor_problem(model, bounded)
+    dt, horizon = problem.dt, problem.horizon
 
     def crocoddyl():
         import crocoddyl as croc

@@ -471,6 +471,44 @@ def trajectory_optimisation_tour(out: Path, quick: bool) -> dict:
                               "cost": float(result.cost), "status": result.messages()[0]}}}
 
 
+def floating_base_tour(out: Path, quick: bool) -> dict:
+    """Crocoddyl's quadrotor example (`mbjax_harness.crocoddyl_examples`: the hector quadrotor, a
+    free base driven by four thrusters through an actuation matrix, thrusts bounded to
+    [0.1, 5] N, flown 1 m over and 1 m up in 33 knots of 0.03 s) solved by iLQR on SE(3) from
+    hover: the cost per iteration, the base's path, the thrusts."""
+    from mbjax_harness.crocoddyl_examples import TARGET, hector, quadrotor_problem
+    from mbjax_harness.plot.trajopt import floating_base_figure
+    from mbjax._src.trajopt import ILQR, solve
+
+    model = hector()
+    problem, us0 = quadrotor_problem(model, bounded=True)
+    result, timing = measure(partial(solve, problem, ILQR(), jnp.asarray(us0)), repeats=3)
+    iterations = int(result.iterations)
+    ts = np.arange(problem.horizon + 1) * problem.dt
+    qs = np.asarray(result.qs)
+    # the pose left to go: the SE(3) logarithm of the target's inverse times the last pose
+    goal = np.r_[TARGET, 1.0, 0.0, 0.0, 0.0]
+    left = np.asarray(model.difference(jnp.asarray(goal), jnp.asarray(qs[-1])))
+    pitch = np.asarray(jax.vmap(lambda q: model.difference(model.neutral(), q))(qs))[:, 1]
+    fig = floating_base_figure(
+        np.asarray(result.costs)[:iterations + 1], ts, qs[:, :3], pitch, np.asarray(result.us),
+        (float(problem.lower[0]), float(problem.upper[0])), TARGET,
+        f"quadrotor by iLQR on SE(3): {iterations} iterations in {timing.run_s:.2f} s, "
+        f"{np.linalg.norm(left[3:]):.1e} m and {np.linalg.norm(left[:3]):.1e} rad from the target "
+        f"({result.messages()[0]})")
+    fig.savefig(out / "floating-base.png", dpi=110)
+    animation = _animate(out, "floating-base", problem.system, ts, result.qs,
+                         "quadrotor by iLQR", quick)
+    return {"figure": "floating-base.png", "animation": animation,
+            "runs": {"ilqr": {"iterations": iterations, "seconds": timing.run_s,
+                              "compile_seconds": timing.compile_s,
+                              "final_position_error_m": float(np.linalg.norm(left[3:])),
+                              "final_rotation_error_rad": float(np.linalg.norm(left[:3])),
+                              "thrust_range_n": [float(np.min(result.us)),
+                                                 float(np.max(result.us))],
+                              "cost": float(result.cost), "status": result.messages()[0]}}}
+
+
 def _model_peers() -> dict:
     """The arm against Pinocchio from the same URDF (`mbjax_harness.reproduce.urdf_corpus`: forward and
     inverse dynamics, mass matrix, frames) and against MuJoCo through MuJoCo's compiler and
@@ -520,6 +558,9 @@ LOOK_AT = {
               "unpowered arm falls through its joint limits and the status says so.",
     "trajectory-optimisation": "the cost falling over the iterations and the flange reaching its "
                                "target at rest.",
+    "floating-base": "the quadrotor pitching forward to fly over and back level to stop at its "
+                     "target, the thrusts held inside their bounds; the same problem in "
+                     "Crocoddyl is `mbjax bench trajopt`'s quadrotor-bounded.",
 }
 
 TOUR = {   # in the order the summary tells them
@@ -533,13 +574,14 @@ TOUR = {   # in the order the summary tells them
     "controls": controls_tour,
     "models": models_tour,
     "trajectory-optimisation": trajectory_optimisation_tour,
+    "floating-base": floating_base_tour,
 }
 
 # Each scene's wall time in a quick tour from a cold cache, one scene at a time (benchmarks/README
 # compile section): `mbjax tour` starts the longest first, which balances its workers best.
 COST = {"time-elements": 9.1, "carpal-wrist": 9.0, "closed-loops": 8.6, "flexible-bodies": 7.7,
         "controls": 6.4, "rigid-chain": 4.8, "trajectory-optimisation": 4.5, "models": 2.6,
-        "torque-free-body": 2.3, "heavy-top": 1.6}
+        "torque-free-body": 2.3, "heavy-top": 1.6, "floating-base": 4.5}
 
 
 def _animate(out: Path, name: str, system, ts, qs, title: str, quick: bool) -> str:

@@ -46,3 +46,30 @@ def reach_figure(costs, ts, flange, target, us, title: str) -> Figure:
         ax.grid(alpha=0.3)
     fig.suptitle(title, fontsize=10)
     return fig
+
+
+def floating_base_figure(costs, ts, positions, angles, us, bounds, target, title: str) -> Figure:
+    """(a) the cost after each iLQR iteration; (b) the base's path in the x-z plane towards its
+    target, with its tilt; (c) the four thrusts and their bounds."""
+    fig = Figure(figsize=(14, 4.2), layout="constrained")
+    ax_c, ax_p, ax_u = fig.subplots(1, 3)
+    ax_c.semilogy(np.arange(len(costs)), costs, "o-", ms=3)
+    ax_c.set(xlabel="iteration", ylabel="cost", title="iLQR: cost after each iteration")
+    ax_p.plot(positions[:, 0], positions[:, 2], "o-", ms=3, label="base")
+    ax_p.plot(*target[[0, 2]], "k*", ms=12, label="target")
+    for p, a in zip(positions[::3], angles[::3], strict=True):
+        ax_p.plot([p[0] - 0.1 * np.cos(a), p[0] + 0.1 * np.cos(a)],
+                  [p[2] + 0.1 * np.sin(a), p[2] - 0.1 * np.sin(a)], color="0.4", lw=1)
+    ax_p.set(xlabel="x [m]", ylabel="z [m]", title="the base's path (bars: its pitch)",
+             aspect="equal")
+    ax_p.legend(fontsize=8)
+    for i, (u, style) in enumerate(zip(us.T, ("-", "--", "-", ":"), strict=False)):
+        ax_u.step(ts[:-1], u, where="post", lw=1.2, ls=style, label=f"rotor {i + 1}")
+    for b in bounds:
+        ax_u.axhline(b, color="k", ls="--", lw=0.8)
+    ax_u.set(xlabel="t [s]", ylabel="thrust [N]", title="thrusts (dashed: their bounds)")
+    ax_u.legend(fontsize=8)
+    for ax in (ax_c, ax_p, ax_u):
+        ax.grid(alpha=0.3)
+    fig.suptitle(title, fontsize=10)
+    return fig

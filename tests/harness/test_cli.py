@@ -121,7 +121,7 @@ def test_reproduce_tree_scaling(tmp_path):
 
 # The tour's scenes in three groups of similar cost, so the two xdist workers share them.
 TOUR_GROUPS = {
-    "rigid": ("torque-free-body", "heavy-top", "rigid-chain", "closed-loops"),
+    "rigid": ("torque-free-body", "heavy-top", "rigid-chain", "closed-loops", "floating-base"),
     "time-elements": ("time-elements", "flexible-bodies", "controls"),
     "carpal-wrist": ("carpal-wrist", "models", "trajectory-optimisation"),
 }
@@ -136,7 +136,7 @@ def test_tour_groups_cover_every_scene():
     assert sorted(s for group in TOUR_GROUPS.values() for s in group) == sorted(TOUR)
     assert set(TOUR) == {"torque-free-body", "heavy-top", "rigid-chain", "time-elements",
                          "closed-loops", "flexible-bodies", "carpal-wrist", "controls", "models",
-                         "trajectory-optimisation"}
+                         "trajectory-optimisation", "floating-base"}
 
 
 def test_tour_rejects_an_unknown_scene(capsys):
@@ -205,6 +205,10 @@ def _check_rigid(scenes):
     assert top_["rk4"]["status"] == "success" and top_["rk4"]["energy_drift"] < 1e-6
     # RK4 at 5 ms follows the Dopri8 reference of the falling chain to micro-radians
     assert rows["rk4 dt=5 ms"]["error_rad"] < 1e-5 and rows["rk4 dt=5 ms"]["energy_error"] < 1e-5
+    # the quadrotor flown on SE(3) by iLQR reaches its target within its bounded thrusts
+    flight = scenes["floating-base"]["runs"]["ilqr"]
+    assert flight["status"] == "success" and flight["final_position_error_m"] < 1e-3
+    assert 0.1 <= flight["thrust_range_n"][0] and flight["thrust_range_n"][1] <= 5.0
 
 
 def _check_time_elements(scenes):
