@@ -35,7 +35,7 @@ class _State(eqx.Module):
 class _Frame(eqx.Module):
     model: eqx.Module
     frame: str = eqx.field(static=True)
-    translation: Array
+    translation: Array | None
     rotation: Array | None
     root: Array
 
@@ -44,6 +44,8 @@ class _Frame(eqx.Module):
         if self.rotation is None:
             return self.root * (p - self.translation)
         omega = log(self.rotation.T @ R, check=False)
+        if self.translation is None:
+            return self.root * omega
         return self.root * jnp.concatenate(
             [omega, gamma_inv(omega) @ (self.rotation.T @ (p - self.translation))])
 
@@ -85,18 +87,21 @@ def state_residual(space, q_ref, v_ref=None, weight=1.0) -> eqx.Module:
     return _State(space, q_ref, v_ref, _root(weight))
 
 
-def frame_residual(model, frame: str, translation, rotation=None, weight=1.0) -> eqx.Module:
-    """A frame's placement or position against a target.
+def frame_residual(model, frame: str, translation=None, rotation=None,
+                   weight=1.0) -> eqx.Module:
+    """A frame's placement, position or orientation against a target.
 
-    With a rotation, the SE(3) logarithm of the target's inverse times the frame's pose,
+    With both targets, the SE(3) logarithm of the target's inverse times the frame's pose,
     r = sqrt(w) (omega; Gamma(omega)^-1 R_ref^T (p - p_ref)) with omega = log(R_ref^T R)
-    (Crocoddyl's `ResidualModelFramePlacement`, in mbjax's (angular; linear) order); without,
-    the translation r = sqrt(w) (p - p_ref) (`ResidualModelFrameTranslation`).
+    (Crocoddyl's `ResidualModelFramePlacement`, in mbjax's (angular; linear) order); with a
+    translation only, r = sqrt(w) (p - p_ref) (`ResidualModelFrameTranslation`); with a rotation
+    only, r = sqrt(w) omega (`ResidualModelFrameRotation`).
 
     Args:
         model: the `mbjax.Model`.
         frame: the frame's, body's or joint's name (`mbjax.rigid.frame_pose`).
-        translation: the target origin in the world [m], shape (3,).
+        translation: the target origin in the world [m], shape (3,); None for a rotation
+            residual.
         rotation: the target orientation (frame to world), shape (3, 3); None for a
             translation residual.
         weight: w, a scalar or one per residual (6 or 3).
@@ -106,10 +111,14 @@ def frame_residual(model, frame: str, translation, rotation=None, weight=1.0) ->
 
     Raises:
         KeyError: no frame of that name.
+        ValueError: neither a translation nor a rotation.
     """
+    if translation is None and rotation is None:
+        raise ValueError("frame_residual needs a target translation, rotation or both")
     frame_pose(model, model.neutral(), frame)                   # a KeyError names the frame
-    rotation = None if rotation is None else jnp.asarray(rotation, dtype=float)
-    return _Frame(model, frame, jnp.asarray(translation, dtype=float), rotation, _root(weight))
+    translation, rotation = (None if x is None else jnp.asarray(x, dtype=float)
+                             for x in (translation, rotation))
+    return _Frame(model, frame, translation, rotation, _root(weight))
 
 
 def control_residual(nu: int, u_ref=None, weight=1.0) -> eqx.Module:

@@ -1,6 +1,7 @@
 """The one entry point of trajectory optimisation: `solve(problem, solver, us0)`."""
 
 import equinox as eqx
+import jax.numpy as jnp
 from jax import Array
 
 from mbjax._src.system.status import raise_on_failure
@@ -10,7 +11,6 @@ from mbjax._src.trajopt.problem import Problem
 from mbjax._src.trajopt.result import AbstractSolver, Result
 
 
-@eqx.filter_jit
 def solve(problem: Problem, solver: AbstractSolver = ILQR(), us0: Array | None = None,
           states0: Array | None = None, throw: bool = False) -> Result:
     """Optimise a problem's controls with a solver strategy.
@@ -45,5 +45,13 @@ def solve(problem: Problem, solver: AbstractSolver = ILQR(), us0: Array | None =
         raise TypeError(f"problem must be a mbjax.trajopt.Problem, got {type(problem).__name__}")
     if not isinstance(solver, AbstractSolver):
         raise TypeError(f"solver must be a solver instance such as ILQR(), got {solver!r}")
+    # strongly typed float arrays: a weakly typed guess (jnp.full(shape, 1.0)) would compile anew
+    us0, states0 = (None if x is None else jnp.asarray(x, dtype=float) for x in (us0, states0))
+    return _solve(problem, solver, us0, states0, throw)
+
+
+@eqx.filter_jit
+def _solve(problem: Problem, solver: AbstractSolver, us0: Array | None, states0: Array | None,
+           throw: bool) -> Result:
     return raise_on_failure(solver.solve(problem, problem.initial_controls(us0), states0), throw,
                             "mbjax._src.trajopt.solve")
