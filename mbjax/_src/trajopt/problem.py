@@ -78,6 +78,7 @@ class Problem(eqx.Module):
     integrator: AbstractIntegrator
     dt: float = eqx.field(static=True)
     horizon: int = eqx.field(static=True)
+    ndq: int = eqx.field(static=True)   # a configuration deviation's length (nv for a tree)
 
     def __init__(self, system: AbstractSystem, q0, v0, *, dt: float, horizon: int,
                  running: Callable, terminal: Callable, lower=None, upper=None,
@@ -108,6 +109,7 @@ class Problem(eqx.Module):
         self.running, self.terminal = running, terminal
         self.integrator = integrator
         self.dt, self.horizon = float(dt), int(horizon)
+        self.ndq = jax.eval_shape(system.difference, self.q0, self.q0).shape[0]
         nu = self.nu
         bounds = []
         for name, value, default in (("lower", lower, -jnp.inf), ("upper", upper, jnp.inf)):
@@ -158,11 +160,6 @@ class Problem(eqx.Module):
         q1, v1, _ = self.integrator.step(system, t, q, v, jnp.asarray(self.dt, x.dtype))
         q1, v1 = system.constrain(t + self.dt, q1, v1)
         return jnp.concatenate([q1, v1])
-
-    @property
-    def ndq(self) -> int:
-        """Length of a configuration deviation (the tangent space's: nv for a tree)."""
-        return jax.eval_shape(self.system.difference, self.q0, self.q0).shape[0]
 
     @property
     def ndx(self) -> int:
