@@ -15,7 +15,9 @@ class RK4(AbstractIntegrator):
     """The classical fourth-order Runge-Kutta method on (q, u), coordinates projected after the step.
 
     Order 4; conditionally stable (|lambda dt| < 2.83 on the imaginary axis). Takes no
-    arguments.
+    arguments. It steps the coordinates themselves, a quaternion's four included, and normalizes
+    after the step: the classical method, kept as the reference for its form on the rotation
+    group and SE(3), `RKMK4` (the Euler methods step on the group).
 
     The four stages run as one `lax.scan` over the tableau rows, so the system's equations of
     motion are traced and compiled once per step, not four times, which shortens compilation
