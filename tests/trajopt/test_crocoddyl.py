@@ -1,6 +1,8 @@
 """iLQR against an independent optimal-control library: Crocoddyl's FDDP (analytic derivatives
 on Pinocchio) on the arm reach built from the same URDF, residuals, weights, semi-implicit Euler
-steps and first guess (`mbjax_harness.peers.crocoddyl_reach`). Skipped where Crocoddyl is not
+steps and first guess (`mbjax_harness.peers.crocoddyl_reach`), and on Crocoddyl's own
+contact-free examples (`mbjax_harness.crocoddyl_examples`: the Kinova arm, the double pendulum,
+the quadrotor's free base with and without thrust bounds). Skipped where Crocoddyl is not
 installed or its pairing with Pinocchio is broken (`peers.crocoddyl_working` says which)."""
 
 import jax.numpy as jnp
