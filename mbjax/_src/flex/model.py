@@ -195,7 +195,8 @@ class FlexibleModel(eqx.Module):
         """The chart point xi (nv,) about q0 at which `retract` gives q1: the rigid model's
         difference, q1 - q0 for the modes."""
         nq = self.model.nq
-        return jnp.concatenate([self.model.difference(q0[:nq], q1[:nq]), q1[nq:] - q0[nq:]])
+        return jnp.concatenate([self.model.difference(q0[:nq], q1[:nq], wrap=False),
+                                q1[nq:] - q0[nq:]])
 
     def local_rate(self, q0: Array, xi: Array, v: Array) -> Array:
         """xi_dot, shape (nv,), at chart point xi about q0 for velocity v."""

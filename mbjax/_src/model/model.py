@@ -463,28 +463,36 @@ class Model(eqx.Module):
         return self._flat_q(self._per_type(
             lambda kind, qk, vk, a, a2: self._pad_q(kind, joint_integrate(kind, qk, vk)), q, v))
 
-    def difference(self, q0: Array, q1: Array) -> Array:
+    def difference(self, q0: Array, q1: Array, *, wrap: bool = True) -> Array:
         """The tangent vector v with q0 (+) v = q1: `integrate`'s inverse.
 
-        q1 - q0, with a revolute joint without limits (URDF continuous) wrapped to [-pi, pi);
-        the body-frame rotation vector (|omega| <= pi) for quaternions and the SE(3)
-        logarithm for free joints. Equal to Pinocchio's `difference` after the state
-        converters.
+        q1 - q0 for revolute, prismatic and universal joints; the body-frame rotation vector
+        (|omega| <= pi) for quaternions and the SE(3) logarithm for free joints. With `wrap`,
+        a revolute joint without limits (URDF continuous) has its difference wrapped to
+        [-pi, pi), as Pinocchio's `difference` (its (cos, sin) coordinates do not count turns):
+        then equal to Pinocchio's after the state converters. Without, it is the exact inverse
+        of `integrate` in mbjax's coordinates, whose angles do count turns, and continuous
+        along any path: what the systems' `difference` and so the trajectory optimisers'
+        feedback and defects use.
 
         Args:
             q0: configuration, shape (nq,).
             q1: configuration, shape (nq,).
+            wrap: wrap continuous joints' angle differences (static).
 
         Returns:
             v, shape (nv,).
         """
         layout, width = _layout(self.joint_types), self.width
-        continuous = jnp.isinf(self.lower) & jnp.isinf(self.upper)
+        continuous = (jnp.isinf(self.lower) & jnp.isinf(self.upper)) if wrap else \
+            jnp.zeros(self.nq, bool)
         if self.euclidean:                       # q1 - q0, continuous angles wrapped
+            d = q1 - q0
+            if not wrap:
+                return d
             revolute = np.zeros(self.nq, bool)
             for k in layout["groups"].get("revolute", ()):
                 revolute[layout["q_start"][k]] = True
-            d = q1 - q0
             return jnp.where(revolute & continuous,
                              d - 2 * jnp.pi * jnp.floor((d + jnp.pi) / (2 * jnp.pi)), d)
         pieces = []

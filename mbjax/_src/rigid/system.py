@@ -271,7 +271,7 @@ class MomentumSystem(AbstractDrivenSystem):
         return self.velocity(q, u)
 
     def difference(self, q0, q1):
-        return self.model.difference(q0, q1)
+        return self.model.difference(q0, q1, wrap=False)
 
     def project(self, q):
         return self.model.normalize(q)

@@ -101,8 +101,9 @@ class AbstractSystem(eqx.Module):
     def difference(self, q0: Array, q1: Array) -> Array:
         """The chart point xi about q0 at which retract(q0, xi) = q1 (q1 - q0 by default).
 
-        What trajectory optimisation measures deviations with (Pinocchio's `difference` for a
-        tree).
+        What trajectory optimisation measures deviations with: for a tree, Pinocchio's
+        `difference` on quaternions, and q1 - q0 on angles, which count turns (the exact inverse
+        of `retract`, continuous along a path: `Model.difference(..., wrap=False)`).
 
         Args:
             q0: the chart's base configuration, shape (nq,).

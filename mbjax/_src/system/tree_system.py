@@ -91,7 +91,7 @@ class AbstractTreeSystem(AbstractDrivenSystem):
         return u
 
     def difference(self, q0: Array, q1: Array) -> Array:
-        return self.model.difference(q0, q1)
+        return self.model.difference(q0, q1, wrap=False)
 
     def normalize(self, q: Array) -> Array:
         """q with every quaternion scaled to unit length.

@@ -62,12 +62,13 @@ def state_residual(space, q_ref, v_ref=None, weight=1.0) -> eqx.Module:
     """State regularisation: r = sqrt(w) (difference(q_ref, q); v - v_ref).
 
     The configuration's deviation is measured on its manifold (`Model.difference`: a continuous
-    joint's angle wrapped, a free joint's SE(3) logarithm), as Crocoddyl's
+    joint's angle wrapped to [-pi, pi), a free joint's SE(3) logarithm), as Crocoddyl's
     `ResidualModelState`.
 
     Args:
-        space: what measures the configuration's deviation: a `mbjax.Model` or a system (its
-            `difference`).
+        space: what measures the configuration's deviation: a `mbjax.Model` (its
+            `difference`, continuous joints wrapped) or a system (its chart's `difference`,
+            angles counting turns).
         q_ref: the reference configuration, shape (nq,).
         v_ref: the reference velocity, shape (nv,); zeros by default.
         weight: w, a scalar or one per residual (nv + nv entries: the tangent of q, then v).
