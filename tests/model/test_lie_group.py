@@ -15,7 +15,7 @@ from mbjax_harness.peers import random_state
 
 pin = pytest.importorskip("pinocchio")
 
-QUICK_ROBOTS = ("hector/quadrotor_base", "solo/solo12", "kinova/kinova")
+QUICK_ROBOTS = ("hector/quadrotor_base", "solo/solo12", "kinova/kinova", "panda/panda")
 
 
 def _against_pinocchio(model, pin_model, seed: int) -> float:
@@ -49,8 +49,10 @@ def _floating_difference(path) -> float | None:
     return max(_against_pinocchio(model, pin_model, seed) for seed in (0, 2))
 
 
+@pytest.mark.filterwarnings("ignore::mbjax.model.ModelWarning")   # implausible CAD inertias
 def test_integrate_and_difference_equal_pinocchios():
-    """A quadrotor, a quadruped and an arm with continuous joints, on free bases."""
+    """A quadrotor, a quadruped, an arm with continuous joints and one with prismatic fingers,
+    on free bases."""
     paths = _corpus(QUICK_ROBOTS)
     assert len(paths) == len(QUICK_ROBOTS)
     for path in paths:
@@ -58,6 +60,7 @@ def test_integrate_and_difference_equal_pinocchios():
 
 
 @pytest.mark.slow
+@pytest.mark.filterwarnings("ignore::mbjax.model.ModelWarning")
 def test_integrate_and_difference_on_every_floating_robot():
     worst = {path.stem: _floating_difference(path) for path in _corpus()}
     worst = {name: d for name, d in worst.items() if d is not None}
@@ -79,19 +82,19 @@ def test_spherical_joint_equals_pinocchios():
 def test_difference_inverts_integrate_with_finite_derivatives_at_zero_and_half_turns():
     """difference(q, integrate(q, v)) = v; its Jacobian in v is the identity at v = 0 and
     finite (and equal to central differences) at a half turn of the free and ball joints."""
-    model = Model([-1, 0, 1], ["free", "spherical", "revolute"], mass=[1.0] * 3,
-                  inertia=[np.eye(3)] * 3)
+    model = Model([-1, 0, 1, 2], ["free", "spherical", "revolute", "universal"],
+                  mass=[1.0] * 4, inertia=[np.eye(3)] * 4)
     q, _, _ = random_state(model, 5)
     q = jnp.asarray(q)
     rng = np.random.default_rng(1)
     for v in (jnp.zeros(model.nv), jnp.asarray(rng.normal(size=model.nv)),
-              jnp.r_[jnp.pi, 0, 0, 0.3, 0.2, 0.1, 0, jnp.pi - 1e-9, 0, 0.5]):
+              jnp.r_[jnp.pi, 0, 0, 0.3, 0.2, 0.1, 0, jnp.pi - 1e-9, 0, 0.5, 0.1, 0.2]):
         np.testing.assert_allclose(model.difference(q, model.integrate(q, v)), v, atol=1e-8)
         J = jax.jacfwd(lambda w: model.difference(q, model.integrate(q, w)))(v)
         assert np.isfinite(J).all()
         if not jnp.any(v):
             np.testing.assert_allclose(J, np.eye(model.nv), atol=1e-12)
-    half = jnp.r_[0, 0, jnp.pi, 0.3, 0.2, 0.1, 0, 0, jnp.pi, 0.5]
+    half = jnp.r_[0, 0, jnp.pi, 0.3, 0.2, 0.1, 0, 0, jnp.pi, 0.5, 0.1, 0.2]
     J = jax.jacfwd(model.integrate, argnums=1)(q, half)
     h = 1e-6
     fd = np.stack([(model.integrate(q, half + h * e) - model.integrate(q, half - h * e)) / (2 * h)
@@ -110,3 +113,17 @@ def test_continuous_angles_wrap_and_limited_ones_do_not():
     np.testing.assert_allclose(model.difference(q0, q1), [2 * np.pi - 6.0, -6.0], atol=1e-15)
     np.testing.assert_allclose(model.difference(q0, q1, wrap=False), [-6.0, -6.0], atol=1e-15)
     np.testing.assert_allclose(TreeSystem(model).difference(q0, q1), [-6.0, -6.0], atol=1e-15)
+
+
+def test_the_chart_rate_is_the_derivative_of_the_chart():
+    """local_rate (what RKMK4 integrates) against the chart itself: d/dt integrate(q0, xi(t))
+    with xi_dot = local_rate(q0, xi, v) is the configuration's rate q_dot(q, v) there, for the
+    SE(3) chart of a free joint (its translation's rate carries Gamma's derivative)."""
+    model = Model([-1, 0], ["free", "spherical"], mass=[1.0] * 2, inertia=[np.eye(3)] * 2)
+    q0, v, _ = random_state(model, 11)
+    rng = np.random.default_rng(4)
+    xi = jnp.asarray(rng.normal(size=model.nv))
+    q0, v = jnp.asarray(q0), jnp.asarray(v)
+    xi_dot = model.local_rate(q0, xi, v)
+    _, q_rate = jax.jvp(lambda x: model.integrate(q0, x), (xi,), (xi_dot,))
+    np.testing.assert_allclose(q_rate, model.q_dot(model.integrate(q0, xi), v), atol=1e-12)
