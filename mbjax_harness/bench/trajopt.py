@@ -23,8 +23,8 @@ Timing. Each solver runs until its own convergence test passes (mbjax: a relativ
 the rolled-out guess. `seconds` is the median wall time of that solve (mbjax after compiling,
 `compile_s` apart); `seconds_to_tolerance` is the median wall time of a solve stopped after the
 iterations the solver needed to come within 1e-6 (relative) of the better of the two final costs
-(`TOLERANCE`, found from each solver's cost history), so a solver is not charged for a tail
-that its convergence test, not the problem, asks for (a full solve passes that point, so its
+(`TOLERANCE`, found from each solver's cost history; None where the solver stops short of it), so
+a solver is not charged for a tail that its convergence test, not the problem, asks for (a full solve passes that point, so its
 time bounds the truncated one's, which on a busy machine can measure longer). Crocoddyl runs
 single-threaded from Python.
 
@@ -116,11 +116,11 @@ def acrobot_example() -> Example:
 PROBLEMS = {"arm-reach": arm_example, "acrobot-swingup": acrobot_example, **EXAMPLES}
 
 
-def _to_tolerance(costs, best: float) -> int:
-    """The first iteration whose cost is within TOLERANCE of best (the last if none)."""
+def _to_tolerance(costs, best: float) -> int | None:
+    """The first iteration whose cost is within TOLERANCE of best (None if none is)."""
     costs = np.asarray(costs)
     within = np.flatnonzero(costs <= best + TOLERANCE * abs(best))
-    return int(within[0]) if len(within) else len(costs) - 1
+    return int(within[0]) if len(within) else None
 
 
 class CrocoddylSolver:
@@ -217,13 +217,17 @@ def single(name: str, repeats: int, common: dict) -> list[dict]:
             "cost_in_other_engine": float(problem.objective(jnp.asarray(us_croc))), **checks})
         best = min(mbjax["cost"], records[-1]["cost"])
         k = _to_tolerance(history, best)
-        records[-1].update(iterations_to_tolerance=k, seconds_to_tolerance=min(
-            croc.timed(max(k, 1), repeats), records[-1]["seconds"]))
+        records[-1].update(iterations_to_tolerance=k, seconds_to_tolerance=None if k is None else
+                           min(croc.timed(max(k, 1), repeats), records[-1]["seconds"]))
     k = _to_tolerance(costs, best)
-    stopped = ILQR(iterations=max(k, 1), **CROCODDYL_SCHEDULE)
-    truncated = (timing.run_s if k >= iterations
-                 else min(measure(solve, problem, stopped, us0, repeats=repeats)[1].run_s,
-                          timing.run_s))
+    if k is None:                    # stopped short of the other engine's optimum
+        truncated = None
+    elif k >= iterations:
+        truncated = timing.run_s
+    else:
+        stopped = ILQR(iterations=max(k, 1), **CROCODDYL_SCHEDULE)
+        truncated = min(measure(solve, problem, stopped, us0, repeats=repeats)[1].run_s,
+                        timing.run_s)
     mbjax.update(iterations_to_tolerance=k, seconds_to_tolerance=truncated)
     for r in records:
         r["best_cost"] = best
@@ -286,9 +290,17 @@ def summarize(records: list[dict], common: dict) -> dict:
     out = {**common, "kind": "summary"}
     singles = {(r["problem"], r["engine"]): r for r in records
                if r["kind"] == "single" and "skipped" not in r}
-    ratios = {p: singles[p, "mbjax"]["seconds_to_tolerance"]
-              / singles[p, "crocoddyl"]["seconds_to_tolerance"]
+    # where one engine never came within TOLERANCE of the other's optimum, the other wins (0 or
+    # inf); where neither did (both stopped short of the better optimum), no ratio
+    def ratio(ours, theirs):
+        if ours is None:
+            return None if theirs is None else float("inf")
+        return 0.0 if theirs is None else ours / theirs
+
+    ratios = {p: ratio(singles[p, "mbjax"]["seconds_to_tolerance"],
+                       singles[p, "crocoddyl"]["seconds_to_tolerance"])
               for p in PROBLEMS if (p, "crocoddyl") in singles}
+    ratios = {p: r for p, r in ratios.items() if r is not None}
     out["single_ratio"] = ratios
     out["single_met"] = min(ratios.values()) <= 2.0 if ratios else None
     many_ = {(r["engine"], r.get("how")): r for r in records
@@ -313,8 +325,10 @@ def table(records: list[dict]) -> str:
             continue
         checks = (f"{r['one_step_agreement']:.1e}, {r['cost_agreement']:.1e}"
                   if "one_step_agreement" in r else "")
+        to = r["seconds_to_tolerance"]
         lines.append(f"| {r['problem']} | {r['engine']} {r['solver']} | {r['iterations']} "
-                     f"({r['iterations_to_tolerance']}) | {r['seconds_to_tolerance'] * 1e3:.1f} | "
+                     f"({r['iterations_to_tolerance'] if to is not None else '-'}) | "
+                     f"{f'{to * 1e3:.1f}' if to is not None else 'not within 1e-6'} | "
                      f"{r['cost']:.10g} | {r['status']} | {checks} |")
     return "\n".join(lines)
 

@@ -297,7 +297,9 @@ def trajopt_bench_figure(records: list[dict]) -> Figure:
                       markevery=max(len(costs) // 12, 1),
                       label=f"{r['engine']} {r['solver']}: {r['iterations']} it, "
                             f"{r['seconds'] * 1e3:.0f} ms; "
-                            f"to 1e-6 {r['seconds_to_tolerance'] * 1e3:.0f} ms")
+                            + (f"to 1e-6 {r['seconds_to_tolerance'] * 1e3:.0f} ms"
+                               if r["seconds_to_tolerance"] is not None
+                               else "stops short of 1e-6"))
         ax.axhline(1e-6, color="0.5", lw=0.8, ls="--")
         ax.set(xlabel="time [s] (each iteration its share of the solve)",
                ylabel="(cost - best) / best", title=problem)
