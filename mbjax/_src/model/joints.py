@@ -162,7 +162,9 @@ def joint_integrate(kind: str, q0: Array, v: Array) -> Array:
     q0 + v for revolute, prismatic and universal joints; the body-frame rotation increment
     quat0 * exp(omega) (Borri 1990 §2) for a spherical joint; for a free joint the exponential of
     the body twist v = (omega; u) on SE(3): R0 exp(omega), p0 + R0 Gamma(omega) u, with Gamma the
-    tangent map of Borri 1990 eq A.17 (Pinocchio's `integrate`, its exp6).
+    tangent map of Borri 1990 eq A.17 (Pinocchio's `integrate`, its exp6). The quaternion is
+    kept in q0's hemisphere (q and -q are one rotation), as Pinocchio keeps it, so that a
+    trajectory's quaternions do not jump sign.
 
     Args:
         kind: the joint type.
@@ -172,12 +174,13 @@ def joint_integrate(kind: str, q0: Array, v: Array) -> Array:
     Returns:
         The configuration, shape (nq,).
     """
-    if kind == "spherical":
-        return quat_multiply(_unit(q0[:4]), quat_from_rotvec(v[:3]))
-    if kind == "free":
-        quat0 = _unit(q0[3:7])
-        return jnp.concatenate([q0[:3] + quat_to_matrix(quat0) @ (gamma(v[:3]) @ v[3:6]),
-                                quat_multiply(quat0, quat_from_rotvec(v[:3]))])
+    if kind in ("spherical", "free"):
+        quat0 = _unit(q0[-4:])
+        quat = quat_multiply(quat0, quat_from_rotvec(v[:3]))
+        quat = jnp.where(quat @ quat0 < 0, -quat, quat)       # q0's hemisphere, as Pinocchio's
+        if kind == "spherical":
+            return quat
+        return jnp.concatenate([q0[:3] + quat_to_matrix(quat0) @ (gamma(v[:3]) @ v[3:6]), quat])
     n = JOINT_TYPES[kind].nq
     return q0[:n] + v[:n]
 
