@@ -137,3 +137,34 @@ def test_the_chart_rate_is_the_derivative_of_the_chart():
     xi_dot = model.local_rate(q0, xi, v)
     _, q_rate = jax.jvp(lambda x: model.integrate(q0, x), (xi,), (xi_dot,))
     np.testing.assert_allclose(q_rate, model.q_dot(model.integrate(q0, xi), v), atol=1e-12)
+
+
+def test_every_systems_difference_inverts_its_retract():
+    """The chart a trajectory optimiser steps in, for each kind of system: retract(q0,
+    difference(q0, q1)) = q1 (rotations compared as matrices), for a floating tree, a flexible
+    arm, a closed four-bar and a rigid body in both rotation coordinates."""
+    from mbjax.flex import FlexibleSystem
+    from mbjax.lie import Quaternion, RotationVector
+    from mbjax.rigid import RigidBody
+    from mbjax.scenes import four_bar, slewing_beam
+
+    rng = np.random.default_rng(3)
+    floating = Model([-1, 0], ["free", "revolute"], mass=[1.0] * 2, inertia=[np.eye(3)] * 2)
+    arm = slewing_beam.model()
+    closed = four_bar.build()[0]
+
+    def placement(q):             # the free joint's rotation as a matrix, the rest as they are
+        return jnp.concatenate([q[:3], quat_to_matrix(q[3:7]).ravel(), q[7:]])
+
+    def body(rotation):
+        system = RigidBody(1.0, np.eye(3), rotation=rotation)
+        n = rotation.size
+        return system, n + 3, lambda q: jnp.concatenate([rotation.to_matrix(q[:n]).ravel(), q[n:]])
+
+    cases = [(TreeSystem(floating), floating.nq, placement), (FlexibleSystem(arm), arm.nq, None),
+             (closed, closed.tree.nq, None), body(Quaternion()), body(RotationVector())]
+    for system, nq, seen in cases:
+        q0, q1 = (system.project(jnp.asarray(rng.uniform(-1.0, 1.0, nq))) for _ in range(2))
+        back = system.retract(q0, system.difference(q0, q1))
+        seen = seen or (lambda q: q)
+        np.testing.assert_allclose(seen(back), seen(q1), atol=1e-12, err_msg=type(system).__name__)

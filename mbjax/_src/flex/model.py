@@ -191,11 +191,12 @@ class FlexibleModel(eqx.Module):
         nq, nv = self.model.nq, self.model.nv
         return jnp.concatenate([self.model.retract(q0[:nq], xi[:nv]), q0[nq:] + xi[nv:]])
 
-    def difference(self, q0: Array, q1: Array) -> Array:
+    def difference(self, q0: Array, q1: Array, *, wrap: bool = True) -> Array:
         """The chart point xi (nv,) about q0 at which `retract` gives q1: the rigid model's
-        difference, q1 - q0 for the modes."""
+        difference (`Model.difference`, continuous joints wrapped with `wrap`), q1 - q0 for
+        the modes."""
         nq = self.model.nq
-        return jnp.concatenate([self.model.difference(q0[:nq], q1[:nq], wrap=False),
+        return jnp.concatenate([self.model.difference(q0[:nq], q1[:nq], wrap=wrap),
                                 q1[nq:] - q0[nq:]])
 
     def local_rate(self, q0: Array, xi: Array, v: Array) -> Array:
