@@ -50,8 +50,8 @@ class AbstractDrivenSystem(AbstractSystem):
 
     @property
     def n_controls(self) -> int:
-        """The number of forces the control returns: len(actuation), the actuation matrix's
-        columns, or nv if all coordinates are actuated."""
+        """The number of forces the control returns: the actuation matrix's columns, or nv if
+        all coordinates are actuated."""
         return self.nv if self.actuation is None else self.actuation.shape[1]
 
     def with_control(self, control) -> "AbstractDrivenSystem":
