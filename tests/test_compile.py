@@ -20,7 +20,7 @@ from jax import monitoring
 import mbjax
 from mbjax import lie
 from mbjax.model import chain
-from mbjax.rigid import forward_kinematics, frame_jacobian
+from mbjax.rigid import forward_kinematics, frame_jacobian, frame_pose
 from mbjax._src.rigid import energy
 
 compiled = []
@@ -47,6 +47,13 @@ counts.update({
     "lie.exp": programs(lambda: lie.exp(np.array([0.1, 0.2, 0.3]))),
     "lie.log": programs(lambda: lie.log(np.eye(3), check=False)),
     "lie.quat_from_matrix": programs(lambda: lie.quat_from_matrix(np.eye(3))),
+    "frame_pose": programs(lambda: frame_pose(model, q, "body4")),
+    "frame_jacobian": programs(lambda: frame_jacobian(model, q, "joint2")),
+})
+# one program serves every frame of a model (the name is resolved outside the trace)
+counts.update({
+    "frame_pose another frame": programs(lambda: frame_pose(model, q, "joint1")),
+    "frame_jacobian another frame": programs(lambda: frame_jacobian(model, q, "body0")),
 })
 print(json.dumps(counts))
 """
@@ -59,4 +66,6 @@ def test_public_functions_called_outside_jit_compile_one_program():
     counts = json.loads(out.stdout.strip().splitlines()[-1])
     assert counts.pop("chain(5)") == 0
     assert counts.pop("forward_dynamics again") == 0
+    assert counts.pop("frame_pose another frame") == 0
+    assert counts.pop("frame_jacobian another frame") == 0
     assert counts == dict.fromkeys(counts, 1), counts

@@ -5,7 +5,6 @@ the fixed joints themselves, MJCF sites: `Model.frame_names`), then its bodies (
 the URDF links or MJCF bodies) and its joints (`Model.joint_names`, whose frame is the body's).
 """
 
-from functools import partial
 
 import jax
 import jax.numpy as jnp
@@ -23,27 +22,32 @@ def frame_names(model: Model) -> tuple[str, ...]:
 
 def frame_placement(model: Model, name: str) -> tuple[int, Array, Array]:
     """(body, R, p): the frame's body (-1: the ground) and its pose in that body's frame; a
-    KeyError that lists the model's names when there is no such frame, body or joint."""
+    KeyError that lists the model's names when there is no such frame, body or joint. NumPy
+    arrays where the model is concrete (no program compiles for them outside jit)."""
+    xp = jnp if isinstance(model.mass, jax.core.Tracer) else np
     if name in model.frame_names:
         i = model.frame_names.index(name)
-        return model.frame_parents[i], model.frame_rotation[i], model.frame_translation[i]
+        return (model.frame_parents[i], xp.asarray(model.frame_rotation)[i],
+                xp.asarray(model.frame_translation)[i])
     for names in (model.names, model.joint_names):
         if name in names:
-            k = names.index(name)
-            return k, jnp.eye(3, dtype=model.mass.dtype), jnp.zeros(3, model.mass.dtype)
+            dtype = model.mass.dtype
+            return names.index(name), xp.eye(3, dtype=dtype), xp.zeros(3, dtype)
     known = frame_names(model)
     raise KeyError(f"no frame, body or joint named {name!r}; the model has {len(known)}: "
                    f"{', '.join(known[:12])}{', ...' if len(known) > 12 else ''}")
 
 
-@partial(jax.jit, static_argnames="name")
 def frame_pose(model: Model, q: Array, name: str) -> tuple[Array, Array]:
     """World pose of the frame, body or joint called `name` (looked up as the module says).
+
+    The name is resolved to its body and placement before tracing, so one compiled program
+    serves every frame of a model.
 
     Args:
         model: the tree.
         q: configuration, shape (nq,).
-        name: a named frame (URDF link or fixed joint, MJCF site), a body or a joint; static.
+        name: a named frame (URDF link or fixed joint, MJCF site), a body or a joint.
 
     Returns:
         (R, p): the frame's rotation (frame to world), shape (3, 3), and its origin in the
@@ -53,24 +57,30 @@ def frame_pose(model: Model, q: Array, name: str) -> tuple[Array, Array]:
         KeyError: no frame, body or joint of that name (the message lists the model's names).
     """
     body, R_f, p_f = frame_placement(model, name)
-    if body < 0:
-        return R_f, p_f
+    return _frame_pose(model, q, np.int32(body), R_f, p_f)
+
+
+@jax.jit
+def _frame_pose(model: Model, q: Array, body: Array, R_f: Array, p_f: Array):
+    """The pose of a frame fixed at (R_f, p_f) in body `body` (-1: the ground), body traced."""
     R, p = forward_kinematics(model, q)
-    return R[body] @ R_f, p[body] + R[body] @ p_f
+    on_ground = body < 0
+    R_b = jnp.where(on_ground, jnp.eye(3, dtype=R.dtype), R[jnp.maximum(body, 0)])
+    p_b = jnp.where(on_ground, 0.0, p[jnp.maximum(body, 0)])
+    return R_b @ R_f, p_b + R_b @ p_f
 
 
-@partial(jax.jit, static_argnames="name")
 def frame_jacobian(model: Model, q: Array, name: str) -> Array:
     """The Jacobian J with (omega; v) = J v of the frame, body or joint called `name`.
 
     omega is the frame's angular velocity and v the velocity of its origin, both in world
     components: Pinocchio's LOCAL_WORLD_ALIGNED, in (angular; linear) order. A frame on the
-    ground has J = 0.
+    ground has J = 0. As `frame_pose`, one compiled program serves every frame of a model.
 
     Args:
         model: the tree.
         q: configuration, shape (nq,).
-        name: a named frame, a body or a joint (as `frame_pose`); static.
+        name: a named frame, a body or a joint (as `frame_pose`).
 
     Returns:
         J, shape (6, nv): rows (omega; v), columns the velocity coordinates.
@@ -78,14 +88,21 @@ def frame_jacobian(model: Model, q: Array, name: str) -> Array:
     Raises:
         KeyError: no frame, body or joint of that name.
     """
-    body, R_f, p_f = frame_placement(model, name)
-    if body < 0:
-        return jnp.zeros((6, model.nv), q.dtype)
+    body, _, p_f = frame_placement(model, name)
+    return _frame_jacobian(model, q, np.int32(body), p_f)
+
+
+@jax.jit
+def _frame_jacobian(model: Model, q: Array, body: Array, p_f: Array) -> Array:
+    """The Jacobian of a point p_f fixed in body `body` (-1: the ground), body traced: the
+    columns of the joints on its path from the ground (Jerkovsky 1978's path matrix, eq 1)."""
     kin = body_kinematics(model, q, jnp.zeros(model.nv, q.dtype))
-    x = kin.p[body] + kin.R[body] @ p_f                   # the frame origin, world
+    k = jnp.maximum(body, 0)
+    x = kin.p[k] + kin.R[k] @ p_f                        # the frame origin, world
     S = model.flat_v(jnp.swapaxes(kin.S, -1, -2))          # (nv, 6) at the ground origin
     w, v0 = S[:, :3], S[:, 3:]
-    support = np.isin(model.dof_body(), (*model.topology.ancestors(body), body))
+    path = jnp.asarray(model.topology.path_matrix()[:, model.dof_body()], bool)   # (n, nv)
+    support = path[k] & (body >= 0)
     columns = jnp.concatenate([w, v0 + jnp.cross(w, x)], -1)
     return jnp.where(support[:, None], columns, 0.0).T
 
