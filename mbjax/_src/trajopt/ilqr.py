@@ -167,11 +167,16 @@ class ILQR(AbstractSolver):
         state = dict(xs=xs, us=us, cost=cost, mu=jnp.asarray(self.regularization, cost.dtype),
                      iteration=jnp.array(0), done=jnp.array(False), stalled=jnp.array(False),
                      costs=history(self.iterations + 1, cost),
-                     K=jnp.zeros((N, nu, nx), cost.dtype),
-                     expansion=self._linearize(problem, xs, us))
+                     K=jnp.zeros((N, nu, nx), cost.dtype), stale=jnp.array(True),
+                     expansion=jax.tree.map(lambda a: jnp.zeros(a.shape, a.dtype), jax.eval_shape(
+                         lambda: self._linearize(problem, xs, us))))
 
         def iterate(s):
-            k, K, decrease, ok = self._backward(problem, s["expansion"], s["us"], s["mu"])
+            # linearized at the top of an iteration, after an accepted step (and first): the
+            # expansion is traced once, inside the loop, not also before it
+            expansion = jax.lax.cond(s["stale"], lambda: self._linearize(problem, s["xs"], s["us"]),
+                                     lambda: s["expansion"])
+            k, K, decrease, ok = self._backward(problem, expansion, s["us"], s["mu"])
 
             def acceptable(trial):
                 _, _, cost, i = trial
@@ -203,12 +208,9 @@ class ILQR(AbstractSolver):
                                      s["mu"] * MU_FACTOR))
             i = s["iteration"] + 1
             # a rejected step leaves the trajectory, and so its expansion, as they were
-            expansion = jax.lax.cond(accept & ~converged,
-                                     lambda: self._linearize(problem, xs, us),
-                                     lambda: s["expansion"])
             return dict(xs=xs, us=us, cost=cost, mu=mu, iteration=i, done=converged,
                         stalled=mu > MU_MAX, costs=s["costs"].at[i].set(cost),
-                        K=jnp.where(accept, K, s["K"]), expansion=expansion)
+                        K=jnp.where(accept, K, s["K"]), expansion=expansion, stale=accept)
 
         def running(s):
             return ~s["done"] & ~s["stalled"] & (s["iteration"] < self.iterations)
