@@ -202,38 +202,28 @@ def quadrotor(bounded: bool = False) -> Example:
     robot = _robot("hector")
     model = _load(robot, floating_base=True)
     problem, us0 = quadrotor_problem(model, bounded)
-    dt, horizon = problem.dt, problem.horizon
 
     def crocoddyl():
         import crocoddyl as croc
         import pinocchio as pin
 
-        from mbjax_harness.peers import _crocoddyl_terms
+        from mbjax_harness.peers import _crocoddyl_shooting
 
         state = croc.StateMultibody(robot.model)
         kinds = {-1.0: croc.ThrusterType.CCW, 1.0: croc.ThrusterType.CW}
         actuation = croc.ActuationModelFloatingBaseThrusters(state, [
             croc.Thruster(pin.SE3(np.eye(3), np.array([x, y, 0.0])), CM / CF, kinds[spin])
             for x, y, spin in THRUSTERS])
-        x_ref = state.zero()
         pose = croc.ResidualModelFramePlacement(state, robot.model.getFrameId("base_link"),
                                                 pin.SE3(np.eye(3), TARGET), 4)
-        running = [("xReg", croc.ResidualModelState(state, x_ref, 4),
+        running = [("xReg", croc.ResidualModelState(state, state.zero(), 4),
                     np.r_[[0.1] * 3, [1000.0] * 3, [1000.0] * 6], 1e-6),
                    ("uReg", croc.ResidualModelControl(state, 4), None, 1e-6),
                    ("trackPose", pose, None, 1e-2)]
-
-        def action(terms, step):
-            dam = croc.DifferentialActionModelFreeFwdDynamics(
-                state, actuation, _crocoddyl_terms(state, 4, terms))
-            model_ = croc.IntegratedActionModelEuler(dam, step)
-            if bounded:
-                model_.u_lb, model_.u_ub = np.full(4, 0.1), np.full(4, 5.0)
-            return model_
-
         x0 = np.concatenate([robot.q0, np.zeros(6)])
-        return croc.ShootingProblem(x0, [action(running, dt)] * horizon,
-                                    action([("goalPose", pose, None, 3.0)], dt))
+        return _crocoddyl_shooting(state, actuation, x0, problem.dt, problem.horizon, running,
+                                   [("goalPose", pose, None, 3.0)],
+                                   bounds=(0.1, 5.0) if bounded else None)
 
     return Example(problem, us0, crocoddyl, "SolverBoxDDP" if bounded else "SolverFDDP",
                    _converter(model))

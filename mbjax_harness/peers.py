@@ -248,15 +248,20 @@ def _crocoddyl_terms(state, nu: int, terms) -> "object":
     return costs
 
 
-def _crocoddyl_shooting(state, actuation, x0, dt: float, horizon: int, running, terminal):
+def _crocoddyl_shooting(state, actuation, x0, dt: float, horizon: int, running, terminal,
+                        bounds=None):
     """Crocoddyl's shooting problem with semi-implicit Euler steps (its
-    `IntegratedActionModelEuler`: v+ = v + dt a, q+ = q + dt v+, running costs times dt)."""
+    `IntegratedActionModelEuler`: v+ = v + dt a, q+ = q + dt v+, running costs times dt), the
+    controls within `bounds` = (lower, upper) where given (for its box solvers)."""
     import crocoddyl
 
     def model(terms, step):
         costs = _crocoddyl_terms(state, actuation.nu, terms)
         dam = crocoddyl.DifferentialActionModelFreeFwdDynamics(state, actuation, costs)
-        return crocoddyl.IntegratedActionModelEuler(dam, step)
+        action = crocoddyl.IntegratedActionModelEuler(dam, step)
+        if bounds is not None:
+            action.u_lb, action.u_ub = (np.full(actuation.nu, float(b)) for b in bounds)
+        return action
 
     return crocoddyl.ShootingProblem(np.asarray(x0, float), [model(running, dt)] * horizon,
                                      model(terminal, 0.0))

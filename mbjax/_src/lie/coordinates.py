@@ -72,6 +72,7 @@ class AbstractRotation(eqx.Module):
             The coordinates of R0 exp(xi), shape (size,).
         """
 
+    @abc.abstractmethod
     def difference(self, rot0: Array, rot1: Array) -> Array:
         """The body-frame rotation vector xi with R1 = R0 exp(xi), |xi| <= pi (`retract`'s inverse).
 
@@ -82,8 +83,6 @@ class AbstractRotation(eqx.Module):
         Returns:
             xi, shape (3,).
         """
-        q0, q1 = (quat.quat_from_matrix(self.to_matrix(r)) for r in (rot0, rot1))
-        return quat.rotvec_from_quat(quat.quat_multiply(quat.quat_conjugate(q0), q1))
 
     @abc.abstractmethod
     def normalize(self, rot: Array) -> Array:

@@ -211,10 +211,12 @@ def joint_difference(kind: str, q0: Array, q1: Array, continuous: Array) -> Arra
         return jnp.concatenate([omega, u])
     n = JOINT_TYPES[kind].nq
     d = q1[:n] - q0[:n]
-    if kind == "revolute":
-        wrapped = d - 2 * jnp.pi * jnp.floor((d + jnp.pi) / (2 * jnp.pi))
-        d = jnp.where(continuous, wrapped, d)
-    return d
+    return jnp.where(continuous, wrap_angle(d), d) if kind == "revolute" else d
+
+
+def wrap_angle(d: Array) -> Array:
+    """An angle, or angles, wrapped to [-pi, pi)."""
+    return d - 2 * jnp.pi * jnp.floor((d + jnp.pi) / (2 * jnp.pi))
 
 
 def joint_local_rate(kind: str, q0: Array, xi: Array, v: Array) -> Array:

@@ -25,6 +25,7 @@ from mbjax._src.model.joints import (
     joint_rate,
     joint_difference,
     joint_integrate,
+    wrap_angle,
 )
 from mbjax._src.model.checks import check_body
 from mbjax._src.tree.take import take
@@ -493,8 +494,7 @@ class Model(eqx.Module):
             revolute = np.zeros(self.nq, bool)
             for k in layout["groups"].get("revolute", ()):
                 revolute[layout["q_start"][k]] = True
-            return jnp.where(revolute & continuous,
-                             d - 2 * jnp.pi * jnp.floor((d + jnp.pi) / (2 * jnp.pi)), d)
+            return jnp.where(revolute & continuous, wrap_angle(d), d)
         pieces = []
         for kind, idx in layout["groups"].items():
             own = layout["q_own"][kind]
