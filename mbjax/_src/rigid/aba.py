@@ -25,6 +25,7 @@ L D L^T factorization of the mass matrix, with which `solve` applies M^-1 in two
 (the derivatives of `mbjax._src.rigid.adjoint` use it).
 """
 
+from functools import partial
 from typing import NamedTuple
 
 import jax
@@ -32,6 +33,7 @@ import jax.numpy as jnp
 from jax import Array
 
 from mbjax._src.linalg import spd_solve as _solve
+from mbjax._src.linear_map import linear_map
 from mbjax._src.model import Model
 from mbjax._src.model.joints import JOINT_TYPES
 from mbjax._src.rigid.kinematics import body_kinematics, gravity_acceleration
@@ -110,6 +112,24 @@ def solve(model: Model, factor: Factor, b: Array) -> Array:
     if root is not None:
         u_dot = _set_row(_widen(u_dot, model.width), root, u_dot_root)
     return model.flat_v(u_dot)
+
+
+def _solves(fixed: tuple, bs: Array) -> Array:
+    """`solve` for a batch bs (B, nv): from nv right-hand sides on, M^-1 once (its columns, M^-1
+    being symmetric) and a product, instead of the passes per right-hand side."""
+    model, factor = fixed
+    if bs.shape[0] < model.nv:
+        return jax.vmap(partial(solve, model, factor))(bs)
+    return bs @ jax.vmap(partial(solve, model, factor))(jnp.eye(model.nv, dtype=bs.dtype))
+
+
+_mass_solve = linear_map("mass_solve", lambda fixed, b: solve(*fixed, b), _solves)
+
+
+def mass_solve(model: Model, factor: Factor, b: Array) -> Array:
+    """`solve(model, factor, b)` as a `linear_map`: the passes for one right-hand side and in
+    reverse mode, M^-1 formed once for a batch of them (`jax.jacfwd`)."""
+    return _mass_solve((model, factor), b)
 
 
 def _set_row(x: Array, k: int, value) -> Array:

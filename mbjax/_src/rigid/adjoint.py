@@ -35,14 +35,13 @@ meaningful); its symmetric part agrees.
 
 from collections.abc import Callable
 
-import equinox as eqx
 import jax
 import jax.numpy as jnp
 from jax import Array
 
 from mbjax._src.model import Model
 from mbjax._src.rigid import rnea_derivatives
-from mbjax._src.rigid.aba import aba_factored, solve
+from mbjax._src.rigid.aba import aba_factored, mass_solve
 from mbjax._src.rigid.rnea import inverse_dynamics
 from mbjax._src.rigid.tangents import instantiate, is_zero
 
@@ -75,23 +74,15 @@ def with_adjoint(fd: Callable) -> Callable:
         if f_ext is None and rnea_derivatives.applies(model) and {1, 2} & set(live):
             # the (q, v) directions written out (`rnea_derivatives`), the model's by autodiff
             dq, dv = (instantiate(t, x) for t, x in ((dargs[1], q), (dargs[2], v)))
-            rhs = rhs - jax.checkpoint(rnea_derivatives.rnea_jvp)(model, q, v, u_dot, dq, dv)
+            rhs = rhs - rnea_derivatives.rnea_tangent(model, q, v, u_dot, dq, dv)
             live = [i for i in live if i not in (1, 2)]
         if live:
             _, d_rnea = jax.jvp(jax.checkpoint(rnea), [args[i] for i in live],
                                 [instantiate(dargs[i], args[i]) for i in live])
             rhs = rhs - d_rnea
-        du_dot = jax.lax.custom_linear_solve(
-            lambda x: _mass_times(model, q, x), rhs,
-            solve=lambda _, b: solve(model, factor, b), symmetric=True)
+        du_dot = mass_solve(model, factor, rhs)
         return u_dot, du_dot
 
     forward.defjvp(_jvp, symbolic_zeros=True)
     return forward
-
-
-def _mass_times(model: Model, q: Array, x: Array) -> Array:
-    """M(q) x: the RNEA's joint forces for accelerations x with no velocity and no gravity."""
-    still = eqx.tree_at(lambda m: m.gravity, model, jnp.zeros_like(model.gravity))
-    return inverse_dynamics(still, q, jnp.zeros_like(x), x)
 
