@@ -56,7 +56,7 @@ def test_rnea_partials_equal_the_rneas_derivative():
     for model in models:
         partials = jax.jit(rnea_derivatives.rnea_partials)
         for q, v, a in _states(model, 3):
-            D_e, D_v = partials(model, q, v, a)
+            D_e, D_v, M = partials(model, q, v, a)
             J_e, J_v = jax.jacfwd(lambda e, v, q=q, a=a: inverse_dynamics(
                 model, model.integrate(q, e), v, a), argnums=(0, 1))(jnp.zeros(model.nv), v)
             scale = max(np.abs(J_e).max(), np.abs(J_v).max())

@@ -26,14 +26,19 @@ the forward pass, about half of what differentiating the recursion itself costs;
 benchmarks/README.md.
 
 `with_adjoint(fd)` gives `fd` (any function computing the forward dynamics of a tree: `aba`, or
-its vmappable form) this rule as a `jax.custom_jvp`. Forward mode, reverse mode (JAX transposes
-the rule; the solve is a `lax.custom_linear_solve`) and higher orders follow, and agree with
-differentiating `aba` itself to rounding (tests/rigid/test_adjoint.py). A gradient with respect to
-a body's `inertia` is defined up to its antisymmetric part (only symmetric inertias are
-meaningful); its symmetric part agrees.
+its vmappable form) this rule as a `jax.custom_jvp`. Its tangent, M^-1 (dtau - dRNEA . (dq, dv)),
+is a `linear_map`: along one direction and in reverse mode (JAX transposes it) it is the
+RNEA's two vector passes and the factor's two; for a batch of directions at one state
+(`jax.jacfwd`, every step Jacobian of `mbjax.trajopt`) the RNEA's partial derivatives and M are
+formed once (`rnea_derivatives.rnea_partials`) and M Cholesky-factorized, as Pinocchio's
+`computeABADerivatives` does. Higher orders follow from JAX's own derivatives of the passes, and
+agree with differentiating `aba` itself to rounding (tests/rigid/test_adjoint.py,
+tests/rigid/test_aba_derivatives.py). A gradient with respect to a body's `inertia` is defined
+up to its antisymmetric part (only symmetric inertias are meaningful); its symmetric part agrees.
 """
 
 from collections.abc import Callable
+from functools import partial
 
 import jax
 import jax.numpy as jnp
@@ -41,7 +46,9 @@ from jax import Array
 
 from mbjax._src.model import Model
 from mbjax._src.rigid import rnea_derivatives
-from mbjax._src.rigid.aba import aba_factored, mass_solve
+from mbjax._src.linear_map import linear_map
+from mbjax._src.rigid.aba import aba_factored, mass_solve, solve
+from mbjax._src.rigid.kinematics import increments_matrix
 from mbjax._src.rigid.rnea import inverse_dynamics
 from mbjax._src.rigid.tangents import instantiate, is_zero
 
@@ -74,15 +81,43 @@ def with_adjoint(fd: Callable) -> Callable:
         if f_ext is None and rnea_derivatives.applies(model) and {1, 2} & set(live):
             # the (q, v) directions written out (`rnea_derivatives`), the model's by autodiff
             dq, dv = (instantiate(t, x) for t, x in ((dargs[1], q), (dargs[2], v)))
-            rhs = rhs - rnea_derivatives.rnea_tangent(model, q, v, u_dot, dq, dv)
-            live = [i for i in live if i not in (1, 2)]
+            dqv, live = jnp.concatenate([dq, dv]), [i for i in live if i not in (1, 2)]
+        else:
+            dqv = None
         if live:
             _, d_rnea = jax.jvp(jax.checkpoint(rnea), [args[i] for i in live],
                                 [instantiate(dargs[i], args[i]) for i in live])
             rhs = rhs - d_rnea
-        du_dot = mass_solve(model, factor, rhs)
-        return u_dot, du_dot
+        if dqv is None:
+            return u_dot, mass_solve(model, factor, rhs)
+        return u_dot, _fd_tangent((model, q, v, u_dot, factor), jnp.concatenate([dqv, rhs]))
 
     forward.defjvp(_jvp, symbolic_zeros=True)
     return forward
 
+
+def _tangent(fixed: tuple, x: Array) -> Array:
+    """The accelerations' tangent M^-1 (dtau - d RNEA / d(q, v) . (dq, dv)) for x = (dq, dv,
+    dtau), at the solved accelerations: the RNEA's two vector passes and the factor's two."""
+    model, q, v, u_dot, factor = fixed
+    dq, dv, dtau = jnp.split(x, [model.nq, model.nq + model.nv])
+    return solve(model, factor, dtau - rnea_derivatives.rnea_jvp(model, q, v, u_dot, dq, dv))
+
+
+def _tangents(fixed: tuple, xs: Array) -> Array:
+    """`_tangent` for a batch xs (B, nq + 2 nv) at one state (`jax.jacfwd`): from a few
+    directions on, the RNEA's partial derivatives and M once (`rnea_partials`), a Cholesky
+    factorization and a product, as Pinocchio's `computeABADerivatives` forms them; the passes
+    per direction below."""
+    model, q, v, u_dot, _ = fixed
+    if xs.shape[0] < DENSE_FROM:
+        return jax.vmap(partial(_tangent, fixed))(xs)
+    D_e, D_v, M = rnea_derivatives.rnea_partials(model, q, v, u_dot)
+    D_q = D_e @ increments_matrix(model, q, v)                         # per coordinate of q
+    dq, dv, dtau = jnp.split(xs, [model.nq, model.nq + model.nv], axis=1)
+    rhs = dtau - dq @ D_q.T - dv @ D_v.T
+    return jax.scipy.linalg.cho_solve(jax.scipy.linalg.cho_factor(M), rhs.T).T
+
+
+DENSE_FROM = 4           # directions from which the matrices beat the passes (benchmarks/README.md)
+_fd_tangent = linear_map("forward_dynamics_tangent", _tangent, _tangents)

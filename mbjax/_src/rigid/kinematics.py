@@ -16,10 +16,13 @@ from typing import NamedTuple
 
 import jax
 import jax.numpy as jnp
+import numpy as np
 from jax import Array
 
 from mbjax._src.lie import vee
 from mbjax._src.model import Model
+from mbjax._src.model.joints import joint_calc
+from mbjax._src.model.model import _layout
 from mbjax._src.rigid.tangents import instantiate, is_zero
 from mbjax._src.spatial import cross_motion, inertia_matrix, skew
 from mbjax._src.tree import forward_pass
@@ -109,6 +112,36 @@ def joint_increments(model: Model, q: Array, v: Array, dq: Array) -> Array:
     Rt = jnp.swapaxes(R, -1, -2)
     twist = jnp.concatenate([jax.vmap(vee)(Rt @ dR), jnp.einsum("kij,kj->ki", Rt, dp)], -1)
     return jnp.einsum("kic,ki->kc", S_local, twist)
+
+
+def increments_matrix(model: Model, q: Array, v: Array) -> Array:
+    """The matrix G (nv, nq) of `joint_increments` (flattened): e = G dq. Each joint's
+    increments depend on its own coordinates only, so G is block-diagonal: the identity for
+    revolute and prismatic joints, S_local^T (vee(R^T dR / dq_k); R^T dp / dq_k) of the joint's
+    own pose for the others (the placement cancels), from `jax.jacfwd` over its few
+    coordinates."""
+    if model.euclidean:
+        return jnp.eye(model.nv, dtype=q.dtype)
+    layout = _layout(model.joint_types)
+    n, width, q_width = model.n, model.width, layout["q_width"]
+
+    def block(kind, qk, vk, axis, axis2):
+        if kind in ("revolute", "prismatic"):
+            return jnp.eye(width, q_width, dtype=qk.dtype)
+        def pose(qk):
+            return joint_calc(kind, qk, vk, axis, axis2, width)[:2]
+        (R, _), (dR, dp) = pose(qk), jax.jacfwd(pose)(qk)               # (3, 3, m), (3, m)
+        twist = jnp.concatenate([jax.vmap(vee)(R.T @ jnp.moveaxis(dR, -1, 0)).T, R.T @ dp])
+        S_local = joint_calc(kind, qk, vk, axis, axis2, width)[2]
+        return jnp.pad(S_local.T @ twist, [(0, 0), (0, q_width - qk.shape[0])])
+
+    blocks = model._per_type(block, q, v)                                  # (n, width, q_width)
+    with jax.ensure_compile_time_eval():          # static: each coordinate's joint and column
+        body_of = np.asarray(model._flat_q(np.broadcast_to(np.arange(n)[:, None], (n, q_width))))
+        q_col = np.asarray(model._flat_q(np.broadcast_to(np.arange(q_width), (n, q_width))))
+        v_col = np.asarray(model.flat_v(np.broadcast_to(np.arange(width), (n, width))))
+    rows = blocks[model.dof_body(), v_col]                                 # (nv, q_width)
+    return jnp.where(model.dof_body()[:, None] == body_of[None, :], rows[:, q_col], 0.0)
 
 
 def columns(S: Array, x: Array) -> Array:

@@ -28,14 +28,11 @@ differentiating the kinematics. Agrees with `jax.jvp` of `inverse_dynamics` to r
 (tests/rigid/test_adjoint.py).
 """
 
-from functools import partial
-
 import jax
 import jax.numpy as jnp
 import numpy as np
 from jax import Array
 
-from mbjax._src.linear_map import linear_map
 from mbjax._src.model import Model
 from mbjax._src.rigid.kinematics import columns, fixed_in_body, gravity_acceleration, joint_increments
 from mbjax._src.rigid.rnea import rnea_passes
@@ -76,12 +73,6 @@ def _times(I: Array, x: Array) -> Array:       # noqa: E741
     return jnp.einsum("kij,kj->ki", I, x)
 
 
-def _mul_sum(x: Array, y: Array, axis: int) -> Array:
-    """(x * y).sum(axis): a contraction XLA fuses into the surrounding elementwise code (a dot of
-    these sizes is a library call, which keeps a loop around it from compiling as one kernel)."""
-    return (x * y).sum(axis)
-
-
 def _outward_sum(model: Model, x: Array, ground: Array) -> Array:
     """ground plus the sum of x over each body's path from the ground (an outward pass)."""
     return forward_pass(model.topology, lambda parent, own: parent + own, ground, x)
@@ -98,20 +89,21 @@ def _parent(model: Model, x: Array, ground: Array) -> Array:
     return take(jnp.concatenate([x, ground[None]]), np.where(parents < 0, model.n, parents))
 
 
-def rnea_partials(model: Model, q: Array, v: Array, a: Array) -> tuple[Array, Array]:
-    """(d tau / d e, d tau / d v), each (nv, nv): the RNEA's partial derivatives at (q, v, a) in
-    the joints' increments e (the tangent space: `joint_increments`) and in v, for a tree of the
-    joints `applies` accepts (damping included).
+def rnea_partials(model: Model, q: Array, v: Array, a: Array) -> tuple[Array, Array, Array]:
+    """(d tau / d e, d tau / d v, d tau / d a = M), each (nv, nv): the RNEA's partial derivatives
+    at (q, v, a) in the joints' increments e (the tangent space: `joint_increments`), in v and in
+    a, for a tree of the joints `applies` accepts (damping and armature included).
 
-    `rnea_jvp` for every direction at once, with one pass over the bodies: a direction along a
+    `rnea_jvp` for every direction at once, with no pass per direction: a direction along a
     column of joint j has its twists at body j alone, so its outward sums P are (g2_j, g3_j) on
     j's outward set and zero elsewhere, and the inward sum of L collects, for joint k's row,
     Ic_k g2_j + Cc_k g3_j when j is on k's path (k included) and Ic_j g2_j + Cc_j g3_j + o_j when
     j is outward of k, with Ic and Cc the sums over a body's outward set of I and of
     C = I (V x) - (V x*) I - (. x* h), the linear map that takes P3 into L. That is Carpentier and
-    Mansard's (RSS 2018) composite-body form of the RNEA derivatives: one inward pass of 6 x 6
-    blocks and a few (nv, 6) by (6, 2 nv) products, masked by the path matrix (Jerkovsky 1978
-    eq 1)."""
+    Mansard's (RSS 2018) composite-body form of the RNEA derivatives: the outward sums as one
+    product with the path matrix (Jerkovsky 1978 eq 1) and a few (nv, 6) by (6, 2 nv) products,
+    masked by it. The same composite inertias give the mass matrix (the composite-rigid-body algorithm,
+    Featherstone RBDA §6.2): M[r, c] = s_r^T Ic_r s_c for c on r's path."""
     F, kin, A = rnea_passes(model, q, v, a, None)
     I, V = kin.I, kin.V                                  # noqa: E741 (the papers' name)
     h = _times(I, V)
@@ -120,7 +112,9 @@ def rnea_partials(model: Model, q: Array, v: Array, a: Array) -> tuple[Array, Ar
     cross = jnp.block([[w, zero], [u, w]])                               # V x, (n, 6, 6)
     by_h = jnp.block([[-hn, -hf], [-hf, zero]])                          # x -> x x* h
     C = I @ cross + jnp.swapaxes(cross, -1, -2) @ I - by_h               # (V x*) = -(V x)^T
-    Ic, Cc = jnp.split(_inward_sum(model, jnp.concatenate([I, C], -1)), 2, -1)
+    pi = model.topology.path_matrix()                    # pi[k, j] = 1: j on k's path
+    Ic, Cc = jnp.split(jnp.einsum("mk,mij->kij", pi.astype(q.dtype),
+                                  jnp.concatenate([I, C], -1)), 2, -1)   # sums over outward sets
     # per degree of freedom: its world column s and its body's quantities
     body = model.dof_body()
     s = jax.vmap(model.flat_v, in_axes=1, out_axes=1)(kin.S)             # (nv, 6)
@@ -135,37 +129,12 @@ def rnea_partials(model: Model, q: Array, v: Array, a: Array) -> tuple[Array, Ar
     Y = (jnp.einsum("rij,rj->ri", jnp.concatenate([Icd, Icd]), g2)
          + jnp.einsum("rij,rj->ri", jnp.concatenate([Ccd, Ccd]), g3) + o)   # (2 nv, 6)
     rows_I, rows_C = jnp.einsum("ri,rij->rj", s, Icd), jnp.einsum("ri,rij->rj", s, Ccd)
-    path = np.asarray(model.topology.path_matrix())[np.ix_(body, body)]  # [r, c]: c's body on r's path
+    path = pi[np.ix_(body, body)]                                      # [r, c]: c's body on r's path
     outward = path.T * (body[:, None] != body[None, :])                 # c's body outward of r's
     path2, outward2 = np.tile(path, 2), np.tile(outward, 2)
-    D = (path2 * (_mul_sum(rows_I[:, None], g2[None], -1) + _mul_sum(rows_C[:, None], g3[None], -1))
-         + outward2 * _mul_sum(s[:, None], Y[None], -1))
+    D = path2 * (rows_I @ g2.T + rows_C @ g3.T) + outward2 * (s @ Y.T)
+    inner = rows_I @ s.T
+    M = path * inner + outward * inner.T + jnp.diag(model.armature)
     nv = model.nv
-    return D[:, :nv], D[:, nv:] + jnp.diag(model.damping)
+    return D[:, :nv], D[:, nv:] + jnp.diag(model.damping), M
 
-
-def _tangent(fixed: tuple, x: Array) -> Array:
-    """`rnea_jvp` along x = (dq, dv)."""
-    model, q, v, a = fixed
-    return rnea_jvp(model, q, v, a, x[:model.nq], x[model.nq:])
-
-
-def _tangents(fixed: tuple, xs: Array) -> Array:
-    """`_tangent` for a batch xs (B, nq + nv): the matrices once (`rnea_partials`) for more than
-    a few directions, the passes per direction otherwise."""
-    model, q, v, a = fixed
-    if xs.shape[0] < DENSE_FROM:
-        return jax.vmap(partial(_tangent, fixed))(xs)
-    D_e, D_v = rnea_partials(model, q, v, a)
-    de = jax.vmap(lambda dq: model.flat_v(joint_increments(model, q, v, dq)))(xs[:, :model.nq])
-    return de @ D_e.T + xs[:, model.nq:] @ D_v.T
-
-
-DENSE_FROM = 4               # directions from which the matrices beat the passes (benchmarks/README.md)
-_rnea_tangent = linear_map("rnea_tangent", _tangent, _tangents)
-
-
-def rnea_tangent(model: Model, q: Array, v: Array, a: Array, dq: Array, dv: Array) -> Array:
-    """`rnea_jvp(model, q, v, a, dq, dv)` as a `linear_map`: one direction, or reverse mode, runs
-    the two passes; a batch of directions at one state (`jax.jacfwd`) forms `rnea_partials` once."""
-    return _rnea_tangent((model, q, v, a), jnp.concatenate([dq, dv]))
