@@ -224,8 +224,8 @@ def _summary_markdown(summary: dict) -> str:
 
 
 def _one_device_per_core() -> None:
-    """The throughput suite splits batches over one XLA CPU device per core, as its peers run one
-    thread per core. Host devices are fixed when JAX starts its backend, so this only takes effect
+    """The throughput and trajopt suites split batches over one XLA CPU device per core, as the
+    peers' batches run one thread per core. Host devices are fixed when JAX starts its backend, so this only takes effect
     before that (as here, from the command line) and where XLA_FLAGS does not set them already."""
     import os
 
@@ -250,7 +250,7 @@ def main(argv=None) -> int:
     args = parser.parse_args(argv)
     if not args.no_cache and args.command != "bench":   # benchmarks time the compiles themselves
         use_compilation_cache()
-    if args.command == "bench" and args.suite == "throughput":
+    if args.command == "bench" and args.suite in ("throughput", "trajopt"):
         _one_device_per_core()
     from mbjax_harness.progress import progress
 

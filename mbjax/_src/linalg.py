@@ -50,3 +50,22 @@ def spd_solve(A: Array, b: Array, unroll: int = UNROLL) -> Array:
     for i in reversed(range(w)):                 # L^T x = y
         x[i] = (y[i] - sum(L[k][i][..., None] * x[k] for k in range(i + 1, w))) / L[i][i][..., None]
     return jnp.stack(x, -2)
+
+
+# the largest product (rows x inner x columns) `small_dot` writes out elementwise: beyond it the
+# broadcast intermediate stops fitting a loop compiled as one kernel (measured, 14 x 14 x 14 in,
+# 21 x 21 x 21 out; see benchmarks/README.md)
+SMALL_DOT = 14**3
+
+
+def small_dot(a: Array, b: Array) -> Array:
+    """a @ b for a matrix a (m, k) and a matrix or vector b (k, ...), as a broadcast product and
+    a sum where it is at most `SMALL_DOT` multiplications: XLA's CPU backend emits a dot of more
+    than 6 x 6 as a library call, which keeps a loop around it (the Riccati pass of
+    `mbjax.trajopt.ILQR`) from compiling as one kernel, 4-6x slower per step at 8-14 columns."""
+    columns = b.shape[1] if b.ndim == 2 else 1
+    if a.shape[0] * a.shape[1] * columns > SMALL_DOT:
+        return a @ b
+    if b.ndim == 1:
+        return (a * b).sum(-1)
+    return (a[:, :, None] * b[None]).sum(1)

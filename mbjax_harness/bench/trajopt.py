@@ -40,6 +40,7 @@ import platform
 import time
 from pathlib import Path
 
+import equinox as eqx
 import jax
 import jax.numpy as jnp
 import numpy as np
@@ -254,10 +255,21 @@ def many(n: int, repeats: int, common: dict, loop: bool = True) -> list[dict]:
                 "max_iterations": int(np.max(iterations)), "converged": int(np.sum(converged)),
                 **extra}
 
+    solver = ILQR(iterations=ITERATIONS, **CROCODDYL_SCHEDULE)
+    problems = eqx.filter_vmap(lambda o: arm.reach_problem(o, arm=model,
+                                                           integrator=SemiImplicitEuler()))(
+        jnp.asarray(offsets))
+    guesses = jnp.broadcast_to(jnp.asarray(us0), (n, *np.shape(us0)))
+    results, timing = measure(solve, problems, solver, guesses, repeats=repeats)
+    records = [summary("mbjax", f"one batched solve (a working set per device, "
+                       f"{len(jax.devices())} devices)", timing.run_s,
+                       np.asarray(results.iterations), np.asarray(results.status) == 0,
+                       compile_s=timing.compile_s, devices=len(jax.devices()))]
     batched = jax.jit(jax.vmap(one))
     results, timing = measure(batched, jnp.asarray(offsets), repeats=repeats)
-    records = [summary("mbjax", "one vmapped solve", timing.run_s, np.asarray(results.iterations),
-                       np.asarray(results.status) == 0, compile_s=timing.compile_s)]
+    records.append(summary("mbjax", "one vmapped solve", timing.run_s,
+                           np.asarray(results.iterations), np.asarray(results.status) == 0,
+                           compile_s=timing.compile_s))
     if loop:
         single_solve = jax.jit(one)
         jax.block_until_ready(single_solve(jnp.asarray(offsets[0])))
@@ -302,7 +314,7 @@ def summarize(records: list[dict], common: dict) -> dict:
               for p in PROBLEMS if (p, "crocoddyl") in singles}
     ratios = {p: r for p, r in ratios.items() if r is not None}
     out["single_ratio"] = ratios
-    out["single_met"] = min(ratios.values()) <= 2.0 if ratios else None
+    out["single_met"] = max(ratios.values()) <= 1.0 if ratios else None      # issue 42: <= 1x
     many_ = {(r["engine"], r.get("how")): r for r in records
              if r["kind"] == "many" and "skipped" not in r}
     croc = [r for (engine, _), r in many_.items() if engine == "crocoddyl"]

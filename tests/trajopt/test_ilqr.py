@@ -2,6 +2,7 @@
 box-constrained optimum against SciPy's bounded quasi-Newton, a 7-dof arm's reach (stationary
 under the single-shooting gradient), many targets in one vmapped solve, and clear errors."""
 
+import equinox as eqx
 import jax
 import jax.numpy as jnp
 import numpy as np
@@ -27,7 +28,7 @@ def _slider() -> TreeSystem:
                             axis=[[1.0, 0.0, 0.0]], gravity=(0.0, 0.0, 0.0)))
 
 
-def _slider_problem(**bounds) -> Problem:
+def _slider_problem(x0=0.0, **bounds) -> Problem:
     def running(q, v, u):
         e = jnp.concatenate([q, v]) - GOAL
         return e @ W_X @ e + W_U * u @ u
@@ -36,7 +37,7 @@ def _slider_problem(**bounds) -> Problem:
         e = jnp.concatenate([q, v]) - GOAL
         return e @ W_F @ e
 
-    return Problem(_slider(), [0.0], [0.0], dt=DT, horizon=N, running=running,
+    return Problem(_slider(), jnp.reshape(x0, (1,)), [0.0], dt=DT, horizon=N, running=running,
                    terminal=terminal, **bounds)
 
 
@@ -150,3 +151,24 @@ def test_single_shooting_reaches_the_lqr_optimum_and_adam_descends():
     assert costs[-1] < 0.05 * costs[0] and float(adam.cost) > optimum - 1e-12
     with pytest.raises(ValueError, match="method must be one of"):
         Shooting("newton")
+
+
+def test_a_batch_of_problems_through_a_working_set_equals_single_solves():
+    """Five starts, two slots: members leave as they converge and the next take their slots;
+    bounded and unbounded, every member as its own solve."""
+    starts = jnp.linspace(-1.0, 2.0, 5)
+    for bounds in ({}, {"lower": -0.4, "upper": 0.4}):
+        problems = eqx.filter_vmap(lambda x0, bounds=bounds: _slider_problem(x0, **bounds))(starts)
+        batch = solve(problems, ILQR(), width=2)
+        assert batch.us.shape == (5, N, 1) and batch.status.shape == (5,)
+        for i, x0 in enumerate(starts):
+            one = solve(_slider_problem(x0, **bounds), ILQR())
+            assert int(batch.iterations[i]) == int(one.iterations)
+            np.testing.assert_allclose(batch.us[i], one.us, rtol=1e-9, atol=1e-12)
+            assert int(batch.status[i]) == int(one.status) == 0
+
+
+def test_a_batch_needs_one_first_guess_per_member():
+    problems = eqx.filter_vmap(_slider_problem)(jnp.zeros(3))
+    with pytest.raises(ValueError, match="us0"):
+        solve(problems, ILQR(), jnp.zeros((N, 1)))

@@ -44,9 +44,9 @@ import jax.numpy as jnp
 from jax import Array
 
 from mbjax._src.system.status import Status
-from mbjax._src.linalg import spd_solve
+from mbjax._src.linalg import small_dot, spd_solve
 from mbjax._src.trajopt.problem import Problem
-from mbjax._src.trajopt.result import AbstractSolver, Result, history, no_states
+from mbjax._src.trajopt.result import AbstractIterativeSolver, Result, history
 
 MU_MIN, MU_MAX, MU_FACTOR = 1e-9, 1e10, 10.0
 CROCODDYL_SCHEDULE = {"steps": tuple(0.5**k for k in range(10)), "acceptance": 0.1,
@@ -92,10 +92,11 @@ def riccati_step(problem: Problem, stage: tuple, u: Array, Vx: Array, Vxx: Array
     of Q_uu; the box's projected Newton steps run only where that step leaves the bounds."""
     A, B, lx, lu, lxx, lux, luu = stage
     eye = jnp.eye(problem.nu, dtype=u.dtype)
-    Qx, Qu = lx + A.T @ Vx, lu + B.T @ Vx
-    VxxA = Vxx @ A
-    Qxx, Qux = lxx + A.T @ VxxA, lux + B.T @ VxxA
-    Quu = luu + B.T @ Vxx @ B
+    At, Bt = A.T, B.T
+    Qx, Qu = lx + small_dot(At, Vx), lu + small_dot(Bt, Vx)
+    VxxA, VxxB = small_dot(Vxx, A), small_dot(Vxx, B)
+    Qxx, Qux = lxx + small_dot(At, VxxA), lux + small_dot(Bt, VxxA)
+    Quu = luu + small_dot(Bt, VxxB)
     H = 0.5 * (Quu + Quu.T) + mu * eye
     kK = -spd_solve(H, jnp.concatenate([Qu[:, None], Qux], 1), UNROLL)
     lower, upper = problem.lower - u, problem.upper - u
@@ -106,14 +107,18 @@ def riccati_step(problem: Problem, stage: tuple, u: Array, Vx: Array, Vxx: Array
         K = -spd_solve(H_free, jnp.where(free[:, None], Qux, 0.0), UNROLL)
         return k, jnp.where(free[:, None], K, 0.0)
 
-    k, K = jax.lax.cond(jnp.any((kK[:, 0] < lower) | (kK[:, 0] > upper)), within_bounds,
-                        lambda: (kK[:, 0], kK[:, 1:]))
-    Vx = Qx + K.T @ Quu @ k + K.T @ Qu + Qux.T @ k
-    Vxx = Qxx + K.T @ Quu @ K + K.T @ Qux + Qux.T @ K
+    if problem.bounded:
+        k, K = jax.lax.cond(jnp.any((kK[:, 0] < lower) | (kK[:, 0] > upper)), within_bounds,
+                            lambda: (kK[:, 0], kK[:, 1:]))
+    else:
+        k, K = kK[:, 0], kK[:, 1:]
+    Kt, QuxT = K.T, Qux.T
+    Vx = Qx + small_dot(Kt, small_dot(Quu, k)) + small_dot(Kt, Qu) + small_dot(QuxT, k)
+    Vxx = Qxx + small_dot(Kt, small_dot(Quu, K)) + small_dot(Kt, Qux) + small_dot(QuxT, K)
     return k, K, Vx, 0.5 * (Vxx + Vxx.T), Qu, Quu
 
 
-class ILQR(AbstractSolver):
+class ILQR(AbstractIterativeSolver):
     """Iterative LQR (DDP with the dynamics' first derivatives) with box-constrained controls.
 
     A solver strategy for `mbjax.trajopt.solve`; the algorithm and its schedule are described
@@ -143,79 +148,69 @@ class ILQR(AbstractSolver):
     grow_below: float = 0.0
     qp_iterations: int = eqx.field(static=True, default=8)
 
-    def solve(self, problem: Problem, us: Array, states: Array | None = None) -> Result:
-        """Optimise the controls of `problem` from `us` (normally through `mbjax.trajopt.solve`).
-
-        Args:
-            problem: the trajectory-optimisation problem.
-            us: the first guess, inside the bounds, shape (horizon, nu).
-            states: must be None: iLQR starts from the rollout of us (a state trajectory as
-                first guess is `MultipleShooting`'s).
-
-        Returns:
-            The `Result`, its status NOT_CONVERGED where the iterations ran out or mu passed
-            its ceiling.
-
-        Raises:
-            ValueError: states were given.
-        """
-        no_states(states, "ILQR")
+    def init(self, problem: Problem, us: Array) -> dict:
+        """The iteration's state before the first iteration, from the first guess us: its
+        rollout and cost, mu, and room for the expansion and the costs' history."""
         xs = problem.rollout(us)
         cost = problem.cost(xs, us)
-        alphas = jnp.asarray(self.steps, cost.dtype)
         N, nx, nu = problem.horizon, problem.ndx, problem.nu
-        state = dict(xs=xs, us=us, cost=cost, mu=jnp.asarray(self.regularization, cost.dtype),
-                     iteration=jnp.array(0), done=jnp.array(False), stalled=jnp.array(False),
-                     costs=history(self.iterations + 1, cost),
-                     K=jnp.zeros((N, nu, nx), cost.dtype), stale=jnp.array(True),
-                     expansion=jax.tree.map(lambda a: jnp.zeros(a.shape, a.dtype), jax.eval_shape(
-                         lambda: self._linearize(problem, xs, us))))
+        return dict(xs=xs, us=us, cost=cost, mu=jnp.asarray(self.regularization, cost.dtype),
+                    iteration=jnp.array(0), done=jnp.array(False), stalled=jnp.array(False),
+                    costs=history(self.iterations + 1, cost),
+                    K=jnp.zeros((N, nu, nx), cost.dtype), stale=jnp.array(True),
+                    expansion=jax.tree.map(lambda a: jnp.zeros(a.shape, a.dtype), jax.eval_shape(
+                        lambda: self._linearize(problem, xs, us))))
 
-        def iterate(s):
-            # linearized at the top of an iteration, after an accepted step (and first): the
-            # expansion is traced once, inside the loop, not also before it
-            expansion = jax.lax.cond(s["stale"], lambda: self._linearize(problem, s["xs"], s["us"]),
-                                     lambda: s["expansion"])
-            k, K, decrease, ok = self._backward(problem, expansion, s["us"], s["mu"])
+    def running(self, s: dict) -> Array:
+        """Whether the iteration goes on from state s (not converged, not stalled, iterations
+        left)."""
+        return ~s["done"] & ~s["stalled"] & (s["iteration"] < self.iterations)
 
-            def acceptable(trial):
-                _, _, cost, i = trial
-                alpha = alphas[jnp.maximum(i - 1, 0)]
-                predicted = -(alpha * decrease[0] + alpha**2 * decrease[1])
-                decreased = s["cost"] - cost > self.acceptance * predicted
-                return (i > 0) & jnp.isfinite(cost) & decreased
+    def step(self, problem: Problem, s: dict) -> dict:
+        """One iteration (steps 1-4 of the module) from state s."""
+        alphas = jnp.asarray(self.steps, s["cost"].dtype)
+        # linearized at the top of an iteration, after an accepted step (and first): the
+        # expansion is traced once, inside the loop, not also before it
+        expansion = jax.lax.cond(s["stale"], lambda: self._linearize(problem, s["xs"], s["us"]),
+                                 lambda: s["expansion"])
+        k, K, decrease, ok = self._backward(problem, expansion, s["us"], s["mu"])
 
-            def next_step(trial):                          # the longest acceptable step first
-                i = trial[3]
-                return (*self._forward(problem, s["xs"], s["us"], k, K, alphas[i]), i + 1)
+        def acceptable(trial):
+            _, _, cost, i = trial
+            alpha = alphas[jnp.maximum(i - 1, 0)]
+            predicted = -(alpha * decrease[0] + alpha**2 * decrease[1])
+            decreased = s["cost"] - cost > self.acceptance * predicted
+            return (i > 0) & jnp.isfinite(cost) & decreased
 
-            first = (s["xs"], s["us"], s["cost"], jnp.array(0))
-            xs, us, cost, tried = jax.lax.while_loop(
-                lambda t: ok & ~acceptable(t) & (t[3] < len(self.steps)), next_step, first)
-            accept = ok & acceptable((xs, us, cost, tried))
-            xs, us, cost = (jnp.where(accept, new, old) for new, old in
-                            zip((xs, us, cost), (s["xs"], s["us"], s["cost"]), strict=True))
-            change = s["cost"] - cost
-            # stationary: the model, not shrunk by a raised regularization, predicts a
-            # negligible decrease, or an accepted step made one
-            converged = ((ok & (s["mu"] <= self.regularization)
-                          & (-decrease[0] <= self.tolerance * jnp.abs(s["cost"])))
-                         | (accept & (change <= self.tolerance * jnp.abs(cost))))
-            taken = alphas[jnp.maximum(tried - 1, 0)]
-            mu = jnp.where(accept & (taken > self.shrink_above),
-                           jnp.maximum(s["mu"] / MU_FACTOR, MU_MIN),
-                           jnp.where(accept & (taken > self.grow_below), s["mu"],
-                                     s["mu"] * MU_FACTOR))
-            i = s["iteration"] + 1
-            # a rejected step leaves the trajectory, and so its expansion, as they were
-            return dict(xs=xs, us=us, cost=cost, mu=mu, iteration=i, done=converged,
-                        stalled=mu > MU_MAX, costs=s["costs"].at[i].set(cost),
-                        K=jnp.where(accept, K, s["K"]), expansion=expansion, stale=accept)
+        def next_step(trial):                          # the longest acceptable step first
+            i = trial[3]
+            return (*self._forward(problem, s["xs"], s["us"], k, K, alphas[i]), i + 1)
 
-        def running(s):
-            return ~s["done"] & ~s["stalled"] & (s["iteration"] < self.iterations)
+        first = (s["xs"], s["us"], s["cost"], jnp.array(0))
+        xs, us, cost, tried = jax.lax.while_loop(
+            lambda t: ok & ~acceptable(t) & (t[3] < len(self.steps)), next_step, first)
+        accept = ok & acceptable((xs, us, cost, tried))
+        xs, us, cost = (jnp.where(accept, new, old) for new, old in
+                        zip((xs, us, cost), (s["xs"], s["us"], s["cost"]), strict=True))
+        change = s["cost"] - cost
+        # stationary: the model, not shrunk by a raised regularization, predicts a
+        # negligible decrease, or an accepted step made one
+        converged = ((ok & (s["mu"] <= self.regularization)
+                      & (-decrease[0] <= self.tolerance * jnp.abs(s["cost"])))
+                     | (accept & (change <= self.tolerance * jnp.abs(cost))))
+        taken = alphas[jnp.maximum(tried - 1, 0)]
+        mu = jnp.where(accept & (taken > self.shrink_above),
+                       jnp.maximum(s["mu"] / MU_FACTOR, MU_MIN),
+                       jnp.where(accept & (taken > self.grow_below), s["mu"],
+                                 s["mu"] * MU_FACTOR))
+        i = s["iteration"] + 1
+        # a rejected step leaves the trajectory, and so its expansion, as they were
+        return dict(xs=xs, us=us, cost=cost, mu=mu, iteration=i, done=converged,
+                    stalled=mu > MU_MAX, costs=s["costs"].at[i].set(cost),
+                    K=jnp.where(accept, K, s["K"]), expansion=expansion, stale=accept)
 
-        s = jax.lax.while_loop(running, iterate, state)
+    def result(self, problem: Problem, s: dict) -> Result:
+        """The `Result` of the iteration's state s."""
         finite = jnp.isfinite(s["cost"]) & jnp.all(jnp.isfinite(s["xs"]))
         status = (jnp.where(s["done"], 0, int(Status.NOT_CONVERGED))
                   | jnp.where(finite, 0, int(Status.NONFINITE)))

@@ -79,6 +79,7 @@ class Problem(eqx.Module):
     dt: float = eqx.field(static=True)
     horizon: int = eqx.field(static=True)
     ndq: int = eqx.field(static=True)   # a configuration deviation's length (nv for a tree)
+    bounded: bool = eqx.field(static=True)   # whether lower or upper was given
 
     def __init__(self, system: AbstractSystem, q0, v0, *, dt: float, horizon: int,
                  running: Callable, terminal: Callable, lower=None, upper=None,
@@ -111,6 +112,7 @@ class Problem(eqx.Module):
         self.dt, self.horizon = float(dt), int(horizon)
         self.ndq = jax.eval_shape(system.difference, self.q0, self.q0).shape[0]
         nu = self.nu
+        self.bounded = lower is not None or upper is not None
         bounds = []
         for name, value, default in (("lower", lower, -jnp.inf), ("upper", upper, jnp.inf)):
             value = jnp.full(nu, default) if value is None else jnp.asarray(value, dtype=float)

@@ -1,8 +1,10 @@
 """What every trajectory-optimisation solver returns, and the interface solvers implement."""
 
 import abc
+from functools import partial
 
 import equinox as eqx
+import jax
 import jax.numpy as jnp
 from jax import Array
 
@@ -60,6 +62,35 @@ class AbstractSolver(eqx.Module):
         Returns:
             The `Result`.
         """
+
+
+class AbstractIterativeSolver(AbstractSolver):
+    """A solver written as an iteration: `init` a state from the first guess, `step` it while
+    `running`, read the `result`. Its `solve` is that loop; a batch of problems runs the same
+    steps through a working set (`mbjax._src.trajopt.batch`), so converged members leave."""
+
+    @abc.abstractmethod
+    def init(self, problem: Problem, us: Array):
+        """The iteration's state (a pytree of arrays) before the first iteration."""
+
+    @abc.abstractmethod
+    def running(self, state) -> Array:
+        """Whether the iteration goes on from `state`."""
+
+    @abc.abstractmethod
+    def step(self, problem: Problem, state):
+        """One iteration from `state`."""
+
+    @abc.abstractmethod
+    def result(self, problem: Problem, state) -> Result:
+        """The `Result` of `state`."""
+
+    def solve(self, problem: Problem, us: Array, states: Array | None = None) -> Result:
+        """Optimise the controls of `problem` from `us` (see `AbstractSolver.solve`)."""
+        no_states(states, type(self).__name__)
+        state = jax.lax.while_loop(self.running, partial(self.step, problem),
+                                   self.init(problem, us))
+        return self.result(problem, state)
 
 
 def history(length: int, first: Array) -> Array:

@@ -1,25 +1,37 @@
 """The one entry point of trajectory optimisation: `solve(problem, solver, us0)`."""
 
 import equinox as eqx
+import jax
 import jax.numpy as jnp
+import numpy as np
 from jax import Array
+from jax.sharding import Mesh, PartitionSpec
 
 from mbjax._src.system.status import raise_on_failure
 
 from mbjax._src.trajopt.ilqr import ILQR
 from mbjax._src.trajopt.problem import Problem
-from mbjax._src.trajopt.result import AbstractSolver, Result
+from mbjax._src.trajopt.batch import working_set
+from mbjax._src.trajopt.result import AbstractIterativeSolver, AbstractSolver, Result
 
 
 def solve(problem: Problem, solver: AbstractSolver = ILQR(), us0: Array | None = None,
-          states0: Array | None = None, throw: bool = False) -> Result:
-    """Optimise a problem's controls with a solver strategy.
+          states0: Array | None = None, throw: bool = False, width: int | None = None) -> Result:
+    """Optimise a problem's controls with a solver strategy, or a batch of problems.
 
-    One compiled program: the solver's iterations run inside it, and `jax.vmap` solves many
-    problems at once. A second problem of the same shapes (another target, another model
-    parameter) reuses the program where its costs hold their data as leaves (equinox modules,
-    or `eqx.Partial` of module-level functions, as `mbjax.scenes.arm.reach_problem` builds
-    them); a fresh closure is a new function, and compiles anew.
+    One compiled program: the solver's iterations run inside it. A second problem of the same
+    shapes (another target, another model parameter) reuses the program where its costs hold
+    their data as leaves (equinox modules, or `eqx.Partial` of module-level functions, as
+    `mbjax.scenes.arm.reach_problem` builds them); a fresh closure is a new function, and
+    compiles anew.
+
+    A batch of problems (every array leaf with a leading axis, as `equinox.filter_vmap` of a problem's
+    builder returns it) is solved in one program too. An iterative solver (`ILQR`) runs it
+    through a working set of `width` problems: a member that stops leaves, and the next problem
+    takes its slot, so the batch costs about its members' total iterations, not its slowest
+    member's for everyone (`mbjax._src.trajopt.batch`), and with several devices (the CPU's
+    cores made devices, GPUs) the batch is split over them, a working set on each. Other
+    solvers are `jax.vmap`ped. `jax.vmap(solve)` stays the plain map.
 
     Args:
         problem: the trajectory-optimisation problem.
@@ -31,9 +43,12 @@ def solve(problem: Problem, solver: AbstractSolver = ILQR(), us0: Array | None =
             None for the rollout of us0.
         throw: raise an error naming the failure (not converged, non-finite) instead of
             returning the result with its status.
+        width: a batch's working set per device (static); None for 1 on a CPU, where a
+            vmapped iteration costs more than its members one by one, and 64 on an
+            accelerator (benchmarks/README.md).
 
     Returns:
-        The `Result`.
+        The `Result`, with a leading batch axis on every field for a batch.
 
     Raises:
         TypeError: problem is not a `Problem` or solver not a solver instance.
@@ -47,6 +62,10 @@ def solve(problem: Problem, solver: AbstractSolver = ILQR(), us0: Array | None =
         raise TypeError(f"solver must be a solver instance such as ILQR(), got {solver!r}")
     # strongly typed float arrays: a weakly typed guess (jnp.full(shape, 1.0)) would compile anew
     us0, states0 = (None if x is None else jnp.asarray(x, dtype=float) for x in (us0, states0))
+    if problem.q0.ndim == 2:
+        if width is None:
+            width = 1 if jax.default_backend() == "cpu" else 64
+        return _solve_batch(problem, solver, us0, states0, throw, width)
     return _solve(problem, solver, us0, states0, throw)
 
 
@@ -55,3 +74,37 @@ def _solve(problem: Problem, solver: AbstractSolver, us0: Array | None, states0:
            throw: bool) -> Result:
     return raise_on_failure(solver.solve(problem, problem.initial_controls(us0), states0), throw,
                             "mbjax._src.trajopt.solve")
+
+
+@eqx.filter_jit
+def _solve_batch(problems: Problem, solver: AbstractSolver, us0: Array | None,
+                 states0: Array | None, throw: bool, width: int) -> Result:
+    params, static = eqx.partition(problems, eqx.is_array)
+    size = problems.q0.shape[0]
+    if us0 is not None and us0.shape[:1] != (size,):
+        raise ValueError(f"us0 must be (batch, horizon, nu) for a batch of {size} problems, got "
+                         f"shape {us0.shape}")
+    us = jax.vmap(lambda p, u: eqx.combine(p, static).initial_controls(u),
+                  in_axes=(0, None if us0 is None else 0))(params, us0)
+    if isinstance(solver, AbstractIterativeSolver) and states0 is None:
+        result = _split(lambda p, u: working_set(solver, eqx.combine(p, static), u, width),
+                        params, us)
+    else:
+        result = jax.vmap(lambda p, u, x: solver.solve(eqx.combine(p, static), u, x),
+                          in_axes=(0, 0, None if states0 is None else 0))(params, us, states0)
+    return raise_on_failure(result, throw, "mbjax._src.trajopt.solve")
+
+
+def _split(fn, params, us: Array):
+    """fn(params, us) of a batch, the batch split over `jax.devices()` (padded with copies of
+    its last member to a multiple of their number) where there are several."""
+    devices = jax.devices()
+    if len(devices) == 1:
+        return fn(params, us)
+    size, pad = us.shape[0], -us.shape[0] % len(devices)
+    params, us = jax.tree.map(lambda x: jnp.concatenate([x, jnp.repeat(x[-1:], pad, axis=0)]),
+                              (params, us))
+    mesh = Mesh(np.asarray(devices), ("batch",))
+    out = jax.shard_map(fn, mesh=mesh, in_specs=PartitionSpec("batch"),
+                        out_specs=PartitionSpec("batch"), check_vma=False)(params, us)
+    return jax.tree.map(lambda x: x[:size], out)
