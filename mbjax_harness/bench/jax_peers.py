@@ -295,3 +295,20 @@ def check_against_pinocchio(urdf_path: str, floating: bool = False, n_states: in
                   / max(np.max(np.abs(ref)), 1.0))
             for args, ref in states)
     return errors
+
+
+def frax_forward_dynamics(urdf_path: str, floating: bool):
+    """frax's forward dynamics (`frax.Robot.forward_dynamics`: a dense CRBA, an RNEA and a
+    Cholesky solve) on the URDF, fixed base: `fd(q, v, tau) -> qdd` (nv,) in Pinocchio's joint
+    order (frax's gravity is 9.81 m/s^2 too)."""
+    import warnings
+    if floating:
+        raise NotImplementedError("the frax adapter here is fixed-base")
+    with warnings.catch_warnings():          # frax's advice on XLA flags, printed at import
+        warnings.simplefilter("ignore")
+        frax = _require("frax", "frax")
+        robot = frax.Robot(str(urdf_path), joint_ordering=joint_names(urdf_path))
+
+    def fd(q, v, tau):
+        return robot.forward_dynamics(q, v, tau, None)
+    return fd

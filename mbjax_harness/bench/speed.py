@@ -1,6 +1,6 @@
 """`mbjax bench speed`: the cost users feel (one call, one trajectory, its gradient, a vmapped
-batch, compile time) on chains and real robots, mbjax against Pinocchio, jaxsim and adam in one
-run.
+batch, the dynamics' derivatives, compile time) on chains and real robots, mbjax against
+Pinocchio, jaxsim, adam and frax in one run.
 
 Robots: the regular 7- and 30-link chains (`mbjax.model.chain`, written with `to_urdf`), and from
 example-robot-data the Panda arm (7 dof, fixed base) and the Unitree G1 humanoid (floating base,
@@ -19,6 +19,11 @@ mbjax and Pinocchio only). Every library reads the same URDF; float64, CPU. Per 
   the temporary memory XLA allocates for it (grad_temp_bytes: what the reverse pass keeps); for
   the 7-link chain also that memory through `simulate`, plain and checkpointed, against the
   horizon (`grad_memory`);
+- derivatives: `jax.jit(jax.jacfwd)` of the accelerations in (q, v, tau), q in its tangent space
+  (q (+) e, e = 0), one call from Python (jac_s) and per state vmapped over JAC_BATCH states
+  (jac_vmap_s, a horizon's knots as a trajectory optimizer linearizes them); Pinocchio:
+  `computeABADerivatives`, the C++ time per call (jac_s, a loop minus an empty loop) and from
+  Python (jac_python_s);
 - compile: lowering and compiling the rollout.
 
 Pinocchio: `aba` per call (the C++ estimate: Python loop time minus an empty loop's) and
@@ -51,8 +56,10 @@ STEPS, QUICK_STEPS = 1000, 100
 BATCH, QUICK_BATCH = 4096, 256
 MEMORY_STEPS = (256, 1024, 4096)            # horizons of `grad_memory` (powers of 2: sqrt exact)
 DT = 1e-3
+JAC_BATCH = 64                  # states of the vmapped derivatives (a horizon's knots)
 # targets
 TARGET_EVAL_RATIO, TARGET_CALL_S, TARGET_GRAD_RATIO = 2.0, 10e-6, 3.0
+TARGET_JAC_RATIO = 2.0          # issue 42: derivatives at Pinocchio's cost
 # instructions that launch no kernel of their own
 _FREE = {"parameter", "get-tuple-element", "tuple", "constant", "bitcast"}
 
@@ -115,10 +122,22 @@ def _rollout(fd, steps: int, retract=None):
 
 def _measure_jax(fd, q, v, tau, Q, V, TAU, steps: int, repeats: int, budget: float,
                  retract=None) -> dict:
-    """call, eval, vmap, grad and compile of one JAX library's fd(q, v, tau)."""
+    """call, eval, vmap, grad, the derivatives and compile of one JAX library's fd(q, v, tau)."""
     record = {}
     _, t = timed(jax.jit(fd), q, v, tau, repeats=repeats * 20, budget_s=budget)
     record["call_s"] = t.run_s
+    # d(v_dot)/d(q, v, tau) by jax.jacfwd, q moving in its tangent space (retract)
+    retract = retract or (lambda q, dq: q + dq)
+
+    def jacobians(q, v, tau):       # one (nv, 3 nv) array: a tuple of three outputs costs a
+        # jitted call about 25 us more per output on this CPU (benchmarks/README.md)
+        return jnp.concatenate(jax.jacfwd(lambda e, v, tau: fd(retract(q, e), v, tau),
+                                          argnums=(0, 1, 2))(jnp.zeros_like(v), v, tau), 1)
+    _, t = timed(jax.jit(jacobians), q, v, tau, repeats=repeats * 20, budget_s=budget)
+    record["jac_s"] = t.run_s
+    _, t = timed(jax.jit(jax.vmap(jacobians)), Q[:JAC_BATCH], V[:JAC_BATCH], TAU[:JAC_BATCH],
+                 repeats=repeats, budget_s=budget)
+    record["jac_vmap_s"] = t.run_s / JAC_BATCH
     batch = jax.jit(jax.vmap(fd))
     acc, t = timed(batch, Q, V, TAU, repeats=repeats, budget_s=budget)
     record["vmap_s"] = t.run_s / len(Q)
@@ -171,18 +190,27 @@ def _pinocchio(urdf: str, floating: bool, Q, V, TAU, repeats: int, budget: float
         record["acc"] = loop["acc"][:8]
         parallel = pinocchio_parallel(urdf, Q, V, TAU, repeats=repeats, budget_s=budget)
         record["vmap_s"] = parallel["per_state_s"]
+        model = pin.buildModelFromXML(urdf)
+        data = model.createData()
+        qs, vs, taus = Q[:64], V[:64], TAU[:64]
     else:                         # random configurations on the free joint's manifold
         model = pin.buildModelFromXML(urdf, pin.JointModelFreeFlyer())
         data = model.createData()
         qs = [pin.randomConfiguration(model, -np.ones(model.nq), np.ones(model.nq))
               for _ in range(64)]
         vs = np.random.default_rng(0).standard_normal((64, model.nv))
+        taus = np.zeros_like(vs)
 
-        def loop(fn):
-            return [fn(model, data, q, v, 0 * v) for q, v in zip(qs, vs, strict=True)]
+    def loop(fn):
+        return [fn(model, data, q, v, tau) for q, v, tau in zip(qs, vs, taus, strict=True)]
+    _, t0 = timed(partial(loop, lambda *a: None), repeats=repeats, budget_s=budget)
+    if floating:
         _, t = timed(partial(loop, pin.aba), repeats=repeats, budget_s=budget)
-        _, t0 = timed(partial(loop, lambda *a: None), repeats=repeats, budget_s=budget)
         record["call_s"] = (t.run_s - t0.run_s) / len(qs)
+    # computeABADerivatives: d(v_dot)/d(q, v, tau) in the tangent space, the C++ time
+    _, t = timed(partial(loop, pin.computeABADerivatives), repeats=repeats, budget_s=budget)
+    record["jac_s"] = (t.run_s - t0.run_s) / len(qs)
+    record["jac_python_s"] = t.run_s / len(qs)
     return record
 
 
@@ -194,7 +222,8 @@ def _peer(name: str, urdf: str):
     path = Path(tempfile.mkdtemp()) / "robot.urdf"
     path.write_text(urdf)
     build = {"jaxsim": jax_peers.jaxsim_forward_dynamics,
-             "adam": jax_peers.adam_forward_dynamics}[name]
+             "adam": jax_peers.adam_forward_dynamics,
+             "frax": jax_peers.frax_forward_dynamics}[name]
     try:
         return build(str(path), floating=False), None
     except Exception as error:    # a missing peer, or one that cannot read this URDF
@@ -242,7 +271,7 @@ def run(out: Path, quick: bool = False) -> list[dict]:
         records.append({**base, "library": "mbjax", **mb})
 
         if not floating:
-            for peer in ("jaxsim", "adam"):
+            for peer in ("jaxsim", "adam", "frax"):
                 fd, why = _peer(peer, urdf)
                 if fd is None:
                     records.append({**base, "library": peer, "skipped": why[:300]})
@@ -293,10 +322,15 @@ def summarize(records: list[dict], common: dict) -> dict:
                        mb["grad_memory"]["checkpoint"]["slope"], 0.6)
             if pin and "vmap_s" in pin:
                 target("chain7: vmap per state / abaInParallel", mb["vmap_s"] / pin["vmap_s"], 1.0)
-        for peer in ("jaxsim", "adam"):
+        if mb and pin and "jac_s" in pin:
+            target(f"{robot}: jax.jacfwd(forward_dynamics) call / computeABADerivatives",
+                   mb["jac_s"] / pin["jac_s"], TARGET_JAC_RATIO)
+            target(f"{robot}: jacfwd per state, vmapped / computeABADerivatives",
+                   mb["jac_vmap_s"] / pin["jac_s"], TARGET_JAC_RATIO)
+        for peer in ("jaxsim", "adam", "frax"):
             other = rows.get((robot, peer))
             if mb and other:
-                for key in ("call_s", "eval_s", "vmap_s", "compile_s"):
+                for key in ("call_s", "eval_s", "vmap_s", "compile_s", "jac_s"):
                     target(f"{robot}: mbjax {key[:-2]} / {peer}", mb[key] / other[key], 1.0)
                 target(f"{robot}: mbjax grad ratio / {peer}'s", mb["grad_ratio"]
                        / other["grad_ratio"], 1.0)
@@ -335,8 +369,9 @@ def plot(records: list[dict], path: Path) -> None:
 def report(records: list[dict]) -> str:
     """The measurements and the targets as Markdown tables."""
     lines = ["| robot | nv | library | call [us] | eval in a rollout [us] | vmap per state [us] "
+             "| derivatives: call [us] | derivatives: vmapped per state [us] "
              "| grad / rollout | grad memory [MB] | compile [s] | agrees with mbjax |",
-             "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |"]
+             "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |"]
     for r in records[:-1]:
         if "skipped" in r:
             continue
@@ -344,7 +379,8 @@ def report(records: list[dict]) -> str:
         def cell(key, scale, digits, r=r):
             return f"{r[key] * scale:.{digits}f}" if key in r else ""
         cells = [r["robot"], str(r["nv"]), r["library"], cell("call_s", 1e6, 2),
-                 cell("eval_s", 1e6, 2), cell("vmap_s", 1e6, 2), cell("grad_ratio", 1, 2),
+                 cell("eval_s", 1e6, 2), cell("vmap_s", 1e6, 2), cell("jac_s", 1e6, 1),
+                 cell("jac_vmap_s", 1e6, 1), cell("grad_ratio", 1, 2),
                  cell("grad_temp_bytes", 1e-6, 1), cell("compile_s", 1, 2),
                  f"{r['rel_diff_mbjax']:.1e}" if "rel_diff_mbjax" in r else ""]
         lines.append("| " + " | ".join(cells) + " |")

@@ -46,6 +46,7 @@ from jax import Array
 
 from mbjax._src.model import Model
 from mbjax._src.rigid import rnea_derivatives
+from mbjax._src.linalg import spd_solve
 from mbjax._src.linear_map import linear_map
 from mbjax._src.rigid.aba import aba_factored, mass_solve, solve
 from mbjax._src.rigid.kinematics import increments_matrix
@@ -106,8 +107,8 @@ def _tangent(fixed: tuple, x: Array) -> Array:
 
 def _tangents(fixed: tuple, xs: Array) -> Array:
     """`_tangent` for a batch xs (B, nq + 2 nv) at one state (`jax.jacfwd`): from a few
-    directions on, the RNEA's partial derivatives and M once (`rnea_partials`), a Cholesky
-    factorization and a product, as Pinocchio's `computeABADerivatives` forms them; the passes
+    directions on, the RNEA's partial derivatives and M once (`rnea_partials`), one Cholesky
+    factorization of M and a solve, as Pinocchio's `computeABADerivatives` forms them; the passes
     per direction below."""
     model, q, v, u_dot, _ = fixed
     if xs.shape[0] < DENSE_FROM:
@@ -116,8 +117,11 @@ def _tangents(fixed: tuple, xs: Array) -> Array:
     D_q = D_e @ increments_matrix(model, q, v)                         # per coordinate of q
     dq, dv, dtau = jnp.split(xs, [model.nq, model.nq + model.nv], axis=1)
     rhs = dtau - dq @ D_q.T - dv @ D_v.T
-    return jax.scipy.linalg.cho_solve(jax.scipy.linalg.cho_factor(M), rhs.T).T
+    return spd_solve(M, rhs.T, unroll=WRITTEN_OUT).T
 
 
 DENSE_FROM = 4           # directions from which the matrices beat the passes (benchmarks/README.md)
+# M's Cholesky written out up to this size (`linalg.spd_solve`): a LAPACK call costs tens of us
+# from Python, more than the whole factorization of a small M
+WRITTEN_OUT = 16
 _fd_tangent = linear_map("forward_dynamics_tangent", _tangent, _tangents)
