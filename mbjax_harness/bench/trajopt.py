@@ -56,6 +56,7 @@ NAME = "trajopt"
 TOLERANCE = 1e-6
 ITERATIONS = 200
 N_TARGETS, QUICK_TARGETS = 64, 8
+N_VARIANTS = 256               # the acrobot sweep (issue 42: batches that pay)
 CONE = np.radians(30.0)
 
 
@@ -297,6 +298,61 @@ def many(n: int, repeats: int, common: dict, loop: bool = True) -> list[dict]:
     return records
 
 
+def sweep_acrobot(n: int, common: dict) -> list[dict]:
+    """The acrobot's swing-up for n variants, both links' masses scaled by factors in
+    [0.8, 1.2]: mbjax's batched solve (a working set per device), a loop of one jitted solve,
+    Crocoddyl's FDDP in a loop (its problems built beforehand, not timed)."""
+    from mbjax._src.model.urdf import to_urdf
+    from mbjax._src.scenes import acrobot
+
+    base = acrobot.model()
+    scales = np.linspace(0.8, 1.2, n)
+    solver = ILQR(iterations=ITERATIONS, **CROCODDYL_SCHEDULE)
+
+    def variant(scale):
+        model = eqx.tree_at(lambda m: m.mass, base, base.mass * scale)
+        return acrobot.swingup_problem(model, integrator=SemiImplicitEuler())
+
+    def summary(engine, how, seconds, iterations, converged, **extra):
+        return {**common, "kind": "sweep", "problem": "acrobot-swingup", "engine": engine,
+                "how": how, "variants": n, "seconds": seconds,
+                "mean_iterations": float(np.mean(iterations)),
+                "max_iterations": int(np.max(iterations)), "converged": int(np.sum(converged)),
+                **extra}
+
+    problems = eqx.filter_vmap(variant)(jnp.asarray(scales))
+    horizon = problems.horizon
+    guesses = jnp.zeros((n, horizon, 1))
+    results, timing = measure(solve, problems, solver, guesses, repeats=1)
+    records = [summary("mbjax", f"one batched solve ({len(jax.devices())} devices)",
+                       timing.run_s, np.asarray(results.iterations),
+                       np.asarray(results.status) == 0, compile_s=timing.compile_s)]
+    one = jax.jit(lambda scale: solve(variant(scale), solver, jnp.zeros((horizon, 1))))
+    jax.block_until_ready(one(jnp.asarray(scales[0])))
+    start = time.perf_counter()
+    looped = [jax.block_until_ready(one(jnp.asarray(c))) for c in scales]
+    records.append(summary("mbjax", "a loop of jitted solves", time.perf_counter() - start,
+                           [int(r.iterations) for r in looped],
+                           [int(r.status) == 0 for r in looped]))
+    why = peers.crocoddyl_working()
+    if why is not None:
+        return records + [{**common, "kind": "sweep", "problem": "acrobot-swingup",
+                           "engine": "crocoddyl", "skipped": why}]
+    goal = jnp.array([0.0, 0.0, 2 * acrobot.LENGTH])
+    built = []
+    for scale in scales:
+        model = eqx.tree_at(lambda m: m.mass, base, base.mass * scale)
+        problem = variant(scale)
+        built.append(CrocoddylSolver(peers.crocoddyl_swingup(
+            to_urdf(model), problem.q0, goal, acrobot.LENGTH, problem.dt, horizon),
+            np.zeros((horizon, 1))))
+    start = time.perf_counter()
+    converged = [croc.solve(ITERATIONS) for croc in built]
+    records.append(summary("crocoddyl", "a Python loop", time.perf_counter() - start,
+                           [croc.solver.iter for croc in built], converged))
+    return records
+
+
 def summarize(records: list[dict], common: dict) -> dict:
     """The targets, met or missed, from the records."""
     out = {**common, "kind": "summary"}
@@ -324,6 +380,14 @@ def summarize(records: list[dict], common: dict) -> dict:
         out["many_met"] = out["many_ratio"] < 1.0
     else:
         out["many_ratio"] = out["many_met"] = None
+    sweeps = {(r["engine"], r.get("how")): r for r in records
+              if r["kind"] == "sweep" and "skipped" not in r}
+    croc = [r for (engine, _), r in sweeps.items() if engine == "crocoddyl"]
+    batch = [r for (engine, how), r in sweeps.items() if engine == "mbjax" and "batched" in how]
+    loop_ = [r for (engine, how), r in sweeps.items() if engine == "mbjax" and "loop" in how]
+    out["sweep_ratio"] = batch[0]["seconds"] / croc[0]["seconds"] if croc and batch else None
+    out["sweep_batch_over_loop"] = (batch[0]["seconds"] / loop_[0]["seconds"]
+                                    if batch and loop_ else None)
     return out
 
 
@@ -358,6 +422,7 @@ def run(out: Path, quick: bool = False) -> list[dict]:
     for name in PROBLEMS:
         records += single(name, repeats, common)
     records += many(QUICK_TARGETS if quick else N_TARGETS, 1, common)
+    records += sweep_acrobot(QUICK_TARGETS if quick else N_VARIANTS, common)
     records.append(summarize(records, common))
 
     out.mkdir(parents=True, exist_ok=True)
@@ -367,14 +432,19 @@ def run(out: Path, quick: bool = False) -> list[dict]:
     for r in records:
         if "skipped" in r:
             print(f"{r['kind']:6s} {r['problem']:18s} {r['engine']:9s} skipped: {r['skipped']}")
+        elif r["kind"] == "sweep":
+            print(f"sweep  {r['variants']} acrobots {r['engine']:9s} {r['how']:24s} "
+                  f"{r['seconds']:7.2f} s, iterations mean {r['mean_iterations']:.0f} max "
+                  f"{r['max_iterations']}, converged {r['converged']}/{r['variants']}")
         elif r["kind"] == "many":
             print(f"many   {r['targets']} targets {r['engine']:9s} {r['how']:24s} "
                   f"{r['seconds']:7.2f} s, iterations mean {r['mean_iterations']:.0f} max "
                   f"{r['max_iterations']}, converged {r['converged']}/{r['targets']}")
         elif r["kind"] == "summary":
-            print(f"targets: one problem within 2x Crocoddyl: {r['single_met']} "
+            print(f"targets: every problem within 1x Crocoddyl: {r['single_met']} "
                   f"({r['single_ratio']}); many targets ahead: {r['many_met']} "
-                  f"(ratio {r['many_ratio']})")
+                  f"(ratio {r['many_ratio']}); acrobot sweep batched / Crocoddyl "
+                  f"{r['sweep_ratio']}, / mbjax loop {r['sweep_batch_over_loop']}")
     print(table(records))
     print(f"wrote {out / (NAME + '.jsonl')} and {out / (NAME + '.png')}")
     return records

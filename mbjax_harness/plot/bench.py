@@ -277,14 +277,14 @@ def throughput_figure(records: list[dict]) -> Figure:
 
 def trajopt_bench_figure(records: list[dict]) -> Figure:
     """`mbjax bench trajopt`: per problem, each engine's cost above the better optimum against
-    the iteration's share of its solve time; then the many-targets times."""
+    the iteration's share of its solve time; then the many-targets and the sweep's times."""
     singles = [r for r in records if r["kind"] == "single" and "skipped" not in r]
     problems = list(dict.fromkeys(r["problem"] for r in singles))
-    ncols = min(len(problems) + 1, 4)
-    nrows = -(-(len(problems) + 1) // ncols)
+    ncols = min(len(problems) + 2, 4)
+    nrows = -(-(len(problems) + 2) // ncols)
     fig = Figure(figsize=(5.2 * ncols, 4.2 * nrows), layout="constrained")
     axes = fig.subplots(nrows, ncols, squeeze=False).ravel()
-    for ax in axes[len(problems) + 1:]:
+    for ax in axes[len(problems) + 2:]:
         ax.set_axis_off()
     style = {"mbjax": ("#1f77b4", "o"), "crocoddyl": ("#d62728", "s")}
     for ax, problem in zip(axes, problems, strict=False):
@@ -316,4 +316,16 @@ def trajopt_bench_figure(records: list[dict]) -> Figure:
     if many:
         ax.set_ylim(0, 1.2 * max(r["seconds"] for r in many))
     ax.set(ylabel="wall time [s]", title=f"arm-reach, {many[0]['targets'] if many else 0} targets")
+    ax = axes[len(problems) + 1]
+    sweep = [r for r in records if r["kind"] == "sweep" and "skipped" not in r]
+    ax.bar(range(len(sweep)), [r["seconds"] for r in sweep],
+           color=[style.get(r["engine"], ("k", "x"))[0] for r in sweep])
+    ax.set_xticks(range(len(sweep)), [f"{r['engine']}\n{r['how']}" for r in sweep], fontsize=7)
+    for i, r in enumerate(sweep):
+        ax.annotate(f"{r['seconds']:.2f} s\n{r['converged']}/{r['variants']} converged",
+                    (i, r["seconds"]), ha="center", va="bottom", fontsize=7)
+    if sweep:
+        ax.set_ylim(0, 1.2 * max(r["seconds"] for r in sweep))
+    ax.set(ylabel="wall time [s]",
+           title=f"acrobot swing-up, {sweep[0]['variants'] if sweep else 0} mass variants")
     return fig

@@ -626,9 +626,12 @@ def test_bench_speed_quick(tmp_path):
     assert "mbjax" in rows and rows["mbjax"]["grad_finite"]
     kernels = rows["mbjax"]["kernels"]
     assert kernels["entry"] and (kernels["per_step"] or kernels["one_kernel_loops"])
-    for peer in ("pinocchio", "jaxsim", "adam"):
+    for peer in ("pinocchio", "jaxsim", "adam", "frax"):
         if peer in rows:
             assert rows[peer]["rel_diff_mbjax"] < 1e-12
+    assert rows["mbjax"]["jac_s"] > 0 and rows["mbjax"]["jac_vmap_s"] > 0
+    if "pinocchio" in rows:
+        assert rows["pinocchio"]["jac_s"] > 0
     memory = rows["mbjax"]["grad_memory"]          # XLA's compiled sizes, not timings
     assert memory["plain"]["slope"] > 0.9 and memory["checkpoint"]["slope"] < 0.6
     targets = records[-1]["targets"]
