@@ -49,8 +49,8 @@ def _jacobians(model, q, v, tau):
 
 @pytest.mark.filterwarnings("ignore::mbjax.model.ModelWarning")
 def test_rnea_partials_equal_the_rneas_derivative():
-    """Every column of the composite-body matrices against `jax.jacfwd` through the RNEA itself:
-    a chain, an arm, a floating quadruped."""
+    """Every column of the composite-body matrices against `jax.jacfwd` through the RNEA itself,
+    and their mass matrix against the operator form's: a chain, an arm, a floating quadruped."""
     models = [chain(7)] + [mbjax.load_urdf(p, floating_base="solo" in str(p))
                            for p in _corpus(("panda/panda", "solo/solo12"))]
     for model in models:
@@ -62,6 +62,8 @@ def test_rnea_partials_equal_the_rneas_derivative():
             scale = max(np.abs(J_e).max(), np.abs(J_v).max())
             assert np.abs(D_e - J_e).max() < 1e-12 * scale
             assert np.abs(D_v - J_v).max() < 1e-12 * scale
+            mass = mbjax.mass_matrix(model, q)                     # Jerkovsky's operator form
+            assert np.abs(M - mass).max() < 1e-12 * np.abs(mass).max()
 
 
 def _against_pinocchio(path, pin, floating: bool, seed: int) -> float | None:

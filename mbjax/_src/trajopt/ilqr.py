@@ -16,7 +16,9 @@ Tassa, Mansard and Todorov 2014):
    the control step k_k minimizes the quadratic model 1/2 d^T Q_uu d + Q_u^T d within the bounds
    (a projected Newton method on the box, a fixed number of iterations), and the feedback
    K_k = -Q_uu_ff^-1 Q_ux on the controls it leaves free (zero rows on the clamped ones); the
-   value function is carried back through the closed loop;
+   value function is carried back through the closed loop. The stage's small products are
+   written out (`linalg.small_dot`) and Q_uu's Cholesky too, so the scan compiles as one
+   kernel (the arm's pass 1.1 -> 0.25 ms, benchmarks/README.md);
 3. a forward pass u = clip(u_k + alpha k_k + K_k difference(x_k, x)), the step length alpha backtracking
    through `steps` until the cost decrease is at least a fraction of the model's prediction;
 4. mu, the regularization of Q_uu, shrinks tenfold after an accepted step longer than
