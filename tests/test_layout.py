@@ -18,7 +18,7 @@ HARNESS = ROOT / "mbjax_harness"
 # mbjax/_src's packages and modules, lowest first: each may import its own layer and those below
 # (and `mbjax.data`, the model files shipped with the package)
 LAYERS = (
-    {"runtime", "linalg", "cache"},
+    {"runtime", "linalg", "linear_map", "cache"},
     {"lie", "spatial", "tree"},
     {"model"},                        # with the closures' data types
     {"control"},
