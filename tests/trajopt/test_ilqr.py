@@ -172,3 +172,40 @@ def test_a_batch_needs_one_first_guess_per_member():
     problems = eqx.filter_vmap(_slider_problem)(jnp.zeros(3))
     with pytest.raises(ValueError, match="us0"):
         solve(problems, ILQR(), jnp.zeros((N, 1)))
+
+
+_TWO_DEVICES = """
+import json, sys
+import equinox as eqx, jax, jax.numpy as jnp
+sys.path.insert(0, sys.argv[1])
+jax.config.update("jax_enable_x64", True)
+from tests.trajopt.test_ilqr import _slider_problem
+from mbjax.trajopt import ILQR, solve
+starts = jnp.linspace(-1.0, 2.0, 5)
+batch = solve(eqx.filter_vmap(_slider_problem)(starts), ILQR())
+ones = [solve(_slider_problem(x0), ILQR()) for x0 in starts]
+print(json.dumps({"devices": len(jax.devices()),
+                  "us": float(max(jnp.abs(batch.us[i] - one.us).max() for i, one in enumerate(ones))),
+                  "iterations": [int(batch.iterations[i]) - int(one.iterations)
+                                 for i, one in enumerate(ones)]}))
+"""
+
+
+def test_a_batch_split_over_two_devices_equals_single_solves():
+    """Five problems over two CPU devices (padded to six, a working set on each), in a fresh
+    process that has them."""
+    import json
+    import os
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    root = Path(__file__).parents[2]
+    env = {**os.environ, "XLA_FLAGS": os.environ.get("XLA_FLAGS", "")
+           + " --xla_force_host_platform_device_count=2"}
+    out = subprocess.run([sys.executable, "-c", _TWO_DEVICES, str(root)], env=env, cwd=root,
+                         capture_output=True, text=True, timeout=600)
+    assert out.returncode == 0, out.stderr[-2000:]
+    result = json.loads(out.stdout.strip().splitlines()[-1])
+    assert result["devices"] == 2
+    assert result["us"] < 1e-9 and result["iterations"] == [0] * 5

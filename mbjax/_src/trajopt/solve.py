@@ -13,6 +13,7 @@ from mbjax._src.trajopt.ilqr import ILQR
 from mbjax._src.trajopt.problem import Problem
 from mbjax._src.trajopt.batch import working_set
 from mbjax._src.trajopt.result import AbstractIterativeSolver, AbstractSolver, Result
+from mbjax._src.trajopt.sweep import padded
 
 
 def solve(problem: Problem, solver: AbstractSolver = ILQR(), us0: Array | None = None,
@@ -25,8 +26,8 @@ def solve(problem: Problem, solver: AbstractSolver = ILQR(), us0: Array | None =
     `mbjax.scenes.arm.reach_problem` builds them); a fresh closure is a new function, and
     compiles anew.
 
-    A batch of problems (every array leaf with a leading axis, as `equinox.filter_vmap` of a problem's
-    builder returns it) is solved in one program too. An iterative solver (`ILQR`) runs it
+    A batch of problems (every array leaf with a leading axis, as `equinox.filter_vmap` of a
+    problem's builder returns it) is solved in one program too. An iterative solver (`ILQR`) runs it
     through a working set of `width` problems: a member that stops leaves, and the next problem
     takes its slot, so the batch costs about its members' total iterations, not its slowest
     member's for everyone (`mbjax._src.trajopt.batch`), and with several devices (the CPU's
@@ -44,8 +45,8 @@ def solve(problem: Problem, solver: AbstractSolver = ILQR(), us0: Array | None =
         throw: raise an error naming the failure (not converged, non-finite) instead of
             returning the result with its status.
         width: a batch's working set per device (static); None for 1 on a CPU, where a
-            vmapped iteration costs more than its members one by one, and 64 on an
-            accelerator (benchmarks/README.md).
+            vmapped iteration costs more than its members one by one (benchmarks/README.md),
+            and 64 on an accelerator (a guess: not yet measured on one).
 
     Returns:
         The `Result`, with a leading batch axis on every field for a batch.
@@ -101,9 +102,8 @@ def _split(fn, params, us: Array):
     devices = jax.devices()
     if len(devices) == 1:
         return fn(params, us)
-    size, pad = us.shape[0], -us.shape[0] % len(devices)
-    params, us = jax.tree.map(lambda x: jnp.concatenate([x, jnp.repeat(x[-1:], pad, axis=0)]),
-                              (params, us))
+    size = us.shape[0]
+    (params, us), _ = padded((params, us), len(devices))
     mesh = Mesh(np.asarray(devices), ("batch",))
     out = jax.shard_map(fn, mesh=mesh, in_specs=PartitionSpec("batch"),
                         out_specs=PartitionSpec("batch"), check_vma=False)(params, us)

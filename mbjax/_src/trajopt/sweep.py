@@ -36,6 +36,16 @@ def size(params) -> int:
     return shapes.pop()[0]
 
 
+def padded(params, multiple: int):
+    """(params padded with copies of its last variant to a multiple of `multiple`, the number of
+    copies added)."""
+    pad = -size(params) % multiple
+    if pad:
+        params = jax.tree.map(lambda x: jnp.concatenate([x, jnp.repeat(x[-1:], pad, axis=0)]),
+                              params)
+    return params, pad
+
+
 def sweep(fn, params, *, devices=None, trim: bool = True):
     """fn(p) for every variant p of a batch, as jit(vmap(fn)), optionally sharded over devices.
 
@@ -63,10 +73,7 @@ def sweep(fn, params, *, devices=None, trim: bool = True):
     mapped = jax.vmap(fn)
     if devices is None or len(devices) == 1:
         return jax.jit(mapped)(params)
-    pad = -n % len(devices)
-    if pad:
-        params = jax.tree.map(lambda x: jnp.concatenate([x, jnp.repeat(x[-1:], pad, axis=0)]),
-                              params)
+    params, pad = padded(params, len(devices))
     sharding = NamedSharding(Mesh(np.asarray(devices), ("variants",)), PartitionSpec("variants"))
     out = jax.jit(mapped, out_shardings=sharding)(jax.device_put(params, sharding))
     return jax.tree.map(lambda x: x[:n], out) if pad and trim else out
