@@ -67,3 +67,14 @@ def pytest_collection_modifyitems(config, items):
     for item in items:            # the slow tests (full-length runs) get an hour, not the default
         if item.get_closest_marker("slow") and not item.get_closest_marker("timeout"):
             item.add_marker(pytest.mark.timeout(3600))
+
+
+def example_robots(names=None) -> list[Path]:
+    """The URDFs of example-robot-data (those whose corpus name is in `names`, or all), or skip
+    the test where the package is not installed."""
+    from mbjax_harness.reproduce import urdf_corpus
+    try:
+        paths = urdf_corpus.corpus_paths()
+    except Exception as err:          # PackageNotFoundError
+        pytest.skip(f"example-robot-data is not installed ({err})")
+    return [p for p in paths if names is None or urdf_corpus.name(p) in names]

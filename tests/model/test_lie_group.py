@@ -13,6 +13,7 @@ from mbjax.lie import quat_to_matrix
 from mbjax.model import Model, state_to_pinocchio
 from mbjax.rigid import TreeSystem
 from mbjax_harness.peers import random_state
+from tests.conftest import example_robots
 
 pin = pytest.importorskip("pinocchio")
 
@@ -32,15 +33,6 @@ def _against_pinocchio(model, pin_model, seed: int) -> float:
                np.abs(difference - pin.difference(pin_model, pq0, pq1)).max())
 
 
-def _corpus(names=None):
-    from mbjax_harness.reproduce import urdf_corpus
-    try:
-        paths = urdf_corpus.corpus_paths()
-    except Exception as err:          # PackageNotFoundError
-        pytest.skip(f"example-robot-data is not installed ({err})")
-    return [p for p in paths if names is None or urdf_corpus.name(p) in names]
-
-
 def _floating_difference(path) -> float | None:
     try:
         model = mbjax.load_urdf(path, floating_base=True)
@@ -54,7 +46,7 @@ def _floating_difference(path) -> float | None:
 def test_integrate_and_difference_equal_pinocchios():
     """A quadrotor, a quadruped, an arm with continuous joints and one with prismatic fingers,
     on free bases."""
-    paths = _corpus(QUICK_ROBOTS)
+    paths = example_robots(QUICK_ROBOTS)
     assert len(paths) == len(QUICK_ROBOTS)
     for path in paths:
         assert _floating_difference(path) < 1e-12, path
@@ -63,7 +55,7 @@ def test_integrate_and_difference_equal_pinocchios():
 @pytest.mark.slow
 @pytest.mark.filterwarnings("ignore::mbjax.model.ModelWarning")
 def test_integrate_and_difference_on_every_floating_robot():
-    worst = {path.stem: _floating_difference(path) for path in _corpus()}
+    worst = {path.stem: _floating_difference(path) for path in example_robots()}
     worst = {name: d for name, d in worst.items() if d is not None}
     assert len(worst) > 60 and max(worst.values()) < 1e-12, worst
 

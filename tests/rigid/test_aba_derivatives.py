@@ -18,17 +18,9 @@ from mbjax._src.rigid import rnea_derivatives
 from mbjax._src.rigid.rnea import inverse_dynamics
 from mbjax.model import chain, state_to_pinocchio
 from mbjax_harness.peers import random_state
+from tests.conftest import example_robots
 
 QUICK_ROBOTS = ("panda/panda", "solo/solo12", "hector/quadrotor_base")
-
-
-def _corpus(names=None):
-    from mbjax_harness.reproduce import urdf_corpus
-    try:
-        paths = urdf_corpus.corpus_paths()
-    except Exception as err:          # PackageNotFoundError
-        pytest.skip(f"example-robot-data is not installed ({err})")
-    return [p for p in paths if names is None or urdf_corpus.name(p) in names]
 
 
 def _states(model, seed):
@@ -52,7 +44,7 @@ def test_rnea_partials_equal_the_rneas_derivative():
     """Every column of the composite-body matrices against `jax.jacfwd` through the RNEA itself,
     and their mass matrix against the operator form's: a chain, an arm, a floating quadruped."""
     models = [chain(7)] + [mbjax.load_urdf(p, floating_base="solo" in str(p))
-                           for p in _corpus(("panda/panda", "solo/solo12"))]
+                           for p in example_robots(("panda/panda", "solo/solo12"))]
     for model in models:
         partials = jax.jit(rnea_derivatives.rnea_partials)
         for q, v, a in _states(model, 3):
@@ -95,7 +87,7 @@ def _against_pinocchio(path, pin, floating: bool, seed: int) -> float | None:
 def test_forward_dynamics_derivatives_equal_pinocchios():
     """An arm, a floating quadruped and a floating quadrotor, in the tangent space."""
     pin = pytest.importorskip("pinocchio")
-    paths = _corpus(QUICK_ROBOTS)
+    paths = example_robots(QUICK_ROBOTS)
     assert len(paths) == len(QUICK_ROBOTS)
     for path in paths:
         floating = "panda" not in str(path)
@@ -107,7 +99,7 @@ def test_forward_dynamics_derivatives_on_every_robot():
     """Every robot of example-robot-data, fixed and on a free base."""
     pin = pytest.importorskip("pinocchio")
     worst = {}
-    for path in _corpus():
+    for path in example_robots():
         for floating in (False, True):
             try:
                 difference = _against_pinocchio(path, pin, floating, 1)
@@ -132,7 +124,7 @@ def test_linear_maps_agree_in_every_mode():
     """jax.jacfwd (the matrices once), jax.jacrev (the passes transposed), a vmapped jvp at many
     states (the passes mapped) and central differences give the same Jacobian. A floating
     quadruped."""
-    model = mbjax.load_urdf(_corpus(("solo/solo12",))[0], floating_base=True)
+    model = mbjax.load_urdf(example_robots(("solo/solo12",))[0], floating_base=True)
     q, v, tau = (jnp.asarray(x) for x in random_state(model, 5))
     fd = _fd(model, q)
     x = jnp.concatenate([jnp.zeros(model.nv), v, tau])
@@ -174,4 +166,4 @@ def test_second_derivatives_through_the_rules():
 @pytest.mark.filterwarnings("ignore::mbjax.model.ModelWarning")
 def test_second_derivatives_on_a_free_body():
     """The quadrotor: a quaternion's tangent through every rule."""
-    _second_derivatives(mbjax.load_urdf(_corpus(("hector/quadrotor_base",))[0], floating_base=True))
+    _second_derivatives(mbjax.load_urdf(example_robots(("hector/quadrotor_base",))[0], floating_base=True))
