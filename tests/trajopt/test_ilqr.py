@@ -168,10 +168,13 @@ def test_a_batch_of_problems_through_a_working_set_equals_single_solves():
             assert int(batch.status[i]) == int(one.status) == 0
 
 
-def test_a_batch_needs_one_first_guess_per_member():
+def test_a_batch_needs_one_first_guess_per_member_and_a_working_set():
     problems = eqx.filter_vmap(_slider_problem)(jnp.zeros(3))
     with pytest.raises(ValueError, match="us0"):
         solve(problems, ILQR(), jnp.zeros((N, 1)))
+    for width in (0, 1.5):
+        with pytest.raises(ValueError, match="width"):
+            solve(problems, ILQR(), width=width)
 
 
 _TWO_DEVICES = """

@@ -53,8 +53,8 @@ def solve(problem: Problem, solver: AbstractSolver = ILQR(), us0: Array | None =
 
     Raises:
         TypeError: problem is not a `Problem` or solver not a solver instance.
-        ValueError: us0 or states0 has the wrong shape, or states0 was given to a solver that
-            starts from a rollout (`ILQR`, `Shooting`).
+        ValueError: us0 or states0 has the wrong shape, states0 was given to a solver that
+            starts from a rollout (`ILQR`, `Shooting`), or width is not a positive int.
         equinox.EquinoxRuntimeError: with throw=True, the solve failed.
     """
     if not isinstance(problem, Problem):
@@ -66,6 +66,8 @@ def solve(problem: Problem, solver: AbstractSolver = ILQR(), us0: Array | None =
     if problem.q0.ndim == 2:
         if width is None:
             width = 1 if jax.default_backend() == "cpu" else 64
+        if not (isinstance(width, int | np.integer) and width >= 1):
+            raise ValueError(f"width must be a positive int (a batch's working set), got {width!r}")
         return _solve_batch(problem, solver, us0, states0, throw, width)
     return _solve(problem, solver, us0, states0, throw)
 
