@@ -38,6 +38,7 @@ the 64 targets ahead of Crocoddyl's loop.
 
 import platform
 import time
+from functools import partial
 from pathlib import Path
 
 import equinox as eqx
@@ -237,6 +238,26 @@ def single(name: str, repeats: int, common: dict) -> list[dict]:
     return records
 
 
+def _batch_record(base: dict, engine: str, how: str, seconds: float, iterations,
+                  converged, **extra) -> dict:
+    """One way of solving a batch of problems: its wall time, iterations and convergence."""
+    return {**base, "engine": engine, "how": how, "seconds": seconds,
+            "mean_iterations": float(np.mean(iterations)),
+            "max_iterations": int(np.max(iterations)), "converged": int(np.sum(converged)),
+            **extra}
+
+
+def _looped(solve_one, inputs) -> tuple[float, list[int], list[bool]]:
+    """(seconds, iterations, converged) of a Python loop of one jitted `solve_one(x)` over
+    inputs, after a compiling call."""
+    one = jax.jit(solve_one)
+    jax.block_until_ready(one(jnp.asarray(inputs[0])))
+    start = time.perf_counter()
+    results = [jax.block_until_ready(one(jnp.asarray(x))) for x in inputs]
+    return (time.perf_counter() - start, [int(r.iterations) for r in results],
+            [int(r.status) == 0 for r in results])
+
+
 def many(n: int, repeats: int, common: dict, loop: bool = True) -> list[dict]:
     """The arm's reach to n targets: mbjax vmapped, mbjax one by one (unless not `loop`: on a
     GPU each solve is thousands of small kernels), Crocoddyl in a loop."""
@@ -246,17 +267,14 @@ def many(n: int, repeats: int, common: dict, loop: bool = True) -> list[dict]:
     model = problem.system.model
     offsets = targets(n)
 
+    solver = ILQR(iterations=ITERATIONS, **CROCODDYL_SCHEDULE)
+
     def one(offset):
         return solve(arm.reach_problem(offset, arm=model, integrator=SemiImplicitEuler()),
-                     ILQR(iterations=ITERATIONS, **CROCODDYL_SCHEDULE), us0)
+                     solver, us0)
 
-    def summary(engine, how, seconds, iterations, converged, **extra):
-        return {**common, "kind": "many", "problem": "arm-reach", "engine": engine, "how": how,
-                "targets": n, "seconds": seconds, "mean_iterations": float(np.mean(iterations)),
-                "max_iterations": int(np.max(iterations)), "converged": int(np.sum(converged)),
-                **extra}
-
-    solver = ILQR(iterations=ITERATIONS, **CROCODDYL_SCHEDULE)
+    summary = partial(_batch_record, {**common, "kind": "many", "problem": "arm-reach",
+                                      "targets": n})
     problems = eqx.filter_vmap(lambda o: arm.reach_problem(o, arm=model,
                                                            integrator=SemiImplicitEuler()))(
         jnp.asarray(offsets))
@@ -272,13 +290,7 @@ def many(n: int, repeats: int, common: dict, loop: bool = True) -> list[dict]:
                            np.asarray(results.iterations), np.asarray(results.status) == 0,
                            compile_s=timing.compile_s))
     if loop:
-        single_solve = jax.jit(one)
-        jax.block_until_ready(single_solve(jnp.asarray(offsets[0])))
-        start = time.perf_counter()
-        looped = [jax.block_until_ready(single_solve(jnp.asarray(o))) for o in offsets]
-        records.append(summary("mbjax", "a loop of jitted solves", time.perf_counter() - start,
-                               [int(r.iterations) for r in looped],
-                               [int(r.status) == 0 for r in looped]))
+        records.append(summary("mbjax", "a loop of jitted solves", *_looped(one, offsets)))
     why = peers.crocoddyl_working()
     if why is not None:
         records.append({**common, "kind": "many", "problem": "arm-reach", "engine": "crocoddyl",
@@ -313,12 +325,8 @@ def sweep_acrobot(n: int, common: dict) -> list[dict]:
         model = eqx.tree_at(lambda m: m.mass, base, base.mass * scale)
         return acrobot.swingup_problem(model, integrator=SemiImplicitEuler())
 
-    def summary(engine, how, seconds, iterations, converged, **extra):
-        return {**common, "kind": "sweep", "problem": "acrobot-swingup", "engine": engine,
-                "how": how, "variants": n, "seconds": seconds,
-                "mean_iterations": float(np.mean(iterations)),
-                "max_iterations": int(np.max(iterations)), "converged": int(np.sum(converged)),
-                **extra}
+    summary = partial(_batch_record, {**common, "kind": "sweep", "problem": "acrobot-swingup",
+                                      "variants": n})
 
     problems = eqx.filter_vmap(variant)(jnp.asarray(scales))
     horizon = problems.horizon
@@ -327,13 +335,8 @@ def sweep_acrobot(n: int, common: dict) -> list[dict]:
     records = [summary("mbjax", f"one batched solve ({len(jax.devices())} devices)",
                        timing.run_s, np.asarray(results.iterations),
                        np.asarray(results.status) == 0, compile_s=timing.compile_s)]
-    one = jax.jit(lambda scale: solve(variant(scale), solver, jnp.zeros((horizon, 1))))
-    jax.block_until_ready(one(jnp.asarray(scales[0])))
-    start = time.perf_counter()
-    looped = [jax.block_until_ready(one(jnp.asarray(c))) for c in scales]
-    records.append(summary("mbjax", "a loop of jitted solves", time.perf_counter() - start,
-                           [int(r.iterations) for r in looped],
-                           [int(r.status) == 0 for r in looped]))
+    records.append(summary("mbjax", "a loop of jitted solves", *_looped(
+        lambda scale: solve(variant(scale), solver, jnp.zeros((horizon, 1))), scales)))
     why = peers.crocoddyl_working()
     if why is not None:
         return records + [{**common, "kind": "sweep", "problem": "acrobot-swingup",
