@@ -117,7 +117,10 @@ def _tangents(fixed: tuple, xs: Array) -> Array:
     D_q = D_e @ increments_matrix(model, q, v)                         # per coordinate of q
     dq, dv, dtau = jnp.split(xs, [model.nq, model.nq + model.nv], axis=1)
     rhs = dtau - dq @ D_q.T - dv @ D_v.T
-    return spd_solve(M, rhs.T, unroll=WRITTEN_OUT).T
+    # M^-1 formed, then a product: XLA would fuse a solve of the right-hand sides into what
+    # consumes it, each output column re-running the written-out substitutions (a step
+    # Jacobian's 2 nv columns: the arm's 1.43 -> 1.05 ms for 100 knots, benchmarks/README.md)
+    return rhs @ spd_solve(M, jnp.eye(model.nv, dtype=M.dtype), unroll=WRITTEN_OUT)
 
 
 # directions from which the matrices beat the passes: for the 7-link chain `rnea_partials` costs
