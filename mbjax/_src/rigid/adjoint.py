@@ -119,7 +119,7 @@ def _tangents(fixed: tuple, xs: Array) -> Array:
     rhs = dtau - dq @ D_q.T - dv @ D_v.T
     # M^-1 formed, then a product: XLA would fuse a solve of the right-hand sides into what
     # consumes it, each output column re-running the written-out substitutions (a step
-    # Jacobian's 2 nv columns: the arm's 1.43 -> 1.05 ms for 100 knots, benchmarks/README.md)
+    # Jacobian's 2 nv columns; benchmarks/README.md, speed)
     return rhs @ spd_solve(M, jnp.eye(model.nv, dtype=M.dtype), unroll=WRITTEN_OUT)
 
 

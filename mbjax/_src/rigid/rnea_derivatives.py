@@ -112,8 +112,8 @@ def rnea_partials(model: Model, q: Array, v: Array, a: Array) -> tuple[Array, Ar
     cross = jnp.block([[w, zero], [u, w]])                               # V x, (n, 6, 6)
     by_h = jnp.block([[-hn, -hf], [-hf, zero]])                          # x -> x x* h
     # I (V x), its 6 terms written out: XLA's CPU backend runs a batch of 6 x 6 products (one
-    # per body and state under `jax.vmap`) as a batched dot several times slower (the arm's
-    # step Jacobians, 100 knots: 1.05 -> 0.82 ms, benchmarks/README.md)
+    # per body and state under `jax.vmap`) as a batched dot several times slower
+    # (benchmarks/README.md, speed)
     IV = sum(I[..., :, i, None] * cross[..., None, i, :] for i in range(6))
     C = IV + jnp.swapaxes(IV, -1, -2) - by_h          # I (V x) - (V x*) I, as I is symmetric
     pi = model.topology.path_matrix()                    # pi[k, j] = 1: j on k's path
