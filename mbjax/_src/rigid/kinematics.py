@@ -88,7 +88,9 @@ def _poses_jvp(primals, tangents):
         path = jnp.asarray(model.topology.path_matrix(), q.dtype)      # Jerkovsky 1978 eq 1
         twist = path @ columns(S, joint_increments(model, q, still, dq))
         w = twist[:, :3]
-        dR, dp = skew(w) @ R, jnp.cross(w, p) + twist[:, 3:]
+        # w x each column of R
+        dR = jnp.swapaxes(jnp.cross(w[:, None], jnp.swapaxes(R, -1, -2)), -1, -2)
+        dp = jnp.cross(w, p) + twist[:, 3:]
     if not is_zero(d_model):
         _, (dR_m, dp_m) = jax.jvp(lambda m: _poses.fun(m, q), (model,),
                                   (instantiate(d_model, model),))
@@ -146,7 +148,7 @@ def increments_matrix(model: Model, q: Array, v: Array) -> Array:
 
 def columns(S: Array, x: Array) -> Array:
     """sum_c S[k, :, c] x[k, c]: (n, 6, width), (n, width) -> (n, 6)."""
-    return jnp.einsum("kic,kc->ki", S, x)
+    return sum(S[..., c] * x[..., c, None] for c in range(S.shape[-1]))
 
 
 def compose(model: Model, R: Array, p: Array) -> tuple[Array, Array]:
