@@ -69,3 +69,24 @@ def small_dot(a: Array, b: Array) -> Array:
     if b.ndim == 1:
         return (a * b).sum(-1)
     return (a[:, :, None] * b[None]).sum(1)
+
+
+def unrolled_dot(a: Array, b: Array) -> Array:
+    """a @ b over a short contraction (a spatial vector's 6 components, a joint's few columns),
+    written as one broadcast product per contracted index and their sum.
+
+    XLA's CPU backend runs a batch of small products (a 6 x 6 block per body, per state and per
+    direction under `jax.vmap` and `jax.jacfwd`) as a batched `dot_general` several times slower
+    than these elementwise products, which it fuses with their neighbours (benchmarks/README.md,
+    speed: the derivatives' batched rules).
+
+    Args:
+        a: matrices, shape (..., m, k), k small.
+        b: matrices (..., k, n) or vectors (..., k), broadcasting with a's leading axes.
+
+    Returns:
+        a @ b, shape (..., m, n) or (..., m).
+    """
+    if b.ndim == a.ndim - 1:
+        return sum(a[..., i] * b[..., i, None] for i in range(a.shape[-1]))
+    return sum(a[..., :, i, None] * b[..., None, i, :] for i in range(a.shape[-1]))

@@ -19,6 +19,7 @@ import jax.numpy as jnp
 import numpy as np
 from jax import Array
 
+from mbjax._src.linalg import unrolled_dot
 from mbjax._src.lie import vee
 from mbjax._src.model import Model
 from mbjax._src.model.joints import joint_calc
@@ -148,7 +149,7 @@ def increments_matrix(model: Model, q: Array, v: Array) -> Array:
 
 def columns(S: Array, x: Array) -> Array:
     """sum_c S[k, :, c] x[k, c]: (n, 6, width), (n, width) -> (n, 6)."""
-    return sum(S[..., c] * x[..., c, None] for c in range(S.shape[-1]))
+    return unrolled_dot(S, x)
 
 
 def compose(model: Model, R: Array, p: Array) -> tuple[Array, Array]:

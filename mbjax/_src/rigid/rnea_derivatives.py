@@ -33,6 +33,7 @@ import jax.numpy as jnp
 import numpy as np
 from jax import Array
 
+from mbjax._src.linalg import unrolled_dot
 from mbjax._src.model import Model
 from mbjax._src.rigid.kinematics import columns, fixed_in_body, gravity_acceleration, joint_increments
 from mbjax._src.rigid.rnea import rnea_passes
@@ -111,10 +112,7 @@ def rnea_partials(model: Model, q: Array, v: Array, a: Array) -> tuple[Array, Ar
     zero = jnp.zeros_like(w)
     cross = jnp.block([[w, zero], [u, w]])                               # V x, (n, 6, 6)
     by_h = jnp.block([[-hn, -hf], [-hf, zero]])                          # x -> x x* h
-    # I (V x), its 6 terms written out: XLA's CPU backend runs a batch of 6 x 6 products (one
-    # per body and state under `jax.vmap`) as a batched dot several times slower
-    # (benchmarks/README.md, speed)
-    IV = sum(I[..., :, i, None] * cross[..., None, i, :] for i in range(6))
+    IV = unrolled_dot(I, cross)                                          # I (V x)
     C = IV + jnp.swapaxes(IV, -1, -2) - by_h          # I (V x) - (V x*) I, as I is symmetric
     pi = model.topology.path_matrix()                    # pi[k, j] = 1: j on k's path
     Ic, Cc = jnp.split(jnp.einsum("mk,mij->kij", pi.astype(q.dtype),
