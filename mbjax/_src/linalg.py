@@ -78,7 +78,9 @@ def unrolled_dot(a: Array, b: Array) -> Array:
     XLA's CPU backend runs a batch of small products (a 6 x 6 block per body, per state and per
     direction under `jax.vmap` and `jax.jacfwd`) as a batched `dot_general` several times slower
     than these elementwise products, which it fuses with their neighbours (benchmarks/README.md,
-    speed: the derivatives' batched rules).
+    speed: the derivatives' batched rules). `small_dot` is the form for one product of up to
+    14 x 14 x 14 inside a loop compiled as one kernel (the Riccati pass); this one is for short
+    contractions over batch axes.
 
     Args:
         a: matrices, shape (..., m, k), k small.
