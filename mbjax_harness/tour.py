@@ -579,9 +579,9 @@ TOUR = {   # in the order the summary tells them
 
 # Each scene's wall time in a quick tour from a cold cache, one scene at a time (benchmarks/README
 # compile section): `mbjax tour` starts the longest first, which balances its workers best.
-COST = {"time-elements": 9.1, "carpal-wrist": 9.0, "closed-loops": 8.6, "flexible-bodies": 7.7,
-        "controls": 6.4, "rigid-chain": 4.8, "trajectory-optimisation": 4.5, "models": 2.6,
-        "torque-free-body": 2.3, "heavy-top": 1.6, "floating-base": 4.5}
+COST = {"time-elements": 17.0, "floating-base": 12.3, "flexible-bodies": 12.8, "carpal-wrist": 12.2,
+        "closed-loops": 11.5, "rigid-chain": 10.4, "controls": 7.7, "trajectory-optimisation": 5.8,
+        "torque-free-body": 5.4, "heavy-top": 4.6, "models": 4.2}
 
 
 def _animate(out: Path, name: str, system, ts, qs, title: str, quick: bool) -> str:

@@ -15,14 +15,15 @@ from pathlib import Path
 
 import jax
 import numpy as np
-from matplotlib.animation import FuncAnimation, PillowWriter
+from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 from matplotlib.ticker import MaxNLocator
+from PIL import Image
 
 from mbjax.wrist import WristSystem
 from mbjax_harness.progress import step
 
-__all__ = ["animate", "frames_along", "stick_animation", "wrist_animation"]
+__all__ = ["animate", "frames_along", "stick_animation", "wrist_animation", "write_gif"]
 
 AXIS_COLORS = ("#d62728", "#2ca02c", "#1f77b4")     # x, y, z
 
@@ -103,10 +104,51 @@ def stick_animation(path: Path, ts, R, p, parents, *, title: str = "",
         return [*sticks, *(line for triad in triad_lines.values() for line in triad),
                 *paths.values(), label]
 
-    animation = FuncAnimation(fig, draw, frames=len(keep), blit=False)
+    return write_gif(path, fig, draw, len(keep), fps)
+
+
+def write_gif(path: Path, fig: Figure, draw, frames: int, fps: int, dpi: int = 72) -> Path:
+    """Write `frames` frames of `fig` as a GIF: its still parts (axes, panes, ticks, labels)
+    rendered once, then for frame i only the artists `draw(i)` updates and returns, drawn over a
+    copy of them (blitting, where matplotlib's writers redraw the whole 3-D axes for every
+    frame). All frames share one palette.
+
+    Args:
+        path: the GIF's path (its folder is made if missing).
+        fig: the figure, its moving artists at any state.
+        draw: draw(i) sets the moving artists to frame i and returns them (the same artists
+            for every i).
+        frames: the number of frames.
+        fps: frames per second.
+        dpi: the resolution.
+
+    Returns:
+        The path.
+    """
+    fig.set_dpi(dpi)
+    canvas = FigureCanvasAgg(fig)
+    moving = draw(0)
+    canvas.draw()                       # lays out the figure and places the moving artists
+    fig.set_layout_engine("none")       # (a title, say) as a full draw would
+    for artist in moving:
+        artist.set_animated(True)       # left out of the still parts' draw
+    canvas.draw()
+    still = canvas.copy_from_bbox(fig.bbox)
+    rgb = []
+    for i in range(frames):
+        canvas.restore_region(still)
+        for artist in draw(i):
+            fig.draw_artist(artist)
+        rgb.append(np.array(canvas.buffer_rgba())[..., :3])
+    # one palette for every frame, from all of them stacked (a third of the time of a palette
+    # per frame, and the colours exact where there are at most 255)
+    stack = Image.fromarray(np.concatenate(rgb)).quantize(255)
+    height = rgb[0].shape[0]
+    images = [stack.crop((0, i * height, stack.width, (i + 1) * height)) for i in range(frames)]
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    animation.save(path, writer=PillowWriter(fps=fps), dpi=72)
+    images[0].save(path, save_all=True, append_images=images[1:], duration=round(1000 / fps),
+                   loop=0)
     return path
 
 
