@@ -30,10 +30,10 @@ def _parser(reproductions, suites, scenes) -> argparse.ArgumentParser:
     commands = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
 
     tour = commands.add_parser("tour", help="run every scene: figures, animations and a summary "
-                               "(about 105 s on 2 cores, 1.3 GB a worker; --quick about 60 s)")
+                               "(about 105 s on 2 cores, 1.3 GB a worker; --quick about 75 s)")
     tour.add_argument("--out", type=Path, default=Path("mbjax-out"), help="output folder")
     tour.add_argument("--quick", action="store_true",
-                      help="shorter runs (about 60 s on 2 cores with nothing compiled, 1.0 GB a worker)")
+                      help="shorter runs (about 75 s on 2 cores with nothing compiled, 1.0 GB a worker)")
     tour.add_argument("--scene", action="append", choices=list(scenes), metavar="NAME",
                       help=f"run only this scene (repeatable), one of: {', '.join(scenes)}")
     tour.add_argument("--jobs", type=_positive_int, default=None, metavar="N",
