@@ -25,8 +25,11 @@ the rolled-out guess. `seconds` is the median wall time of that solve (mbjax aft
 iterations the solver needed to come within 1e-6 (relative) of the better of the two final costs
 (`TOLERANCE`, found from each solver's cost history; None where the solver stops short of it), so
 a solver is not charged for a tail that its convergence test, not the problem, asks for (a full solve passes that point, so its
-time bounds the truncated one's, which on a busy machine can measure longer). Crocoddyl runs
-single-threaded from Python.
+time bounds the truncated one's, which on a busy machine can measure longer). Single problems
+run single-threaded against single-threaded: Crocoddyl's problem with `nthreads = 1` (its
+default, a thread per core, computes the knots' derivatives in parallel with OpenMP), mbjax's
+one jitted solve (XLA ran it no faster with a second core). The batches run on the same two
+cores: Crocoddyl's loop with its default threads, mbjax's batch split over a device per core.
 
 Many targets: `N_TARGETS` flange targets 0.4 m from the start in a 30-degree cone about the
 single problem's direction (seeded), solved by mbjax as one `jax.vmap`ped solve (every problem
@@ -128,11 +131,14 @@ def _to_tolerance(costs, best: float) -> int | None:
 
 class CrocoddylSolver:
     """One Crocoddyl problem's solver (FDDP, or BoxDDP for bounded controls), from a fixed first
-    guess and its rollout."""
+    guess and its rollout, its problem's derivatives computed on `threads` threads (OpenMP over
+    the knots)."""
 
-    def __init__(self, problem, us0, solver: str = "SolverFDDP"):
+    def __init__(self, problem, us0, solver: str = "SolverFDDP", threads: int | None = 1):
         import crocoddyl
 
+        if threads is not None:          # None: Crocoddyl's default, a thread per core
+            problem.nthreads = threads
         self.problem, self.us0 = problem, [np.asarray(u, float) for u in us0]
         self.solver = getattr(crocoddyl, solver)(problem)
 
@@ -297,7 +303,7 @@ def many(n: int, repeats: int, common: dict, loop: bool = True) -> list[dict]:
                         "skipped": why})
         return records
     croc_problem, set_target = build()
-    croc = CrocoddylSolver(croc_problem, us0)
+    croc = CrocoddylSolver(croc_problem, us0, threads=None)
     start_flange = np.asarray(arm.flange(model, problem.q0))
     iterations, converged = [], []
     start = time.perf_counter()
@@ -348,7 +354,7 @@ def sweep_acrobot(n: int, common: dict) -> list[dict]:
         problem = variant(scale)
         built.append(CrocoddylSolver(peers.crocoddyl_swingup(
             to_urdf(model), problem.q0, goal, acrobot.LENGTH, problem.dt, horizon),
-            np.zeros((horizon, 1))))
+            np.zeros((horizon, 1)), threads=None))
     start = time.perf_counter()
     converged = [croc.solve(ITERATIONS) for croc in built]
     records.append(summary("crocoddyl", "a Python loop", time.perf_counter() - start,

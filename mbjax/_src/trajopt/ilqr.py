@@ -29,9 +29,9 @@ Tassa, Mansard and Todorov 2014):
 The defaults shrink mu after every accepted step and accept a step achieving 1e-4 of the
 predicted decrease (Armijo), with the step lengths 1, 1/2, 1/4, 1/10, ..., 1e-3.
 `ILQR(**CROCODDYL_SCHEDULE)` takes Crocoddyl's FDDP schedule instead (Mastalli et al. 2020):
-steps halving from 1 to 2^-9, a tenth of the predicted decrease to accept, mu shrunk only after
-steps above 1/2 and grown after steps of 1/100 or shorter (mu starts at `regularization`, 1e-6;
-FDDP's 1e-9 stalls this iLQR on the acrobot's swing-up, see benchmarks/README.md).
+steps halving from 1 to 2^-9, a tenth of the predicted decrease to accept, mu starting at
+FDDP's 1e-9, shrunk only after steps above 1/2 and grown after steps of 1/100 or shorter. From a
+rolled-out guess it then takes FDDP's iterations on Crocoddyl's examples (benchmarks/README.md).
 Neither schedule wins everywhere (Crocoddyl's on the semi-implicit Euler benchmark problems, the
 defaults on the acrobot with RK4 steps); see benchmarks/README.md.
 
@@ -52,7 +52,7 @@ from mbjax._src.trajopt.result import AbstractIterativeSolver, Result, history
 
 MU_MIN, MU_MAX, MU_FACTOR = 1e-9, 1e10, 10.0
 CROCODDYL_SCHEDULE = {"steps": tuple(0.5**k for k in range(10)), "acceptance": 0.1,
-                      "shrink_above": 0.5, "grow_below": 0.01}
+                      "shrink_above": 0.5, "grow_below": 0.01, "regularization": 1e-9}
 # the control blocks' Cholesky written out up to this size (`linalg.spd_solve`), so that the
 # backward pass compiles as one kernel (a LAPACK call would keep it kernel by kernel)
 UNROLL = 16
