@@ -30,8 +30,8 @@ The defaults shrink mu after every accepted step and accept a step achieving 1e-
 predicted decrease (Armijo), with the step lengths 1, 1/2, 1/4, 1/10, ..., 1e-3.
 `ILQR(**CROCODDYL_SCHEDULE)` takes Crocoddyl's FDDP schedule instead (Mastalli et al. 2020):
 steps halving from 1 to 2^-9, a tenth of the predicted decrease to accept, mu starting at
-FDDP's 1e-9, shrunk only after steps above 1/2 and grown after steps of 1/100 or shorter. From a
-rolled-out guess it then takes FDDP's iterations on Crocoddyl's examples (benchmarks/README.md).
+FDDP's 1e-9, shrunk only after steps above 1/2 and grown after steps of 1/100 or shorter (the
+iterations it takes against FDDP's: benchmarks/README.md).
 Neither schedule wins everywhere (Crocoddyl's on the semi-implicit Euler benchmark problems, the
 defaults on the acrobot with RK4 steps); see benchmarks/README.md.
 
