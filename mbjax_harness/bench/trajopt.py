@@ -27,9 +27,10 @@ iterations the solver needed to come within 1e-6 (relative) of the better of the
 a solver is not charged for a tail that its convergence test, not the problem, asks for: the
 fastest of `TIMED_RUNS` solves of each engine, the two taking turns (this machine's slow spells,
 +-25 % over seconds, otherwise decided ratios near 1). Single problems
-run single-threaded against single-threaded: Crocoddyl's problem with `nthreads = 1` (its
-default, a thread per core, computes the knots' derivatives in parallel with OpenMP), mbjax's
-one jitted solve (XLA ran it no faster with a second core). The batches run on the same two
+run single-threaded against single-threaded: Crocoddyl's problem with `nthreads = 1` (with its
+default, a thread per core, it ran on both cores, its CPU time twice its wall time, although this
+build warns that `nthreads` has no effect), mbjax's one jitted solve (XLA ran it no faster with a
+second core). The batches run on the same two
 cores: Crocoddyl's loop with its default threads, mbjax's batch split over a device per core.
 
 Many targets: `N_TARGETS` flange targets 0.4 m from the start in a 30-degree cone about the
@@ -133,13 +134,13 @@ def _to_tolerance(costs, best: float) -> int | None:
 
 class CrocoddylSolver:
     """One Crocoddyl problem's solver (FDDP, or BoxDDP for bounded controls), from a fixed first
-    guess and its rollout, its problem's derivatives computed on `threads` threads (OpenMP over
-    the knots)."""
+    guess and its rollout, its problem set to `threads` threads (None: Crocoddyl's default, a
+    thread per core)."""
 
     def __init__(self, problem, us0, solver: str = "SolverFDDP", threads: int | None = 1):
         import crocoddyl
 
-        if threads is not None:          # None: Crocoddyl's default, a thread per core
+        if threads is not None:
             problem.nthreads = threads
         self.problem, self.us0 = problem, [np.asarray(u, float) for u in us0]
         self.solver = getattr(crocoddyl, solver)(problem)
