@@ -1,8 +1,9 @@
-"""The one timing helper every benchmark and reproduction uses.
+"""The timing helpers every benchmark and reproduction uses.
 
-Compile time and run time are reported separately: the first call compiles and runs, later calls
-only run. Run time is the median of `repeats` calls after that warm-up, each ending with
+`measure`: compile time and run time reported separately: the first call compiles and runs, later
+calls only run. Run time is the median of `repeats` calls after that warm-up, each ending with
 `jax.block_until_ready` on the output so that JAX's asynchronous dispatch is not mistaken for speed.
+`in_turns`: engines compared side by side, each the fastest of its calls, the calls alternating.
 """
 
 import functools
@@ -39,6 +40,22 @@ def measure(fn: Callable, *args, repeats: int = 10) -> tuple[object, Timing]:
         samples.append(time.perf_counter() - start)
     run = statistics.median(samples)
     return out, Timing(compile_s=max(first - run, 0.0), run_s=run, runs=repeats)
+
+
+def in_turns(runs: dict[str, Callable], repeats: int) -> dict[str, float]:
+    """The fastest of `repeats` calls of each of `runs` (name: a function of no arguments, which
+    blocks until its result is ready), after one warm-up call each, the functions taking turns:
+    a slow spell of a shared machine then falls on every one of them, not on one."""
+    step("runs in turns")
+    for run in runs.values():
+        run()
+    samples = {name: [] for name in runs}
+    for _ in range(repeats):
+        for name, run in runs.items():
+            start = time.perf_counter()
+            run()
+            samples[name].append(time.perf_counter() - start)
+    return {name: min(times) for name, times in samples.items()}
 
 
 def _name(fn: Callable) -> str:

@@ -54,7 +54,7 @@ import numpy as np
 from mbjax_harness import peers
 from mbjax_harness.crocoddyl_examples import EXAMPLES, Example
 from mbjax._src.integrate import SemiImplicitEuler
-from mbjax_harness.timing import measure, write_jsonl
+from mbjax_harness.timing import in_turns, measure, write_jsonl
 from mbjax._src.trajopt import ILQR, solve
 from mbjax._src.trajopt.ilqr import CROCODDYL_SCHEDULE
 
@@ -231,15 +231,14 @@ def single(name: str, repeats: int, common: dict) -> list[dict]:
         records[-1]["iterations_to_tolerance"] = _to_tolerance(history, best)
     k = _to_tolerance(costs, best)
     mbjax["iterations_to_tolerance"] = k
-    # the solves stopped at the tolerance, timed in turns (`_alternated`)
+    # the solves stopped at the tolerance, timed in turns
     runs = {}
     if k is not None:
         stopped = ILQR(iterations=max(k, 1), **CROCODDYL_SCHEDULE)
-        solve(problem, stopped, us0)
         runs["mbjax"] = lambda: jax.block_until_ready(solve(problem, stopped, us0).us)
     if why is None and records[-1]["iterations_to_tolerance"] is not None:
         runs["crocoddyl"] = partial(croc.solve, max(records[-1]["iterations_to_tolerance"], 1))
-    seconds = _alternated(runs, TIMED_RUNS)
+    seconds = in_turns(runs, TIMED_RUNS)
     for r in records:
         if "skipped" not in r:
             r["seconds_to_tolerance"] = seconds.get(r["engine"])
@@ -247,18 +246,6 @@ def single(name: str, repeats: int, common: dict) -> list[dict]:
         r["best_cost"] = best
         r["relative_to_best"] = (r["cost"] - best) / abs(best) if "cost" in r else None
     return records
-
-
-def _alternated(runs: dict, repeats: int) -> dict:
-    """The fastest of `repeats` timed calls of each of `runs` (name: function), taking turns,
-    so that a slow spell of the machine falls on both engines, not on one."""
-    times = {name: [] for name in runs}
-    for _ in range(repeats):
-        for name, run in runs.items():
-            start = time.perf_counter()
-            run()
-            times[name].append(time.perf_counter() - start)
-    return {name: min(samples) for name, samples in times.items()}
 
 
 def _batch_record(base: dict, engine: str, how: str, seconds: float, iterations,
