@@ -76,7 +76,11 @@ def axis_rotation(axis: Array, angle: Array) -> Array:
         The rotation matrix, shape (3, 3).
     """
     K = skew(axis)
-    return jnp.eye(3, dtype=K.dtype) + jnp.sin(angle) * K + (1 - jnp.cos(angle)) * (K @ K)
+    # one product of (sin, 1 - cos) with the constant (K, K^2): as a sum of two scaled matrices,
+    # XLA fuses the library's sin and cos into each of the nine entries, nine calls where one
+    # does (most of the time of a batch of forward kinematics; benchmarks/README.md, trajopt)
+    terms = jnp.stack([jnp.sin(angle), 1 - jnp.cos(angle)]) @ jnp.stack([K, K @ K]).reshape(2, 9)
+    return jnp.eye(3, dtype=K.dtype) + terms.reshape(3, 3)
 
 
 def _unit(q: Array) -> Array:

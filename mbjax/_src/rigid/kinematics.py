@@ -86,8 +86,10 @@ def _poses_jvp(primals, tangents):
     dR, dp = jnp.zeros_like(R), jnp.zeros_like(p)
     if not is_zero(dq):
         S = to_ground(R, p, S_local)
-        path = jnp.asarray(model.topology.path_matrix(), q.dtype)      # Jerkovsky 1978 eq 1
-        twist = path @ columns(S, joint_increments(model, q, still, dq))
+        # xi = pi (S e) (Jerkovsky 1978 eq 1) as an outward pass: a product with pi over the
+        # body axis would transpose the columns body-major under `jax.vmap`
+        twist = forward_pass(model.topology, lambda parent, own: parent + own,
+                             jnp.zeros(6, q.dtype), columns(S, joint_increments(model, q, still, dq)))
         w = twist[:, :3]
         # w x each column of R
         dR = jnp.swapaxes(jnp.cross(w[:, None], jnp.swapaxes(R, -1, -2)), -1, -2)

@@ -102,21 +102,23 @@ def rnea_partials(model: Model, q: Array, v: Array, a: Array) -> tuple[Array, Ar
     j is outward of k, with Ic and Cc the sums over a body's outward set of I and of
     C = I (V x) - (V x*) I - (. x* h), the linear map that takes P3 into L. That is Carpentier and
     Mansard's (RSS 2018) composite-body form of the RNEA derivatives: the outward sums as one
-    product with the path matrix (Jerkovsky 1978 eq 1) and a few (nv, 6) by (6, 2 nv) products,
-    masked by it. The same composite inertias give the mass matrix (the composite-rigid-body algorithm,
+    inward pass (of I, I (V x) and h, of which Cc is linear), and a few (nv, 6) by (6, 2 nv)
+    products masked by the path matrix (Jerkovsky 1978 eq 1). The pass, not a product with the
+    path matrix over the body axis: under `jax.vmap` (the step Jacobians of every knot) such a
+    product transposes every (n, 6, 6) array body-major first, the largest single cost of the
+    arm's step Jacobians (benchmarks/README.md, trajopt). The same composite inertias give the mass matrix (the composite-rigid-body algorithm,
     Featherstone RBDA §6.2): M[r, c] = s_r^T Ic_r s_c for c on r's path."""
     F, kin, A = rnea_passes(model, q, v, a, None)
     I, V = kin.I, kin.V                                  # noqa: E741 (the papers' name)
     h = _times(I, V)
-    w, u, hn, hf = (skew(x) for x in (V[:, :3], V[:, 3:], h[:, :3], h[:, 3:]))
+    w, u = skew(V[:, :3]), skew(V[:, 3:])
     zero = jnp.zeros_like(w)
-    cross = jnp.block([[w, zero], [u, w]])                               # V x, (n, 6, 6)
-    by_h = jnp.block([[-hn, -hf], [-hf, zero]])                          # x -> x x* h
-    IV = unrolled_dot(I, cross)                                          # I (V x)
-    C = IV + jnp.swapaxes(IV, -1, -2) - by_h          # I (V x) - (V x*) I, as I is symmetric
+    IV = unrolled_dot(I, jnp.block([[w, zero], [u, w]]))                  # I (V x)
+    # the sums over outward sets of I, I (V x) and h: Cc = IVc + IVc^T - (. x* hc)
+    Ic, IVc, hc = _inward_sum(model, (I, IV, h))
+    hn, hf = skew(hc[:, :3]), skew(hc[:, 3:])
+    Cc = IVc + jnp.swapaxes(IVc, -1, -2) + jnp.block([[hn, hf], [hf, zero]])
     pi = model.topology.path_matrix()                    # pi[k, j] = 1: j on k's path
-    Ic, Cc = jnp.split(jnp.einsum("mk,mij->kij", pi.astype(q.dtype),
-                                  jnp.concatenate([I, C], -1)), 2, -1)   # sums over outward sets
     # per degree of freedom: its world column s and its body's quantities
     body = model.dof_body()
     s = jax.vmap(model.flat_v, in_axes=1, out_axes=1)(kin.S)             # (nv, 6)
