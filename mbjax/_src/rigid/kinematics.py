@@ -26,7 +26,7 @@ from mbjax._src.model.joints import joint_calc
 from mbjax._src.model.model import _layout
 from mbjax._src.rigid.tangents import instantiate, is_zero
 from mbjax._src.spatial import cross_motion, inertia_matrix, skew
-from mbjax._src.tree import forward_pass
+from mbjax._src.tree import forward_pass, path_sum
 
 # the joints whose motion subspace is fixed in the joint's own body: moving joint j along one of
 # its columns moves j's outward set rigidly about that screw (a universal joint's first axis is
@@ -86,10 +86,7 @@ def _poses_jvp(primals, tangents):
     dR, dp = jnp.zeros_like(R), jnp.zeros_like(p)
     if not is_zero(dq):
         S = to_ground(R, p, S_local)
-        # xi = pi (S e) (Jerkovsky 1978 eq 1) as an outward pass: a product with pi over the
-        # body axis would transpose the columns body-major under `jax.vmap`
-        twist = forward_pass(model.topology, lambda parent, own: parent + own,
-                             jnp.zeros(6, q.dtype), columns(S, joint_increments(model, q, still, dq)))
+        twist = path_sum(model.topology, columns(S, joint_increments(model, q, still, dq)))
         w = twist[:, :3]
         # w x each column of R
         dR = jnp.swapaxes(jnp.cross(w[:, None], jnp.swapaxes(R, -1, -2)), -1, -2)

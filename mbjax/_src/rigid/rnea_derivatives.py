@@ -38,7 +38,7 @@ from mbjax._src.model import Model
 from mbjax._src.rigid.kinematics import columns, fixed_in_body, gravity_acceleration, joint_increments
 from mbjax._src.rigid.rnea import rnea_passes
 from mbjax._src.spatial import cross_force, cross_motion, skew
-from mbjax._src.tree import backward_pass, forward_pass
+from mbjax._src.tree import backward_pass, forward_pass, outward_sum
 from mbjax._src.tree.take import take
 
 def applies(model: Model) -> bool:
@@ -101,12 +101,9 @@ def rnea_partials(model: Model, q: Array, v: Array, a: Array) -> tuple[Array, Ar
     Ic_k g2_j + Cc_k g3_j when j is on k's path (k included) and Ic_j g2_j + Cc_j g3_j + o_j when
     j is outward of k, with Ic and Cc the sums over a body's outward set of I and of
     C = I (V x) - (V x*) I - (. x* h), the linear map that takes P3 into L. That is Carpentier and
-    Mansard's (RSS 2018) composite-body form of the RNEA derivatives: the outward sums as one
-    inward pass (of I, I (V x) and h, of which Cc is linear), and a few (nv, 6) by (6, 2 nv)
-    products masked by the path matrix (Jerkovsky 1978 eq 1). The pass, not a product with the
-    path matrix over the body axis: under `jax.vmap` (the step Jacobians of every knot) such a
-    product transposes every (n, 6, 6) array body-major first, the largest single cost of the
-    arm's step Jacobians (benchmarks/README.md, trajopt). The same composite inertias give the mass matrix (the composite-rigid-body algorithm,
+    Mansard's (RSS 2018) composite-body form of the RNEA derivatives: the outward sums of I,
+    I (V x) and h (of which Cc is linear) by `tree.outward_sum`, and a few (nv, 6) by (6, 2 nv)
+    products masked by the path matrix (Jerkovsky 1978 eq 1). The same composite inertias give the mass matrix (the composite-rigid-body algorithm,
     Featherstone RBDA §6.2): M[r, c] = s_r^T Ic_r s_c for c on r's path."""
     F, kin, A = rnea_passes(model, q, v, a, None)
     I, V = kin.I, kin.V                                  # noqa: E741 (the papers' name)
@@ -115,7 +112,7 @@ def rnea_partials(model: Model, q: Array, v: Array, a: Array) -> tuple[Array, Ar
     zero = jnp.zeros_like(w)
     IV = unrolled_dot(I, jnp.block([[w, zero], [u, w]]))                  # I (V x)
     # the sums over outward sets of I, I (V x) and h: Cc = IVc + IVc^T - (. x* hc)
-    Ic, IVc, hc = _inward_sum(model, (I, IV, h))
+    Ic, IVc, hc = outward_sum(model.topology, (I, IV, h))
     hn, hf = skew(hc[:, :3]), skew(hc[:, 3:])
     Cc = IVc + jnp.swapaxes(IVc, -1, -2) + jnp.block([[hn, hf], [hf, zero]])
     pi = model.topology.path_matrix()                    # pi[k, j] = 1: j on k's path

@@ -145,3 +145,28 @@ def backward_pass(topology: Topology, f: Callable, init, inputs=None):
 
     received, outs = jax.lax.scan(level, (received, outs), (order, write, send, step_inputs))[0]
     return outs, _rows(received, n)
+
+
+def path_sum(topology: Topology, x):
+    """pi x (Jerkovsky 1978 eq 1): for each body, the sum of x (n, ...) over its path from the
+    ground, itself included (x a pytree of such arrays).
+
+    An outward pass for a chain (a carry-only scan), a product with the path matrix for a
+    branched tree. Under `jax.vmap` (a horizon's knots, a Jacobian's directions) the product
+    first transposes x body-major, which costs a chain more than the pass; the pass's indexed
+    rows cost a tree more than the product (benchmarks/README.md, trajopt)."""
+    if _is_chain(topology):
+        return forward_pass(topology, lambda parent, own: jax.tree.map(jnp.add, parent, own),
+                            jax.tree.map(lambda a: jnp.zeros(a.shape[1:], a.dtype), x), x)
+    pi = topology.path_matrix()
+    return jax.tree.map(lambda a: jnp.tensordot(pi.astype(a.dtype), a, 1), x)
+
+
+def outward_sum(topology: Topology, x):
+    """pi^T x: for each body, the sum of x (n, ...) over its outward set, itself included (an
+    inward pass for a chain, a product with the path matrix for a branched tree; see
+    `path_sum`)."""
+    if _is_chain(topology):
+        return backward_pass(topology, lambda received, _: (received, received), x)[0]
+    pi = topology.path_matrix()
+    return jax.tree.map(lambda a: jnp.tensordot(pi.T.astype(a.dtype), a, 1), x)
