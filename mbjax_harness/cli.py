@@ -9,8 +9,10 @@ Every long command shows a running clock on stderr and ends by naming the files 
 peers it skipped (and why).
 
 Compiled programs are kept on disk between runs (`mbjax._src.cache`; `mbjax --no-cache ...` or
-MBJAX_NO_CACHE=1 turns that off), except by `mbjax bench`, which times the compiles. Unknown
-names and bad options exit with status 2 and list the valid choices.
+MBJAX_NO_CACHE=1 turns that off), except by `mbjax bench`, which times the compiles. Outputs are
+written whole or not at all (`mbjax_harness.outputs`): an interrupted run leaves the previous
+run's files. Unknown names, bad options and an output or cache folder that cannot be written
+exit with status 2 and a one-line reason.
 """
 
 import argparse
@@ -20,6 +22,8 @@ import re
 import sys
 from functools import partial
 from pathlib import Path
+
+from mbjax_harness.outputs import OutputError, staged
 
 
 def _parser(reproductions, suites, scenes) -> argparse.ArgumentParser:
@@ -126,13 +130,14 @@ def _tour(out: Path, quick: bool, scenes=None, jobs=None) -> None:
     from mbjax_harness.tour import COST, TOUR, run_scene
 
     names = [name for name in TOUR if not scenes or name in scenes]
-    out.mkdir(parents=True, exist_ok=True)
     # side by side, the longest first balances the workers; one at a time, the summary's order
     order = names if jobs == 1 else sorted(names, key=lambda name: -COST.get(name, 0.0))
-    results = parallel.run(partial(run_scene, out=out, quick=quick), order, jobs, "mbjax tour")
-    summary = {"quick": quick, "scenes": {name: results[name] for name in names}}
-    (out / "summary.json").write_text(json.dumps(summary, indent=1))
-    (out / "summary.md").write_text(_summary_markdown(summary))
+    with staged(out) as staging:
+        results = parallel.run(partial(run_scene, out=staging, quick=quick), order, jobs,
+                               "mbjax tour")
+        summary = {"quick": quick, "scenes": {name: results[name] for name in names}}
+        (staging / "summary.json").write_text(json.dumps(summary, indent=1))
+        (staging / "summary.md").write_text(_summary_markdown(summary))
     files = [f for s in summary["scenes"].values() for f in (s["figure"], s.get("animation")) if f]
     _report([out / "summary.json", out / "summary.md", *(out / f for f in files)], summary)
 
@@ -241,41 +246,59 @@ def main(argv=None) -> int:
 
     jax.config.update("jax_enable_x64", True)
     from mbjax_harness.bench import SUITES
-    from mbjax._src.cache import use_compilation_cache
     from mbjax_harness.reproduce import REPRODUCTIONS
 
     from mbjax_harness.tour import TOUR
 
     parser = _parser(REPRODUCTIONS, SUITES, TOUR)
     args = parser.parse_args(argv)
+    try:
+        return _run(parser, args, REPRODUCTIONS, SUITES, TOUR)
+    except OutputError as error:
+        print(f"mbjax: error: --out: {error}", file=sys.stderr)
+        return 2
+
+
+def _run(parser, args, reproductions: dict, suites: dict, scenes: dict) -> int:
+    """The parsed command `args`; its exit status."""
+    from mbjax._src.cache import use_compilation_cache
+
     if not args.no_cache and args.command != "bench":   # benchmarks time the compiles themselves
-        use_compilation_cache()
+        try:
+            use_compilation_cache()
+        except OSError as error:
+            print(f"mbjax: error: the compilation cache's folder ({error.filename}) cannot be "
+                  f"written: {error.strerror or error}; set JAX_COMPILATION_CACHE_DIR or run "
+                  "mbjax --no-cache", file=sys.stderr)
+            return 2
     if args.command == "bench" and args.suite in ("throughput", "trajopt"):
         _one_device_per_core()
     from mbjax_harness.progress import progress
 
     if args.command == "tour":
         if args.list:
-            print(_listing(TOUR))
+            print(_listing(scenes))
             return 0
         _tour(args.out, args.quick, args.scene, args.jobs)
     elif args.command == "reproduce":
         if args.list:
-            print(_listing(REPRODUCTIONS))
+            print(_listing(reproductions))
             return 0
         if args.name is None:
-            parser.error(f"reproduce needs a NAME, one of: {', '.join(sorted(REPRODUCTIONS))}")
-        for name in progress([args.name], 1, "mbjax reproduce"):     # a running clock
-            data = REPRODUCTIONS[name](args.out, quick=args.quick)
+            parser.error(f"reproduce needs a NAME, one of: {', '.join(sorted(reproductions))}")
+        with staged(args.out) as staging:
+            for name in progress([args.name], 1, "mbjax reproduce"):     # a running clock
+                data = reproductions[name](staging, quick=args.quick)
         _report([args.out / f"{args.name}.json", args.out / f"{args.name}.png"], data)
     elif args.command == "bench":
         if args.list:
-            print(_listing(SUITES))
+            print(_listing(suites))
             return 0
         if args.suite is None:
-            parser.error(f"bench needs a SUITE, one of: {', '.join(sorted(SUITES))}")
-        for name in progress([args.suite], 1, "mbjax bench"):
-            records = SUITES[name](args.out, quick=args.quick)
+            parser.error(f"bench needs a SUITE, one of: {', '.join(sorted(suites))}")
+        with staged(args.out) as staging:
+            for name in progress([args.suite], 1, "mbjax bench"):
+                records = suites[name](staging, quick=args.quick)
         _report([args.out / f"{args.suite}.jsonl", args.out / f"{args.suite}.png"], records)
     return 0
 
