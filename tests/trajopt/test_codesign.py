@@ -27,3 +27,18 @@ def test_optimal_cost_gradient_matches_differences_of_re_solved_problems():
                - float(optimal_cost(_build, mass - h, SOLVER))) / (2 * h)
     assert abs(float(grad)) > 1e-4                     # the design matters
     assert abs(float(grad) - central) < 1e-3 * abs(central)
+
+
+def test_an_unconverged_optimum_raises_by_default_and_is_returned_with_throw_false():
+    """The envelope theorem holds at the optimum only: a solve stopped after 2 iterations
+    (status not converged) raises, naming it, under `jax.grad` too; throw=False returns the
+    cost it reached, the solve's own."""
+    import pytest
+
+    mass = jnp.asarray(float(scene.model().mass[3]))
+    early = ILQR(iterations=2)
+    assert solve(_build(mass), early).messages() != ["success"]
+    with pytest.raises(eqx.EquinoxRuntimeError, match="not converged"):
+        jax.grad(lambda m: optimal_cost(_build, m, early))(mass)
+    cost = optimal_cost(_build, mass, early, throw=False)
+    assert float(cost) == float(solve(_build(mass), early).cost)

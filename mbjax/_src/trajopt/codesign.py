@@ -25,13 +25,14 @@ from mbjax._src.trajopt.solve import solve
 
 
 def optimal_cost(build: Callable[..., Problem], theta, solver: AbstractSolver = ILQR(),
-                 us0: Array | None = None) -> Array:
+                 us0: Array | None = None, throw: bool = True) -> Array:
     """The optimal cost J*(theta) of a design, differentiable by the envelope theorem.
 
     `jax.grad` of it with respect to theta is dJ/dtheta at the solved controls (see the
     module), one reverse pass through the rollout; the solver's iterations are never
-    differentiated. Check the solve's status (`solve(build(theta), solver, us0)`) before
-    trusting either.
+    differentiated. The envelope theorem needs the optimum: by default a solve that failed
+    (not converged, non-finite) raises, naming the failure, instead of returning a cost and a
+    gradient that are not the optimum's.
 
     Args:
         build: a function of the design returning its `Problem`; the control bounds must not
@@ -40,17 +41,23 @@ def optimal_cost(build: Callable[..., Problem], theta, solver: AbstractSolver = 
             state).
         solver: the solver strategy.
         us0: the first guess, shape (horizon, nu); None for zeros.
+        throw: raise if the solve failed (default); False returns the cost the solver reached
+            whatever its status (`solve(build(theta), solver, us0).status` tells it).
 
     Returns:
         The cost the solver reaches, a scalar.
+
+    Raises:
+        equinox.EquinoxRuntimeError: with throw=True, the solve failed (under `jax.jit` and
+            `jax.vmap` too).
     """
 
     @jax.custom_vjp
     def value(theta):
-        return solve(build(theta), solver, us0).cost
+        return solve(build(theta), solver, us0, throw=throw).cost
 
     def forward(theta):
-        result = solve(build(theta), solver, us0)
+        result = solve(build(theta), solver, us0, throw=throw)
         return result.cost, (theta, result.us)
 
     def backward(residuals, cotangent):
