@@ -161,3 +161,23 @@ def test_wrist_external_wrench_through_the_newton_euler_jacobians():
     R = wrist.forward_kinematics(theta).rotation
     np.testing.assert_allclose(elsewhere.torques(0.0, theta, jnp.zeros(3)),
                                J_v.T @ F + J_omega.T @ (n + jnp.cross(R @ lever, F)), rtol=1e-12)
+
+
+def test_pd_checks_its_indices_and_gains_against_the_state():
+    """An index past the state (a gather would clamp it and servo the last coordinate), a gain
+    of the wrong length and a servo of every coordinate on a floating base (nq != nv) are named
+    errors, inside a simulation too; negative indices count from the end, as in NumPy."""
+    q, v = jnp.array([0.1, 0.2, 0.3, 0.4]), jnp.array([1.0, 2.0, 3.0])
+    with pytest.raises(ValueError, match=r"q_index \[4\] out of range for a state of 4"):
+        PD(1.0, 1.0, 0.0, q_index=[1, 4], v_index=[0, 1])(0.0, q, v)
+    with pytest.raises(ValueError, match=r"v_index \[3\] out of range for a state of 3"):
+        PD(1.0, 1.0, 0.0, q_index=[1, 2], v_index=[0, 3])(0.0, q, v)
+    with pytest.raises(ValueError, match=r"kp must be a scalar or have shape \(2,\).*\(3,\)"):
+        PD(jnp.ones(3), 1.0, 0.0, q_index=[1, 2], v_index=[0, 1])(0.0, q, v)
+    with pytest.raises(ValueError, match="nq == nv.*nq = 4, nv = 3"):
+        PD(1.0, 1.0, 0.0)(0.0, q, v)
+    np.testing.assert_allclose(PD(2.0, 0.0, 0.0, q_index=[-1], v_index=[-1])(0.0, q, v), [-0.8])
+    model = chain(3)
+    system = TreeSystem(model, PD(jnp.full(4, 10.0), 1.0, 0.0))               # 4 gains, 3 joints
+    with pytest.raises(ValueError, match=r"kp must be a scalar or have shape \(3,\)"):
+        simulate(system, RK4(), model.neutral(), jnp.zeros(3), dt=0.01, t1=0.02)

@@ -126,3 +126,18 @@ def test_epsilon_dynamics_keeps_the_velocity_error_at_epsilon_times_the_loads():
     rates = jax.jit(jax.vmap(LOOPS.rate))(sol.qs, sol.us[:, :3])
     np.testing.assert_allclose(rates, 1e-2 * sol.us[:, 3:], atol=1e-9)
     assert float(jnp.abs(sol.us[-1, 3:]).max()) > 1.0        # the loads did act
+
+
+def test_a_velocity_state_of_the_wrong_length_is_a_named_error():
+    """simulate checks u against the method's state: v (nv,) for the coupled method, (v, f_c)
+    (nv + m,) for Stabilized(epsilon > 0)."""
+    nv = MODEL.nv
+    with pytest.raises(ValueError, match=rf"u0.*\({nv},\)"):
+        simulate(SYSTEM, RK4(), Q0, jnp.zeros(nv + 1), dt=1e-3, t1=2e-3)
+    epsilon = ClosedSystem(TREE, SYSTEM.closures, Stabilized(epsilon=1e-2))
+    m = LOOPS.m
+    assert epsilon.state_sizes() == (MODEL.nq, nv + m)
+    with pytest.raises(ValueError, match=rf"u0.*\({nv + m},\)"):
+        simulate(epsilon, RK4(), Q0, V0, dt=1e-3, t1=2e-3)           # v without the loads
+    u0 = epsilon.initial_state(Q0, V0)
+    assert simulate(epsilon, RK4(), Q0, u0, dt=1e-3, t1=2e-3).us.shape[-1] == nv + m

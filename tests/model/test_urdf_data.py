@@ -227,8 +227,15 @@ def test_state_converters_round_trip_and_layout():
         q2, v2 = back(model, *to(model, q, v))
         np.testing.assert_allclose(q2, q, atol=1e-15)
         np.testing.assert_allclose(v2, v, atol=1e-15)
-    with pytest.raises(ValueError, match="must have 10 and 8 entries for this model, got 9 and 8"):
+    with pytest.raises(ValueError, match=r"shapes \(10,\) and \(8,\).*got \(9,\) and \(8,\)"):
         mbjax.model.state_from_pinocchio(model, q, v)
+    # every direction checks both lengths (a gather would clamp a short state's indices)
+    for convert in (mbjax.model.state_to_pinocchio, mbjax.model.state_to_mujoco,
+                    mbjax.model.state_from_mujoco):
+        with pytest.raises(ValueError, match=r"shapes \(9,\) and \(8,\).*got \(8,\) and \(8,\)"):
+            convert(model, q[:-1], v)
+        with pytest.raises(ValueError, match=r"got \(9,\) and \(9,\)"):
+            convert(model, q, jnp.concatenate([v, v[:1]]))
 
 
 def test_floating_base_against_mujoco_free_joint_layout():

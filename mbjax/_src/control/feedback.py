@@ -32,7 +32,9 @@ class PD(AbstractControl):
             q_index.
 
     Raises:
-        ValueError: only one of q_index and v_index is given, or they differ in length.
+        ValueError: only one of q_index and v_index is given, or they differ in length; when
+            called, an index outside the state, a gain or target neither a scalar nor one per
+            servoed coordinate, or no indices where nq != nv.
     """
 
     kp: Array
@@ -53,9 +55,32 @@ class PD(AbstractControl):
                              f"coordinate; got {self.q_index} and {self.v_index}")
 
     def __call__(self, t, q, v):
+        self._check(q.shape[0], v.shape[0])
         if self.q_index is not None:
             q, v = q[jnp.array(self.q_index)], v[jnp.array(self.v_index)]
         return self.kp * (self.q_ref - q) + self.kd * (self.v_ref - v) + self.feedforward
+
+    def _check(self, nq: int, nv: int) -> None:
+        """Indices within the state (a gather would clamp them, servoing another coordinate)
+        and every gain and target a scalar or one per servoed coordinate."""
+        if self.q_index is None:
+            if nq != nv:
+                raise ValueError(f"PD without q_index and v_index servoes every coordinate, which "
+                                 f"needs nq == nv; this system has nq = {nq}, nv = {nv} (a "
+                                 "floating base?): give q_index and v_index")
+            m = nq
+        else:
+            for name, index, n in (("q_index", self.q_index, nq), ("v_index", self.v_index, nv)):
+                outside = [i for i in index if not -n <= i < n]
+                if outside:
+                    raise ValueError(f"PD's {name} {outside} out of range for a state of {n} "
+                                     f"coordinates (valid: 0 ... {n - 1})")
+            m = len(self.q_index)
+        for name in ("kp", "kd", "q_ref", "v_ref", "feedforward"):
+            shape = getattr(self, name).shape
+            if shape not in ((), (1,), (m,)):
+                raise ValueError(f"PD's {name} must be a scalar or have shape ({m},), one per "
+                                 f"servoed coordinate, got shape {shape}")
 
 
 class MLPPolicy(AbstractControl):

@@ -38,6 +38,10 @@ class AbstractLoopMethod(eqx.Module):
         """The state u for joint velocities v, shape (nv,) (v by default)."""
         return v
 
+    def state_size(self, loops) -> int | None:
+        """The length of u (the tree's nv by default; None where the tree does not say)."""
+        return loops.tree.state_sizes()[1]
+
     @abc.abstractmethod
     def acceleration(self, loops, t: Array, q: Array, u: Array) -> Array:
         """u_dot, the shape of u.

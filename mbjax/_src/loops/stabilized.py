@@ -95,6 +95,11 @@ class Stabilized(AbstractLoopMethod):
     def with_velocity(self, loops, q, u, v):
         return v if self.epsilon == 0.0 else jnp.concatenate([v, u[loops.tree.nv:]])
 
+    def state_size(self, loops) -> int | None:
+        """nv, and the m loads for epsilon > 0."""
+        nv = loops.tree.state_sizes()[1]
+        return nv if self.epsilon == 0.0 or nv is None else nv + loops.m
+
     def initial_state(self, loops, q, v, t, consistent):
         """v, and for epsilon > 0 the load state: with consistent=True the algebraic loads of
         eq 93 at epsilon = 0, so that the error A v + B stays epsilon times the change of the

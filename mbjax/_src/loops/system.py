@@ -192,8 +192,9 @@ class ClosedSystem(AbstractSystem):
         return self.tree.normalize(q)
 
     def state_sizes(self):
-        """The tree's nq; u is the method's (`Stabilized(epsilon > 0)` adds the loads to v)."""
-        return self.tree.nq, None
+        """The tree's nq and the length of the method's u (`Stabilized(epsilon > 0)` adds the
+        loads to v)."""
+        return self.tree.nq, self.method.state_size(self.loops)
 
     @property
     def n_controls(self) -> int:

@@ -36,12 +36,17 @@ from mbjax._src.model.model import Model
 _XYZW = (1, 2, 3, 0)           # Pinocchio's quaternion (x, y, z, w) from mbjax's (w, x, y, z)
 
 
-def _check(model: Model, q: Array, v: Array, peer: str) -> tuple[Array, Array]:
+def _check(model: Model, q: Array, v: Array, peer: str, nq: int) -> tuple[Array, Array]:
+    """q and v as arrays of shapes (nq,) and (model.nv,) (nq: the layout they are given in),
+    on a model whose joints the peer has."""
     q, v = jnp.asarray(q), jnp.asarray(v)
     for k, kind in enumerate(model.joint_types):
         if kind == "universal":
             raise ValueError(f"joint {model.joint_names[k]!r} is universal: {peer} has no such "
                              "joint (make it two revolute joints)")
+    if q.shape != (nq,) or v.shape != (model.nv,):
+        raise ValueError(f"q and v must have shapes ({nq},) and ({model.nv},) for this model in "
+                         f"this layout, got {q.shape} and {v.shape}; use jax.vmap for batches")
     return q, v
 
 
@@ -103,10 +108,11 @@ def state_to_pinocchio(model: Model, q: Array, v: Array) -> tuple[Array, Array]:
         v_pin: Pinocchio's velocity, shape (nv,).
 
     Raises:
-        ValueError: the model has a universal joint (Pinocchio has none).
+        ValueError: the model has a universal joint (Pinocchio has none), or q and v have the
+            wrong shapes.
         TypeError: the model's limits are traced.
     """
-    q, v = _check(model, q, v, "Pinocchio")
+    q, v = _check(model, q, v, "Pinocchio", model.nq)
     lay = _pinocchio_layout(model.joint_types, _continuous(model))
     q_pin = (jnp.zeros(lay["nq"], q.dtype).at[lay["dst"]].set(q[lay["src"]])
              .at[lay["cos"]].set(jnp.cos(q[lay["angle"]]))
@@ -130,11 +136,8 @@ def state_from_pinocchio(model: Model, q: Array, v: Array) -> tuple[Array, Array
         ValueError: the model has a universal joint, or q and v have the wrong sizes.
         TypeError: the model's limits are traced.
     """
-    q, v = _check(model, q, v, "Pinocchio")
     lay = _pinocchio_layout(model.joint_types, _continuous(model))
-    if q.shape != (lay["nq"],) or v.shape != (model.nv,):
-        raise ValueError(f"Pinocchio q and v must have {lay['nq']} and {model.nv} entries for "
-                         f"this model, got {q.shape[0]} and {v.shape[0]}")
+    q, v = _check(model, q, v, "Pinocchio", lay["nq"])
     q_mb = (jnp.zeros(model.nq, q.dtype).at[lay["src"]].set(q[lay["dst"]])
             .at[lay["angle"]].set(jnp.arctan2(q[lay["sin"]], q[lay["cos"]])))
     return q_mb, v[lay["v_dst"]]
@@ -191,9 +194,9 @@ def state_to_mujoco(model: Model, q: Array, v: Array) -> tuple[Array, Array]:
 
     Raises:
         ValueError: the model has a universal joint, or a free joint on a body that does not
-            hang from the world (MuJoCo allows neither).
+            hang from the world (MuJoCo allows neither), or q and v have the wrong shapes.
     """
-    q, v = _check(model, q, v, "MuJoCo")
+    q, v = _check(model, q, v, "MuJoCo", model.nq)
     return q, _mujoco_velocity(model, q, v, to_world=True)
 
 
@@ -211,7 +214,7 @@ def state_from_mujoco(model: Model, q: Array, v: Array) -> tuple[Array, Array]:
 
     Raises:
         ValueError: the model has a universal joint, or a free joint on a body that does not
-            hang from the world.
+            hang from the world, or q and v have the wrong shapes.
     """
-    q, v = _check(model, q, v, "MuJoCo")
+    q, v = _check(model, q, v, "MuJoCo", model.nq)
     return q, _mujoco_velocity(model, q, v, to_world=False)
