@@ -68,7 +68,7 @@ def test_what_trajectory_optimisation_asks_of_any_system():
     assert tree.state_sizes() == (3, 3) and tree.n_controls == 2
     assert tree.with_control(Constant(jnp.ones(2))).control.value.tolist() == [1.0, 1.0]
     closed, q0, v0 = four_bar.build()
-    assert closed.state_sizes() == (3, None) and closed.n_controls == 3
+    assert closed.state_sizes() == (3, 3) and closed.n_controls == 3     # u is checked too
     driven = closed.with_control(Constant(jnp.ones(3)))
     assert driven.tree.control is not None and closed.tree.control is None
     problem = Problem(closed, q0, v0, dt=0.01, horizon=2, running=lambda q, v, u: u,

@@ -212,3 +212,21 @@ def test_a_batch_split_over_two_devices_equals_single_solves():
     result = json.loads(out.stdout.strip().splitlines()[-1])
     assert result["devices"] == 2
     assert result["us"] < 1e-9 and result["iterations"] == [0] * 5
+
+
+def test_a_cost_undefined_over_part_of_the_controls_is_not_reported_converged():
+    """The slider's cost made NaN wherever a control passes 0.5 N (as sqrt(0.5 - u) would):
+    the unconstrained optimum lies beyond, so the line search's longer steps meet NaN and the
+    accepted short ones change the cost little. That is not convergence: the status says not
+    converged and names the non-finite cost, and the cost stays finite; the same problem with
+    an ordinary cost converges with success."""
+    optimum = solve(_slider_problem(), ILQR())
+    assert optimum.messages() == ["success"] and float(jnp.max(optimum.us)) > 0.5
+    problem = _slider_problem()
+    nan_beyond = eqx.tree_at(
+        lambda p: p.running, problem,
+        lambda q, v, u: problem.running(q, v, u) + jnp.where(u[0] > 0.5, jnp.nan, 0.0))
+    result = solve(nan_beyond, ILQR(iterations=50))
+    assert not bool(result.ok)
+    assert "not converged" in result.messages()[0] and "nonfinite" in result.messages()[0]
+    assert bool(jnp.isfinite(result.cost)) and float(jnp.max(result.us)) <= 0.5

@@ -37,7 +37,10 @@ defaults on the acrobot with RK4 steps); see benchmarks/README.md.
 
 The iterations are one `lax.while_loop`, so `solve` compiles once. It stops with success when an
 accepted step lowers the cost by less than `tolerance` relative to it (or the model predicts
-less), and with NOT_CONVERGED when `iterations` run out or mu passes its ceiling.
+less), and with NOT_CONVERGED when `iterations` run out or mu passes its ceiling. A step cut
+short because a longer one's cost was not finite (a cost or dynamics undefined over part of
+the controls) does not count as converged, however small its change: where a solve stops
+unconverged with its last line search cut short so, its status adds NONFINITE.
 """
 
 import equinox as eqx
@@ -158,6 +161,7 @@ class ILQR(AbstractIterativeSolver):
         N, nx, nu = problem.horizon, problem.ndx, problem.nu
         return dict(xs=xs, us=us, cost=cost, mu=jnp.asarray(self.regularization, cost.dtype),
                     iteration=jnp.array(0), done=jnp.array(False), stalled=jnp.array(False),
+                    met_nonfinite=jnp.array(False),
                     costs=history(self.iterations + 1, cost),
                     K=jnp.zeros((N, nu, nx), cost.dtype), stale=jnp.array(True),
                     expansion=jax.tree.map(lambda a: jnp.zeros(a.shape, a.dtype), jax.eval_shape(
@@ -178,28 +182,30 @@ class ILQR(AbstractIterativeSolver):
         k, K, decrease, ok = self._backward(problem, expansion, s["us"], s["mu"])
 
         def acceptable(trial):
-            _, _, cost, i = trial
+            _, _, cost, i, _ = trial
             alpha = alphas[jnp.maximum(i - 1, 0)]
             predicted = -(alpha * decrease[0] + alpha**2 * decrease[1])
             decreased = s["cost"] - cost > self.acceptance * predicted
             return (i > 0) & jnp.isfinite(cost) & decreased
 
         def next_step(trial):                          # the longest acceptable step first
-            i = trial[3]
-            return (*self._forward(problem, s["xs"], s["us"], k, K, alphas[i]), i + 1)
+            i, blocked = trial[3], trial[4]
+            xs, us, cost = self._forward(problem, s["xs"], s["us"], k, K, alphas[i])
+            return xs, us, cost, i + 1, blocked | ~jnp.isfinite(cost)
 
-        first = (s["xs"], s["us"], s["cost"], jnp.array(0))
-        xs, us, cost, tried = jax.lax.while_loop(
+        first = (s["xs"], s["us"], s["cost"], jnp.array(0), jnp.array(False))
+        xs, us, cost, tried, blocked = jax.lax.while_loop(
             lambda t: ok & ~acceptable(t) & (t[3] < len(self.steps)), next_step, first)
-        accept = ok & acceptable((xs, us, cost, tried))
+        accept = ok & acceptable((xs, us, cost, tried, blocked))
         xs, us, cost = (jnp.where(accept, new, old) for new, old in
                         zip((xs, us, cost), (s["xs"], s["us"], s["cost"]), strict=True))
         change = s["cost"] - cost
         # stationary: the model, not shrunk by a raised regularization, predicts a
-        # negligible decrease, or an accepted step made one
+        # negligible decrease, or an accepted step made one, unless a longer step's cost was
+        # not finite (the step was cut short by the non-finite region, not by the optimum)
         converged = ((ok & (s["mu"] <= self.regularization)
                       & (-decrease[0] <= self.tolerance * jnp.abs(s["cost"])))
-                     | (accept & (change <= self.tolerance * jnp.abs(cost))))
+                     | (accept & ~blocked & (change <= self.tolerance * jnp.abs(cost))))
         taken = alphas[jnp.maximum(tried - 1, 0)]
         mu = jnp.where(accept & (taken > self.shrink_above),
                        jnp.maximum(s["mu"] / MU_FACTOR, MU_MIN),
@@ -209,11 +215,15 @@ class ILQR(AbstractIterativeSolver):
         # a rejected step leaves the trajectory, and so its expansion, as they were
         return dict(xs=xs, us=us, cost=cost, mu=mu, iteration=i, done=converged,
                     stalled=mu > MU_MAX, costs=s["costs"].at[i].set(cost),
-                    K=jnp.where(accept, K, s["K"]), expansion=expansion, stale=accept)
+                    K=jnp.where(accept, K, s["K"]), expansion=expansion, stale=accept,
+                    met_nonfinite=blocked)
 
     def result(self, problem: Problem, s: dict) -> Result:
         """The `Result` of the iteration's state s."""
-        finite = jnp.isfinite(s["cost"]) & jnp.all(jnp.isfinite(s["xs"]))
+        # NONFINITE also where it stopped unconverged with its last line search cut short by
+        # a non-finite cost (the region it could not step into is what stopped it)
+        finite = (jnp.isfinite(s["cost"]) & jnp.all(jnp.isfinite(s["xs"]))
+                  & (s["done"] | ~s["met_nonfinite"]))
         status = (jnp.where(s["done"], 0, int(Status.NOT_CONVERGED))
                   | jnp.where(finite, 0, int(Status.NONFINITE)))
         q, v = problem.split(s["xs"])
