@@ -38,7 +38,7 @@ def test_an_unconverged_optimum_raises_by_default_and_is_returned_with_throw_fal
     mass = jnp.asarray(float(scene.model().mass[3]))
     early = ILQR(iterations=2)
     assert solve(_build(mass), early).messages() != ["success"]
-    with pytest.raises(eqx.EquinoxRuntimeError, match="the run failed with status"):
+    with pytest.raises(eqx.EquinoxRuntimeError, match="not converged"):
         jax.grad(lambda m: optimal_cost(_build, m, early))(mass)
     cost = optimal_cost(_build, mass, early, throw=False)
     assert float(cost) == float(solve(_build(mass), early).cost)

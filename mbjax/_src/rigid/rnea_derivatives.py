@@ -103,8 +103,9 @@ def rnea_partials(model: Model, q: Array, v: Array, a: Array) -> tuple[Array, Ar
     C = I (V x) - (V x*) I - (. x* h), the linear map that takes P3 into L. That is Carpentier and
     Mansard's (RSS 2018) composite-body form of the RNEA derivatives: the outward sums of I,
     I (V x) and h (of which Cc is linear) by `tree.outward_sum`, and a few (nv, 6) by (6, 2 nv)
-    products masked by the path matrix (Jerkovsky 1978 eq 1). The same composite inertias give the mass matrix (the composite-rigid-body algorithm,
-    Featherstone RBDA §6.2): M[r, c] = s_r^T Ic_r s_c for c on r's path."""
+    products masked by the path matrix (Jerkovsky 1978 eq 1). The same composite inertias give
+    the mass matrix (the composite-rigid-body algorithm, Featherstone RBDA §6.2):
+    M[r, c] = s_r^T Ic_r s_c for c on r's path."""
     F, kin, A = rnea_passes(model, q, v, a, None)
     I, V = kin.I, kin.V                                  # noqa: E741 (the papers' name)
     h = _times(I, V)

@@ -40,7 +40,8 @@ accepted step lowers the cost by less than `tolerance` relative to it (or the mo
 less), and with NOT_CONVERGED when `iterations` run out or mu passes its ceiling. A step cut
 short because a longer one's cost was not finite (a cost or dynamics undefined over part of
 the controls) does not count as converged, however small its change: where a solve stops
-unconverged with its last line search cut short so, its status adds NONFINITE.
+unconverged after an iteration that a non-finite cost kept from progressing (no acceptable
+step, or one changing the cost by less than the tolerance), its status adds NONFINITE.
 """
 
 import equinox as eqx
@@ -216,12 +217,12 @@ class ILQR(AbstractIterativeSolver):
         return dict(xs=xs, us=us, cost=cost, mu=mu, iteration=i, done=converged,
                     stalled=mu > MU_MAX, costs=s["costs"].at[i].set(cost),
                     K=jnp.where(accept, K, s["K"]), expansion=expansion, stale=accept,
-                    met_nonfinite=blocked)
+                    met_nonfinite=blocked & ~(accept & (change > self.tolerance * jnp.abs(cost))))
 
     def result(self, problem: Problem, s: dict) -> Result:
         """The `Result` of the iteration's state s."""
-        # NONFINITE also where it stopped unconverged with its last line search cut short by
-        # a non-finite cost (the region it could not step into is what stopped it)
+        # NONFINITE also where it stopped unconverged after an iteration that a non-finite
+        # cost kept from progressing (the region it could not step into is what stopped it)
         finite = (jnp.isfinite(s["cost"]) & jnp.all(jnp.isfinite(s["xs"]))
                   & (s["done"] | ~s["met_nonfinite"]))
         status = (jnp.where(s["done"], 0, int(Status.NOT_CONVERGED))

@@ -17,8 +17,8 @@ class Result(WithStatus):
 
     The status is success when the solver's convergence test passed, NOT_CONVERGED when it ran
     out of iterations or could not make progress, NONFINITE when the cost or the trajectory
-    blew up (for `ILQR` also when it stopped unconverged with its last line search cut short
-    by a non-finite cost). N is the problem's horizon, nx = nq + nv.
+    blew up (for `ILQR` also when it stopped unconverged after an iteration that a non-finite
+    cost kept from progressing). N is the problem's horizon, nx = nq + nv.
 
     Args:
         qs: configurations, shape (N + 1, nq).
