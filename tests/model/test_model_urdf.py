@@ -450,3 +450,22 @@ def test_malformed_urdf_numbers_are_refused_by_name_or_read_exactly():
             assert np.all(np.isfinite(np.asarray(model.inertia[0])))
 
     check()
+
+
+def test_a_revolute_joint_without_limit_loads_unlimited_with_a_warning():
+    """URDF requires <limit> on revolute and prismatic joints, and its lower and upper default
+    to 0: read literally, a joint without it could not move, and every run would report its
+    limit exceeded. It loads without position limits, as MuJoCo's URDF import reads it, with a
+    warning naming the joint (an error with strict=True); a <limit> element keeps its meaning."""
+    no_limit = GOOD.replace(LIMIT, "")
+    with pytest.warns(ModelWarning, match="joint 'j' \\(revolute\\) has no <limit>"):
+        model = mbjax.load_urdf(no_limit)
+    assert np.isneginf(model.lower).all() and np.isposinf(model.upper).all()
+    system = rigid.TreeSystem(model)
+    sol = mbjax.integrate.simulate(system, mbjax.integrate.RK4(), jnp.array([3.0]),
+                                   jnp.array([1.0]), dt=0.01, t1=0.1)
+    assert sol.messages() == ["success"]
+    with pytest.raises(ValueError, match="has no <limit>.*strict=True"):
+        mbjax.load_urdf(no_limit, strict=True)
+    limited = mbjax.load_urdf(GOOD)
+    assert float(limited.lower[0]) == -10.0 and float(limited.upper[0]) == 10.0

@@ -16,9 +16,11 @@ computable data (CAD inertias that break the triangle inequality, round-off nega
 leaf on a moving joint) loads with a `ModelWarning` naming the link and the fix (`strict=True`:
 an error; `mbjax._src.model.checks`); non-finite or unparsable numbers are errors.
 
-Joint data: <limit> gives position (revolute, prismatic), effort and velocity limits, <dynamics>
-damping (used by the dynamics) and friction (kept as data); `armature=` adds rotor inertia to
-every joint (URDF has no field for it). <mimic> joints load as independent joints, as Pinocchio
+Joint data: <limit> gives position (revolute, prismatic), effort and velocity limits (a revolute
+or prismatic joint without <limit>, which the specification requires, loads without position
+limits, as MuJoCo reads it, with a warning), <dynamics> damping (used by the dynamics) and
+friction (kept as data); `armature=` adds rotor inertia to every joint (URDF has no field for
+it). <mimic> joints load as independent joints, as Pinocchio
 and MuJoCo load them, with a warning; their couplings are the model's `closures`
 (`mbjax.loops.Coupling`s), which `mbjax.loops.ClosedSystem(TreeSystem(model), model.closures)`
 enforces.
@@ -239,6 +241,12 @@ def load_urdf(source: str | os.PathLike, *, floating_base: bool = False,
                 raise ValueError(f"URDF: joint {name!r} has a zero axis")
             limit, dynamics = joint.find("limit"), joint.find("dynamics")
             bounded = joint.get("type") in ("revolute", "prismatic")
+            if bounded and limit is None:
+                # the specification requires <limit> here (its lower and upper default to 0);
+                # without it, no position limits, as MuJoCo's URDF import reads the joint
+                warn(f"URDF: {what} ({joint.get('type')}) has no <limit>, which the URDF "
+                     "specification requires; it loads without position limits", strict)
+                bounded = False
             bodies.append(dict(
                 parent=body, kind=kind, joint=name, link=child, R=R_place, p=p_place, axis=axis,
                 inertial=links[child], mimic=joint.find("mimic"),
