@@ -97,7 +97,7 @@ class Stabilized(AbstractLoopMethod):
 
     def state_size(self, loops) -> int | None:
         """nv, and the m loads for epsilon > 0."""
-        nv = loops.tree.state_sizes()[1]
+        nv = super().state_size(loops)
         return nv if self.epsilon == 0.0 or nv is None else nv + loops.m
 
     def initial_state(self, loops, q, v, t, consistent):
