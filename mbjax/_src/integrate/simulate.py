@@ -9,10 +9,12 @@ import numpy as np
 from jax import Array
 
 from mbjax._src.integrate.base import AbstractIntegrator
-from mbjax._src.system.invariants import relative_drift
 from mbjax._src.integrate.solution import Solution
-from mbjax._src.system.accuracy import ERROR_SAMPLES, doubled, number, sample_indices, tolerances
-from mbjax._src.system.status import Status, raise_on_failure
+from mbjax._src.system.accuracy import (ERROR_SAMPLES, RESOLUTION_LIMIT, doubled,
+                                        number, sample_indices, step_ratio, tolerances)
+from mbjax._src.system.invariants import drifts
+from mbjax._src.system.status import (DRIFTED, ESTIMATED, FLAGS, RESOLVED, Status,
+                                      raise_on_failure)
 from mbjax._src.system.system import AbstractSystem
 
 
@@ -158,12 +160,12 @@ def simulate(system: AbstractSystem, integrator: AbstractIntegrator, q0: Array, 
     block = math.gcd(*kept.tolist(), n_steps)
     nq, nv = system.state_sizes()
     q0, u0 = _state(q0, "q0", nq), _state(u0, "u0", nv)
-    qs, us, status = _rollout(system, integrator, q0, u0, float(t0), float(dt), block,
-                              n_steps // block, tuple((kept // block).tolist()),
-                              _segment(block) if checkpoint else block)
+    qs, us, status, fields = _rollout(system, integrator, q0, u0, float(t0), float(dt), block,
+                                      n_steps // block, tuple((kept // block).tolist()),
+                                      _segment(block) if checkpoint else block)
     ts = jnp.asarray(t0 + idx * dt, dtype=q0.dtype)
     if not checked:
-        return raise_on_failure(Solution(ts=ts, qs=qs, us=us, status=status), throw,
+        return raise_on_failure(Solution(ts=ts, qs=qs, us=us, status=status, **fields), throw,
                                 "mbjax.simulate")
     all_qs, all_us, all_ts = qs, us, jnp.asarray(t0 + kept * dt, dtype=q0.dtype)
     if len(kept) != len(idx):
@@ -176,12 +178,24 @@ def simulate(system: AbstractSystem, integrator: AbstractIntegrator, q0: Array, 
               jnp.concatenate([u0[None], all_us[picks]]),
               jnp.concatenate([jnp.asarray([t0], q0.dtype), all_ts[picks]]))
     error, ratio = _error_estimate(system, integrator, *starts, float(dt), n_steps, rtol, atol)
+    estimated = ratio > 1.0
+    new = status | jnp.where(estimated, int(Status.INACCURATE), 0).astype(status.dtype)
+    # the estimate is of the final state's error: at t1 unless raised before
+    first = _raised(fields["flagged_at"], status, new, jnp.asarray(t1, q0.dtype))
+    by = fields["inaccurate_by"] | jnp.where(estimated, ESTIMATED, 0)
     drift = _drift(system, jnp.concatenate([jnp.asarray([t0], q0.dtype), all_ts]),
-                   jnp.concatenate([q0[None], all_qs]), jnp.concatenate([u0[None], all_us]))
-    inaccurate = (ratio > 1.0) | (drift > rtol) & (rtol > 0)
-    status = status | jnp.where(inaccurate, int(Status.INACCURATE), 0).astype(status.dtype)
-    return raise_on_failure(Solution(ts=ts, qs=qs, us=us, status=status, error=error,
-                                     drift=drift), throw, "mbjax.simulate")
+                   jnp.concatenate([q0[None], all_qs]), jnp.concatenate([u0[None], all_us]),
+                   rtol)
+    if drift is not None:
+        (value, which, when), names = drift
+        drifted = (value > rtol) & (rtol > 0)
+        status, new = new, new | jnp.where(drifted, int(Status.INACCURATE), 0).astype(new.dtype)
+        first = _raised(first, status, new, when)
+        by = by | jnp.where(drifted, DRIFTED, 0)
+        fields.update(drift=value, drifting=which, invariant_names=names)
+    fields.update(flagged_at=first, inaccurate_by=by)
+    return raise_on_failure(Solution(ts=ts, qs=qs, us=us, status=new, error=error, **fields),
+                            throw, "mbjax.simulate")
 
 
 @eqx.filter_jit
@@ -208,12 +222,18 @@ def _error_estimate(system, integrator, q, u, t, dt: float, n_steps: int, rtol, 
 
 
 @eqx.filter_jit
-def _drift(system, ts, qs, us):
-    """The invariants' largest relative drift over the start and the saved states
-    (`mbjax._src.system.invariants.relative_drift`); NaN for a system that knows none."""
+def _drift(system, ts, qs, us, rtol: float):
+    """((the invariants' largest relative drift over the states (ts, qs, us), the index of the
+    invariant, the first time it exceeds a positive rtol or NaN), their names), or None for a
+    system that knows none (`mbjax._src.system.invariants.drifts`)."""
     if system.invariants(ts[0], qs[0], us[0]) is None:
-        return jnp.asarray(jnp.nan, qs.dtype)
-    return relative_drift(jax.vmap(system.invariants)(ts, qs, us))
+        return None
+    history = jax.vmap(system.invariants)(ts, qs, us)
+    ratios = drifts(history)                                    # (T, k)
+    over = (jnp.max(ratios, axis=1) > rtol) & (rtol > 0)
+    when = jnp.where(jnp.any(over), ts[jnp.argmax(over)], jnp.nan)
+    return ((jnp.max(ratios, initial=0.0), jnp.argmax(jnp.max(ratios, axis=0)), when),
+            history.labels())
 
 
 def _sample_steps(n_steps: int, idx: np.ndarray) -> np.ndarray:
@@ -237,24 +257,46 @@ def _segment(block: int) -> int:
     return max(k for k in range(1, math.isqrt(block) + 1) if block % k == 0)
 
 
+def _raised(first: Array, old: Array, new: Array, t: Array) -> Array:
+    """The times each flag was first raised, with those `new` raises over `old` at t."""
+    bits = jnp.asarray([int(f) for f in FLAGS], old.dtype)
+    return jnp.where(((new & bits) != 0) & ((old & bits) == 0), t, first)
+
+
 @eqx.filter_jit
 def _rollout(system, integrator, q0, u0, t0, dt, block: int, n_blocks: int, keep: tuple,
              segment: int):
+    """(saved qs, us, status, the default check's `Solution` fields): the steps with the
+    resolution watched at every step, the system's check at the block ends."""
     dtype = q0.dtype
+    t0, dt = jnp.asarray(t0, dtype), jnp.asarray(dt, dtype)
+    inaccurate = jnp.asarray(int(Status.INACCURATE), jnp.int32)
 
     def step(carry, k):
-        q, u, status = carry
-        t = jnp.asarray(t0, dtype) + k * jnp.asarray(dt, dtype)
+        q, u, status, (d, r1, r2, worst, first) = carry
+        t = t0 + k * dt
         # sampled controls take their value at the step's start for all of its stages
-        q1, u1, converged = integrator.step(system.hold(t, q, u), t, q, u, jnp.asarray(dt, dtype))
+        q1, u1, converged = integrator.step(system.hold(t, q, u), t, q, u, dt)
         q1, u1 = system.constrain(t + dt, q1, u1)
         finite = jnp.all(jnp.isfinite(q1)) & jnp.all(jnp.isfinite(u1))
-        status = (status | jnp.where(finite, 0, int(Status.NONFINITE))
-                  | jnp.where(converged, 0, int(Status.NOT_CONVERGED)))
-        return (q1, u1, status), None
+        # the default check: the step times the motion's rate, from consecutive increments
+        # (not differentiated: the status is not)
+        y0, y1 = (jax.lax.stop_gradient(jnp.concatenate(y)) for y in ((q, u), (q1, u1)))
+        r = step_ratio(d, y1 - y0, y0)
+        held = jnp.minimum(r, jnp.minimum(r1, r2))
+        new = (status | jnp.where(finite, 0, int(Status.NONFINITE))
+               | jnp.where(converged, 0, int(Status.NOT_CONVERGED))
+               | jnp.where(held > RESOLUTION_LIMIT, inaccurate, 0))
+        watch = (y1 - y0, r, r1, jnp.maximum(worst, held), _raised(first, status, new, t + dt))
+        return (q1, u1, new, watch), None
 
     def run_segment(carry, ks):
         return jax.lax.scan(step, carry, ks)[0], None
+
+    def checked(t, q, u):
+        """The system's flags at a state (not differentiated)."""
+        return system.check(t, jax.lax.stop_gradient(q), jax.lax.stop_gradient(u)).astype(
+            jnp.int32)
 
     def run_block(carry, b):
         ks = b * block + jnp.arange(block)
@@ -263,16 +305,17 @@ def _rollout(system, integrator, q0, u0, t0, dt, block: int, n_blocks: int, keep
                                     ks.reshape(block // segment, segment))
         else:
             carry, _ = run_segment(carry, ks)
-        q, u, status = carry
-        t = jnp.asarray(t0, dtype) + (b + 1) * block * jnp.asarray(dt, dtype)
-        # at the block ends (the saved states); the status is not differentiated, so neither is
-        # the check (reverse mode would otherwise trace through it)
-        status = status | system.check(t, jax.lax.stop_gradient(q), jax.lax.stop_gradient(u))
-        return (q, u, status), (q, u)
+        q, u, status, watch = carry
+        t = t0 + (b + 1) * block * dt
+        new = status | checked(t, q, u)
+        watch = (*watch[:4], _raised(watch[4], status, new, t))
+        return (q, u, new, watch), (q, u)
 
     # the start is a saved state too: the system's check sees it (a start on a singularity)
-    init = (q0, u0, system.check(jnp.asarray(t0, dtype), jax.lax.stop_gradient(q0),
-                                 jax.lax.stop_gradient(u0)).astype(jnp.int32))
+    flags = checked(t0, q0, u0)
+    first = _raised(jnp.full(len(FLAGS), jnp.nan, dtype), jnp.zeros((), jnp.int32), flags, t0)
+    zero = jnp.zeros((), dtype)
+    init = (q0, u0, flags, (jnp.zeros(q0.size + u0.size, dtype), zero, zero, zero, first))
     # Scans nest (blocks, segments, steps, an integrator's stages), and reverse mode traces a
     # scan's body several times per level: a level of length one is a plain call instead.
     if n_blocks == 1:
@@ -280,6 +323,8 @@ def _rollout(system, integrator, q0, u0, t0, dt, block: int, n_blocks: int, keep
         qs, us = q[None], u[None]
     else:
         final, (qs, us) = jax.lax.scan(run_block, init, jnp.arange(n_blocks))
+    status, (_, _, _, resolution, first) = final[2], final[3]
     qs = jnp.concatenate([q0[None], qs])[jnp.array(keep)]
     us = jnp.concatenate([u0[None], us])[jnp.array(keep)]
-    return qs, us, final[2]
+    return qs, us, status, dict(resolution=resolution, flagged_at=first,
+                                inaccurate_by=jnp.where(resolution > RESOLUTION_LIMIT, RESOLVED, 0))

@@ -1,8 +1,9 @@
 """The result of a simulation."""
 
+import equinox as eqx
 from jax import Array
 
-from mbjax._src.system.status import WithStatus
+from mbjax._src.system.status import WithStatus, accuracy_notes
 
 
 class Solution(WithStatus):
@@ -19,9 +20,18 @@ class Solution(WithStatus):
         error: the estimated global error of the final state (largest component, in the
             state's units) where the run was asked for a tolerance (`simulate(..., rtol=,
             atol=)`), else NaN.
-        drift: with a tolerance, the largest relative drift of the system's invariants (its
-            energy, its momenta: `mbjax._src.system.invariants`) over the saved states; NaN
-            where it has none or no tolerance was asked.
+        drift: the largest relative drift of the system's invariants (its energy, its
+            momenta: `mbjax._src.system.invariants`) over the start and the states the rollout
+            checks; NaN where it has none.
+        resolution: the step times the motion's fastest rate, held over `SUSTAINED` steps,
+            at its largest along the run (`mbjax._src.system.accuracy.step_ratio`); above
+            `RESOLUTION_LIMIT` (1) the steps do not resolve the motion.
+        drifting: the index of the invariant that drifted most (-1 where none).
+        flagged_at: the time [s] each `Status` flag (1, 2, 4, ... in order) was first raised,
+            NaN where never, shape (8,).
+        inaccurate_by: why the run is INACCURATE, a mask: 1 the resolution, 2 the drift, 4
+            the error estimate.
+        invariant_names: the names of the system's invariants (static).
     """
 
     ts: Array
@@ -30,3 +40,12 @@ class Solution(WithStatus):
     status: Array
     error: Array = float("nan")
     drift: Array = float("nan")
+    resolution: Array = float("nan")
+    drifting: Array = -1
+    flagged_at: Array | None = None
+    inaccurate_by: Array = 0
+    invariant_names: tuple[str, ...] = eqx.field(static=True, default=())
+
+    def notes(self, i: int) -> dict:
+        """What tripped each flag of the i-th run (`WithStatus.messages`)."""
+        return accuracy_notes(self, i, self.flagged_at)

@@ -21,7 +21,8 @@ from mbjax._src import lie
 from mbjax._src.control import AbstractControl
 from mbjax._src.lie.coordinates import AbstractRotation, Quaternion
 from mbjax._src.system.driven import AbstractDrivenSystem, about_origins, drive
-from mbjax._src.system.invariants import Invariants, along_gravity, energy_invariant, join
+from mbjax._src.system.invariants import (ANGULAR, LINEAR, Invariants, along_gravity,
+                                          energy_invariant, join)
 from mbjax._src.spatial import check_inertia
 
 
@@ -265,9 +266,9 @@ class RigidBody(AbstractDrivenSystem):
         H = along_gravity(spin + orbital, g)
         parts = [energy_invariant(self.energy(q, u), self.kinetic_energy(q, u), False),
                  Invariants(H, jnp.full(3, jnp.linalg.norm(spin) + jnp.linalg.norm(orbital)),
-                            jnp.ones(3, bool), jnp.zeros(3, bool))]
+                            jnp.ones(3, bool), jnp.zeros(3, bool), ANGULAR)]
         if not self.fixed_point:
             P = self.mass * (u[3:] - g * t)
             parts.append(Invariants(P, jnp.full(3, self.mass * jnp.linalg.norm(u[3:])),
-                                    jnp.ones(3, bool), jnp.zeros(3, bool)))
+                                    jnp.ones(3, bool), jnp.zeros(3, bool), LINEAR))
         return join(*parts)

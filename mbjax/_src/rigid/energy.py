@@ -10,7 +10,7 @@ import jax.numpy as jnp
 import numpy as np
 from jax import Array
 
-from mbjax._src.system.invariants import Invariants, along_gravity
+from mbjax._src.system.invariants import ANGULAR, LINEAR, Invariants, along_gravity
 from mbjax._src.model import Model
 from mbjax._src.rigid.kinematics import body_kinematics, forward_kinematics
 
@@ -86,4 +86,5 @@ def free_momenta(model: Model, t: Array, q: Array, v: Array) -> Invariants:
     bases = np.flatnonzero(np.asarray(model.topology.parents) < 0)
     undamped = jnp.all(model.body_v(model.damping)[bases] == 0)
     return Invariants(values=jnp.concatenate([H, P]), scale=scale,
-                      conserved=jnp.full(6, undamped), decreasing=jnp.zeros(6, bool))
+                      conserved=jnp.full(6, undamped), decreasing=jnp.zeros(6, bool),
+                      names=ANGULAR + LINEAR)

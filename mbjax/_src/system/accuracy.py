@@ -59,3 +59,49 @@ def doubled(step, state, t, h, span):
 
     _, ends = jax.lax.scan(one, state, jnp.arange(3))
     return tuple(jax.tree.map(lambda x, i=i: x[i], ends) for i in range(3))
+
+
+# The default check (no tolerance asked): `simulate`, `solve_tfe` and `mbjax.trajopt.solve` flag
+# INACCURATE past these loose limits (benchmarks/README.md, "The default accuracy check", measures
+# their false alarms over every scene and reproduction, none, and their cost).
+# The step times the motion's fastest rate, estimated from consecutive increments of the state:
+# 1 is about six steps per period of an oscillation, where a fourth-order method already errs by
+# about 1 % a step; a run past its stability limit reads 1.5 or more at every step.
+RESOLUTION_LIMIT = 1.0
+# steps in a row the estimate must exceed the limit (a kick, a control switch, a wrap is one)
+SUSTAINED = 3
+# the invariants' drift relative to the motion's scale (`mbjax._src.system.invariants`)
+DRIFT_LIMIT = 0.1
+
+
+def step_ratio(previous: jax.Array, increment: jax.Array, state: jax.Array) -> jax.Array:
+    """|d_k - d_(k-1)| / |d_(k-1)| for consecutive increments d of a state sequence: for a
+    smooth motion sampled every h, h |y''| / |y'|, the step times the motion's rate (h omega for
+    an oscillation), whatever the state's units; 0 where the previous increment is at the level
+    of round-off of the state (at rest)."""
+    size = jnp.linalg.norm(previous)
+    floor = 1e3 * jnp.finfo(state.dtype).eps * (1.0 + jnp.linalg.norm(state))
+    return jnp.where(size > floor, jnp.linalg.norm(increment - previous)
+                     / jnp.where(size > floor, size, 1.0), 0.0)
+
+
+def sustained(ratios: jax.Array) -> jax.Array:
+    """Each step's ratio held for `SUSTAINED` steps: the least of it and the previous ones
+    (leading axis: steps); 0 for the first."""
+    held = ratios
+    for lag in range(1, SUSTAINED):
+        held = jnp.minimum(held, jnp.concatenate([jnp.zeros(lag, ratios.dtype), ratios[:-lag]]))
+    return held
+
+
+def resolution(states: jax.Array) -> tuple[jax.Array, jax.Array]:
+    """(the largest sustained step ratio along a state sequence (T, n), the index of the state
+    where it first exceeds `RESOLUTION_LIMIT`, or -1): `step_ratio` between every three
+    consecutive states, held for `SUSTAINED` steps."""
+    states = jax.lax.stop_gradient(states)
+    d = jnp.diff(states, axis=0)
+    ratios = jax.vmap(step_ratio)(d[:-1], d[1:], states[1:-1])
+    held = sustained(ratios)
+    over = held > RESOLUTION_LIMIT
+    return (jnp.max(held, initial=0.0),
+            jnp.where(jnp.any(over), jnp.argmax(over) + 2, -1))

@@ -13,6 +13,10 @@ import equinox as eqx
 import jax.numpy as jnp
 from jax import Array
 
+# the names of a momentum's components, for the status's words
+ANGULAR = ("angular momentum x", "angular momentum y", "angular momentum z")
+LINEAR = ("linear momentum x", "linear momentum y", "linear momentum z")
+
 
 class Invariants(eqx.Module):
     """k quantities at one state (batched over a trajectory by `jax.vmap`).
@@ -20,24 +24,33 @@ class Invariants(eqx.Module):
     values: the quantities; scale: the magnitude each drift is measured against (non-negative);
     conserved: where False the quantity is not held to anything (a momentum whose root joint is
     damped); decreasing: where True only a rise counts as drift (the energy of a damped
-    system)."""
+    system); names: what each quantity is, for the status's words ("energy", "angular
+    momentum", ...)."""
 
     values: Array
     scale: Array
     conserved: Array
     decreasing: Array
+    names: tuple[str, ...] | None = eqx.field(static=True, default=None)
 
     def __check_init__(self):
         if jnp.shape(self.values) != jnp.shape(self.scale):
             raise ValueError(f"values and scale must have one shape, got "
                              f"{jnp.shape(self.values)} and {jnp.shape(self.scale)}")
 
+    def labels(self) -> tuple[str, ...]:
+        """The quantities' names, "invariant k" where none was given."""
+        n = jnp.shape(self.values)[-1]
+        return self.names if self.names is not None else tuple(f"invariant {k}"
+                                                               for k in range(n))
+
 
 def energy_invariant(energy: Array, kinetic: Array, dissipative) -> Invariants:
     """The energy, measured against the kinetic energy; with `dissipative` it may fall."""
     return Invariants(values=jnp.atleast_1d(energy), scale=jnp.atleast_1d(jnp.abs(kinetic)),
                       conserved=jnp.ones(1, bool),
-                      decreasing=jnp.atleast_1d(jnp.asarray(dissipative, bool)))
+                      decreasing=jnp.atleast_1d(jnp.asarray(dissipative, bool)),
+                      names=("energy",))
 
 
 def along_gravity(H: Array, gravity: Array) -> Array:
@@ -52,14 +65,20 @@ def along_gravity(H: Array, gravity: Array) -> Array:
 def join(*parts: Invariants) -> Invariants:
     """Several systems' or several kinds' invariants as one."""
     return Invariants(*(jnp.concatenate([getattr(p, name) for p in parts])
-                        for name in ("values", "scale", "conserved", "decreasing")))
+                        for name in ("values", "scale", "conserved", "decreasing")),
+                      names=sum((p.labels() for p in parts), ()))
 
 
-def relative_drift(history: Invariants) -> Array:
-    """max over the invariants of max_t |I(t) - I(t_0)| / max_t scale(t) for a trajectory's
-    invariants (leading axis: time); a `decreasing` one counts only its rises. 0 for none."""
+def drifts(history: Invariants) -> Array:
+    """|I(t) - I(t_0)| / max_t scale(t) for a trajectory's invariants (leading axis: time),
+    shape (T, k); a `decreasing` one counts only its rises, one not `conserved` is 0."""
     change = history.values - history.values[:1]
     change = jnp.where(history.decreasing[0], jnp.maximum(change, 0.0), jnp.abs(change))
     scale = jnp.maximum(jnp.max(history.scale, axis=0), jnp.finfo(change.dtype).eps)
-    ratio = jnp.where(history.conserved[0], jnp.max(change, axis=0) / scale, 0.0)
-    return jnp.max(ratio, initial=0.0)
+    return jnp.where(history.conserved[0], change / scale, 0.0)
+
+
+def relative_drift(history: Invariants) -> Array:
+    """max over the invariants of max_t |I(t) - I(t_0)| / max_t scale(t) (`drifts`); 0 for
+    none."""
+    return jnp.max(drifts(history), initial=0.0)

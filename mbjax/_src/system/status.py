@@ -52,6 +52,10 @@ class Status(enum.IntFlag):
                 | cls.INACCURATE | cls.SINGULAR)
 
 
+# the flags in order: `flagged_at` keeps the time each was first raised
+FLAGS = tuple(flag for flag in Status if flag)
+
+
 def raise_on_failure(result, throw: bool, who: str):
     """`result` (a `WithStatus`) as it is, or, with throw=True, an error (`eqx.error_if`, so also
     under jit and vmap) naming the first failure flag set in its status, as diffrax's
@@ -80,12 +84,58 @@ class WithStatus(eqx.Module):
     def messages(self) -> list[str]:
         """Human-readable status for each (possibly batched) run; needs concrete values.
 
+        Each flag is spelled out with what tripped it where the result knows (the time a flag
+        was first raised, the measure that found a run inaccurate, the invariant that drifted).
+
         Returns:
-            One string per run ("success", or the flags' names joined by commas), in the
-            order of `status` flattened.
+            One string per run ("success", or the flags' names joined by commas, each with its
+            particulars in parentheses), in the order of `status` flattened.
         """
-        out = []
-        for code in np.atleast_1d(np.asarray(self.status)).ravel():
-            flags = [f.name.lower().replace("_", " ") for f in Status if f and Status(int(code)) & f]
-            out.append(", ".join(flags) if flags else "success")
-        return out
+        codes = np.atleast_1d(np.asarray(self.status)).ravel()
+        return [describe(int(code), self.notes(i)) for i, code in enumerate(codes)]
+
+    def notes(self, i: int) -> dict:
+        """{flag: what tripped it} for the i-th run (flattened); none by default."""
+        return {}
+
+
+def describe(code: int, notes: dict) -> str:
+    """A status in words: the flags set in `code` by name, each followed by its note."""
+    words = [flag.name.lower().replace("_", " ") + (f" ({notes[flag]})" if notes.get(flag) else "")
+             for flag in Status if flag and code & flag]
+    return ", ".join(words) or "success"
+
+
+# why a run is INACCURATE (`Solution.inaccurate_by`, a mask of these)
+RESOLVED, DRIFTED, ESTIMATED = 1, 2, 4
+
+
+def accuracy_notes(result, i: int, flags_at=None) -> dict:
+    """The notes of a result that carries the accuracy check's measures (`Solution`,
+    `TFESolution`: resolution, drift, drifting, invariant_names, error, inaccurate_by) and
+    optionally the time each flag was first raised, for its i-th (flattened) run."""
+    def member(x):
+        x = np.asarray(x)
+        return x.reshape(-1, *x.shape[np.ndim(result.status):])[i] if x.ndim else x
+
+    notes = {}
+    if flags_at is not None:
+        at = member(flags_at)
+        for k, flag in enumerate(f for f in Status if f):
+            if np.isfinite(at[k]):
+                notes[flag] = f"first at t = {at[k]:.4g} s"
+    by = int(member(result.inaccurate_by))
+    reasons = []
+    if by & RESOLVED:
+        reasons.append(f"the steps do not resolve the motion: step x rate reached "
+                       f"{float(member(result.resolution)):.3g} > 1")
+    if by & DRIFTED:
+        k = int(member(result.drifting))
+        name = result.invariant_names[k] if 0 <= k < len(result.invariant_names) else "invariant"
+        reasons.append(f"the {name} drifted by {float(member(result.drift)):.3g} of its scale")
+    if by & ESTIMATED:
+        reasons.append(f"estimated error {float(member(result.error)):.3g} beyond the tolerance")
+    if reasons:
+        notes[Status.INACCURATE] = "; ".join(reasons + ([notes[Status.INACCURATE]]
+                                                        if Status.INACCURATE in notes else []))
+    return notes

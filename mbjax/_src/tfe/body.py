@@ -18,7 +18,8 @@ import numpy as np
 from jax import Array
 
 from mbjax._src import lie
-from mbjax._src.system.invariants import Invariants, along_gravity, energy_invariant, join
+from mbjax._src.system.invariants import (ANGULAR, LINEAR, Invariants, along_gravity,
+                                          energy_invariant, join)
 from mbjax._src.rigid import RigidBody
 from mbjax._src.spatial import check_inertia
 
@@ -186,9 +187,9 @@ class Body(eqx.Module):
         H = along_gravity(h + orbital, g)
         parts = [energy_invariant(self.energy(R, x, p_hat), self.kinetic_energy(R, p_hat), False),
                  Invariants(H, jnp.full(3, jnp.linalg.norm(h) + jnp.linalg.norm(orbital)),
-                            jnp.ones(3, bool), jnp.zeros(3, bool))]
+                            jnp.ones(3, bool), jnp.zeros(3, bool), ANGULAR)]
         if not self.fixed_point:
             parts.append(Invariants(p_hat[3:] - self.mass * g * t,
                                     jnp.full(3, jnp.linalg.norm(p_hat[3:])),
-                                    jnp.ones(3, bool), jnp.zeros(3, bool)))
+                                    jnp.ones(3, bool), jnp.zeros(3, bool), LINEAR))
         return join(*parts)

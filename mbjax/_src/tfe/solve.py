@@ -9,6 +9,7 @@ function of the solution with respect to the initial state or the body's paramet
 and cheap.
 """
 
+import dataclasses
 from functools import partial
 
 import equinox as eqx
@@ -16,10 +17,12 @@ import jax
 import jax.numpy as jnp
 from jax import Array
 
-from mbjax._src.system.invariants import relative_drift
-from mbjax._src.system.accuracy import doubled
-from mbjax._src.system.accuracy import sample_indices, tolerances
-from mbjax._src.system.status import Status, WithStatus, raise_on_failure
+from mbjax._src.system.accuracy import (DRIFT_LIMIT, RESOLUTION_LIMIT, doubled, sample_indices,
+                                        tolerances)
+from mbjax._src.system.accuracy import resolution as accuracy_resolution
+from mbjax._src.system.invariants import drifts
+from mbjax._src.system.status import (DRIFTED, ESTIMATED, FLAGS, RESOLVED, Status, WithStatus,
+                                      accuracy_notes, raise_on_failure)
 from mbjax._src.tfe.body import Body
 from mbjax._src.tfe.elements import Element
 from mbjax._src.tfe.form import AbstractForm
@@ -80,8 +83,14 @@ class TFESolution(WithStatus):
         status: the `Status` flags, an integer array.
         error: the estimated error of the final state, as `mbjax.integrate.Solution`'s (NaN
             where no tolerance was asked).
-        drift: the invariants' largest relative drift, as `mbjax.integrate.Solution`'s (NaN
-            where no tolerance was asked).
+        drift: the invariants' largest relative drift over the boundaries, as
+            `mbjax.integrate.Solution`'s.
+        resolution: the element's span times the motion's rate, from consecutive boundaries,
+            as `mbjax.integrate.Solution`'s.
+        drifting: the index of the invariant that drifted most.
+        flagged_at: the time [s] each `Status` flag was first raised (NaN: never), shape (8,).
+        inaccurate_by: why the march is INACCURATE (a mask, as `mbjax.integrate.Solution`'s).
+        invariant_names: the names of the body's invariants (static).
     """
 
     ts: Array
@@ -93,6 +102,15 @@ class TFESolution(WithStatus):
     status: Array
     error: Array = float("nan")
     drift: Array = float("nan")
+    resolution: Array = float("nan")
+    drifting: Array = -1
+    flagged_at: Array | None = None
+    inaccurate_by: Array = 0
+    invariant_names: tuple[str, ...] = eqx.field(static=True, default=())
+
+    def notes(self, i: int) -> dict:
+        """What tripped each flag of the i-th march (`WithStatus.messages`)."""
+        return accuracy_notes(self, i, self.flagged_at)
 
     def energy(self, body: Body) -> Array:
         """The total energy at every boundary.
@@ -178,10 +196,43 @@ def _march(body, state0, dt, tol, prescribed, *, form, element, n_elements, refe
     _, (states, iterations, residual, converged) = jax.lax.scan(step, state0, jnp.arange(n_elements))
     join = lambda a, b: jnp.concatenate([a[None], b])  # noqa: E731
     R, x, p_hat = (join(getattr(state0, k), getattr(states, k)) for k in ("R", "x", "p_hat"))
-    finite = jnp.all(jnp.isfinite(p_hat)) & jnp.all(jnp.isfinite(R))
+    finite = jnp.all(jnp.isfinite(p_hat), axis=1) & jnp.all(jnp.isfinite(R), axis=(1, 2))
     status = (jnp.where(jnp.all(converged), 0, int(Status.NOT_CONVERGED))
-              | jnp.where(finite, 0, int(Status.NONFINITE)))
-    return TFESolution(jnp.arange(n_elements + 1) * h, R, x, p_hat, iterations, residual, status)
+              | jnp.where(jnp.all(finite), 0, int(Status.NONFINITE)))
+    ts = jnp.arange(n_elements + 1) * h
+    first = jnp.full(len(FLAGS), jnp.nan, ts.dtype)
+    first = first.at[FLAGS.index(Status.NONFINITE)].set(_first(ts, ~finite))
+    first = first.at[FLAGS.index(Status.NOT_CONVERGED)].set(_first(ts[1:], ~converged))
+    return TFESolution(ts, R, x, p_hat, iterations, residual, status, flagged_at=first)
+
+
+def _first(ts, where):
+    """The first of `ts` where `where` holds, NaN if none."""
+    return jnp.where(jnp.any(where), ts[jnp.argmax(where)], jnp.nan)
+
+
+@jax.jit
+def _checked(body, solution: TFESolution, drift_limit) -> TFESolution:
+    """The solution with the default check (`solve_tfe`): the resolution over the boundaries
+    and the invariants' drift past `drift_limit`."""
+    # the momentum and the position, not the attitude: an element's reference carries the
+    # rotation exactly (a spin of many radians per element is not an error)
+    resolution, at = accuracy_resolution(jnp.concatenate([solution.x, solution.p_hat], axis=1))
+    history = jax.vmap(body.invariants)(solution.ts, solution.R, solution.x, solution.p_hat)
+    ratios = drifts(history)
+    drift = jnp.max(ratios, initial=0.0)
+    over = jnp.max(ratios, axis=1) > drift_limit
+    resolved, drifted = resolution > RESOLUTION_LIMIT, jnp.any(over)
+    when = jnp.minimum(jnp.where(resolved, solution.ts[at], jnp.inf),
+                       jnp.where(drifted, solution.ts[jnp.argmax(over)], jnp.inf))
+    k = FLAGS.index(Status.INACCURATE)
+    first = solution.flagged_at.at[k].set(jnp.where(jnp.isfinite(when), when, jnp.nan))
+    status = solution.status | jnp.where(resolved | drifted, int(Status.INACCURATE), 0)
+    by = jnp.where(resolved, RESOLVED, 0) | jnp.where(drifted, DRIFTED, 0)
+    return dataclasses.replace(solution, status=status.astype(solution.status.dtype),
+                               drift=drift, resolution=resolution,
+                               drifting=jnp.argmax(jnp.max(ratios, axis=0)), flagged_at=first,
+                               inaccurate_by=by, invariant_names=history.labels())
 
 
 @partial(jax.jit, static_argnames=(*_STATIC, "n_elements"))
@@ -205,13 +256,6 @@ def _error_estimate(body, states: State, ts, dt, tol, prescribed, rtol, atol, *,
 
     errors, ratios = jax.vmap(local)(states, ts)
     return n_elements * jnp.mean(errors), n_elements * jnp.mean(ratios)
-
-
-@jax.jit
-def _drift(body, solution):
-    """The body's invariants' largest relative drift over the boundaries (`Body.invariants`)."""
-    return relative_drift(jax.vmap(body.invariants)(solution.ts, solution.R, solution.x,
-                                                    solution.p_hat))
 
 
 def solve_tfe(body: Body, state0: State, *, dt, n_elements: int, form: AbstractForm = Mixed(),
@@ -281,14 +325,20 @@ def solve_tfe(body: Body, state0: State, *, dt, n_elements: int, form: AbstractF
     static = dict(form=form, element=element, n_elements=n_elements, reference=reference,
                   max_iter=max_iter)
     solution = _march(body, state0, dt, tol, prescribed, **static)
+    solution = _checked(body, solution, rtol if checked and rtol > 0 else DRIFT_LIMIT)
     if checked:
         picks = jnp.asarray(sample_indices(n_elements))
         states = State(solution.R[picks], solution.x[picks], solution.p_hat[picks])
         error, ratio = _error_estimate(body, states, solution.ts[picks], dt, tol, prescribed,
                                        rtol, atol, **static)
-        drift = _drift(body, solution)
-        inaccurate = (ratio > 1.0) | (drift > rtol) & (rtol > 0)
-        status = solution.status | jnp.where(inaccurate, int(Status.INACCURATE), 0)
-        solution = eqx.tree_at(lambda s: (s.status, s.error, s.drift), solution,
-                               (status.astype(solution.status.dtype), error, drift))
+        estimated = ratio > 1.0
+        k = FLAGS.index(Status.INACCURATE)
+        first = solution.flagged_at.at[k].set(jnp.where(
+            jnp.isnan(solution.flagged_at[k]) & estimated, solution.ts[-1],
+            solution.flagged_at[k]))
+        status = solution.status | jnp.where(estimated, int(Status.INACCURATE), 0)
+        solution = eqx.tree_at(lambda s: (s.status, s.error, s.flagged_at, s.inaccurate_by),
+                               solution, (status.astype(solution.status.dtype), error, first,
+                                          solution.inaccurate_by
+                                          | jnp.where(estimated, ESTIMATED, 0)))
     return raise_on_failure(solution, throw, "mbjax.tfe.solve_tfe")
