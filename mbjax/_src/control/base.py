@@ -96,7 +96,15 @@ class Sum(AbstractControl):
         self.terms = tuple(flat)
 
     def __call__(self, t, q, v):
-        return sum(term(t, q, v) for term in self.terms)   # a few terms, fixed at trace time
+        # a few terms, fixed at trace time; their lengths must agree (a scalar term adds to all)
+        outs = [jnp.asarray(term(t, q, v)) for term in self.terms]
+        shapes = {out.shape for out in outs if out.shape != ()}
+        if len(shapes) > 1:
+            found = ", ".join(f"term {k} ({type(term).__name__}): {out.shape}"
+                              for k, (term, out) in enumerate(zip(self.terms, outs)))
+            raise ValueError(f"the terms of a Sum of controls must give forces of one length; "
+                             f"got {found}")
+        return sum(outs)
 
     def hold(self, t, q, v):
         return Sum(tuple(term.hold(t, q, v) for term in self.terms))

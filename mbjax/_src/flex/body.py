@@ -122,7 +122,7 @@ class ModalBody(eqx.Module):
             The `ModalBody`.
 
         Raises:
-            ValueError: stiffness not of shape (mu, mu).
+            ValueError: stiffness or damping not of shape (mu, mu).
         """
         m, rho, phi, psi, inertia = (jnp.asarray(points.mass, float), points.position,
                                      points.phi, points.psi, points.inertia)
@@ -131,6 +131,11 @@ class ModalBody(eqx.Module):
         stiffness = jnp.asarray(stiffness, float)
         if stiffness.shape != (mu, mu):
             raise ValueError(f"stiffness must be ({mu}, {mu}) for {mu} modes, got {stiffness.shape}")
+        damping = jnp.zeros((mu, mu)) if damping is None else jnp.asarray(damping, float)
+        if damping.shape != (mu, mu):
+            raise ValueError(f"damping must be the modal damping matrix of shape ({mu}, {mu}) for "
+                             f"{mu} modes, got shape {damping.shape} (per-mode coefficients c: "
+                             "jnp.diag(c))")
         if nodes is None:
             nodes = (jnp.zeros((0, 3)), jnp.zeros((0, 3, mu)), jnp.zeros((0, 3, mu)))
         node_position, node_phi, node_psi = (jnp.asarray(x, float) for x in nodes)
@@ -143,7 +148,7 @@ class ModalBody(eqx.Module):
             modal_mass=(jnp.einsum("p,pis,pit->st", m, phi, phi)
                         + jnp.einsum("pis,pij,pjt->st", psi, inertia, psi)),
             stiffness=stiffness,
-            damping=jnp.zeros((mu, mu)) if damping is None else jnp.asarray(damping, float),
+            damping=damping,
             inertial_stiffening=(jnp.zeros((21, mu, mu)) if inertial_stiffening is None
                                  else jnp.asarray(inertial_stiffening, float)),
             node_position=node_position, node_phi=node_phi, node_psi=node_psi,

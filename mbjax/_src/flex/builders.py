@@ -39,8 +39,20 @@ def beam_body(beam: Beam, basis: ModalBasis, nodes=(), *, clamped_node: int = 0,
 
     Returns:
         The `ModalBody`.
+
+    Raises:
+        ValueError: a basis built for a beam of another number of nodes, a node outside the
+            beam, or damping not of shape (mu, mu).
     """
     nodes = tuple(int(h) for h in nodes)
+    if basis.shapes.shape[0] != 6 * beam.n_nodes:
+        raise ValueError(f"basis has shapes for {basis.shapes.shape[0] // 6} nodes (6 dofs each) "
+                         f"but beam has {beam.n_nodes}: build the basis from this beam "
+                         "(craig_bampton(beam, ...))")
+    outside = [h for h in (*nodes, clamped_node) if not 0 <= h < beam.n_nodes]
+    if outside:
+        raise ValueError(f"nodes and clamped_node must be nodes of the beam (0 ... "
+                         f"{beam.n_nodes - 1}), got {outside}")
     _, K_r = reduced(beam, basis)
     index = np.asarray(nodes, dtype=int)
     node_position = jnp.zeros((len(nodes), 3)).at[:, 0].set(beam.node_x()[index])

@@ -10,6 +10,7 @@ from jax import Array
 
 from mbjax._src.integrate.base import AbstractIntegrator
 from mbjax._src.integrate.solution import Solution
+from mbjax._src.lie.inputs import check_unit_quaternions
 from mbjax._src.system.accuracy import (ERROR_SAMPLES, RESOLUTION_LIMIT, doubled,
                                         number, sample_indices, step_ratio, tolerances)
 from mbjax._src.system.invariants import drifts
@@ -137,7 +138,8 @@ def simulate(system: AbstractSystem, integrator: AbstractIntegrator, q0: Array, 
             or u0 is not real, or dt, t0, t1, rtol, atol are traced or not real numbers.
         ValueError: dt is not positive, t1 - t0 is not a positive whole number of steps,
             saveat is off the grid, empty, non-finite or decreasing, q0 or u0 has the wrong
-            shape, or rtol and atol are negative or both zero.
+            shape, a quaternion in a concrete q0 is not of unit norm (within 1e-6), or rtol
+            and atol are negative or both zero.
         equinox.EquinoxRuntimeError: with throw=True, the run failed (raised when the compiled
             program runs).
     """
@@ -160,6 +162,7 @@ def simulate(system: AbstractSystem, integrator: AbstractIntegrator, q0: Array, 
     block = math.gcd(*kept.tolist(), n_steps)
     nq, nv = system.state_sizes()
     q0, u0 = _state(q0, "q0", nq), _state(u0, "u0", nv)
+    check_unit_quaternions(q0, system.quaternions(), "q0")
     qs, us, status, fields = _rollout(system, integrator, q0, u0, float(t0), float(dt), block,
                                       n_steps // block, tuple((kept // block).tolist()),
                                       _segment(block) if checkpoint else block)
@@ -258,9 +261,10 @@ def _segment(block: int) -> int:
 
 
 def _raised(first: Array, old: Array, new: Array, t: Array) -> Array:
-    """The times each flag was first raised, with those `new` raises over `old` at t."""
-    bits = jnp.asarray([int(f) for f in FLAGS], old.dtype)
-    return jnp.where(((new & bits) != 0) & ((old & bits) == 0), t, first)
+    """The times each flag was first raised (shape status + (8,)), with those `new` raises over
+    `old` at t."""
+    bits = jnp.asarray([int(f) for f in FLAGS], jnp.int32)
+    return jnp.where(((new[..., None] & bits) != 0) & ((old[..., None] & bits) == 0), t, first)
 
 
 @eqx.filter_jit
@@ -271,6 +275,13 @@ def _rollout(system, integrator, q0, u0, t0, dt, block: int, n_blocks: int, keep
     dtype = q0.dtype
     t0, dt = jnp.asarray(t0, dtype), jnp.asarray(dt, dtype)
     inaccurate = jnp.asarray(int(Status.INACCURATE), jnp.int32)
+    # one status per copy for a batched system (its copies along the state's last axis)
+    members = q0.shape[-1:] if system.batched else ()
+
+    def flat(q, u):
+        """The state as one column (per copy), not differentiated."""
+        return jax.lax.stop_gradient(jnp.concatenate([q.reshape(-1, *members),
+                                                      u.reshape(-1, *members)]))
 
     def step(carry, k):
         q, u, status, (d, r1, r2, worst, first) = carry
@@ -278,10 +289,9 @@ def _rollout(system, integrator, q0, u0, t0, dt, block: int, n_blocks: int, keep
         # sampled controls take their value at the step's start for all of its stages
         q1, u1, converged = integrator.step(system.hold(t, q, u), t, q, u, dt)
         q1, u1 = system.constrain(t + dt, q1, u1)
-        finite = jnp.all(jnp.isfinite(q1)) & jnp.all(jnp.isfinite(u1))
+        y0, y1 = flat(q, u), flat(q1, u1)
+        finite = jnp.all(jnp.isfinite(y1), axis=0)
         # the default check: the step times the motion's rate, from consecutive increments
-        # (not differentiated: the status is not)
-        y0, y1 = (jax.lax.stop_gradient(jnp.concatenate(y)) for y in ((q, u), (q1, u1)))
         r = step_ratio(d, y1 - y0, y0)
         held = jnp.minimum(r, jnp.minimum(r1, r2))
         new = (status | jnp.where(finite, 0, int(Status.NONFINITE))
@@ -312,10 +322,11 @@ def _rollout(system, integrator, q0, u0, t0, dt, block: int, n_blocks: int, keep
         return (q, u, new, watch), (q, u)
 
     # the start is a saved state too: the system's check sees it (a start on a singularity)
-    flags = checked(t0, q0, u0)
-    first = _raised(jnp.full(len(FLAGS), jnp.nan, dtype), jnp.zeros((), jnp.int32), flags, t0)
-    zero = jnp.zeros((), dtype)
-    init = (q0, u0, flags, (jnp.zeros(q0.size + u0.size, dtype), zero, zero, zero, first))
+    flags = jnp.broadcast_to(checked(t0, q0, u0), members)
+    first = _raised(jnp.full((*members, len(FLAGS)), jnp.nan, dtype), jnp.zeros_like(flags),
+                    flags, t0)
+    zero = jnp.zeros(members, dtype)
+    init = (q0, u0, flags, (jnp.zeros_like(flat(q0, u0)), zero, zero, zero, first))
     # Scans nest (blocks, segments, steps, an integrator's stages), and reverse mode traces a
     # scan's body several times per level: a level of length one is a plain call instead.
     if n_blocks == 1:

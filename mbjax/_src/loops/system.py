@@ -216,6 +216,10 @@ class ClosedSystem(AbstractSystem):
         v = project_velocity(self.loops, q, self.velocity(q, u), t)
         return q, self.method.with_velocity(self.loops, q, u, v)
 
+    def quaternions(self):
+        """The tree's quaternions in q."""
+        return self.tree.quaternions()
+
     def check(self, t, q, u):
         """`Status.CONSTRAINT_VIOLATED` where |Phi| > tolerance, `Status.REDUNDANT` where the
         constraint Jacobian has lost rank, and the tree's own flags; an int32 scalar."""

@@ -32,6 +32,8 @@ import jax.numpy as jnp
 import numpy as np
 from jax import Array
 
+from mbjax._src.lie.inputs import check_rotation
+
 GROUND = -1             # the ground as a body index (`CutJoint`'s body_b)
 SIZES = {"spherical": 3, "revolute": 5, "universal": 4, "weld": 6, "prismatic": 5,
          "point_on_line": 2, "point_on_plane": 1}
@@ -40,6 +42,14 @@ SIZES = {"spherical": 3, "revolute": 5, "universal": 4, "weld": 6, "prismatic": 
 def _vee_antisym(R: Array) -> Array:
     """vee((R - R^T) / 2): sin(angle) * axis, zero at R = I."""
     return 0.5 * jnp.array([R[2, 1] - R[1, 2], R[0, 2] - R[2, 0], R[1, 0] - R[0, 1]])
+
+
+def _point(x, name: str) -> Array:
+    """x as a float array of shape (3,), or a ValueError naming it."""
+    x = jnp.asarray(x, dtype=float)
+    if x.shape != (3,):
+        raise ValueError(f"{name} must be a point of shape (3,) [m], got shape {x.shape}")
+    return x
 
 
 class CutJoint(eqx.Module):
@@ -60,7 +70,8 @@ class CutJoint(eqx.Module):
         rotation_b: rotation of frame B in body_b's frame, shape (3, 3); None: the identity.
 
     Raises:
-        ValueError: an unknown kind, the same body twice, or the ground as body_a.
+        ValueError: an unknown kind, the same body twice, the ground as body_a, an origin not
+            of shape (3,), or a rotation that is not one (orthonormal within 1e-6, det +1).
         TypeError: body indices that are not ints.
     """
 
@@ -83,10 +94,13 @@ class CutJoint(eqx.Module):
         if body_a < 0:
             raise ValueError("body_a must be a body of the model (the ground can only be body_b)")
         self.kind, self.body_a, self.body_b = kind, int(body_a), int(body_b)
-        self.rotation_a = jnp.asarray(np.eye(3) if rotation_a is None else rotation_a, float)
-        self.rotation_b = jnp.asarray(np.eye(3) if rotation_b is None else rotation_b, float)
-        self.origin_a = jnp.asarray(origin_a, float)
-        self.origin_b = jnp.asarray(origin_b, float)
+        self.rotation_a = check_rotation(np.eye(3) if rotation_a is None else rotation_a,
+                                         f"cut joint {kind!r}: rotation_a")
+        self.rotation_b = check_rotation(np.eye(3) if rotation_b is None else rotation_b,
+                                         f"cut joint {kind!r}: rotation_b")
+        self.origin_a, self.origin_b = (_point(x, f"cut joint {kind!r}: {name}")
+                                        for x, name in ((origin_a, "origin_a"),
+                                                        (origin_b, "origin_b")))
 
     @property
     def size(self) -> int:

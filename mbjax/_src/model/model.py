@@ -353,6 +353,15 @@ class Model(eqx.Module):
         """(n, width) static mask: which padded joint columns are real velocity coordinates."""
         return _layout(self.joint_types)["v_mask"]
 
+    def quaternions(self) -> tuple[tuple[int, int, str], ...]:
+        """Where q holds unit quaternions: (start, stop, "joint NAME's quaternion") for each
+        spherical and free joint, in joint order."""
+        starts = _layout(self.joint_types)["q_start"]
+        return tuple((starts[k] + (3 if kind == "free" else 0),
+                      starts[k] + (7 if kind == "free" else 4),
+                      f"joint {self.joint_names[k]!r}'s quaternion")
+                     for k, kind in enumerate(self.joint_types) if kind in ("spherical", "free"))
+
     def body_v(self, v: Array) -> Array:
         """The velocity coordinates grouped per body, zero-padded to the widest joint.
 

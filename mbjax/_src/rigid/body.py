@@ -111,6 +111,10 @@ class RigidBody(AbstractDrivenSystem):
         """The number of rotation coordinates at the start of q (4 or 3)."""
         return self.rotation.size
 
+    def quaternions(self):
+        """q[:4] with quaternion coordinates; none with a rotation vector."""
+        return ((0, 4, "the body's quaternion"),) if self.n_rot == 4 else ()
+
     def rotation_matrix(self, q: Array) -> Array:
         """R, body to space.
 

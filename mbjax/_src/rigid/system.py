@@ -91,6 +91,10 @@ class TreeSystem(AbstractTreeSystem):
         are in `mbjax.rigid.frame_pose`)."""
         return forward_kinematics(self.model, q)
 
+    def quaternions(self):
+        """The spherical and free joints' quaternions in q (`Model.quaternions`)."""
+        return self.model.quaternions()
+
     def check(self, t, q, u):
         """`Status.LIMIT_EXCEEDED` where the state or the control is beyond the model's joint
         limits (`mbjax._src.model.limits`); limits are data here, not contact forces.
@@ -165,8 +169,9 @@ class BatchTreeSystem(AbstractSystem):
 
     q and u are (nv, B) and u_dot = `batch_aba(model, q, u, tau)`. `simulate` integrates all of
     them in one scan, with the throughput layout of `mbjax._src.rigid.batched` (the same
-    trajectories as `jax.vmap` of a `TreeSystem` simulation). Gravity comes from the model; no
-    control or external load; no invariants.
+    trajectories as `jax.vmap` of a `TreeSystem` simulation), and reports a status for each copy
+    (`Solution.status` of shape (B,)). Gravity comes from the model; no control or external
+    load; no invariants.
 
     Args:
         model: a tree of revolute and prismatic joints only.
@@ -184,6 +189,9 @@ class BatchTreeSystem(AbstractSystem):
     def __init__(self, model: Model, tau=None):
         self.model = model
         self.tau = jnp.zeros(model.nv) if tau is None else jnp.asarray(tau)
+
+    # the copies lie along the state's last axis: `simulate` reports a status for each
+    batched = True
 
     def kinematics(self, q, u):
         return u
@@ -238,6 +246,10 @@ class MomentumSystem(AbstractDrivenSystem):
     def nv(self) -> int:
         """Number of velocity coordinates (and of momenta)."""
         return self.model.nv
+
+    def quaternions(self):
+        """The spherical and free joints' quaternions in q (`Model.quaternions`)."""
+        return self.model.quaternions()
 
     def velocity(self, q, p):
         """The joint velocities of the momenta, v = M(q)^-1 p, by Cholesky.

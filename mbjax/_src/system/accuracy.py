@@ -78,10 +78,11 @@ def step_ratio(previous: jax.Array, increment: jax.Array, state: jax.Array) -> j
     """|d_k - d_(k-1)| / |d_(k-1)| for consecutive increments d of a state sequence: for a
     smooth motion sampled every h, h |y''| / |y'|, the step times the motion's rate (h omega for
     an oscillation), whatever the state's units; 0 where the previous increment is at the level
-    of round-off of the state (at rest)."""
-    size = jnp.linalg.norm(previous)
-    floor = 1e3 * jnp.finfo(state.dtype).eps * (1.0 + jnp.linalg.norm(state))
-    return jnp.where(size > floor, jnp.linalg.norm(increment - previous)
+    of round-off of the state (at rest). Norms over the first axis (a batch of states, one per
+    column, gives a ratio per column)."""
+    size = jnp.linalg.norm(previous, axis=0)
+    floor = 1e3 * jnp.finfo(state.dtype).eps * (1.0 + jnp.linalg.norm(state, axis=0))
+    return jnp.where(size > floor, jnp.linalg.norm(increment - previous, axis=0)
                      / jnp.where(size > floor, size, 1.0), 0.0)
 
 

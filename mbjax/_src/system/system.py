@@ -156,6 +156,18 @@ class AbstractSystem(eqx.Module):
         """
         return q, u
 
+    # whether the state holds a batch of copies along its last axis (`BatchTreeSystem`), each
+    # with a status of its own
+    batched = False
+
+    def quaternions(self) -> tuple[tuple[int, int, str], ...]:
+        """Where the configuration holds unit quaternions, which `simulate` checks in q0.
+
+        Returns:
+            (start, stop, what) for each, q[start:stop] a quaternion; none by default.
+        """
+        return ()
+
     def check(self, t: Array, q: Array, u: Array) -> Array:
         """`Status` flags for a state `simulate` saves.
 

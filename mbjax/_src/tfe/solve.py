@@ -17,6 +17,7 @@ import jax
 import jax.numpy as jnp
 from jax import Array
 
+from mbjax._src.lie.inputs import check_rotation
 from mbjax._src.system.accuracy import (DRIFT_LIMIT, RESOLUTION_LIMIT, doubled, sample_indices,
                                         tolerances)
 from mbjax._src.system.accuracy import resolution as accuracy_resolution
@@ -60,7 +61,7 @@ def initial_state(body: Body, R0, Omega0, x0=(0.0, 0.0, 0.0), v0=(0.0, 0.0, 0.0)
     Returns:
         The `State` (R0, x0, p_hat).
     """
-    R0 = jnp.asarray(R0, dtype=float)
+    R0 = check_rotation(R0, "R0")
     w = R0 @ jnp.asarray(Omega0, dtype=float)
     if not body.fixed_point:
         w = jnp.concatenate([w, jnp.asarray(v0, dtype=float)])
@@ -258,6 +259,20 @@ def _error_estimate(body, states: State, ts, dt, tol, prescribed, rtol, atol, *,
     return n_elements * jnp.mean(errors), n_elements * jnp.mean(ratios)
 
 
+def _checked_state(body: Body, state0) -> State:
+    """state0 with its shapes checked against the body ((3, 3), (3,), (nq,)) and its R a
+    rotation where concrete; errors name the field."""
+    if not isinstance(state0, State):
+        raise TypeError(f"state0 must be a tfe.State (initial_state(body, R0, Omega0)), got "
+                        f"{type(state0).__name__}")
+    x, p_hat = (jnp.asarray(a, dtype=float) for a in (state0.x, state0.p_hat))
+    for name, value, shape in (("x", x, (3,)), ("p_hat", p_hat, (body.nq,))):
+        if value.shape != shape:
+            raise ValueError(f"state0.{name} must have shape {shape} for this body, got "
+                             f"{value.shape}")
+    return State(check_rotation(state0.R, "state0.R"), x, p_hat)
+
+
 def solve_tfe(body: Body, state0: State, *, dt, n_elements: int, form: AbstractForm = Mixed(),
               element: Element = Element(4), reference: str | Reference = "constant_velocity",
               tol=1e-10, max_iter: int = 20, rtol: float | None = None,
@@ -303,8 +318,9 @@ def solve_tfe(body: Body, state0: State, *, dt, n_elements: int, form: AbstractF
 
     Raises:
         ValueError: reference is neither one of `REFERENCES` nor a `Reference`, n_elements is
-            not a positive int, or rtol and atol are negative or both zero.
-        TypeError: element is not an `Element`.
+            not a positive int, rtol and atol are negative or both zero, or state0's arrays
+            have the wrong shapes or its R is not a rotation.
+        TypeError: element is not an `Element`, or state0 not a `State`.
         equinox.EquinoxRuntimeError: with throw=True, the march failed.
     """
     prescribed = reference if isinstance(reference, Reference) else None
@@ -317,6 +333,7 @@ def solve_tfe(body: Body, state0: State, *, dt, n_elements: int, form: AbstractF
         raise ValueError(f"n_elements must be a positive int, got {n_elements!r}")
     if not isinstance(element, Element):
         raise TypeError(f"element must be a tfe.Element, got {type(element).__name__}")
+    state0 = _checked_state(body, state0)
     dt = jnp.asarray(dt, dtype=float)
     checked = rtol is not None or atol is not None
     if checked:

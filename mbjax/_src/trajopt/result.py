@@ -8,7 +8,9 @@ import jax
 import jax.numpy as jnp
 from jax import Array
 
-from mbjax._src.system.status import Status, WithStatus
+from mbjax._src.system.accuracy import RESOLUTION_LIMIT
+from mbjax._src.system.accuracy import resolution as accuracy_resolution
+from mbjax._src.system.status import RESOLVED, Status, WithStatus, accuracy_notes
 from mbjax._src.trajopt.problem import Problem
 
 
@@ -31,7 +33,13 @@ class Result(WithStatus):
         feedback: the time-varying gains K_k of u = u_k + K_k dx on the deviation
             dx = `Problem.difference`(x_k, x), shape (N, nu, ndx), where the solver has them (DDP: from its last accepted iteration's backward pass,
             about the trajectory before that step, the same at convergence), else zeros.
-        status: the `Status` flags.
+        status: the `Status` flags; `mbjax.trajopt.solve` adds INACCURATE where the
+            trajectory's steps do not resolve its motion (`resolution` above 1).
+        resolution: the step times the trajectory's fastest rate, from consecutive increments
+            of its states, held over 3 steps (`mbjax.integrate.Solution`'s default check):
+            above 1 the discrete dynamics the solver optimised are far from the continuous
+            ones (an optimum that exploits the integrator's error); NaN before the check.
+        inaccurate_by: 1 where the resolution made it INACCURATE, else 0.
     """
 
     qs: Array
@@ -42,6 +50,22 @@ class Result(WithStatus):
     iterations: Array
     feedback: Array
     status: Array
+    resolution: Array = float("nan")
+    inaccurate_by: Array = 0
+
+    def notes(self, i: int) -> dict:
+        """What tripped each flag of the i-th result (`WithStatus.messages`)."""
+        return accuracy_notes(self, i)
+
+
+def checked(result: Result) -> Result:
+    """The result with the default accuracy check: INACCURATE where its steps do not resolve
+    its motion (`mbjax._src.system.accuracy.resolution` over the states)."""
+    resolution, _ = accuracy_resolution(jnp.concatenate([result.qs, result.vs], axis=1))
+    over = resolution > RESOLUTION_LIMIT
+    return eqx.tree_at(lambda r: (r.status, r.resolution, r.inaccurate_by), result,
+                       (result.status | jnp.where(over, int(Status.INACCURATE), 0).astype(
+                           result.status.dtype), resolution, jnp.where(over, RESOLVED, 0)))
 
 
 class AbstractSolver(eqx.Module):

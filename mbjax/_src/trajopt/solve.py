@@ -12,7 +12,7 @@ from mbjax._src.system.status import raise_on_failure
 from mbjax._src.trajopt.ilqr import ILQR
 from mbjax._src.trajopt.problem import Problem
 from mbjax._src.trajopt.batch import working_set
-from mbjax._src.trajopt.result import AbstractIterativeSolver, AbstractSolver, Result
+from mbjax._src.trajopt.result import AbstractIterativeSolver, AbstractSolver, Result, checked
 from mbjax._src.trajopt.sweep import padded
 
 
@@ -75,8 +75,8 @@ def solve(problem: Problem, solver: AbstractSolver = ILQR(), us0: Array | None =
 @eqx.filter_jit
 def _solve(problem: Problem, solver: AbstractSolver, us0: Array | None, states0: Array | None,
            throw: bool) -> Result:
-    return raise_on_failure(solver.solve(problem, problem.initial_controls(us0), states0), throw,
-                            "mbjax._src.trajopt.solve")
+    result = solver.solve(problem, problem.initial_controls(us0), states0)
+    return raise_on_failure(checked(result), throw, "mbjax._src.trajopt.solve")
 
 
 @eqx.filter_jit
@@ -95,7 +95,7 @@ def _solve_batch(problems: Problem, solver: AbstractSolver, us0: Array | None,
     else:
         result = jax.vmap(lambda p, u, x: solver.solve(eqx.combine(p, static), u, x),
                           in_axes=(0, 0, None if states0 is None else 0))(params, us, states0)
-    return raise_on_failure(result, throw, "mbjax._src.trajopt.solve")
+    return raise_on_failure(jax.vmap(checked)(result), throw, "mbjax._src.trajopt.solve")
 
 
 def _split(fn, params, us: Array):

@@ -66,8 +66,22 @@ def sweep(fn, params, *, devices=None, trim: bool = True):
         trim=False).
 
     Raises:
-        ValueError: params has no array leaves or they do not share a leading axis.
+        ValueError: params has no array leaves or they do not share a leading axis, or
+            devices is an empty sequence.
+        TypeError: devices is not a sequence of JAX devices.
     """
+    if devices is not None:
+        try:
+            devices = list(devices)
+        except TypeError as error:
+            raise TypeError(f"devices must be None or a sequence of JAX devices (jax.devices()), "
+                            f"got {type(devices).__name__}") from error
+        if not devices:
+            raise ValueError("devices must be None (one device) or a non-empty sequence of JAX "
+                             "devices (jax.devices()), got an empty one")
+        if not all(isinstance(d, jax.Device) for d in devices):
+            raise TypeError(f"devices must be JAX devices (jax.devices()), got "
+                            f"{sorted({type(d).__name__ for d in devices})}")
     params = jax.tree.map(jnp.asarray, params)
     n = size(params)
     mapped = jax.vmap(fn)
