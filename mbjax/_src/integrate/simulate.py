@@ -11,7 +11,7 @@ from jax import Array
 from mbjax._src.integrate.base import AbstractIntegrator
 from mbjax._src.integrate.solution import Solution
 from mbjax._src.lie.inputs import check_unit_quaternions
-from mbjax._src.system.accuracy import (ERROR_SAMPLES, RESOLUTION_LIMIT, doubled,
+from mbjax._src.system.accuracy import (ERROR_SAMPLES, RESOLUTION_LIMIT, SUSTAINED, doubled,
                                         number, sample_indices, step_ratio, tolerances)
 from mbjax._src.system.invariants import drifts
 from mbjax._src.system.status import (DRIFTED, ESTIMATED, FLAGS, RESOLVED, Status,
@@ -279,25 +279,26 @@ def _rollout(system, integrator, q0, u0, t0, dt, block: int, n_blocks: int, keep
     members = q0.shape[-1:] if system.batched else ()
 
     def flat(q, u):
-        """The state as one column (per copy), not differentiated."""
-        return jax.lax.stop_gradient(jnp.concatenate([q.reshape(-1, *members),
-                                                      u.reshape(-1, *members)]))
+        """The state's parts as columns (one per copy), not differentiated."""
+        return tuple(jax.lax.stop_gradient(x.reshape(-1, *members)) for x in (q, u))
 
     def step(carry, k):
-        q, u, status, (d, r1, r2, worst, first) = carry
+        q, u, status, (d, moved, recent, worst, first) = carry
         t = t0 + k * dt
         # sampled controls take their value at the step's start for all of its stages
         q1, u1, converged = integrator.step(system.hold(t, q, u), t, q, u, dt)
         q1, u1 = system.constrain(t + dt, q1, u1)
         y0, y1 = flat(q, u), flat(q1, u1)
-        finite = jnp.all(jnp.isfinite(y1), axis=0)
+        finite = jnp.all(jnp.isfinite(y1[0]), axis=0) & jnp.all(jnp.isfinite(y1[1]), axis=0)
         # the default check: the step times the motion's rate, from consecutive increments
-        r = step_ratio(d, y1 - y0, y0)
-        held = jnp.minimum(r, jnp.minimum(r1, r2))
+        increment = tuple(b - a for a, b in zip(y0, y1))
+        r, moved = step_ratio(d, increment, y0, moved)
+        held = jnp.minimum(r, jnp.min(recent, axis=0))     # over SUSTAINED steps
         new = (status | jnp.where(finite, 0, int(Status.NONFINITE))
                | jnp.where(converged, 0, int(Status.NOT_CONVERGED))
                | jnp.where(held > RESOLUTION_LIMIT, inaccurate, 0))
-        watch = (y1 - y0, r, r1, jnp.maximum(worst, held), _raised(first, status, new, t + dt))
+        watch = (increment, moved, jnp.concatenate([recent[1:], r[None]]),
+                 jnp.fmax(worst, held), _raised(first, status, new, t + dt))
         return (q1, u1, new, watch), None
 
     def run_segment(carry, ks):
@@ -326,7 +327,9 @@ def _rollout(system, integrator, q0, u0, t0, dt, block: int, n_blocks: int, keep
     first = _raised(jnp.full((*members, len(FLAGS)), jnp.nan, dtype), jnp.zeros_like(flags),
                     flags, t0)
     zero = jnp.zeros(members, dtype)
-    init = (q0, u0, flags, (jnp.zeros_like(flat(q0, u0)), zero, zero, zero, first))
+    init = (q0, u0, flags, (jax.tree.map(jnp.zeros_like, flat(q0, u0)),
+                            (jnp.zeros(members, jnp.int32),) * 2,
+                            jnp.zeros((SUSTAINED - 1, *members), dtype), zero, first))
     # Scans nest (blocks, segments, steps, an integrator's stages), and reverse mode traces a
     # scan's body several times per level: a level of length one is a plain call instead.
     if n_blocks == 1:
@@ -334,8 +337,9 @@ def _rollout(system, integrator, q0, u0, t0, dt, block: int, n_blocks: int, keep
         qs, us = q[None], u[None]
     else:
         final, (qs, us) = jax.lax.scan(run_block, init, jnp.arange(n_blocks))
-    status, (_, _, _, resolution, first) = final[2], final[3]
+    status, (*_, resolution, first) = final[2], final[3]
     qs = jnp.concatenate([q0[None], qs])[jnp.array(keep)]
     us = jnp.concatenate([u0[None], us])[jnp.array(keep)]
     return qs, us, status, dict(resolution=resolution, flagged_at=first,
-                                inaccurate_by=jnp.where(resolution > RESOLUTION_LIMIT, RESOLVED, 0))
+                                inaccurate_by=jnp.where(status & int(Status.INACCURATE), RESOLVED,
+                                                        0))

@@ -1,6 +1,7 @@
 """What every driver asks of its accuracy arguments (dt, rtol, atol) and how it estimates its error:
 concrete numbers checked once, and step doubling on a few sampled states."""
 
+import functools
 import math
 
 import jax
@@ -70,20 +71,38 @@ def doubled(step, state, t, h, span):
 RESOLUTION_LIMIT = 1.0
 # steps in a row the estimate must exceed the limit (a kick, a control switch, a wrap is one)
 SUSTAINED = 3
+# steps a part must have been in motion before its ratio counts (`step_ratio`)
+ONSET = 8
 # the invariants' drift relative to the motion's scale (`mbjax._src.system.invariants`)
 DRIFT_LIMIT = 0.1
 
 
-def step_ratio(previous: jax.Array, increment: jax.Array, state: jax.Array) -> jax.Array:
-    """|d_k - d_(k-1)| / |d_(k-1)| for consecutive increments d of a state sequence: for a
-    smooth motion sampled every h, h |y''| / |y'|, the step times the motion's rate (h omega for
-    an oscillation), whatever the state's units; 0 where the previous increment is at the level
-    of round-off of the state (at rest). Norms over the first axis (a batch of states, one per
-    column, gives a ratio per column)."""
-    size = jnp.linalg.norm(previous, axis=0)
-    floor = 1e3 * jnp.finfo(state.dtype).eps * (1.0 + jnp.linalg.norm(state, axis=0))
-    return jnp.where(size > floor, jnp.linalg.norm(increment - previous, axis=0)
-                     / jnp.where(size > floor, size, 1.0), 0.0)
+def step_ratio(previous, increment, state, moved):
+    """The step times the motion's rate from consecutive increments d of a state sequence:
+    |d_k - d_(k-1)| / |d_(k-1)|, which for a smooth motion sampled every h is h |y''| / |y'|
+    (h omega for an oscillation), whatever the state's units.
+
+    Each argument is a tuple of the state's parts (the configuration, the velocity), and the
+    ratio is the least of the parts': an unresolved or unstable motion shows in all of them,
+    while a control switched at every step jumps only the velocity's increments and a turning
+    point only the configuration's. A part counts once its increments have exceeded
+    sqrt(eps) (1 + |y|) for `ONSET` steps in a row: at rest it says nothing, and a motion
+    starting from rest like t^p reads about p / k at its k-th step. 0 where no part counts.
+    Norms over the first axis (a batch of states, one per column, gives a ratio per column).
+
+    Returns:
+        (the ratio, the parts' updated counts of steps in motion).
+    """
+    ratios, counts = [], []
+    for d0, d1, y, n in zip(previous, increment, state, moved):
+        size = jnp.linalg.norm(d0, axis=0)
+        moving = size > jnp.sqrt(jnp.finfo(y.dtype).eps) * (1.0 + jnp.linalg.norm(y, axis=0))
+        n = jnp.where(moving, n + 1, 0)
+        ratios.append(jnp.where(n > ONSET, jnp.linalg.norm(d1 - d0, axis=0)
+                                / jnp.where(moving, size, 1.0), jnp.inf))
+        counts.append(n)
+    least = functools.reduce(jnp.minimum, ratios)
+    return jnp.where(jnp.isinf(least), 0.0, least), tuple(counts)
 
 
 def sustained(ratios: jax.Array) -> jax.Array:
@@ -95,13 +114,21 @@ def sustained(ratios: jax.Array) -> jax.Array:
     return held
 
 
-def resolution(states: jax.Array) -> tuple[jax.Array, jax.Array]:
-    """(the largest sustained step ratio along a state sequence (T, n), the index of the state
-    where it first exceeds `RESOLUTION_LIMIT`, or -1): `step_ratio` between every three
-    consecutive states, held for `SUSTAINED` steps."""
-    states = jax.lax.stop_gradient(states)
-    d = jnp.diff(states, axis=0)
-    ratios = jax.vmap(step_ratio)(d[:-1], d[1:], states[1:-1])
+def resolution(*parts: jax.Array) -> tuple[jax.Array, jax.Array]:
+    """(the largest sustained step ratio along a state sequence given by its parts (T, n_i)
+    (configurations, velocities), the index of the state where it first exceeds
+    `RESOLUTION_LIMIT`, or -1): `step_ratio` between every three consecutive states, held for
+    `SUSTAINED` steps."""
+    parts = tuple(jax.lax.stop_gradient(x) for x in parts)
+    d = tuple(jnp.diff(x, axis=0) for x in parts)
+
+    def one(moved, k):
+        ratio, moved = step_ratio(tuple(x[k] for x in d), tuple(x[k + 1] for x in d),
+                                  tuple(x[k + 1] for x in parts), moved)
+        return moved, ratio
+
+    zeros = tuple(jnp.zeros((), int) for _ in parts)
+    _, ratios = jax.lax.scan(one, zeros, jnp.arange(len(parts[0]) - 2))
     held = sustained(ratios)
     over = held > RESOLUTION_LIMIT
     return (jnp.max(held, initial=0.0),

@@ -218,7 +218,7 @@ def _checked(body, solution: TFESolution, drift_limit) -> TFESolution:
     and the invariants' drift past `drift_limit`."""
     # the momentum and the position, not the attitude: an element's reference carries the
     # rotation exactly (a spin of many radians per element is not an error)
-    resolution, at = accuracy_resolution(jnp.concatenate([solution.x, solution.p_hat], axis=1))
+    resolution, at = accuracy_resolution(solution.x, solution.p_hat)
     history = jax.vmap(body.invariants)(solution.ts, solution.R, solution.x, solution.p_hat)
     ratios = drifts(history)
     drift = jnp.max(ratios, initial=0.0)
