@@ -1,6 +1,7 @@
 """The fixed-step simulation driver."""
 
 import math
+from typing import NamedTuple
 
 import equinox as eqx
 import jax
@@ -84,7 +85,21 @@ def simulate(system: AbstractSystem, integrator: AbstractIntegrator, q0: Array, 
     The returned `Solution.status` flags non-finite states and unconverged implicit steps, and
     whatever the system's `check` reports at the start and at the ends of the blocks (every
     saved state). Each step runs the system as `system.hold(t, q, u)` gives it (sampled
-    controls frozen at the step's start), and the system's `constrain` after it.
+    controls frozen at the step's start), and the system's `constrain` after it. A batched
+    system (`BatchTreeSystem`) has a status per copy. `Solution.messages()` says each flag in
+    words with what tripped it and when it was first raised (`Solution.flagged_at`).
+
+    The default accuracy check, always on. At every step the rollout estimates the step times
+    the motion's fastest rate from consecutive increments of the state, |d_k - d_(k-1)| /
+    |d_(k-1)|, the least over the configuration's and the velocity's
+    (`mbjax._src.system.accuracy.step_ratio`), and sets INACCURATE where it stays above 1
+    (about six steps per period of an oscillation) for 3 steps in a row: a method past its
+    stability limit (1.2 to 3.5 measured) or a step far too long for the motion, caught before
+    the state overflows. `Solution.resolution` is its largest value. Its cost is a few vector
+    operations per step (benchmarks/README.md, "The default accuracy check", measures it and
+    its false alarms over every scene and reproduction: none). It does not see errors that grow
+    slowly through a resolved motion (a chaotic chain's, an energy drift): the tolerance below
+    does.
 
     Accuracy check (rtol, atol). Given either, the solution carries an error estimate
     (`Solution.error`) and the status INACCURATE where it exceeds the tolerance: the root mean
@@ -260,6 +275,19 @@ def _segment(block: int) -> int:
     return max(k for k in range(1, math.isqrt(block) + 1) if block % k == 0)
 
 
+class _Watch(NamedTuple):
+    """What the rollout carries for its status besides the flags: the last increments of the
+    state's parts and their steps in motion (`step_ratio`), the last ratios, the largest held
+    one, the time each flag was first raised, and what first tripped the system's check."""
+
+    increment: tuple
+    moved: tuple
+    recent: Array
+    worst: Array
+    first: Array
+    culprit: Array
+
+
 def _raised(first: Array, old: Array, new: Array, t: Array) -> Array:
     """The times each flag was first raised (shape status + (8,)), with those `new` raises over
     `old` at t."""
@@ -283,7 +311,7 @@ def _rollout(system, integrator, q0, u0, t0, dt, block: int, n_blocks: int, keep
         return tuple(jax.lax.stop_gradient(x.reshape(-1, *members)) for x in (q, u))
 
     def step(carry, k):
-        q, u, status, (d, moved, recent, worst, first) = carry
+        q, u, status, watch = carry
         t = t0 + k * dt
         # sampled controls take their value at the step's start for all of its stages
         q1, u1, converged = integrator.step(system.hold(t, q, u), t, q, u, dt)
@@ -292,22 +320,28 @@ def _rollout(system, integrator, q0, u0, t0, dt, block: int, n_blocks: int, keep
         finite = jnp.all(jnp.isfinite(y1[0]), axis=0) & jnp.all(jnp.isfinite(y1[1]), axis=0)
         # the default check: the step times the motion's rate, from consecutive increments
         increment = tuple(b - a for a, b in zip(y0, y1))
-        r, moved = step_ratio(d, increment, y0, moved)
-        held = jnp.minimum(r, jnp.min(recent, axis=0))     # over SUSTAINED steps
+        r, moved = step_ratio(watch.increment, increment, y0, watch.moved)
+        held = jnp.minimum(r, jnp.min(watch.recent, axis=0))     # over SUSTAINED steps
         new = (status | jnp.where(finite, 0, int(Status.NONFINITE))
                | jnp.where(converged, 0, int(Status.NOT_CONVERGED))
                | jnp.where(held > RESOLUTION_LIMIT, inaccurate, 0))
-        watch = (increment, moved, jnp.concatenate([recent[1:], r[None]]),
-                 jnp.fmax(worst, held), _raised(first, status, new, t + dt))
+        watch = watch._replace(increment=increment, moved=moved,
+                               recent=jnp.concatenate([watch.recent[1:], r[None]]),
+                               worst=jnp.fmax(watch.worst, held),
+                               first=_raised(watch.first, status, new, t + dt))
         return (q1, u1, new, watch), None
 
     def run_segment(carry, ks):
         return jax.lax.scan(step, carry, ks)[0], None
 
-    def checked(t, q, u):
-        """The system's flags at a state (not differentiated)."""
-        return system.check(t, jax.lax.stop_gradient(q), jax.lax.stop_gradient(u)).astype(
-            jnp.int32)
+    def checked(t, q, u, status, watch):
+        """The status and watch with the system's check at a state (not differentiated)."""
+        q, u = jax.lax.stop_gradient(q), jax.lax.stop_gradient(u)
+        flags = system.check(t, q, u).astype(jnp.int32)
+        culprit = jnp.where((watch.culprit < 0) & (flags != 0), system.culprit(t, q, u),
+                            watch.culprit)
+        new = status | flags
+        return new, watch._replace(first=_raised(watch.first, status, new, t), culprit=culprit)
 
     def run_block(carry, b):
         ks = b * block + jnp.arange(block)
@@ -317,19 +351,17 @@ def _rollout(system, integrator, q0, u0, t0, dt, block: int, n_blocks: int, keep
         else:
             carry, _ = run_segment(carry, ks)
         q, u, status, watch = carry
-        t = t0 + (b + 1) * block * dt
-        new = status | checked(t, q, u)
-        watch = (*watch[:4], _raised(watch[4], status, new, t))
-        return (q, u, new, watch), (q, u)
+        status, watch = checked(t0 + (b + 1) * block * dt, q, u, status, watch)
+        return (q, u, status, watch), (q, u)
 
     # the start is a saved state too: the system's check sees it (a start on a singularity)
-    flags = jnp.broadcast_to(checked(t0, q0, u0), members)
-    first = _raised(jnp.full((*members, len(FLAGS)), jnp.nan, dtype), jnp.zeros_like(flags),
-                    flags, t0)
     zero = jnp.zeros(members, dtype)
-    init = (q0, u0, flags, (jax.tree.map(jnp.zeros_like, flat(q0, u0)),
-                            (jnp.zeros(members, jnp.int32),) * 2,
-                            jnp.zeros((SUSTAINED - 1, *members), dtype), zero, first))
+    watch = _Watch(increment=jax.tree.map(jnp.zeros_like, flat(q0, u0)),
+                   moved=(jnp.zeros(members, jnp.int32),) * 2,
+                   recent=jnp.zeros((SUSTAINED - 1, *members), dtype), worst=zero,
+                   first=jnp.full((*members, len(FLAGS)), jnp.nan, dtype),
+                   culprit=jnp.full(members, -1, jnp.int32))
+    init = (q0, u0, *checked(t0, q0, u0, jnp.zeros(members, jnp.int32), watch))
     # Scans nest (blocks, segments, steps, an integrator's stages), and reverse mode traces a
     # scan's body several times per level: a level of length one is a plain call instead.
     if n_blocks == 1:
@@ -337,9 +369,10 @@ def _rollout(system, integrator, q0, u0, t0, dt, block: int, n_blocks: int, keep
         qs, us = q[None], u[None]
     else:
         final, (qs, us) = jax.lax.scan(run_block, init, jnp.arange(n_blocks))
-    status, (*_, resolution, first) = final[2], final[3]
+    status, watch = final[2], final[3]
     qs = jnp.concatenate([q0[None], qs])[jnp.array(keep)]
     us = jnp.concatenate([u0[None], us])[jnp.array(keep)]
-    return qs, us, status, dict(resolution=resolution, flagged_at=first,
+    return qs, us, status, dict(resolution=watch.worst, flagged_at=watch.first,
+                                culprit=watch.culprit, culprit_names=system.culprit_names(),
                                 inaccurate_by=jnp.where(status & int(Status.INACCURATE), RESOLVED,
                                                         0))

@@ -32,6 +32,9 @@ class Solution(WithStatus):
         inaccurate_by: why the run is INACCURATE, a mask: 1 the resolution, 2 the drift, 4
             the error estimate.
         invariant_names: the names of the system's invariants (static).
+        culprit: what first made the system's check flag a state (an index into
+            culprit_names: a joint's limit, a singularity), -1 for none.
+        culprit_names: the names culprit indexes (static; `AbstractSystem.culprit_names`).
     """
 
     ts: Array
@@ -45,6 +48,8 @@ class Solution(WithStatus):
     flagged_at: Array | None = None
     inaccurate_by: Array = 0
     invariant_names: tuple[str, ...] = eqx.field(static=True, default=())
+    culprit: Array = -1
+    culprit_names: tuple[str, ...] = eqx.field(static=True, default=())
 
     def notes(self, i: int) -> dict:
         """What tripped each flag of the i-th run (`WithStatus.messages`)."""

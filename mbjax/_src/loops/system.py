@@ -220,6 +220,14 @@ class ClosedSystem(AbstractSystem):
         """The tree's quaternions in q."""
         return self.tree.quaternions()
 
+    def culprit(self, t, q, u):
+        """The tree's (a joint beyond its limit)."""
+        return self.tree.culprit(t, q, self.velocity(q, u))
+
+    def culprit_names(self):
+        """The tree's."""
+        return self.tree.culprit_names()
+
     def check(self, t, q, u):
         """`Status.CONSTRAINT_VIOLATED` where |Phi| > tolerance, `Status.REDUNDANT` where the
         constraint Jacobian has lost rank, and the tree's own flags; an int32 scalar."""

@@ -24,7 +24,7 @@ from mbjax._src.system.system import AbstractSystem
 from mbjax._src.system.tree_system import AbstractTreeSystem
 from mbjax._src.system.status import Status
 from mbjax._src.model import Model
-from mbjax._src.model.limits import exceeded
+from mbjax._src.model.limits import exceeded, excess_names, first_exceeded
 from mbjax._src.rigid.aba import aba_responses
 from mbjax._src.rigid.batched import batch_aba
 from mbjax._src.rigid.dense import dense_responses
@@ -109,6 +109,14 @@ class TreeSystem(AbstractTreeSystem):
         """
         over = exceeded(self.model, q, u, self.applied(t, q, u))
         return jnp.where(over, int(Status.LIMIT_EXCEEDED), 0).astype(jnp.int32)
+
+    def culprit(self, t, q, u):
+        """The first coordinate beyond its limit (`mbjax._src.model.limits.first_exceeded`)."""
+        return first_exceeded(self.model, q, u, self.applied(t, q, u))
+
+    def culprit_names(self):
+        """Each joint coordinate's position, velocity and effort limit."""
+        return excess_names(self.model)
 
     def energy(self, q, v):
         """Kinetic plus gravitational energy [J], a scalar (`mbjax.rigid.kinetic_energy` plus

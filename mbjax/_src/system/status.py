@@ -24,8 +24,10 @@ class Status(enum.IntFlag):
             or a singular configuration); least-squares loads were used.
         LIMIT_EXCEEDED: a note: a saved state or control is beyond the model's joint limits
             (position, velocity or effort; `mbjax._src.model.limits`).
-        INACCURATE: the estimated error exceeds the tolerance asked for (`simulate`'s rtol and
-            atol; `Solution.error`).
+        INACCURATE: the steps do not resolve the motion (the default check,
+            `Solution.resolution` above 1), or the estimated error or the invariants' drift
+            exceeds the tolerance asked for (`simulate`'s rtol and atol; `Solution.error`,
+            `Solution.drift`).
         SINGULAR: a saved state at (or within the system's tolerance of) a singular
             configuration, where the dynamics are not defined (the Carpal Wrist's inverse or
             direct singularity: `WristSystem.check`).
@@ -124,6 +126,13 @@ def accuracy_notes(result, i: int, flags_at=None) -> dict:
         for k, flag in enumerate(f for f in Status if f):
             if np.isfinite(at[k]):
                 notes[flag] = f"first at t = {at[k]:.4g} s"
+    culprit = int(member(getattr(result, "culprit", -1)))
+    names = getattr(result, "culprit_names", ())
+    raised = [flag for flag in (Status.LIMIT_EXCEEDED, Status.SINGULAR)
+              if int(member(result.status)) & flag]
+    if 0 <= culprit < len(names) and raised:
+        # the system's check names what it found (`AbstractSystem.culprit`)
+        notes[raised[0]] = "; ".join(filter(None, (names[culprit], notes.get(raised[0]))))
     by = int(member(result.inaccurate_by))
     reasons = []
     if by & RESOLVED:

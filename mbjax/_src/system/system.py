@@ -184,6 +184,24 @@ class AbstractSystem(eqx.Module):
         """
         return jnp.array(0, jnp.int32)
 
+    def culprit(self, t: Array, q: Array, u: Array) -> Array:
+        """What made `check` flag a state, for the status's words.
+
+        Args:
+            t: time [s], a scalar.
+            q: configuration, shape (nq,).
+            u: velocity state, shape (nu,).
+
+        Returns:
+            An int32 index into `culprit_names()`, -1 for none; -1 by default.
+        """
+        return jnp.array(-1, jnp.int32)
+
+    def culprit_names(self) -> tuple[str, ...]:
+        """The names `culprit` indexes (a joint's position limit, a singularity); none by
+        default."""
+        return ()
+
     def invariants(self, t: Array, q: Array, u: Array) -> Invariants | None:
         """The quantities the exact motion conserves at a state.
 

@@ -284,14 +284,20 @@ def solve_tfe(body: Body, state0: State, *, dt, n_elements: int, form: AbstractF
     max_iter); dt, tol, the body and the state are traced, so sweeps over them do not recompile
     and they can be differentiated.
 
+    The default accuracy check, always on: `resolution`, the element's span times the
+    motion's rate from consecutive boundaries' momenta and positions (`mbjax.simulate`'s check;
+    the attitude is left out, since each element's reference carries the rotation exactly),
+    and `drift`, the largest relative drift of the body's invariants (`Body.invariants`: the
+    energy, the momenta), set INACCURATE above 1 and above `DRIFT_LIMIT` (0.1) respectively; a
+    single body's invariants cost little to evaluate.
+
     With a tolerance (rtol, atol, as `mbjax.simulate`'s) the solution carries `error`, a
     step-doubling estimate of the final state's error (at up to `ERROR_SAMPLES` boundaries,
     one element against two of half the spacing; their difference is taken as the element's
     local error, the elements being of high order, and summed over the march; the rotation
-    matrix, position and momentum components together), and `drift`, the largest relative
-    drift of the body's invariants (`Body.invariants`: the energy, the momenta), and the status
-    INACCURATE where the first exceeds the tolerance (root mean square norm) or the second
-    exceeds a positive rtol. The primal form past its stability boundary is caught this way
+    matrix, position and momentum components together), the status INACCURATE where it
+    exceeds the tolerance (root mean square norm), and a positive rtol replaces `DRIFT_LIMIT`
+    as the drift's bound. The primal form past its stability boundary is caught this way
     (tests/tfe/test_accuracy.py).
 
     Args:

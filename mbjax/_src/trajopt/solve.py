@@ -34,6 +34,10 @@ def solve(problem: Problem, solver: AbstractSolver = ILQR(), us0: Array | None =
     cores made devices, GPUs) the batch is split over them, a working set on each. Other
     solvers are `jax.vmap`ped. `jax.vmap(solve)` stays the plain map.
 
+    The result's status also carries `mbjax.simulate`'s default accuracy check over the
+    optimised trajectory (`Result.resolution`): INACCURATE where its steps do not resolve its
+    motion, an optimum of the discrete dynamics that the continuous ones would not follow.
+
     Args:
         problem: the trajectory-optimisation problem.
         solver: the method, an `AbstractSolver` instance (`ILQR()`, `MultipleShooting()`,

@@ -104,6 +104,15 @@ class WristSystem(AbstractDrivenSystem):
         near = jnp.minimum(jnp.abs(m.inverse), jnp.abs(m.direct)) < SINGULAR_TOLERANCE
         return jnp.where(near, int(Status.SINGULAR), 0).astype(jnp.int32)
 
+    def culprit(self, t: Array, q: Array, u: Array) -> Array:
+        """0 where the inverse singularity is the nearer, 1 the direct."""
+        m = kinematics.singularity_measures(self.model, q)
+        return jnp.where(jnp.abs(m.inverse) <= jnp.abs(m.direct), 0, 1).astype(jnp.int32)
+
+    def culprit_names(self) -> tuple[str, ...]:
+        """The two singularities."""
+        return ("an inverse singularity", "a direct singularity")
+
     def energy(self, q: Array, u: Array) -> Array:
         """T + V of the tool [J], a scalar; the work of the motors and the external wrench is not
         included."""
