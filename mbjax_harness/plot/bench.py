@@ -329,3 +329,37 @@ def trajopt_bench_figure(records: list[dict]) -> Figure:
     ax.set(ylabel="wall time [s]",
            title=f"acrobot swing-up, {sweep[0]['variants'] if sweep else 0} mass variants")
     return fig
+
+
+def accuracy_bench_figure(records: list[dict]) -> Figure:
+    """Left: each case's final error against the default check's resolution, at the step that
+    fails (filled: flagged by default) and at the step that resolves it. Right: the 7-link
+    chain's rollout, simulate (status and default check) against the bare loop."""
+    fig = Figure(figsize=(12, 5), layout="constrained")
+    ax_cases, ax_cost = fig.subplots(1, 2, width_ratios=(2, 1))
+    cases = [r for r in records if r["kind"] == "case"]
+    for k, name in enumerate(dict.fromkeys(r["case"] for r in cases)):
+        color = f"C{k % 10}"
+        for r in (r for r in cases if r["case"] == name):
+            error = r["error"] if r["error"] is not None else 1e3
+            ax_cases.loglog(max(r["resolution"], 1e-3), max(error, 1e-12),
+                            marker="o" if r["ok"] else "s", ms=8, color=color,
+                            mfc="none" if r["ok"] else color,
+                            label=name if r["dt"] == max(c["dt"] for c in cases
+                                                         if c["case"] == name) else None)
+    ax_cases.axvline(1.0, color="k", lw=0.8, ls="--")
+    ax_cases.set(xlabel="resolution: step x the motion's rate (default check, limit 1)",
+                 ylabel="final error (1e3: diverged)",
+                 title="default check: filled = flagged INACCURATE, hollow = success")
+    ax_cases.legend(fontsize=7)
+    cost = [r for r in records if r["kind"] == "cost"]
+    names = [r["variant"] for r in cost]
+    x = np.arange(len(names))
+    ax_cost.bar(x - 0.2, [r["first_call_s"] for r in cost], 0.4, label="first call [s]")
+    ax_cost.bar(x + 0.2, [r["warm_s"] * 1e3 for r in cost], 0.4, label="warm call [ms]")
+    ax_cost.set_xticks(x, names)
+    ax_cost.set(title="7-link chain, RK4, 200 steps")
+    for ax in (ax_cases, ax_cost):
+        ax.grid(True, which="both", alpha=0.3)
+    ax_cost.legend(fontsize=8)
+    return fig

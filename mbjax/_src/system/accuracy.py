@@ -1,5 +1,6 @@
-"""What every driver asks of its accuracy arguments (dt, rtol, atol) and how it estimates its error:
-concrete numbers checked once, and step doubling on a few sampled states."""
+"""What every driver asks of its accuracy arguments (dt, rtol, atol) and how it checks its accuracy:
+concrete numbers checked once; by default, the step against the motion's rate at every step
+(`step_ratio`); with a tolerance, step doubling on a few sampled states."""
 
 import functools
 import math

@@ -123,7 +123,7 @@ def accuracy_notes(result, i: int, flags_at=None) -> dict:
     notes = {}
     if flags_at is not None:
         at = member(flags_at)
-        for k, flag in enumerate(f for f in Status if f):
+        for k, flag in enumerate(FLAGS):
             if np.isfinite(at[k]):
                 notes[flag] = f"first at t = {at[k]:.4g} s"
     culprit = int(member(getattr(result, "culprit", -1)))
