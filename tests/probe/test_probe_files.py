@@ -252,9 +252,6 @@ def test_sibling_orders_are_checked(good, bad):
         mbjax.load_urdf(urdf(), sibling_order=bad)
 
 
-@pytest.mark.xfail(strict=True, reason="issue 43: load_urdf(armature=<wrong length>) fails in NumPy "
-                   "('operands could not be broadcast together with remapped shapes') without "
-                   "naming armature")
 @DEFECT
 @given(st.integers(2, 5))
 def test_armature_of_the_wrong_length_is_named(n):
@@ -262,9 +259,6 @@ def test_armature_of_the_wrong_length_is_named(n):
         mbjax.load_urdf(urdf(), armature=np.ones(n))
 
 
-@pytest.mark.xfail(strict=True, reason="issue 43: load_urdf(<bytes>) fails in pathlib ('argument "
-                   "should be a str object or an os.PathLike object returning str') without naming "
-                   "source")
 @DEFECT
 @given(st.just(urdf().encode()))
 def test_a_source_in_bytes_is_read_or_named(source):

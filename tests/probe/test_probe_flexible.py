@@ -71,9 +71,6 @@ def test_element_counts_that_are_not_positive_ints_are_named(n):
         Beam(**GOOD, n_elements=n)
 
 
-@pytest.mark.xfail(strict=True, reason="issue 43: Beam(n_elements=NaN, inf or None) fails in int() "
-                   "('cannot convert float NaN to integer', OverflowError, TypeError) without "
-                   "naming n_elements")
 @DEFECT
 @given(st.sampled_from([np.nan, np.inf, -np.inf, None]))
 def test_element_counts_that_are_not_numbers_are_named(n):
@@ -171,8 +168,6 @@ def test_node_lists_outside_the_beam_repeated_or_clashing_are_named(clamped, int
                       static_load_nodes=static)
 
 
-@pytest.mark.xfail(strict=True, reason="issue 43: craig_bampton truncates a fractional clamped_node "
-                   "(1.5 -> node 1) instead of refusing it")
 @DEFECT
 @given(floats(0.1, NODES - 1.1).filter(lambda x: x != int(x)))
 def test_fractional_clamped_nodes_are_named(node):
@@ -211,8 +206,6 @@ def test_attachment_nodes_outside_the_beam_are_named(nodes, clamped):
         beam_body(BEAM, _basis(), nodes=nodes, clamped_node=clamped)
 
 
-@pytest.mark.xfail(strict=True, reason="issue 43: beam_body truncates fractional attachment nodes "
-                   "(2.5 -> node 2) instead of refusing them")
 @DEFECT
 @given(floats(0.1, NODES - 1.1).filter(lambda x: x != int(x)))
 def test_fractional_attachment_nodes_are_named(node):
@@ -220,9 +213,6 @@ def test_fractional_attachment_nodes_are_named(node):
         beam_body(BEAM, _basis(), nodes=(node,))
 
 
-@pytest.mark.xfail(strict=True, reason="issue 43: beam_body accepts a basis that is not clamped at "
-                   "clamped_node (documented: 'clamped at clamped_node'): its shapes move the joint "
-                   "grid J, silently giving another body")
 @DEFECT
 @given(st.integers(4, NODES - 1))
 def test_a_basis_clamped_elsewhere_is_named(node):

@@ -155,10 +155,6 @@ def test_cut_joint_origins_of_the_wrong_shape_are_named(which, shape):
         CutJoint("spherical", 1, 2, **{which: np.zeros(shape)})
 
 
-@pytest.mark.xfail(strict=True, reason="issue 43: CutJoint accepts non-finite origins (NaN, inf); "
-                   "the loop's residual is then NaN, which `check` never flags as constraint "
-                   "violated (NaN > tolerance is false), and consistent_state fails with 'cannot "
-                   "be projected' instead of naming the origin")
 @DEFECT
 @given(which=st.sampled_from(["origin_a", "origin_b"]), entry=st.integers(0, 2),
        value=st.sampled_from([np.nan, np.inf, -np.inf]))
@@ -228,9 +224,6 @@ def test_consistent_state_that_is_not_finite_is_named(which, entry, value):
         consistent_state(_scene().closed, state["q"], state["v"])
 
 
-@pytest.mark.xfail(strict=True, reason="issue 43: consistent_state with tol <= 0 or NaN fails with "
-                   "'the initial configuration cannot be projected onto the loop closures: |Phi| = "
-                   "2.8e-17 ...', blaming the mechanism instead of naming tol")
 @DEFECT
 @given(st.sampled_from([0.0, -1.0, -1e-12, np.nan]))
 def test_consistent_state_tolerance_that_is_not_positive_is_named(tol):
@@ -240,8 +233,6 @@ def test_consistent_state_tolerance_that_is_not_positive_is_named(tol):
 
 # -- the closed system's state -----------------------------------------------------------------------
 
-@pytest.mark.xfail(strict=True, reason="issue 43: ClosedSystem.initial_state accepts q and v of any "
-                   "length and returns a velocity state of the wrong length silently")
 @DEFECT
 @given(nq=st.integers(1, 5), nv=st.integers(1, 5))
 def test_initial_state_of_the_wrong_length_is_named(nq, nv):
@@ -251,10 +242,6 @@ def test_initial_state_of_the_wrong_length_is_named(nq, nv):
         _scene().closed.initial_state(np.zeros(nq), np.zeros(nv))
 
 
-@pytest.mark.xfail(strict=True, reason="issue 43: Loops.phi, project_configuration and "
-                   "project_velocity given a state of the wrong length fail inside JAX ('jvp called "
-                   "with different primal and tangent shapes', 'cannot reshape array') instead of "
-                   "naming q or v")
 @DEFECT
 @given(which=st.sampled_from(["phi", "configuration", "velocity"]),
        n=st.sampled_from([2, 4]))
@@ -314,8 +301,6 @@ def test_loop_method_gains_that_are_negative_or_nan_are_named(alpha, beta, epsil
             Stabilized(epsilon=epsilon)
 
 
-@pytest.mark.xfail(strict=True, reason="issue 43: Coupled(baumgarte=(alpha, nan)) is accepted when "
-                   "alpha is a number: the check takes min(alpha, nan), which is alpha")
 @DEFECT
 @given(floats(0, 1e3))
 def test_a_nan_baumgarte_beta_is_named(alpha):
@@ -323,8 +308,6 @@ def test_a_nan_baumgarte_beta_is_named(alpha):
         Coupled(baumgarte=(alpha, np.nan))
 
 
-@pytest.mark.xfail(strict=True, reason="issue 43: Coupled(baumgarte=<a number>) fails with an opaque "
-                   "TypeError ('float' object is not iterable) instead of naming baumgarte")
 @DEFECT
 @given(floats(0, 10))
 def test_a_single_baumgarte_gain_is_named(gain):

@@ -147,8 +147,6 @@ def test_element_counts_that_are_not_positive_ints_are_named(n):
         _march(n_elements=n)
 
 
-@pytest.mark.xfail(strict=True, reason="issue 43: solve_tfe(n_elements=True) passes the int check "
-                   "and fails inside JAX ('iota does not accept dtype bool')")
 @DEFECT
 @given(st.just(True))
 def test_a_boolean_element_count_is_named(n):
@@ -201,9 +199,6 @@ def test_a_newton_tolerance_that_cannot_be_met_is_named_or_flagged(tol):
     assert int(sol.status) & Status.NOT_CONVERGED and not bool(sol.ok)
 
 
-@pytest.mark.xfail(strict=True, reason="issue 43: solve_tfe(tol=inf) runs no Newton iteration and "
-                   "reports success with the first guess (rotation off by 4e-3 against Euler's "
-                   "equations) instead of refusing tol")
 @DEFECT
 @given(st.just(np.inf))
 def test_an_infinite_newton_tolerance_is_named_or_still_right(tol):
@@ -217,8 +212,6 @@ def test_an_infinite_newton_tolerance_is_named_or_still_right(tol):
                                        float(sol.ts[-1]))).max() < 1e-7
 
 
-@pytest.mark.xfail(strict=True, reason="issue 43: a non-finite initial position x0 gives a solution "
-                   "whose x is NaN at every boundary with status success")
 @DEFECT
 @given(entry=st.integers(0, 2), value=st.sampled_from([np.nan, np.inf]))
 def test_a_nonfinite_initial_position_is_named_or_flagged(entry, value):
@@ -246,9 +239,6 @@ def test_a_nonfinite_initial_rate_is_flagged(entry, value):
     assert int(sol.status) & Status.NONFINITE and not bool(sol.ok)
 
 
-@pytest.mark.xfail(strict=True, reason="issue 43: initial_state with Omega0 (or v0) of the wrong "
-                   "length fails inside JAX ('dot_general requires contracting dimensions to have "
-                   "the same shape') instead of naming it")
 @DEFECT
 @given(st.sampled_from([0, 1, 2, 4, 6]))
 def test_an_initial_rate_of_the_wrong_length_is_named(n):
@@ -263,9 +253,6 @@ def test_unknown_references_are_named(reference):
         _march(reference=reference)
 
 
-@pytest.mark.xfail(strict=True, reason="issue 43: solve_tfe(form='mixed' or the class Mixed) fails "
-                   "with AttributeError (\"'str' object has no attribute 'to_form'\") instead of "
-                   "naming form")
 @DEFECT
 @given(st.sampled_from(["mixed", Mixed, 3]))
 def test_a_form_that_is_not_a_form_instance_is_named(form):
@@ -273,8 +260,6 @@ def test_a_form_that_is_not_a_form_instance_is_named(form):
         _march(form=form)
 
 
-@pytest.mark.xfail(strict=True, reason="issue 43: solve_tfe(max_iter < 0) fails with an opaque "
-                   "IndexError ('index is out of bounds for axis 0 with size 0')")
 @DEFECT
 @given(st.integers(-5, -1))
 def test_a_negative_iteration_count_is_named(max_iter):
@@ -292,8 +277,6 @@ def test_body_masses_and_centres_that_are_not_physical_are_named(mass, com):
         Body(1.0, INERTIA, com=com)
 
 
-@pytest.mark.xfail(strict=True, reason="issue 43: tfe.Body accepts gravity of the wrong shape; the "
-                   "march then fails inside JAX ('dot_general requires contracting dimensions')")
 @DEFECT
 @given(st.sampled_from([(0.0, 0.0), (0.0, 0.0, -9.81, 0.0), ()]))
 def test_gravity_of_the_wrong_shape_is_named(gravity):

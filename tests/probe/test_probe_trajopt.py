@@ -117,10 +117,6 @@ def test_the_optimal_cost_gradient_is_the_least_squares_optimum_finite_differenc
     np.testing.assert_allclose(grad, fd, rtol=1e-6, atol=1e-8)
 
 
-@pytest.mark.xfail(strict=True, reason="issue 43: a problem already solved by its first guess "
-                   "(optimal cost 0, or round-off like 6e-33) ends 'not converged' after many "
-                   "iterations: ILQR's and MultipleShooting's stopping tests are relative to the "
-                   "cost only, with no absolute floor")
 @DEFECT
 @given(v0=floats(-1, 1).filter(lambda v: v != 0), q0=floats(-1, 1),
        solver=st.sampled_from([ILQR(), MultipleShooting()]))
@@ -152,9 +148,6 @@ def test_steps_that_are_not_positive_numbers_are_named(dt):
         problem(dt=dt)
 
 
-@pytest.mark.xfail(strict=True, reason="issue 43: Problem(dt=None) or a complex dt fails in float() "
-                   "(\"float() argument must be a string or a real number, not 'NoneType'\") "
-                   "without naming dt")
 @DEFECT
 @given(st.sampled_from([None, 1j, object()]))
 def test_steps_that_are_not_numbers_are_named(dt):

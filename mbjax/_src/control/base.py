@@ -11,6 +11,7 @@ import abc
 from collections.abc import Callable
 
 import equinox as eqx
+import jax
 import jax.numpy as jnp
 import numpy as np
 from jax import Array
@@ -144,13 +145,29 @@ class Saturated(AbstractControl):
 
     def __init__(self, control, limit):
         self.control = as_control(control)
-        self.limit = jnp.asarray(limit, dtype=float)
+        self.limit = checked_limit(limit, "Saturated")
 
     def __call__(self, t, q, v):
         return saturate(self.control(t, q, v), self.limit)
 
     def hold(self, t, q, v):
         return Saturated(self.control.hold(t, q, v), self.limit)
+
+
+def checked_limit(limit, who: str) -> Array | None:
+    """A saturation level as a float array, None kept; an error naming `who`'s limit where a
+    concrete one is not positive and finite (limit tanh(x / limit) is NaN at 0 and flips the
+    sign below)."""
+    if limit is None:
+        return None
+    limit = jnp.asarray(limit, dtype=float)
+    try:
+        value = np.asarray(limit)
+    except jax.errors.TracerArrayConversionError:
+        return limit
+    if not np.all(np.isfinite(value) & (value > 0)):
+        raise ValueError(f"{who}'s limit must be positive and finite, got {value}")
+    return limit
 
 
 def saturate(x: Array, limit: Array | None) -> Array:

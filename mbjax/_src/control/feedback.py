@@ -5,11 +5,19 @@ import jax.numpy as jnp
 import numpy as np
 from jax import Array
 
-from mbjax._src.control.base import AbstractControl, saturate
+from mbjax._src.control.base import AbstractControl, checked_limit, saturate
 
 
-def _index(index):
-    return None if index is None else tuple(int(i) for i in np.atleast_1d(index))
+def _index(index, name: str):
+    """Coordinate indices as a tuple of ints; an error naming `name` for any that is not a
+    whole number (a fraction would be truncated and servo another coordinate)."""
+    if index is None:
+        return None
+    values = np.atleast_1d(np.asarray(index))
+    if values.dtype == bool or not (np.issubdtype(values.dtype, np.integer) or (
+            np.issubdtype(values.dtype, np.floating) and np.all(values == np.round(values)))):
+        raise ValueError(f"PD's {name} must be whole coordinate indices, got {index!r}")
+    return tuple(int(i) for i in values)
 
 
 class PD(AbstractControl):
@@ -48,7 +56,7 @@ class PD(AbstractControl):
     def __init__(self, kp, kd, q_ref, v_ref=0.0, feedforward=0.0, *, q_index=None, v_index=None):
         self.kp, self.kd, self.q_ref, self.v_ref, self.feedforward = (
             jnp.asarray(x, dtype=float) for x in (kp, kd, q_ref, v_ref, feedforward))
-        self.q_index, self.v_index = _index(q_index), _index(v_index)
+        self.q_index, self.v_index = _index(q_index, "q_index"), _index(v_index, "v_index")
         if (self.q_index is None) != (self.v_index is None) or (
                 self.q_index is not None and len(self.q_index) != len(self.v_index)):
             raise ValueError("q_index and v_index must both be given, with one entry per servoed "
@@ -113,12 +121,17 @@ class MLPPolicy(AbstractControl):
 
     def __init__(self, n_in: int, n_out: int, *, key, width: int = 32, depth: int = 2, scale=1.0,
                  limit=None, time: bool = False, activation=jnp.tanh):
+        for name, value, least in (("n_in", n_in, 1), ("n_out", n_out, 1), ("width", width, 1),
+                                   ("depth", depth, 0)):
+            if not (isinstance(value, int | np.integer) and not isinstance(value, bool)
+                    and value >= least):
+                raise ValueError(f"MLPPolicy's {name} must be an int >= {least}, got {value!r}")
         mlp = eqx.nn.MLP(n_in + int(time), n_out, width, depth, activation=activation, key=key)
         last = mlp.layers[-1]
         self.mlp = eqx.tree_at(lambda m: (m.layers[-1].weight, m.layers[-1].bias), mlp,
                                (jnp.zeros_like(last.weight), jnp.zeros_like(last.bias)))
         self.scale = jnp.asarray(scale, dtype=float)
-        self.limit = None if limit is None else jnp.asarray(limit, dtype=float)
+        self.limit = checked_limit(limit, "MLPPolicy")
         self.time = time
 
     def __call__(self, t, q, v):

@@ -10,6 +10,7 @@ import jax.numpy as jnp
 from jax import Array
 
 from mbjax._src.control.base import AbstractControl, Constant, as_control
+from mbjax._src.system.accuracy import number
 
 # Times within this fraction of a step of a sample time count as on it (the step grid t0 + k dt
 # is computed in floating point).
@@ -41,9 +42,11 @@ class ZeroOrderHold(AbstractControl):
         values = jnp.asarray(values, dtype=float)
         if values.ndim == 1:
             values = values[:, None]
-        if values.shape[0] < 1:
-            raise ValueError(f"values must be (K, ...) samples, K >= 1, got shape {values.shape}")
-        if not float(dt) > 0:
+        if values.ndim != 2 or values.shape[0] < 1:
+            raise ValueError(f"values must be K >= 1 samples, shape (K,) or (K, m), got shape "
+                             f"{values.shape}")
+        dt, t0 = number(dt, "ZeroOrderHold's dt"), number(t0, "ZeroOrderHold's t0")
+        if not dt > 0:
             raise ValueError(f"dt must be positive, got {dt}")
         self.values = values
         self.dt = float(dt)

@@ -5,7 +5,7 @@ import jax
 import jax.numpy as jnp
 from jax import Array
 
-from mbjax._src.control.base import AbstractControl, saturate
+from mbjax._src.control.base import AbstractControl, checked_limit, saturate
 
 
 def bspline_basis(t: Array, duration: float, n_knots: int, t0: float = 0.0) -> Array:
@@ -64,7 +64,7 @@ class CubicSpline(AbstractControl):
         if not float(duration) > 0:
             raise ValueError(f"duration must be positive, got {duration}")
         self.knots = knots
-        self.limit = None if limit is None else jnp.asarray(limit, dtype=float)
+        self.limit = checked_limit(limit, "CubicSpline")
         self.duration = float(duration)
         self.t0 = float(t0)
 
@@ -120,5 +120,10 @@ class CubicSpline(AbstractControl):
             The `CubicSpline` equal to value on [t0, t0 + duration].
         """
         value = jnp.atleast_1d(jnp.asarray(value, dtype=float))
+        limit = checked_limit(limit, "CubicSpline.constant")
+        if limit is not None and not isinstance(value, jax.core.Tracer) \
+                and bool(jnp.any(jnp.abs(value) >= limit)):
+            raise ValueError(f"CubicSpline.constant's value {value} must lie strictly inside "
+                             f"+-limit {limit} (the spline saturates there)")
         s = value if limit is None else limit * jnp.arctanh(value / limit)
         return cls(jnp.tile(s, (n_knots, 1)), duration, limit, t0)

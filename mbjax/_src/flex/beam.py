@@ -51,6 +51,12 @@ def _check_positive(name, value):
         raise ValueError(f"Beam: {name} must be positive and finite, got {value!r}")
 
 
+def _whole(x) -> bool:
+    """Whether x is a whole number (an int, or a float with no fraction), not a bool."""
+    return (isinstance(x, int | float | np.integer | np.floating) and not isinstance(x, bool)
+            and math.isfinite(x) and x == int(x))
+
+
 class Beam(eqx.Module):
     """Uniform straight beam along the body x axis, n_elements equal 2-node, 12-dof elements.
 
@@ -89,7 +95,7 @@ class Beam(eqx.Module):
     timoshenko: bool = eqx.field(static=True)
 
     def __init__(self, L, E, G, rho, A, Iy, Iz, J, n_elements=10, *, timoshenko=False, kappa=5.0 / 6.0):
-        if isinstance(n_elements, bool) or int(n_elements) != n_elements or n_elements < 1:
+        if not _whole(n_elements) or n_elements < 1:
             raise ValueError(f"Beam: n_elements must be an integer >= 1, got {n_elements!r}")
         for name, v in dict(L=L, E=E, G=G, rho=rho, A=A, Iy=Iy, Iz=Iz, J=J, kappa=kappa).items():
             _check_positive(name, v)

@@ -7,17 +7,17 @@ points where other bodies or cut joints attach.
 """
 
 import equinox as eqx
+import jax
 import jax.numpy as jnp
 import numpy as np
 
 from mbjax._src.flex.beam import Beam
 from mbjax._src.flex.body import ModalBody
-from mbjax._src.flex.modal import ModalBasis, reduced
+from mbjax._src.flex.modal import ModalBasis, reduced, whole_nodes
 from mbjax._src.flex.points import mass_points, node_shapes
 from mbjax._src.flex.stiffening import distal_stiffening, inertial_stiffening
 
 
-@eqx.filter_jit
 def beam_body(beam: Beam, basis: ModalBasis, nodes=(), *, clamped_node: int = 0,
               stiffening: bool = True, damping=None) -> ModalBody:
     """The modal body of `beam` in `basis`, ready for a `FlexibleModel`.
@@ -41,10 +41,12 @@ def beam_body(beam: Beam, basis: ModalBasis, nodes=(), *, clamped_node: int = 0,
         The `ModalBody`.
 
     Raises:
-        ValueError: a basis built for a beam of another number of nodes, a node outside the
-            beam, or damping not of shape (mu, mu).
+        ValueError: a basis built for a beam of another number of nodes or clamped at
+            another node, a node outside the beam or not a whole number, or damping not of
+            shape (mu, mu).
     """
-    nodes = tuple(int(h) for h in nodes)
+    nodes = whole_nodes("beam_body", "nodes", nodes) if len(nodes) else ()
+    (clamped_node,) = whole_nodes("beam_body", "clamped_node", clamped_node)
     if basis.shapes.shape[0] != 6 * beam.n_nodes:
         raise ValueError(f"basis has shapes for {basis.shapes.shape[0] // 6} nodes (6 dofs each) "
                          f"but beam has {beam.n_nodes}: build the basis from this beam "
@@ -53,6 +55,18 @@ def beam_body(beam: Beam, basis: ModalBasis, nodes=(), *, clamped_node: int = 0,
     if outside:
         raise ValueError(f"nodes and clamped_node must be nodes of the beam (0 ... "
                          f"{beam.n_nodes - 1}), got {outside}")
+    held = basis.shapes[6 * clamped_node:6 * clamped_node + 6]
+    if not isinstance(held, jax.core.Tracer) and bool(jnp.any(held != 0)):   # concrete only
+        raise ValueError(f"basis moves clamped_node {clamped_node} (the body frame's joint "
+                         "grid): build it with craig_bampton(beam, clamped_node="
+                         f"{clamped_node}, ...)")
+    return _beam_body(beam, basis, nodes, clamped_node, stiffening, damping)
+
+
+@eqx.filter_jit
+def _beam_body(beam: Beam, basis: ModalBasis, nodes: tuple, clamped_node: int,
+               stiffening: bool, damping) -> ModalBody:
+    """`beam_body` once its arguments are checked."""
     _, K_r = reduced(beam, basis)
     index = np.asarray(nodes, dtype=int)
     node_position = jnp.zeros((len(nodes), 3)).at[:, 0].set(beam.node_x()[index])

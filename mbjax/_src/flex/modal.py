@@ -51,8 +51,19 @@ class ModalBasis(eqx.Module):
         return self.shapes.shape[1]
 
 
+def whole_nodes(who: str, name: str, nodes) -> tuple[int, ...]:
+    """Node indices as ints; an error naming `name` where one is not a whole number (a
+    fraction would be truncated to another node)."""
+    values = np.atleast_1d(np.asarray(nodes))
+    if values.dtype == bool or not (np.issubdtype(values.dtype, np.integer) or (
+            np.issubdtype(values.dtype, np.floating) and np.all(np.isfinite(values))
+            and np.all(values == np.round(values)))):
+        raise ValueError(f"{who}: {name} must be whole node indices, got {nodes!r}")
+    return tuple(int(n) for n in values)
+
+
 def _nodes(name, nodes, beam, exclude=()):
-    nodes = tuple(int(n) for n in np.atleast_1d(np.asarray(nodes, dtype=int)))
+    nodes = whole_nodes("craig_bampton", name, nodes)
     bad = [n for n in nodes if not 0 <= n < beam.n_nodes]
     if bad:
         raise ValueError(f"craig_bampton: {name} {bad} outside 0..{beam.n_nodes - 1}")

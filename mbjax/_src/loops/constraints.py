@@ -69,8 +69,16 @@ class Loops(eqx.Module):
         """Number of scalar constraint equations (redundant ones included)."""
         return sum(c.size for c in self.closures)
 
+    def checked(self, q: Array, v: Array | None = None) -> None:
+        """An error naming q or v where its shape is not the tree's (nq,) or (nv,)."""
+        for name, x, n in (("q", q, self.tree.nq), ("v", v, self.tree.nv)):
+            if x is not None and jnp.shape(x) != (n,):
+                raise ValueError(f"{name} must have shape ({n},) for this tree, got "
+                                 f"{jnp.shape(x)}")
+
     def phi(self, q: Array, t=0.0) -> Array:
         """The residual Phi(q, t), shape (m,), for q of shape (nq,) at time t [s]."""
+        self.checked(q)
         if any(isinstance(c, CutJoint) for c in self.closures):
             R, p = self.tree.frames(q)
         else:                         # prescribed motions only: no kinematics to trace
@@ -79,6 +87,7 @@ class Loops(eqx.Module):
 
     def rate(self, q: Array, v: Array, t=0.0) -> Array:
         """A v + B = dPhi/dt along the motion, shape (m,), for v of shape (nv,)."""
+        self.checked(q, v)
         return jax.jvp(self.phi, (q, jnp.asarray(t, q.dtype)),
                        (self.tree.q_dot(q, v), jnp.ones((), q.dtype)))[1]
 

@@ -10,6 +10,7 @@ e_ddot + 2 alpha e_dot + beta^2 e = 0 instead of drifting. The mass matrix is de
 (O(n^3)); `mbjax._src.loops.stabilized` is Anderson 1993's O(n + m^3) route.
 """
 
+import math
 import equinox as eqx
 import jax
 from jax import Array
@@ -37,6 +38,14 @@ def coupled_acceleration(loops: Loops, q: Array, v: Array, t=0.0,
     return a_free + nu_At @ K_c, K_c, rank
 
 
+def _gains(gains) -> tuple:
+    """baumgarte as a tuple of floats, or a TypeError naming it."""
+    try:
+        return tuple(float(g) for g in gains)
+    except TypeError as error:
+        raise TypeError(f"baumgarte must be two gains (alpha, beta), got {gains!r}") from error
+
+
 class Coupled(AbstractLoopMethod):
     """u = v; v_dot from the coupled Lagrange-multiplier equations (Jerkovsky 1978 eqs 89-93),
     with optional Baumgarte stabilization (see the module docstring). Dense, O(n^3); needs a
@@ -50,12 +59,13 @@ class Coupled(AbstractLoopMethod):
         ValueError: not two non-negative gains.
     """
 
-    baumgarte: tuple = eqx.field(static=True, default=(0.0, 0.0),
-                                 converter=lambda g: tuple(float(x) for x in g))
+    baumgarte: tuple = eqx.field(static=True, default=(0.0, 0.0), converter=_gains)
 
     def __check_init__(self):
-        if len(self.baumgarte) != 2 or not min(self.baumgarte) >= 0:
-            raise ValueError(f"baumgarte must be two gains (alpha, beta) >= 0, got {self.baumgarte}")
+        if len(self.baumgarte) != 2 or not all(g >= 0 and math.isfinite(g)
+                                               for g in self.baumgarte):
+            raise ValueError(f"baumgarte must be two gains (alpha, beta) >= 0, finite, got "
+                             f"{self.baumgarte}")
 
     def validate(self, tree):
         require_symmetric("Coupled", tree)

@@ -142,7 +142,8 @@ def consistent_state(system, q, v, t=0.0, *, project: bool = True, tol: float = 
 
     Raises:
         TypeError: `system` is neither a `ClosedSystem` nor `Loops`.
-        ValueError: q or v of the wrong shape or non-finite; with project=True, positions that
+        ValueError: q or v of the wrong shape or non-finite, or tol not positive; with
+            project=True, positions that
             cannot be brought within tol (the loop cannot close near q: an unreachable closure
             or a wrong branch); with project=False, a state that violates the constraints (the
             message gives the residuals).
@@ -150,6 +151,8 @@ def consistent_state(system, q, v, t=0.0, *, project: bool = True, tol: float = 
     loops = getattr(system, "loops", system)
     if not isinstance(loops, Loops):
         raise TypeError(f"system must be a ClosedSystem or Loops, got {type(system).__name__}")
+    if not (isinstance(tol, int | float | np.number) and tol > 0 and np.isfinite(tol)):
+        raise ValueError(f"tol must be a positive finite number, got {tol!r}")
     q, v = jnp.asarray(q, float), jnp.asarray(v, float)
     tree = loops.tree
     if q.shape != (tree.nq,) or v.shape != (tree.nv,):

@@ -152,6 +152,7 @@ class ClosedSystem(AbstractSystem):
             (nv + m,) (`Stabilized(epsilon > 0)`).
         """
         q, v = jnp.asarray(q, float), jnp.asarray(v, float)
+        self.loops.checked(q, v)
         return self.method.initial_state(self.loops, q, v, jnp.asarray(t, q.dtype), consistent)
 
     def loads(self, t, q: Array, u: Array) -> Array:

@@ -28,6 +28,7 @@ only two); the solvers detect the rank and report it, see `mbjax._src.loops.coup
 from collections.abc import Callable
 
 import equinox as eqx
+import jax
 import jax.numpy as jnp
 import numpy as np
 from jax import Array
@@ -45,10 +46,12 @@ def _vee_antisym(R: Array) -> Array:
 
 
 def _point(x, name: str) -> Array:
-    """x as a float array of shape (3,), or a ValueError naming it."""
+    """x as a finite float array of shape (3,), or a ValueError naming it."""
     x = jnp.asarray(x, dtype=float)
     if x.shape != (3,):
         raise ValueError(f"{name} must be a point of shape (3,) [m], got shape {x.shape}")
+    if not isinstance(x, jax.core.Tracer) and not bool(jnp.all(jnp.isfinite(x))):
+        raise ValueError(f"{name} must be finite, got {x}")
     return x
 
 

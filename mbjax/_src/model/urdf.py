@@ -130,7 +130,16 @@ def _read(text: str):
     return robot
 
 
-def load_urdf(source: str | os.PathLike, *, floating_base: bool = False,
+def _armature(armature, nv: int) -> np.ndarray:
+    """armature as one value per velocity coordinate, or an error naming it."""
+    value = np.asarray(armature, float)
+    if value.shape not in ((), (nv,)):
+        raise ValueError(f"armature must be a number or one per velocity coordinate, shape "
+                         f"({nv},), got shape {value.shape}")
+    return np.broadcast_to(value, (nv,))
+
+
+def load_urdf(source: str | bytes | os.PathLike, *, floating_base: bool = False,
               gravity=(0.0, 0.0, -9.81), sibling_order: str = "name", armature=0.0,
               min_mass: float = 0.0, min_inertia: float = 0.0, strict: bool = False) -> Model:
     """A `Model` from a URDF file or XML string (see the module docstring for the mapping).
@@ -164,7 +173,7 @@ def load_urdf(source: str | os.PathLike, *, floating_base: bool = False,
     """
     if sibling_order not in ("name", "document"):
         raise ValueError(f"sibling_order must be 'name' or 'document', got {sibling_order!r}")
-    text = str(source)
+    text = source.decode() if isinstance(source, bytes) else str(source)
     if isinstance(source, os.PathLike) or not text.lstrip().startswith("<"):
         path = Path(source)
         if not path.is_file():
@@ -288,8 +297,7 @@ def load_urdf(source: str | os.PathLike, *, floating_base: bool = False,
         effort_limit=per_coordinate("effort", "nv"),
         velocity_limit=per_coordinate("velocity", "nv"),
         damping=per_coordinate("damping", "nv"), friction=per_coordinate("friction", "nv"),
-        armature=np.broadcast_to(np.asarray(armature, float), (sum(
-            JOINT_TYPES[b["kind"]].nv for b in bodies),)),
+        armature=_armature(armature, sum(JOINT_TYPES[b["kind"]].nv for b in bodies)),
         frame_names=[f[0] for f in frames], frame_parents=[f[1] for f in frames],
         frame_rotation=np.reshape([f[2] for f in frames], (-1, 3, 3)),
         frame_translation=np.reshape([f[3] for f in frames], (-1, 3)), strict=strict)

@@ -80,10 +80,14 @@ class AbstractDrivenSystem(AbstractSystem):
 
         Raises:
             ValueError: the control returned a shape other than (n_controls,).
+            TypeError: the control returned complex or non-numeric forces.
         """
         if self.control is None:
             return jnp.zeros(self.nv, v.dtype)
-        tau = jnp.asarray(self.control(t, q, v), v.dtype)
+        tau = jnp.asarray(self.control(t, q, v))
+        if jnp.iscomplexobj(tau) or not jnp.issubdtype(tau.dtype, jnp.number):
+            raise TypeError(f"the control returned {tau.dtype} forces; they must be real")
+        tau = tau.astype(v.dtype)
         if tau.shape != (self.n_controls,):
             raise ValueError(f"the control returned shape {tau.shape}; this system expects "
                              f"({self.n_controls},): " + (

@@ -58,6 +58,9 @@ class Body(eqx.Module):
         if not isinstance(com, jax.core.Tracer) and (
                 np.shape(com) != (3,) or not np.all(np.isfinite(com))):
             raise ValueError(f"com must be a finite 3-vector, got {com!r}")
+        if not isinstance(gravity, jax.core.Tracer) and (
+                np.shape(gravity) != (3,) or not np.all(np.isfinite(gravity))):
+            raise ValueError(f"gravity must be a finite 3-vector [m/s^2], got {gravity!r}")
         self.mass = jnp.asarray(mass, dtype=float)
         self.com = jnp.asarray(com, dtype=float)
         self.inertia = jnp.asarray(inertia, dtype=float)

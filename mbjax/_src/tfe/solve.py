@@ -15,6 +15,7 @@ from functools import partial
 import equinox as eqx
 import jax
 import jax.numpy as jnp
+import numpy as np
 from jax import Array
 
 from mbjax._src.lie.inputs import check_rotation
@@ -62,10 +63,22 @@ def initial_state(body: Body, R0, Omega0, x0=(0.0, 0.0, 0.0), v0=(0.0, 0.0, 0.0)
         The `State` (R0, x0, p_hat).
     """
     R0 = check_rotation(R0, "R0")
-    w = R0 @ jnp.asarray(Omega0, dtype=float)
+    Omega0, x0, v0 = (_vector(x, name) for x, name in ((Omega0, "Omega0"), (x0, "x0"),
+                                                        (v0, "v0")))
+    w = R0 @ Omega0
     if not body.fixed_point:
-        w = jnp.concatenate([w, jnp.asarray(v0, dtype=float)])
-    return State(R0, jnp.asarray(x0, dtype=float), body.mass_matrix(R0) @ w)
+        w = jnp.concatenate([w, v0])
+    return State(R0, x0, body.mass_matrix(R0) @ w)
+
+
+def _vector(x, name: str) -> Array:
+    """x as a float array of shape (3,), finite where concrete; an error naming it otherwise."""
+    x = jnp.asarray(x, dtype=float)
+    if x.shape != (3,):
+        raise ValueError(f"{name} must have shape (3,), got {x.shape}")
+    if not isinstance(x, jax.core.Tracer) and not bool(jnp.all(jnp.isfinite(x))):
+        raise ValueError(f"{name} must be finite, got {x}")
+    return x
 
 
 class TFESolution(WithStatus):
@@ -197,7 +210,8 @@ def _march(body, state0, dt, tol, prescribed, *, form, element, n_elements, refe
     _, (states, iterations, residual, converged) = jax.lax.scan(step, state0, jnp.arange(n_elements))
     join = lambda a, b: jnp.concatenate([a[None], b])  # noqa: E731
     R, x, p_hat = (join(getattr(state0, k), getattr(states, k)) for k in ("R", "x", "p_hat"))
-    finite = jnp.all(jnp.isfinite(p_hat), axis=1) & jnp.all(jnp.isfinite(R), axis=(1, 2))
+    finite = (jnp.all(jnp.isfinite(p_hat), axis=1) & jnp.all(jnp.isfinite(R), axis=(1, 2))
+              & jnp.all(jnp.isfinite(x), axis=1))
     status = (jnp.where(jnp.all(converged), 0, int(Status.NOT_CONVERGED))
               | jnp.where(jnp.all(finite), 0, int(Status.NONFINITE)))
     ts = jnp.arange(n_elements + 1) * h
@@ -323,10 +337,12 @@ def solve_tfe(body: Body, state0: State, *, dt, n_elements: int, form: AbstractF
         The `TFESolution` at the n_elements + 1 boundaries.
 
     Raises:
-        ValueError: reference is neither one of `REFERENCES` nor a `Reference`, n_elements is
-            not a positive int, rtol and atol are negative or both zero, or state0's arrays
-            have the wrong shapes or its R is not a rotation.
-        TypeError: element is not an `Element`, or state0 not a `State`.
+        ValueError: reference is neither one of `REFERENCES` nor a `Reference`, n_elements or
+            max_iter is not a positive int, tol is not positive and finite, rtol and atol are
+            negative or both zero, or state0's arrays have the wrong shapes or its R is not a
+            rotation.
+        TypeError: element is not an `Element`, form not a form instance, or state0 not a
+            `State`.
         equinox.EquinoxRuntimeError: with throw=True, the march failed.
     """
     prescribed = reference if isinstance(reference, Reference) else None
@@ -335,10 +351,16 @@ def solve_tfe(body: Body, state0: State, *, dt, n_elements: int, form: AbstractF
     elif reference not in REFERENCES:
         raise ValueError(f"reference must be one of {REFERENCES} or a tfe.Reference, "
                          f"got {reference!r}")
-    if not (isinstance(n_elements, int) and n_elements >= 1):
-        raise ValueError(f"n_elements must be a positive int, got {n_elements!r}")
+    for name, value in (("n_elements", n_elements), ("max_iter", max_iter)):
+        if not (isinstance(value, int) and not isinstance(value, bool) and value >= 1):
+            raise ValueError(f"{name} must be a positive int, got {value!r}")
     if not isinstance(element, Element):
         raise TypeError(f"element must be a tfe.Element, got {type(element).__name__}")
+    if not isinstance(form, AbstractForm):
+        hint = " (an instance: Mixed(), not Mixed)" if isinstance(form, type) else ""
+        raise TypeError(f"form must be a weak form such as Mixed(){hint}, got {form!r}")
+    if not isinstance(tol, jax.core.Tracer) and not (float(tol) > 0 and np.isfinite(tol)):
+        raise ValueError(f"tol must be positive and finite (Newton's tolerance), got {tol!r}")
     state0 = _checked_state(body, state0)
     dt = jnp.asarray(dt, dtype=float)
     checked = rtol is not None or atol is not None

@@ -52,7 +52,7 @@ from jax import Array
 from mbjax._src.system.status import Status
 from mbjax._src.linalg import small_dot, spd_solve
 from mbjax._src.trajopt.problem import Problem
-from mbjax._src.trajopt.result import AbstractIterativeSolver, Result, history
+from mbjax._src.trajopt.result import AbstractIterativeSolver, Result, cost_floor, history
 
 MU_MIN, MU_MAX, MU_FACTOR = 1e-9, 1e10, 10.0
 CROCODDYL_SCHEDULE = {"steps": tuple(0.5**k for k in range(10)), "acceptance": 0.1,
@@ -204,9 +204,11 @@ class ILQR(AbstractIterativeSolver):
         # stationary: the model, not shrunk by a raised regularization, predicts a
         # negligible decrease, or an accepted step made one, unless a longer step's cost was
         # not finite (the step was cut short by the non-finite region, not by the optimum)
+        # (relative to the cost, above round-off: `cost_floor`, an exact optimum's 0)
+        floor = cost_floor(cost.dtype)
         converged = ((ok & (s["mu"] <= self.regularization)
-                      & (-decrease[0] <= self.tolerance * jnp.abs(s["cost"])))
-                     | (accept & ~blocked & (change <= self.tolerance * jnp.abs(cost))))
+                      & (-decrease[0] <= self.tolerance * jnp.abs(s["cost"]) + floor))
+                     | (accept & ~blocked & (change <= self.tolerance * jnp.abs(cost) + floor)))
         taken = alphas[jnp.maximum(tried - 1, 0)]
         mu = jnp.where(accept & (taken > self.shrink_above),
                        jnp.maximum(s["mu"] / MU_FACTOR, MU_MIN),

@@ -36,7 +36,8 @@ from jax import Array
 
 from mbjax._src.trajopt.ilqr import riccati_step
 from mbjax._src.trajopt.problem import Problem
-from mbjax._src.trajopt.result import AbstractSolver, Result, history, rollout_result
+from mbjax._src.trajopt.result import (AbstractSolver, Result, cost_floor, history,
+                                       rollout_result)
 
 STEPS = tuple(0.5**k for k in range(10))
 
@@ -152,7 +153,9 @@ class MultipleShooting(AbstractSolver):
             xs, us = jnp.where(accept, x, xs), jnp.where(accept, u, us)
             change = value - m
             value = jnp.where(accept, m, value)
-            settled = accept & (change <= self.tolerance * jnp.abs(value))
+            # a merit at round-off (`cost_floor`: an exact optimum's 0) cannot decrease further
+            settled = ((accept & (change <= self.tolerance * jnp.abs(value)))
+                       | (jnp.abs(value) <= cost_floor(value.dtype)))
             mu = jnp.where(accept, jnp.maximum(mu / 10.0, 1e-9), mu * 10.0)
             return xs, us, lam, rho, mu, value, settled, i + 1, costs.at[i + 1].set(value)
 

@@ -91,8 +91,10 @@ class Problem(eqx.Module):
             raise TypeError(f"integrator must be an instance such as RK4(), got {integrator!r}")
         if not (isinstance(horizon, int | np.integer) and horizon >= 1):
             raise ValueError(f"horizon must be a positive int (the number of steps), got {horizon!r}")
-        if isinstance(dt, str | bytes) or not (np.ndim(dt) == 0 and float(dt) > 0):
-            raise ValueError(f"dt must be a positive number, got {dt!r}")
+        if not (isinstance(dt, int | float | np.integer | np.floating | np.ndarray | jax.Array)
+                and not isinstance(dt, bool) and np.ndim(dt) == 0
+                and np.isrealobj(dt) and float(dt) > 0 and np.isfinite(dt)):
+            raise ValueError(f"dt must be a positive number, finite, got {dt!r}")
         running, terminal = (Sum(tuple(c)) if isinstance(c, list | tuple) else c
                              for c in (running, terminal))
         if not (callable(running) and callable(terminal)):

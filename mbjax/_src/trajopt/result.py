@@ -58,6 +58,13 @@ class Result(WithStatus):
         return accuracy_notes(self, i)
 
 
+def cost_floor(dtype) -> float:
+    """The cost below which a solver counts it as an exact optimum's zero: (1e3 eps)^2, the
+    square of residuals at round-off of quantities of order one (the stopping tests are
+    relative to the cost, which never holds at a cost of 0)."""
+    return float((1e3 * jnp.finfo(dtype).eps) ** 2)
+
+
 def checked(result: Result) -> Result:
     """The result with the default accuracy check: INACCURATE where its steps do not resolve
     its motion (`mbjax._src.system.accuracy.resolution` over the states)."""
