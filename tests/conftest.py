@@ -55,6 +55,7 @@ _SHARED_OUT = ("test_notebooks.py", "test_readme.py")
 _LONG_FIRST = ("test_notebooks.py", "test_cli.py")
 
 
+@pytest.hookimpl(tryfirst=True)     # before xdist's own, which reads the groups to schedule them
 def pytest_collection_modifyitems(config, items):
     def rank(item):
         name = item.path.name

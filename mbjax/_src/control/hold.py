@@ -5,16 +5,28 @@ step (RK4's four, an implicit step's Newton iterations) the value of the step's 
 of time alone cannot do this: a step's last stage falls on the next sample's time.
 """
 
+import math
+
 import equinox as eqx
 import jax.numpy as jnp
 from jax import Array
 
 from mbjax._src.control.base import AbstractControl, Constant, as_control
-from mbjax._src.system.accuracy import number
 
 # Times within this fraction of a step of a sample time count as on it (the step grid t0 + k dt
 # is computed in floating point).
 _GRID_TOLERANCE = 1e-6
+
+
+def _number(x, name: str) -> float:
+    """A finite real number, or an error naming ZeroOrderHold's argument."""
+    try:
+        value = float(x)
+    except (TypeError, ValueError) as error:
+        raise TypeError(f"ZeroOrderHold's {name} must be a real number, got {x!r:.60}") from error
+    if not math.isfinite(value):
+        raise ValueError(f"ZeroOrderHold's {name} must be finite, got {value}")
+    return value
 
 
 class ZeroOrderHold(AbstractControl):
@@ -42,10 +54,10 @@ class ZeroOrderHold(AbstractControl):
         values = jnp.asarray(values, dtype=float)
         if values.ndim == 1:
             values = values[:, None]
-        if values.ndim != 2 or values.shape[0] < 1:
-            raise ValueError(f"values must be K >= 1 samples, shape (K,) or (K, m), got shape "
+        if values.ndim < 2 or values.shape[0] < 1:
+            raise ValueError(f"values must be K >= 1 samples, shape (K,) or (K, ...), got shape "
                              f"{values.shape}")
-        dt, t0 = number(dt, "ZeroOrderHold's dt"), number(t0, "ZeroOrderHold's t0")
+        dt, t0 = _number(dt, "dt"), _number(t0, "t0")
         if not dt > 0:
             raise ValueError(f"dt must be positive, got {dt}")
         self.values = values

@@ -19,11 +19,9 @@ import numpy as np
 from jax import Array
 
 from mbjax._src.lie.inputs import check_rotation
-from mbjax._src.system.accuracy import (DRIFT_LIMIT, RESOLUTION_LIMIT, doubled, sample_indices,
-                                        tolerances)
-from mbjax._src.system.accuracy import resolution as accuracy_resolution
+from mbjax._src.system.accuracy import DRIFT_LIMIT, doubled, sample_indices, tolerances
 from mbjax._src.system.invariants import drifts
-from mbjax._src.system.status import (DRIFTED, ESTIMATED, FLAGS, RESOLVED, Status, WithStatus,
+from mbjax._src.system.status import (DRIFTED, ESTIMATED, FLAGS, Status, WithStatus,
                                       accuracy_notes, raise_on_failure)
 from mbjax._src.tfe.body import Body
 from mbjax._src.tfe.elements import Element
@@ -99,8 +97,6 @@ class TFESolution(WithStatus):
             where no tolerance was asked).
         drift: the invariants' largest relative drift over the boundaries, as
             `mbjax.integrate.Solution`'s.
-        resolution: the element's span times the motion's rate, from consecutive boundaries,
-            as `mbjax.integrate.Solution`'s.
         drifting: the index of the invariant that drifted most.
         flagged_at: the time [s] each `Status` flag was first raised (NaN: never), shape (8,).
         inaccurate_by: why the march is INACCURATE (a mask, as `mbjax.integrate.Solution`'s).
@@ -116,7 +112,6 @@ class TFESolution(WithStatus):
     status: Array
     error: Array = float("nan")
     drift: Array = float("nan")
-    resolution: Array = float("nan")
     drifting: Array = -1
     flagged_at: Array | None = None
     inaccurate_by: Array = 0
@@ -228,24 +223,20 @@ def _first(ts, where):
 
 @jax.jit
 def _checked(body, solution: TFESolution, drift_limit) -> TFESolution:
-    """The solution with the default check (`solve_tfe`): the resolution over the boundaries
-    and the invariants' drift past `drift_limit`."""
-    # the momentum and the position, not the attitude: an element's reference carries the
-    # rotation exactly (a spin of many radians per element is not an error)
-    resolution, at = accuracy_resolution(solution.x, solution.p_hat)
+    """The solution with the default check (`solve_tfe`): the invariants' drift past
+    `drift_limit`."""
     history = jax.vmap(body.invariants)(solution.ts, solution.R, solution.x, solution.p_hat)
     ratios = drifts(history)
     drift = jnp.max(ratios, initial=0.0)
     over = jnp.max(ratios, axis=1) > drift_limit
-    resolved, drifted = resolution > RESOLUTION_LIMIT, jnp.any(over)
-    when = jnp.minimum(jnp.where(resolved, solution.ts[at], jnp.inf),
-                       jnp.where(drifted, solution.ts[jnp.argmax(over)], jnp.inf))
+    drifted = jnp.any(over)
     k = FLAGS.index(Status.INACCURATE)
-    first = solution.flagged_at.at[k].set(jnp.where(jnp.isfinite(when), when, jnp.nan))
-    status = solution.status | jnp.where(resolved | drifted, int(Status.INACCURATE), 0)
-    by = jnp.where(resolved, RESOLVED, 0) | jnp.where(drifted, DRIFTED, 0)
+    first = solution.flagged_at.at[k].set(jnp.where(drifted, solution.ts[jnp.argmax(over)],
+                                                    jnp.nan))
+    status = solution.status | jnp.where(drifted, int(Status.INACCURATE), 0)
+    by = jnp.where(drifted, DRIFTED, 0)
     return dataclasses.replace(solution, status=status.astype(solution.status.dtype),
-                               drift=drift, resolution=resolution,
+                               drift=drift,
                                drifting=jnp.argmax(jnp.max(ratios, axis=0)), flagged_at=first,
                                inaccurate_by=by, invariant_names=history.labels())
 
@@ -298,12 +289,12 @@ def solve_tfe(body: Body, state0: State, *, dt, n_elements: int, form: AbstractF
     max_iter); dt, tol, the body and the state are traced, so sweeps over them do not recompile
     and they can be differentiated.
 
-    The default accuracy check, always on: `resolution`, the element's span times the
-    motion's rate from consecutive boundaries' momenta and positions (`mbjax.simulate`'s check;
-    the attitude is left out, since each element's reference carries the rotation exactly),
-    and `drift`, the largest relative drift of the body's invariants (`Body.invariants`: the
-    energy, the momenta), set INACCURATE above 1 and above `DRIFT_LIMIT` (0.1) respectively; a
-    single body's invariants cost little to evaluate.
+    The default accuracy check, always on: `drift`, the largest relative drift of the body's
+    invariants (`Body.invariants`: the energy, the momenta) over the boundaries, sets
+    INACCURATE above `DRIFT_LIMIT` (0.1); a single body's invariants cost little to evaluate.
+    (`mbjax.simulate`'s step ratio does not apply: an element's reference carries the rotation
+    exactly, and a conserved momentum's boundary values differ only by Newton's tolerance,
+    whose increments read as a motion on the element's scale.)
 
     With a tolerance (rtol, atol, as `mbjax.simulate`'s) the solution carries `error`, a
     step-doubling estimate of the final state's error (at up to `ERROR_SAMPLES` boundaries,
