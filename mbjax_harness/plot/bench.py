@@ -337,7 +337,7 @@ def accuracy_bench_figure(records: list[dict]) -> Figure:
     chain's rollout, simulate (status and default check) against the bare loop."""
     fig = Figure(figsize=(12, 5), layout="constrained")
     ax_cases, ax_cost = fig.subplots(1, 2, width_ratios=(2, 1))
-    cases = [r for r in records if r["kind"] == "case"]
+    cases = [r for r in records if r["kind"] == "case" and r["resolution"] is not None]
     for k, name in enumerate(dict.fromkeys(r["case"] for r in cases)):
         color = f"C{k % 10}"
         for r in (r for r in cases if r["case"] == name):
