@@ -6,7 +6,7 @@
 runs the command in this process with every `simulate`, `solve_tfe` and `mbjax.trajopt.solve`
 result logged to LOG.jsonl as it is made (its type, the harness line that made it, its
 `resolution` and status), then prints, per log, the largest resolution and the runs the
-default check flagged. This is how benchmarks/README.md ("The default accuracy check") counts
+default check flagged. This is how benchmarks/README.md (section "accuracy") counts
 the check's false alarms over every scene and reproduction: a run flagged by it whose error
 the scene itself shows to be small would be one. Run the tour with --jobs 1 (workers are other
 processes, which this script does not reach).

@@ -96,10 +96,9 @@ def simulate(system: AbstractSystem, integrator: AbstractIntegrator, q0: Array, 
     (about six steps per period of an oscillation) for 3 steps in a row: a method past its
     stability limit (1.2 to 3.5 measured) or a step far too long for the motion, caught before
     the state overflows. `Solution.resolution` is its largest value. Its cost is a few vector
-    operations per step (benchmarks/README.md, "The default accuracy check", measures it and
-    its false alarms over every scene and reproduction: none). It does not see errors that grow
-    slowly through a resolved motion (a chaotic chain's, an energy drift): the tolerance below
-    does.
+    operations per step (benchmarks/README.md, section "accuracy", measures it and its false
+    alarms over every scene and reproduction: none). It does not see errors that grow slowly
+    through a resolved motion (a chaotic chain's, an energy drift): the tolerance below does.
 
     Accuracy check (rtol, atol). Given either, the solution carries an error estimate
     (`Solution.error`) and the status INACCURATE where it exceeds the tolerance: the root mean

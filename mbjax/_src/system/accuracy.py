@@ -64,11 +64,11 @@ def doubled(step, state, t, h, span):
 
 
 # The default check (no tolerance asked): `simulate`, `solve_tfe` and `mbjax.trajopt.solve` flag
-# INACCURATE past these loose limits (benchmarks/README.md, "The default accuracy check", measures
+# INACCURATE past these loose limits (benchmarks/README.md, section "accuracy", measures
 # their false alarms over every scene and reproduction, none, and their cost).
 # The step times the motion's fastest rate, estimated from consecutive increments of the state:
 # 1 is about six steps per period of an oscillation, where a fourth-order method already errs by
-# about 1 % a step; a run past its stability limit reads 1.5 or more at every step.
+# about 1 % a step; runs past their stability limit read 1.2 to 3.5 (benchmarks/README.md).
 RESOLUTION_LIMIT = 1.0
 # steps in a row the estimate must exceed the limit (a kick, a control switch, a wrap is one)
 SUSTAINED = 3
