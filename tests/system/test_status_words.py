@@ -11,6 +11,7 @@ from mbjax.flex import Beam, beam_body, craig_bampton
 from mbjax.integrate import RK4
 from mbjax.model import chain
 from mbjax.rigid import TreeSystem
+from mbjax.trajopt import Problem
 
 LIMIT = 0.5
 
@@ -33,11 +34,14 @@ def test_a_limit_is_named_by_its_joint_and_the_time_it_was_first_exceeded():
 def test_a_quaternion_start_that_is_not_a_unit_quaternion_is_refused():
     system = TreeSystem(chain(2, joint_types="spherical"))
     q0 = jnp.array([1.0, 0.0, 0.0, 0.0, 2.0, 0.0, 0.0, 0.0])     # the second of norm 2
-    with pytest.raises(ValueError, match=r"q0\[4:8\] \(joint 'joint1's quaternion\) must be a "
+    with pytest.raises(ValueError, match=r"q0\[4:8\] \(the quaternion of joint 'joint1'\) must be a "
                                          r"unit quaternion .* got norm 2"):
         simulate(system, RK4(), q0, jnp.zeros(6), dt=0.01, t1=0.1)
     sol = simulate(system, RK4(), q0.at[4].set(1.0), jnp.zeros(6), dt=0.01, t1=0.1)
     assert sol.messages() == ["success"]
+    with pytest.raises(ValueError, match=r"q0\[4:8\] \(the quaternion of joint 'joint1'\)"):
+        Problem(system, q0, jnp.zeros(6), dt=0.01, horizon=3,
+                running=lambda q, v, u: jnp.sum(u**2), terminal=lambda q, v: jnp.sum(v**2))
 
 
 def test_a_basis_built_for_another_beam_is_refused():

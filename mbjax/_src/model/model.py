@@ -354,12 +354,12 @@ class Model(eqx.Module):
         return _layout(self.joint_types)["v_mask"]
 
     def quaternions(self) -> tuple[tuple[int, int, str], ...]:
-        """Where q holds unit quaternions: (start, stop, "joint NAME's quaternion") for each
-        spherical and free joint, in joint order."""
+        """Where q holds unit quaternions: (start, stop, "the quaternion of joint 'NAME'") for
+        each spherical and free joint, in joint order."""
         starts = _layout(self.joint_types)["q_start"]
         return tuple((starts[k] + (3 if kind == "free" else 0),
                       starts[k] + (7 if kind == "free" else 4),
-                      f"joint {self.joint_names[k]!r}'s quaternion")
+                      f"the quaternion of joint {self.joint_names[k]!r}")
                      for k, kind in enumerate(self.joint_types) if kind in ("spherical", "free"))
 
     def body_v(self, v: Array) -> Array:

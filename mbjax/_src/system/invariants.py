@@ -5,8 +5,9 @@ with damping can only lose it; a free-floating tree also conserves its angular m
 the gravity axis (all of it without gravity) and its linear momentum less the weight's impulse
 M g t. `simulate(..., rtol=)` compares each invariant along the saved states with its value at
 the start, relative to a scale of the motion (the largest kinetic energy for the energy, the
-sum of the bodies' momentum magnitudes for the momentum), and reports the largest ratio as
-`Solution.drift` and `Status.INACCURATE` where it exceeds rtol.
+sum of the bodies' momentum magnitudes for the momentum: `drifts`), and reports the largest
+ratio as `Solution.drift` and `Status.INACCURATE` where it exceeds rtol; `solve_tfe` does so by
+default, against `DRIFT_LIMIT`.
 """
 
 import equinox as eqx
@@ -76,9 +77,3 @@ def drifts(history: Invariants) -> Array:
     change = jnp.where(history.decreasing[0], jnp.maximum(change, 0.0), jnp.abs(change))
     scale = jnp.maximum(jnp.max(history.scale, axis=0), jnp.finfo(change.dtype).eps)
     return jnp.where(history.conserved[0], change / scale, 0.0)
-
-
-def relative_drift(history: Invariants) -> Array:
-    """max over the invariants of max_t |I(t) - I(t_0)| / max_t scale(t) (`drifts`); 0 for
-    none."""
-    return jnp.max(drifts(history), initial=0.0)

@@ -42,6 +42,7 @@ from jax import Array
 from mbjax._src.control import Constant
 from mbjax._src.integrate import RK4
 from mbjax._src.integrate.base import AbstractIntegrator
+from mbjax._src.lie.inputs import check_unit_quaternions
 from mbjax._src.system.system import AbstractSystem
 
 
@@ -109,6 +110,7 @@ class Problem(eqx.Module):
         for name, x, size in zip(("q0", "v0"), (self.q0, self.v0), system.state_sizes(), strict=True):
             if size is not None and x.shape != (size,):
                 raise ValueError(f"{name} must have shape ({size},) for this system, got {x.shape}")
+        check_unit_quaternions(self.q0, system.quaternions(), "q0")
         self.running, self.terminal = running, terminal
         self.integrator = integrator
         self.dt, self.horizon = float(dt), int(horizon)
