@@ -84,3 +84,15 @@ def check_unit_quaternions(q, spans, name: str) -> None:
             raise ValueError(f"{name}[{a}:{b}] ({what}) must be a unit quaternion (norm 1 within "
                              f"{ROTATION_TOLERANCE:g}), got norm {norm:.6g}: normalise it "
                              f"(q / |q|)")
+
+
+def check_point(x, name: str, what: str = "a vector") -> Array:
+    """x as a float array of shape (3,), finite where it is concrete; a ValueError naming
+    `name` (`what` it is) otherwise."""
+    x = jnp.asarray(x, dtype=float)
+    if x.shape != (3,):
+        raise ValueError(f"{name} must be {what} of shape (3,), got shape {x.shape}")
+    value = _concrete(x)
+    if value is not None and not np.all(np.isfinite(value)):
+        raise ValueError(f"{name} must be finite, got {value}")
+    return x

@@ -28,12 +28,11 @@ only two); the solvers detect the rank and report it, see `mbjax._src.loops.coup
 from collections.abc import Callable
 
 import equinox as eqx
-import jax
 import jax.numpy as jnp
 import numpy as np
 from jax import Array
 
-from mbjax._src.lie.inputs import check_rotation
+from mbjax._src.lie.inputs import check_point, check_rotation
 
 GROUND = -1             # the ground as a body index (`CutJoint`'s body_b)
 SIZES = {"spherical": 3, "revolute": 5, "universal": 4, "weld": 6, "prismatic": 5,
@@ -43,16 +42,6 @@ SIZES = {"spherical": 3, "revolute": 5, "universal": 4, "weld": 6, "prismatic": 
 def _vee_antisym(R: Array) -> Array:
     """vee((R - R^T) / 2): sin(angle) * axis, zero at R = I."""
     return 0.5 * jnp.array([R[2, 1] - R[1, 2], R[0, 2] - R[2, 0], R[1, 0] - R[0, 1]])
-
-
-def _point(x, name: str) -> Array:
-    """x as a finite float array of shape (3,), or a ValueError naming it."""
-    x = jnp.asarray(x, dtype=float)
-    if x.shape != (3,):
-        raise ValueError(f"{name} must be a point of shape (3,) [m], got shape {x.shape}")
-    if not isinstance(x, jax.core.Tracer) and not bool(jnp.all(jnp.isfinite(x))):
-        raise ValueError(f"{name} must be finite, got {x}")
-    return x
 
 
 class CutJoint(eqx.Module):
@@ -101,7 +90,7 @@ class CutJoint(eqx.Module):
                                          f"cut joint {kind!r}: rotation_a")
         self.rotation_b = check_rotation(np.eye(3) if rotation_b is None else rotation_b,
                                          f"cut joint {kind!r}: rotation_b")
-        self.origin_a, self.origin_b = (_point(x, f"cut joint {kind!r}: {name}")
+        self.origin_a, self.origin_b = (check_point(x, f"cut joint {kind!r}: {name}", "a point")
                                         for x, name in ((origin_a, "origin_a"),
                                                         (origin_b, "origin_b")))
 

@@ -18,7 +18,7 @@ import jax.numpy as jnp
 import numpy as np
 from jax import Array
 
-from mbjax._src.lie.inputs import check_rotation
+from mbjax._src.lie.inputs import check_point, check_rotation
 from mbjax._src.system.accuracy import DRIFT_LIMIT, doubled, sample_indices, tolerances
 from mbjax._src.system.invariants import drifts
 from mbjax._src.system.status import (DRIFTED, ESTIMATED, FLAGS, Status, WithStatus,
@@ -61,22 +61,12 @@ def initial_state(body: Body, R0, Omega0, x0=(0.0, 0.0, 0.0), v0=(0.0, 0.0, 0.0)
         The `State` (R0, x0, p_hat).
     """
     R0 = check_rotation(R0, "R0")
-    Omega0, x0, v0 = (_vector(x, name) for x, name in ((Omega0, "Omega0"), (x0, "x0"),
-                                                        (v0, "v0")))
+    Omega0, x0, v0 = (check_point(x, name) for x, name in ((Omega0, "Omega0"), (x0, "x0"),
+                                                            (v0, "v0")))
     w = R0 @ Omega0
     if not body.fixed_point:
         w = jnp.concatenate([w, v0])
     return State(R0, x0, body.mass_matrix(R0) @ w)
-
-
-def _vector(x, name: str) -> Array:
-    """x as a float array of shape (3,), finite where concrete; an error naming it otherwise."""
-    x = jnp.asarray(x, dtype=float)
-    if x.shape != (3,):
-        raise ValueError(f"{name} must have shape (3,), got {x.shape}")
-    if not isinstance(x, jax.core.Tracer) and not bool(jnp.all(jnp.isfinite(x))):
-        raise ValueError(f"{name} must be finite, got {x}")
-    return x
 
 
 class TFESolution(WithStatus):
