@@ -116,11 +116,10 @@ def sustained(ratios: jax.Array) -> jax.Array:
     return held
 
 
-def resolution(*parts: jax.Array) -> tuple[jax.Array, jax.Array]:
-    """(the largest sustained step ratio along a state sequence given by its parts (T, n_i)
-    (configurations, velocities), the index of the state where it first exceeds
-    `RESOLUTION_LIMIT`, or -1): `step_ratio` between every three consecutive states, held for
-    `SUSTAINED` steps."""
+def resolution(*parts: jax.Array) -> jax.Array:
+    """The largest sustained step ratio along a state sequence given by its parts (T, n_i)
+    (configurations, velocities): `step_ratio` between every three consecutive states, held
+    for `SUSTAINED` steps."""
     parts = tuple(jax.lax.stop_gradient(x) for x in parts)
     d = tuple(jnp.diff(x, axis=0) for x in parts)
 
@@ -131,7 +130,4 @@ def resolution(*parts: jax.Array) -> tuple[jax.Array, jax.Array]:
 
     zeros = tuple(jnp.zeros((), int) for _ in parts)
     _, ratios = jax.lax.scan(one, zeros, jnp.arange(len(parts[0]) - 2))
-    held = sustained(ratios)
-    over = held > RESOLUTION_LIMIT
-    return (jnp.max(held, initial=0.0),
-            jnp.where(jnp.any(over), jnp.argmax(over) + 2, -1))
+    return jnp.max(sustained(ratios), initial=0.0)

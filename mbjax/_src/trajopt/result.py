@@ -68,7 +68,7 @@ def cost_floor(dtype) -> float:
 def checked(result: Result) -> Result:
     """The result with the default accuracy check: INACCURATE where its steps do not resolve
     its motion (`mbjax._src.system.accuracy.resolution` over the states)."""
-    resolution, _ = accuracy_resolution(result.qs, result.vs)
+    resolution = accuracy_resolution(result.qs, result.vs)
     over = resolution > RESOLUTION_LIMIT
     return eqx.tree_at(lambda r: (r.status, r.resolution, r.inaccurate_by), result,
                        (result.status | jnp.where(over, int(Status.INACCURATE), 0).astype(
