@@ -172,12 +172,32 @@ def test_pd_checks_its_indices_and_gains_against_the_state():
         PD(1.0, 1.0, 0.0, q_index=[1, 4], v_index=[0, 1])(0.0, q, v)
     with pytest.raises(ValueError, match=r"v_index \[3\] out of range for a state of 3"):
         PD(1.0, 1.0, 0.0, q_index=[1, 2], v_index=[0, 3])(0.0, q, v)
-    with pytest.raises(ValueError, match=r"kp must be a scalar or have shape \(2,\).*\(3,\)"):
+    with pytest.raises(ValueError, match=r"kp must be a scalar or have shape \(2,\) or \(2, 2\).*\(3,\)"):
         PD(jnp.ones(3), 1.0, 0.0, q_index=[1, 2], v_index=[0, 1])(0.0, q, v)
     with pytest.raises(ValueError, match="nq == nv.*nq = 4, nv = 3"):
         PD(1.0, 1.0, 0.0)(0.0, q, v)
     np.testing.assert_allclose(PD(2.0, 0.0, 0.0, q_index=[-1], v_index=[-1])(0.0, q, v), [-0.8])
     model = chain(3)
     system = TreeSystem(model, PD(jnp.full(4, 10.0), 1.0, 0.0))               # 4 gains, 3 joints
-    with pytest.raises(ValueError, match=r"kp must be a scalar or have shape \(3,\)"):
+    with pytest.raises(ValueError, match=r"kp must be a scalar or have shape \(3,\) or \(3, 3\)"):
         simulate(system, RK4(), model.neutral(), jnp.zeros(3), dt=0.01, t1=0.02)
+
+
+def test_pd_matrix_gains_place_every_mode_of_the_arm():
+    """Gains w^2 M and 2 w M with the arm's mass matrix M at the target make the linearized
+    closed loop M a = -kp e - kd e_dot exactly e_ddot = -w^2 e - 2 w e_dot: every eigenvalue of
+    M^-1 kp is w^2 (against scalar multiples of M's diagonal, which leave a spread of modes);
+    the law is kp @ e, and a (m, m + 1) gain is refused by name."""
+    import mbjax
+    arm = mbjax.load_urdf(mbjax.data.ARM7)
+    q0, w = arm.home(), 10.0
+    M = mbjax.mass_matrix(arm, q0)
+    servo = PD(w**2 * M, 2 * w * M, q0)
+    e, e_dot = jnp.linspace(-0.1, 0.1, 7), jnp.linspace(0.2, -0.3, 7)
+    np.testing.assert_allclose(servo(0.0, q0 - e, -e_dot), M @ (w**2 * e + 2 * w * e_dot),
+                               rtol=1e-12)
+    np.testing.assert_allclose(np.linalg.eigvals(np.linalg.solve(M, w**2 * M)).real, w**2)
+    spread = np.linalg.eigvals(np.linalg.solve(M, w**2 * np.diag(np.diag(M)))).real
+    assert spread.max() / spread.min() > 10
+    with pytest.raises(ValueError, match=r"kd must be a scalar or have shape \(7,\) or \(7, 7\)"):
+        PD(1.0, jnp.ones((7, 8)), q0)(0.0, q0, jnp.zeros(7))

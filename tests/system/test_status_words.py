@@ -2,6 +2,7 @@
 rotations and mismatched data are refused where they enter."""
 
 import equinox as eqx
+import jax
 import jax.numpy as jnp
 import numpy as np
 import pytest
@@ -27,7 +28,7 @@ def test_a_limit_is_named_by_its_joint_and_the_time_it_was_first_exceeded():
     beyond = np.abs(np.asarray(sol.qs)) > LIMIT
     step, joint = np.argwhere(beyond)[0]
     assert Status(int(sol.status)) == Status.LIMIT_EXCEEDED and bool(sol.ok)
-    assert sol.messages() == [f"limit exceeded (joint '{model.joint_names[joint]}' position; "
+    assert sol.messages() == [f"limit exceeded (joint '{model.joint_names[joint]}' position out of range; "
                               f"first at t = {float(sol.ts[step]):.4g} s)"]
 
 
@@ -53,3 +54,48 @@ def test_a_basis_built_for_another_beam_is_refused():
     with pytest.raises(ValueError, match=r"damping must be the modal damping matrix of shape "
                                          r"\(2, 2\)"):
         beam_body(beam, craig_bampton(beam, n_modes=2), damping=jnp.ones(2))
+
+
+def test_a_solution_prints_its_status_in_words():
+    """`print(sol)` shows the words and the cause, one line; a batch counts its runs."""
+    model = eqx.tree_at(lambda m: (m.lower, m.upper), chain(3),
+                        (jnp.full(3, -LIMIT), jnp.full(3, LIMIT)))
+    starts = jnp.array([[0.0, 0.3, 0.0], [0.0, 0.0, 0.0]])
+    sols = jax.vmap(lambda q: simulate(TreeSystem(model), RK4(), q, jnp.array([0.0, 3.0, 0.0]),
+                                       dt=0.01, t1=1.0))(starts)
+    first = jax.tree.map(lambda x: x[0], sols)
+    assert str(first) == "Solution: " + first.messages()[0]
+    assert str(first).startswith("Solution: limit exceeded (joint 'joint1' position out of range")
+    assert str(sols).startswith("Solution, 2 runs: ")
+    assert sum(int(part.split()[0]) for part in str(sols)[len("Solution, 2 runs: "):].split("; ")
+               if part[0].isdigit()) == 2
+
+
+def test_home_lies_inside_every_limit_of_every_example_robot():
+    """`Model.home()` is inside [lower, upper] on every URDF of example-robot-data (the Panda's
+    elbow, whose range excludes zero, among those it moves), and equals `neutral()` where zero
+    is inside."""
+    import warnings
+
+    from mbjax.model import load_urdf
+    try:
+        from mbjax_harness.reproduce import urdf_corpus
+        paths = urdf_corpus.corpus_paths()
+    except Exception as err:          # PackageNotFoundError
+        pytest.skip(f"example-robot-data is not installed ({err})")
+    moved = []
+    for path in paths:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            try:
+                model = load_urdf(path)
+            except ValueError:        # no movable joint: nothing to place
+                continue
+        home, neutral = np.asarray(model.home()), np.asarray(model.neutral())
+        lower, upper = np.asarray(model.lower), np.asarray(model.upper)
+        assert np.all((home >= lower) & (home <= upper)), urdf_corpus.name(path)
+        outside = (neutral < lower) | (neutral > upper)
+        np.testing.assert_array_equal(home[~outside], neutral[~outside])
+        if outside.any():
+            moved.append(urdf_corpus.name(path))
+    assert any("panda" in name for name in moved), moved

@@ -24,11 +24,14 @@ class PD(AbstractControl):
     """A PD servo: tau = kp (q_ref - q[q_index]) + kd (v_ref - v[v_index]) + feedforward.
 
     Every array is a differentiable leaf; gains and targets may be scalars or one per servoed
-    coordinate.
+    coordinate, and the gains also matrices: `kp = w**2 * M`, `kd = 2 * w * M` with the mass
+    matrix M at q_ref puts every mode of the linearized arm at w rad/s, critically damped, where
+    gains scaled by M's diagonal alone can leave a stiff, fast mode that an explicit step does
+    not resolve.
 
     Args:
-        kp: stiffness, a scalar or shape (m,) [N m / rad or N / m].
-        kd: damping, a scalar or shape (m,) [N m s / rad or N s / m].
+        kp: stiffness, a scalar, shape (m,) or a matrix (m, m) [N m / rad or N / m].
+        kd: damping, a scalar, shape (m,) or a matrix (m, m) [N m s / rad or N s / m].
         q_ref: target configuration of the servoed coordinates, a scalar or shape (m,).
         v_ref: target velocity, a scalar or shape (m,); 0 by default.
         feedforward: force added to the feedback (a gravity torque, say), a scalar or shape
@@ -66,7 +69,7 @@ class PD(AbstractControl):
         self._check(q.shape[0], v.shape[0])
         if self.q_index is not None:
             q, v = q[jnp.array(self.q_index)], v[jnp.array(self.v_index)]
-        return self.kp * (self.q_ref - q) + self.kd * (self.v_ref - v) + self.feedforward
+        return _gain(self.kp, self.q_ref - q) + _gain(self.kd, self.v_ref - v) + self.feedforward
 
     def _check(self, nq: int, nv: int) -> None:
         """Indices within the state (a gather would clamp them, servoing another coordinate)
@@ -86,9 +89,16 @@ class PD(AbstractControl):
             m = len(self.q_index)
         for name in ("kp", "kd", "q_ref", "v_ref", "feedforward"):
             shape = getattr(self, name).shape
-            if shape not in ((), (1,), (m,)):
-                raise ValueError(f"PD's {name} must be a scalar or have shape ({m},), one per "
+            matrix = name in ("kp", "kd") and shape == (m, m)
+            if shape not in ((), (1,), (m,)) and not matrix:
+                kinds = f"({m},) or ({m}, {m})" if name in ("kp", "kd") else f"({m},)"
+                raise ValueError(f"PD's {name} must be a scalar or have shape {kinds}, one per "
                                  f"servoed coordinate, got shape {shape}")
+
+
+def _gain(k: Array, error: Array) -> Array:
+    """A gain times an error: a matrix gain multiplies, a scalar or per-coordinate one scales."""
+    return k @ error if k.ndim == 2 else k * error
 
 
 class MLPPolicy(AbstractControl):

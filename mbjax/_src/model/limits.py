@@ -38,14 +38,14 @@ def first_exceeded(model, q: Array, v: Array, tau: Array | None = None) -> Array
 
 
 def excess_names(model) -> tuple[str, ...]:
-    """What each entry of `excess` bounds: "joint 'NAME' position" (its nq coordinates, a
-    joint's k-th as "position k" where it has several), then velocity and effort per velocity
-    coordinate."""
+    """What each entry of `excess` bounds: "joint 'NAME' position out of range" (its nq
+    coordinates, a joint's k-th as "position k" where it has several), then velocity and effort
+    per velocity coordinate."""
     names = {"position": [], "velocity": []}
     for kind, size_of in (("position", "nq"), ("velocity", "nv")):
         sizes = [getattr(JOINT_TYPES[t], size_of) for t in model.joint_types]
         for joint, size in zip(model.joint_names, sizes):
             names[kind] += [f"joint {joint!r} {kind}" + (f" {k}" if size > 1 else "")
-                            for k in range(size)]
+                            + " out of range" for k in range(size)]
     return (*names["position"], *names["velocity"],
             *(name.replace("velocity", "effort") for name in names["velocity"]))

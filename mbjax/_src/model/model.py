@@ -348,6 +348,22 @@ class Model(eqx.Module):
         """
         return jnp.asarray([x for kind in self.joint_types for x in NEUTRAL[kind]], dtype=float)
 
+    def home(self) -> Array:
+        """A configuration inside every joint's limits: `neutral()`, with each coordinate whose
+        zero lies outside [lower, upper] moved to the middle of its range (or onto its one finite
+        bound), so that a simulation started there succeeds without a limit note.
+
+        A robot's neutral configuration need not be a reachable one (the Panda's elbow, joint 4,
+        ranges over [-3.07, -0.07] rad); Pinocchio's `neutral` is likewise the zero.
+
+        Returns:
+            q, shape (nq,).
+        """
+        q, lower, upper = self.neutral(), jnp.asarray(self.lower), jnp.asarray(self.upper)
+        middle = jnp.where(jnp.isfinite(lower) & jnp.isfinite(upper), (lower + upper) / 2,
+                           jnp.where(jnp.isfinite(lower), lower, upper))
+        return jnp.where((q >= lower) & (q <= upper), q, middle)
+
     @property
     def v_mask(self) -> np.ndarray:
         """(n, width) static mask: which padded joint columns are real velocity coordinates."""

@@ -1,9 +1,11 @@
 """The status every run reports: `Status` flags, results that carry them, and the error a
 failed run raises when asked to (throw=True)."""
 
+import collections
 import enum
 
 import equinox as eqx
+import jax
 import jax.numpy as jnp
 import numpy as np
 from jax import Array
@@ -99,6 +101,18 @@ class WithStatus(eqx.Module):
     def notes(self, i: int) -> dict:
         """{flag: what tripped it} for the i-th run (flattened); none by default."""
         return {}
+
+    def __str__(self) -> str:
+        """The status in words, as `print(result)` shows it: "Solution: success", or each flag
+        with its cause (`messages()`); a batch counts its runs per message."""
+        if isinstance(self.status, jax.core.Tracer):
+            return repr(self)
+        words = self.messages()
+        if len(words) == 1:
+            return f"{type(self).__name__}: {words[0]}"
+        counts = collections.Counter(words)
+        return (f"{type(self).__name__}, {len(words)} runs: "
+                + "; ".join(f"{n} {word}" for word, n in counts.most_common()))
 
 
 def describe(code: int, notes: dict) -> str:
