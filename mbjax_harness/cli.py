@@ -20,6 +20,7 @@ import inspect
 import json
 import re
 import sys
+import textwrap
 from functools import partial
 from pathlib import Path
 
@@ -70,51 +71,97 @@ def _version() -> str:
     return f"mbjax {mbjax.__version__} (jax {jax.__version__}, Python {platform.python_version()})"
 
 
-def describe(obj, limit: int | None = 100) -> str:
-    """The first sentence of a module's or function's docstring, without its "`mbjax ...`:"
-    prefix, on one line of at most `limit` characters; limit None: the whole first paragraph."""
-    doc = inspect.getdoc(sys.modules.get(obj.__module__) if inspect.isfunction(obj)
-                         and obj.__name__ in ("run", "reproduce") else obj) or ""
+def _owner(obj):
+    """What describes `obj`: a suite's `run` or a reproduction's `reproduce` its module."""
+    if inspect.isfunction(obj) and obj.__name__ in ("run", "reproduce"):
+        return sys.modules.get(obj.__module__)
+    return obj
+
+
+def describe(obj, whole: bool = False) -> str:
+    """The first sentence of a module's or function's docstring, whole (never cut), without its
+    "`mbjax ...`:" prefix and starting with a capital; whole=True: the whole first paragraph."""
+    doc = inspect.getdoc(_owner(obj)) or ""
     text = re.sub(r"^`mbjax [^`]*`:\s*", "", " ".join(doc.split("\n\n")[0].split()))
-    if limit is None:
-        return text
-    sentence = re.split(r"(?<=\.)\s(?=[A-Z(])", text)[0]
-    if len(sentence) <= limit:
-        return sentence
-    return sentence[:limit - 3].rsplit(" ", 1)[0].rstrip(",;:") + "..."
+    text = text[:1].upper() + text[1:]
+    return text if whole else re.split(r"(?<=\.)\s(?=[A-Z(])", text)[0]
+
+
+LISTING_WIDTH = 100
 
 
 def _listing(entries: dict) -> str:
+    """One entry a line: its name and what it does (`describe`); a sentence longer than the line
+    goes on under the name's column rather than being cut."""
     width = max(len(name) for name in entries) + 2
-    return "\n".join(f"{name:{width}s}{describe(fn)}" for name, fn in sorted(entries.items()))
+    return "\n".join(textwrap.fill(describe(fn), LISTING_WIDTH, initial_indent=f"{name:{width}s}",
+                                    subsequent_indent=" " * width, break_on_hyphens=False)
+                      for name, fn in sorted(entries.items()))
+
+
+SKIPPED = ("unavailable", "failed", "skipped")
 
 
 def _skipped(records) -> list[str]:
-    """The peers a command skipped and why: every record (or JSON object) that names an engine
-    or peer other than mbjax and whose status says "unavailable", "failed" or "skipped", as
-    "engine: status"."""
-    found = []
+    """The peers a command skipped and why, as "peer: status", followed by the scenes that
+    skipped it where there are scenes ("mujoco: unavailable: ... (controls, models)"). Found in
+    every record (or JSON object) that names an engine, peer or library other than mbjax and
+    whose status says "unavailable", "failed" or "skipped" or that has a "skipped" reason; in
+    every scene's "peers" ({peer: {"status": ...}}, `mbjax_harness.tour`); the scenes are the keys
+    of a "scenes" object (the tour's summary)."""
+    found: dict[tuple[str, str], list[str]] = {}
 
-    def walk(value):
+    def add(engine, status, scene):
+        if isinstance(engine, str) and engine != "mbjax" and isinstance(status, str):
+            scenes = found.setdefault((engine, status), [])
+            if scene is not None and scene not in scenes:
+                scenes.append(scene)
+
+    def walk(value, scene=None):
         if isinstance(value, dict):
-            engine, status = value.get("engine", value.get("peer")), value.get("status")
-            if (isinstance(engine, str) and engine != "mbjax" and isinstance(status, str)
-                    and status.startswith(("unavailable", "failed", "skipped"))):
-                found.append(f"{engine}: {status}")
-            for item in value.values():
-                walk(item)
+            engine = value.get("engine", value.get("peer", value.get("library")))
+            status, reason = value.get("status"), value.get("skipped")
+            if isinstance(status, str) and status.startswith(SKIPPED):
+                add(engine, status, scene)
+            elif isinstance(reason, str):
+                add(engine, reason if reason.startswith(SKIPPED) else f"skipped: {reason}", scene)
+            for key, item in value.items():
+                if key == "scenes" and isinstance(item, dict):
+                    for name, one in item.items():
+                        walk(one, name)
+                elif key == "peers" and isinstance(item, dict):
+                    for peer, record in item.items():
+                        if isinstance(record, dict) and str(record.get("status")).startswith(SKIPPED):
+                            add(peer, record["status"], scene)
+                else:
+                    walk(item, scene)
         elif isinstance(value, list):
             for item in value:
-                walk(item)
+                walk(item, scene)
 
     walk(records)
-    return sorted(set(found))
+    return [f"{engine}: {status}" + (f" ({', '.join(scenes)})" if scenes else "")
+            for (engine, status), scenes in sorted(found.items())]
 
 
-def _report(written: list[Path], records) -> None:
-    """The files a command wrote and the peers it skipped."""
+def _declared(fn) -> list[dict]:
+    """A record {"peer", "status"} for each peer that a suite's or reproduction's module declares
+    it compares with (its PEERS) and that is not installed (`mbjax_harness.peers.missing`), for
+    the closing line: those modules leave such a peer out of their records."""
+    from mbjax_harness import peers
+
+    names = getattr(_owner(fn), "PEERS", ())
+    return [{"peer": name, "status": why} for name in names
+            if (why := peers.missing(name)) is not None]
+
+
+def _report(written: list[Path], records, declared=()) -> None:
+    """The files a command wrote and the peers it skipped: those its records name (`_skipped`)
+    and those `declared` (`_declared`) that its records do not already name."""
     print("wrote " + ", ".join(str(p) for p in written if p.exists()))
     skipped = _skipped(records)
+    named = {line.split(":", 1)[0] for line in skipped}
+    skipped += _skipped([d for d in declared if d["peer"] not in named])
     print("peers skipped: " + ("; ".join(skipped) if skipped else "none"))
 
 
@@ -187,7 +234,7 @@ def _tables(scene: dict) -> tuple[list[str], list[str]]:
     scalar as a fact."""
     tables, facts = [], []
     for key, value in scene.items():
-        if key in ("figure", "animation", "wall_seconds"):
+        if key in ("figure", "animation", "wall_seconds", "look_at"):
             continue
         if isinstance(value, dict) and value and all(isinstance(v, dict) for v in value.values()):
             columns = list(dict.fromkeys(k for row in value.values() for k in row
@@ -208,15 +255,17 @@ def _tables(scene: dict) -> tuple[list[str], list[str]]:
 
 def _summary_markdown(summary: dict) -> str:
     """`summary.md` for people: per scene, what it shows and what to look at (the scene's own
-    description, `mbjax_harness.tour.LOOK_AT`), its figure, one table per experiment with headers in
-    words and units, its settings and results, and its wall time."""
-    from mbjax_harness.tour import LOOK_AT, TOUR
+    description, its "look_at", `mbjax_harness.tour.look_at`), its figure, one table per
+    experiment with headers in words and units (the peers it compared with, or why not, among
+    them), its settings and results, and its wall time."""
+    from mbjax_harness.tour import TOUR, look_at
 
     lines = ["# mbjax tour" + (" (quick)" if summary["quick"] else ""), "", STATUS_NOTE, ""]
     for name, scene in summary["scenes"].items():
-        lines += [f"## {name}", "", describe(TOUR[name], limit=None) if name in TOUR else "", ""]
-        if name in LOOK_AT:
-            lines += [f"*What to look at:* {LOOK_AT[name]}", ""]
+        lines += [f"## {name}", "", describe(TOUR[name], whole=True) if name in TOUR else "", ""]
+        sentence = scene.get("look_at") or look_at(name, scene)
+        if sentence:
+            lines += [f"*What to look at:* {sentence}", ""]
         lines += [f"![{name}]({scene['figure']})", ""]
         if "animation" in scene:
             lines += [f"![{name}, the motion]({scene['animation']})", ""]
@@ -289,7 +338,8 @@ def _run(parser, args, reproductions: dict, suites: dict, scenes: dict) -> int:
         with staged(args.out) as staging:
             for name in progress([args.name], 1, "mbjax reproduce"):     # a running clock
                 data = reproductions[name](staging, quick=args.quick)
-        _report([args.out / f"{args.name}.json", args.out / f"{args.name}.png"], data)
+        _report([args.out / f"{args.name}.json", args.out / f"{args.name}.png"], data,
+                _declared(reproductions[args.name]))
     elif args.command == "bench":
         if args.list:
             print(_listing(suites))
@@ -299,7 +349,8 @@ def _run(parser, args, reproductions: dict, suites: dict, scenes: dict) -> int:
         with staged(args.out) as staging:
             for name in progress([args.suite], 1, "mbjax bench"):
                 records = suites[name](staging, quick=args.quick)
-        _report([args.out / f"{args.suite}.jsonl", args.out / f"{args.suite}.png"], records)
+        _report([args.out / f"{args.suite}.jsonl", args.out / f"{args.suite}.png"], records,
+                _declared(suites[args.suite]))
     return 0
 
 

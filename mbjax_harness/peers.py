@@ -1,7 +1,9 @@
 """Peer engines, built to match mbjax scenes, for the benchmarks and the cross-engine tests (one
 place for both): MuJoCo, exudyn and Crocoddyl scenes, and mbjax's coordinates in Pinocchio's order.
 
-Each peer is optional: `available(name)` says whether it imports.
+Each peer is optional: `available(name)` says whether it imports, `missing(name)` why not, in
+the words a command's closing line and its records use ("unavailable: mujoco is not installed"),
+`note(name, status)` in a figure's ("MuJoCo not installed: pip install mujoco").
 """
 
 import importlib.util
@@ -14,8 +16,40 @@ from mbjax._src.model.joints import JOINT_TYPES
 MUJOCO_INTEGRATORS = ("Euler", "RK4", "implicit", "implicitfast")
 
 
+# the package that installs each peer, where its name differs from the module's
+PIP_NAMES = {"pinocchio": "pin", "mujoco.mjx": "mujoco-mjx", "adam": "adam-robotics",
+             "dm_control": "dm_control"}
+
+
 def available(name: str) -> bool:
-    return importlib.util.find_spec(name) is not None
+    """Whether module `name` (a peer, or a submodule such as "mujoco.mjx") can be imported; a
+    module set to None in `sys.modules`, as tests do to hide one, cannot."""
+    try:
+        return importlib.util.find_spec(name) is not None
+    except (ImportError, ValueError):          # a parent missing or hidden
+        return False
+
+
+# how figures and sentences name each peer
+TITLES = {"mujoco": "MuJoCo", "pinocchio": "Pinocchio", "crocoddyl": "Crocoddyl",
+          "mujoco.mjx": "MJX"}
+
+
+def note(name: str, status: str) -> str:
+    """Peer `name`'s status in a figure's or a sentence's words: "MuJoCo not installed: pip
+    install mujoco" for a peer `missing` says is unavailable, else "MuJoCo <status>"."""
+    title = TITLES.get(name, name)
+    if status.startswith("unavailable"):
+        return f"{title} not installed: pip install {PIP_NAMES.get(name, name)}"
+    return f"{title} {status}"
+
+
+def missing(name: str) -> str | None:
+    """None when peer `name` imports, else a status saying so: "unavailable: mujoco is not
+    installed" (`note` adds what to install)."""
+    if available(name):
+        return None
+    return f"unavailable: {name} is not installed"
 
 
 def mujoco_heavy_top(mass: float, inertia_pivot, com, gravity: float, dt: float,

@@ -1,8 +1,15 @@
 """What `mbjax tour` runs for each scene: a short simulation, a figure and a few numbers.
 
-Each entry takes (out, quick) and returns a summary dict naming the figure it wrote in out.
+Each entry takes (out, quick) and returns a summary dict naming the figure it wrote in out. A
+scene that compares with a peer engine (MuJoCo, Pinocchio) records each one under "peers", with
+the status "compared" or why not ("unavailable: mujoco is not installed", "failed: ..."): the
+command's closing line names the peers skipped from there, and the scene's figure and "what to
+look at" sentence say what was not compared (`look_at`).
+
+The first sentence of each scene's docstring is its line in `mbjax tour --list`.
 """
 
+import os
 import time
 from functools import partial
 from pathlib import Path
@@ -11,6 +18,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
+from mbjax_harness import peers
 from mbjax_harness.timing import measure
 from mbjax._src.integrate import INTEGRATORS, simulate, solve_reference
 from mbjax._src.scenes import TOLERANCE
@@ -24,6 +32,34 @@ def _max_abs(x) -> float:
     return float(np.max(np.abs(np.asarray(x))))
 
 
+def _save(fig, out: Path, name: str) -> str:
+    """Write fig as out/name; with MBJAX_LINT_FIGURES set (the tests set it), first check that
+    it reads (`mbjax_harness.plot.style.lint`: two labelled ticks on every log axis, a legend
+    wherever several lines are drawn) and raise naming what does not."""
+    fig.savefig(out / name, dpi=110)
+    if os.environ.get("MBJAX_LINT_FIGURES"):
+        from mbjax_harness.plot.style import lint
+
+        problems = lint(fig)
+        if problems:
+            raise AssertionError(f"{name}: " + "; ".join(problems))
+    return name
+
+
+def _peer(name: str, compares: str, compute):
+    """(value, record) of a comparison with peer engine `name`: compute()'s value and
+    {"status": "compared", "compares": compares}, or None and the status saying why not: the
+    peer is not installed (`mbjax_harness.peers.missing`), or it raised (a peer's failure is
+    reported, not the scene's)."""
+    why = peers.missing(name)
+    if why is not None:
+        return None, {"status": why, "compares": compares}
+    try:
+        value = compute()
+    except Exception as error:  # noqa: BLE001 (any failure of the peer's run is reported)
+        return None, {"status": f"failed: {type(error).__name__}: {error}"[:300],
+                      "compares": compares}
+    return value, {"status": "compared", "compares": compares}
 
 
 def torque_free_body_tour(out: Path, quick: bool) -> dict:
@@ -44,14 +80,14 @@ def torque_free_body_tour(out: Path, quick: bool) -> dict:
                       "invariant_drift": float(sol.drift), "seconds": timing.run_s, "status": sol.messages()[0]}
     fig = error_history_figure(histories, f"torque-free body (Borri 1990 §8.1), dt = {dt} s: "
                                "rotation error against the closed form")
-    fig.savefig(out / "torque-free-body.png", dpi=110)
+    _save(fig, out, "torque-free-body.png")
     animation = _animate_body(out, "torque-free-body", body, saveat, motions["rk4"],
                               "torque-free body (RK4)", quick)
     return {"figure": "torque-free-body.png", "animation": animation, "dt": dt, "integrators": rows}
 
 
 def heavy_top_tour(out: Path, quick: bool) -> dict:
-    """The Simo-Wong top: path of the symmetry axis and energy error of each integrator."""
+    """The Simo-Wong heavy top: each integrator's axis path and energy error."""
     from mbjax_harness.plot.scenes import heavy_top_figure
 
     dt = 2e-3 if quick else 1e-3
@@ -72,7 +108,7 @@ def heavy_top_tour(out: Path, quick: bool) -> dict:
                       "seconds": timing.run_s,
                       "status": sol.messages()[0]}
     fig = heavy_top_figure(runs, f"heavy top (Simo-Wong), dt = {dt * 1e3:g} ms, {duration:g} s")
-    fig.savefig(out / "heavy-top.png", dpi=110)
+    _save(fig, out, "heavy-top.png")
     animation = _animate_body(out, "heavy-top", body, saveat, motions["rkmk4"], "heavy top (RKMK4)",
                               quick)
     return {"figure": "heavy-top.png", "animation": animation, "dt": dt, "duration": duration,
@@ -86,10 +122,11 @@ QUICK_CHAIN_STEPS = {"rk4": (0.02, 5e-3), "implicit_midpoint": (0.01,)}
 
 
 def rigid_chain_tour(out: Path, quick: bool) -> dict:
-    """The 7-link chain falling under gravity (`TreeSystem`, method "auto"): speed against
-    accuracy of RK4, RKMK4 and implicit midpoint at a few steps, the error being the largest joint
-    angle error at the end against an adaptive Dopri8 reference (rtol 1e-12). On a revolute chain
-    the configuration space is a vector space, so RKMK4 is RK4 and lands on the same points."""
+    """A 7-link chain falling: three integrators' speed against accuracy. The chain is a
+    `TreeSystem` (method "auto"), run by RK4, RKMK4 and implicit midpoint at a few steps, the
+    error being the largest joint angle error at the end against an adaptive Dopri8 reference
+    (rtol 1e-12). On a revolute chain the configuration space is a vector space, so RKMK4 is RK4
+    and lands on the same points."""
     from mbjax_harness.plot.trees import rigid_chain_figure
     from mbjax._src.rigid import TreeSystem, forward_kinematics
 
@@ -126,7 +163,7 @@ def rigid_chain_tour(out: Path, quick: bool) -> dict:
     snapshots = list(zip(np.asarray(ref.ts).tolist(), np.asarray(points(ref.qs)), strict=True))
     fig = rigid_chain_figure(snapshots, runs, f"{rc.N_LINKS}-link chain falling under gravity, "
                              f"{duration:g} s, forward dynamics \"{route}\"")
-    fig.savefig(out / "rigid-chain.png", dpi=110)
+    _save(fig, out, "rigid-chain.png")
     frames = np.round(np.arange(0.0, duration + 1e-9, 0.02), 10)
     motion = simulate(system, INTEGRATORS["rk4"](), q0, v0, dt=5e-3, t1=duration, saveat=frames)
     animation = _animate(out, "rigid-chain", system, frames, motion.qs,
@@ -137,9 +174,9 @@ def rigid_chain_tour(out: Path, quick: bool) -> dict:
 
 
 def time_elements_tour(out: Path, quick: bool) -> dict:
-    """Borri 1990's time elements on a sleeping top (`mbjax reproduce top-long-run`, shortened): the
-    primal form of eq 4.1 grows at the rate its transition matrix predicts, the mixed form of eq
-    4.9 keeps the physical tilt."""
+    """Borri 1990's time elements on a sleeping top: primal against mixed form. As in a shortened
+    `mbjax reproduce top-long-run`, the primal form of eq 4.1 grows at the rate its transition
+    matrix predicts, the mixed form of eq 4.9 keeps the physical tilt."""
     from mbjax_harness.plot.tfe import top_long_run_figure
     from mbjax_harness.reproduce import top_long_run as tlr
 
@@ -150,7 +187,7 @@ def time_elements_tour(out: Path, quick: bool) -> dict:
     data = {"scene": f"time elements: vertical top at {tlr.SPIN_RATIO:g} Omega_c, {tlr.NODES}-node "
                      f"elements {tlr.DT:g} s between nodes, {duration:g} s (Borri 1990 §6-7)",
             "physical": tlr.physical(duration), "runs": runs}
-    top_long_run_figure(data).savefig(out / "time-elements.png", dpi=110)
+    _save(top_long_run_figure(data), out, "time-elements.png")
     return {"figure": "time-elements.png", "animation": animation, "duration": duration,
             "runs": {r["form"]: {k: r[k] for k in ("predicted_growth", "measured_growth", "max_tilt",
                                                    "seconds", "status")} for r in runs},
@@ -163,11 +200,12 @@ QUICK_LOOP_SYSTEMS = ("coupled, none", "coupled, projection", "O(n + m^3), none"
 
 
 def closed_loops_tour(out: Path, quick: bool) -> dict:
-    """Anderson 1993's closed chain (12 dof, 4 closure equations, `mbjax reproduce closed-chain` in
-    small): speed against accuracy of the coupled multipliers (Jerkovsky 1978) with no stabilization,
-    with Baumgarte's and with projection after every step, and of Anderson 1993's O(n + m^3) route, the
-    error being the largest joint-angle error after 1 s against an adaptive Dopri8 reference
-    (rtol 1e-12), with the constraint residual |Phi| reached."""
+    """Anderson 1993's closed chain: loop-closure methods' speed against accuracy. The chain has
+    12 dof and 4 closure equations (`mbjax reproduce closed-chain` in small); the methods are the
+    coupled multipliers (Jerkovsky 1978) with no stabilization, with Baumgarte's and with
+    projection after every step, and Anderson 1993's O(n + m^3) route, the error being the largest
+    joint-angle error after 1 s against an adaptive Dopri8 reference (rtol 1e-12), with the
+    constraint residual |Phi| reached."""
     from mbjax._src.integrate import RK4
     from mbjax._src.loops import ClosedSystem, Coupled, Stabilized
     from mbjax_harness.plot.loops import closed_loops_tour_figure
@@ -203,7 +241,7 @@ def closed_loops_tour(out: Path, quick: bool) -> dict:
                                                   "status": sol.messages()[0]}
         drift[name] = (saveat, phi)
     fig = closed_loops_tour_figure(runs, drift, f"closed chain, 12 dof, {duration:g} s, RK4")
-    fig.savefig(out / "closed-loops.png", dpi=110)
+    _save(fig, out, "closed-loops.png")
     animation = _animate(out, "closed-loops", chain, saveat, ref.qs,
                          "closed chain (reference solution)", quick)
     return {"figure": "closed-loops.png", "animation": animation, "duration": duration,
@@ -223,10 +261,11 @@ FLEX_AGREEMENT = 0.1
 
 
 def flexible_bodies_tour(out: Path, quick: bool) -> dict:
-    """Kane's spin-up beam (Anderson 1993 §3.2, `mbjax reproduce spin-up-beam` in small): the modal
-    model (RK4, 2 ms, Anderson 1993's O(n + m^3) route) with 1, 2, 4 bending modes (quick: 2), each with
-    and without geometric stiffening, against the geometrically nonlinear ANCF beam (4 elements):
-    speed against accuracy, the error being the largest tip-deflection difference over the run.
+    """Kane's spin-up beam: modal models, stiffened or not, against an ANCF beam. As in Anderson
+    1993 §3.2 (`mbjax reproduce spin-up-beam` in small), the modal model (RK4, 2 ms, Anderson
+    1993's O(n + m^3) route) with 1, 2, 4 bending modes (quick: 2), each with and without
+    geometric stiffening, runs against the geometrically nonlinear ANCF beam (4 elements): speed
+    against accuracy, the error being the largest tip-deflection difference over the run.
     The window (10 s, quick 8 s) holds the peak lag (0.57 m at 6.8 s) and the unstiffened run's
     runaway as omega nears the first bending frequency (3.8 rad/s at 8.5 s). Stiffening is data in
     the flexible body, so each mode count compiles once for both runs. Then the most modes once
@@ -287,7 +326,7 @@ def flexible_bodies_tour(out: Path, quick: bool) -> dict:
     fig = flexible_tour_figure(runs, histories, (np.asarray(ref.ts), ref_tip, FLEX_REFERENCE_ELEMENTS),
                                f"Kane's spin-up beam, {duration:g} s, RK4 {FLEX_DT * 1e3:g} ms: "
                                f"modal model against the ANCF beam ({ref_seconds:.0f} s)")
-    fig.savefig(out / "flexible-bodies.png", dpi=110)
+    _save(fig, out, "flexible-bodies.png")
     animation = _animate_beam(out, *motion, quick)
     return {"figure": "flexible-bodies.png", "animation": animation, "duration": duration,
             "dt": FLEX_DT,
@@ -297,8 +336,9 @@ def flexible_bodies_tour(out: Path, quick: bool) -> dict:
 
 
 def carpal_wrist_tour(out: Path, quick: bool) -> dict:
-    """The Carpal Wrist (Canfield 1997 §6.4): the chapter's explicit Euler (eq 6.45) and the foundation's
-    integrators (quick: RK4 only) on the torque-free tool (error against RK4 at 0.1 ms, energy drift) and on the
+    """The Carpal Wrist: each integrator's error and stability against the step. As in Canfield
+    1997 §6.4, the chapter's explicit Euler (eq 6.45) and the foundation's integrators (quick: RK4
+    only) run on the torque-free tool (error against RK4 at 0.1 ms, energy drift) and on the
     servoed wrist under gravity (stable or not), against the step; the run time of each method is
     per step of the free-motion runs (all steps vmapped in one call)."""
     from mbjax_harness.plot.wrist import integrator_figure
@@ -313,7 +353,7 @@ def carpal_wrist_tour(out: Path, quick: bool) -> dict:
     rows, critical = cwr.integrator_study(cwr.QUICK_STEPS if quick else cwr.STEPS, seconds, methods,
                                           motion)
     fig = integrator_figure(rows, critical, seconds)
-    fig.savefig(out / "carpal-wrist.png", dpi=110)
+    _save(fig, out, "carpal-wrist.png")
     wrist_animation(out / "carpal-wrist.gif", cws.wrist(), motion["ts"], motion["qs"],
                     title="Carpal Wrist, torque-free tool", frames=30 if quick else 40)
     animation = "carpal-wrist.gif"
@@ -325,10 +365,11 @@ def carpal_wrist_tour(out: Path, quick: bool) -> dict:
 
 
 def controls_tour(out: Path, quick: bool) -> dict:
-    """A 7-dof arm from a URDF (`mbjax._src.scenes.arm`): held by a PD servo with gravity feed-forward,
-    pushed at its flange for 0.1 s; driven by a torque history sampled per step as MuJoCo applies
-    it, against `mujoco.rollout` (when installed); and `jax.grad` of a reach loss with respect to
-    a torque spline's knots and a link mass against central differences."""
+    """A URDF arm under a servo and sampled torques, with jax.grad through it. The 7-dof arm
+    (`mbjax._src.scenes.arm`) is held by a PD servo with gravity feed-forward and pushed at its
+    flange for 0.1 s; driven by a torque history sampled per step as MuJoCo applies it, against
+    `mujoco.rollout` (when installed); and `jax.grad` of a reach loss with respect to a torque
+    spline's knots and a link mass is checked against central differences."""
 
     from mbjax._src.control import ZeroOrderHold
     from mbjax_harness.plot.scenes import controls_figure
@@ -351,9 +392,10 @@ def controls_tour(out: Path, quick: bool) -> dict:
     sampled = simulate(TreeSystem(arm, ZeroOrderHold(history, scene.DT), actuation=[1, 3, 5]),
                        INTEGRATORS["rk4"](), q0, v0, dt=scene.DT, t1=steps * scene.DT,
                        saveat=[steps * scene.DT])
-    mujoco_diff = _mujoco_sampled(arm, scene.Q_REF, history, [1, 3, 5], scene.DT, steps)
-    if mujoco_diff is not None:
-        mujoco_diff = float(np.abs(mujoco_diff - np.asarray(sampled.qs[-1])).max())
+    mujoco_diff, mujoco = _peer(
+        "mujoco", "the sampled-torque run against mujoco.rollout",
+        lambda: _max_abs(_mujoco_sampled(arm, scene.Q_REF, history, [1, 3, 5], scene.DT, steps)
+                         - np.asarray(sampled.qs[-1])))
 
     horizon = 100 if quick else 250
     knots, mass = 0.5 * jnp.ones((6, 7)), arm.mass[3]
@@ -366,11 +408,13 @@ def controls_tour(out: Path, quick: bool) -> dict:
               "d loss / d mass of link 4": (float(grads[1]), fd_mass)}
     rows = {name: {"jax_grad": g, "central_difference": fd,
                    "relative_difference": abs(g - fd) / abs(fd)} for name, (g, fd) in checks.items()}
+    sampled_note = (f"sampled control vs mujoco.rollout: {mujoco_diff:.1e} rad"
+                    if mujoco_diff is not None else
+                    f"sampled control not compared ({peers.note('mujoco', mujoco['status'])})")
     fig = controls_figure(np.asarray(ts), np.asarray(pushed.qs - q0), displacement, checks,
                           f"7-dof arm (mbjax.data.ARM7), PD servo + gravity feed-forward, RK4 "
-                          f"{scene.DT * 1e3:g} ms" + (f"; sampled control vs mujoco.rollout: "
-                                                       f"{mujoco_diff:.1e} rad" if mujoco_diff is not None else ""))
-    fig.savefig(out / "controls.png", dpi=110)
+                          f"{scene.DT * 1e3:g} ms; {sampled_note}")
+    _save(fig, out, "controls.png")
     animation = _animate(out, "controls", TreeSystem(arm), ts, pushed.qs,
                          "arm under a PD servo, pushed at its flange", quick)
     return {"figure": "controls.png", "animation": animation, "duration": duration,
@@ -379,17 +423,15 @@ def controls_tour(out: Path, quick: bool) -> dict:
                      "sampled": {"max_abs_diff_mujoco_rad": mujoco_diff,
                                  "status": sampled.messages()[0]}},
             "gradients": rows, "grad_seconds": grad_timing.run_s,
-            "grad_compile_seconds": grad_timing.compile_s}
+            "grad_compile_seconds": grad_timing.compile_s, "peers": {"mujoco": mujoco}}
 
 
 def _mujoco_sampled(arm, q0, history, actuated, dt, steps):
-    """The final qpos of `mujoco.rollout` with `history` as qfrc_applied on `actuated` and RK4;
-    None without MuJoCo."""
-    try:
-        import mujoco
-        from mujoco import rollout
-    except ImportError:
-        return None
+    """The final qpos of `mujoco.rollout` with `history` as qfrc_applied on `actuated` and RK4
+    (MuJoCo installed: `_peer` asks first)."""
+    import mujoco
+    from mujoco import rollout
+
     from mbjax._src.model.urdf import to_urdf
 
     mj = mujoco.MjModel.from_xml_string(to_urdf(arm))
@@ -408,10 +450,11 @@ def _mujoco_sampled(arm, q0, history, actuated, dt, steps):
 
 
 def models_tour(out: Path, quick: bool) -> dict:
-    """A URDF arm as a user brings it (`mbjax.data.ARM7`): its links and fixed joints as named
-    frames, the flange's pose and Jacobian by name, its joint limits as data that `simulate`'s
-    status checks (the unpowered arm falls through them), and the same arm through MuJoCo's
-    compiler (`mbjax.model.from_mujoco`) and Pinocchio, when installed, against their dynamics."""
+    """A URDF arm as a user brings it: frames, joint limits, peers' dynamics. The arm
+    (`mbjax.data.ARM7`) has its links and fixed joints as named frames, the flange's pose and
+    Jacobian by name, its joint limits as data that `simulate`'s status checks (the unpowered arm
+    falls through them), and the same arm through MuJoCo's compiler (`mbjax.model.from_mujoco`)
+    and Pinocchio, when installed, against their dynamics."""
     from mbjax._src.model.limits import excess
     from mbjax_harness.plot.scenes import models_figure
     from mbjax._src.rigid import TreeSystem, frame_jacobian, frame_pose
@@ -428,24 +471,25 @@ def models_tour(out: Path, quick: bool) -> dict:
     first = int(np.argmax(np.asarray(beyond).max(axis=1) > 0))
     J = frame_jacobian(arm, q0, "flange")
     manipulability = float(jnp.sqrt(jnp.linalg.det(J[3:] @ J[3:].T)))
-    peers = _model_peers()
+    compared = _model_peers()
     fig = models_figure(np.asarray(ts), np.asarray(fall.qs), np.asarray(arm.lower),
-                        np.asarray(arm.upper), np.asarray(flange), peers,
+                        np.asarray(arm.upper), np.asarray(flange), compared,
                         f"{len(arm.frame_names)} named frames; status: {fall.messages()[0]}")
-    fig.savefig(out / "models.png", dpi=110)
+    _save(fig, out, "models.png")
     animation = _animate(out, "models", TreeSystem(arm), ts, fall.qs,
                          "the URDF arm falling unpowered", quick)
     return {"figure": "models.png", "animation": animation, "frames": list(arm.frame_names),
             "flange_at_start_m": np.asarray(flange[0]).tolist(),
             "flange_manipulability": manipulability, "status": fall.messages()[0],
             "first_limit_exceeded_s": float(ts[first]) if np.asarray(beyond).any() else None,
-            "peers_max_relative_difference": peers}
+            "peers": compared}
 
 
 def trajectory_optimisation_tour(out: Path, quick: bool) -> dict:
-    """The 7-dof arm's reach (`mbjax._src.scenes.arm.reach_problem`: the flange 0.4 m sideways at
-    rest after 1 s, 100 knots of 0.01 s) solved by iLQR (`mbjax.trajopt`) from the torques that
-    hold the start pose: the cost per iteration, the flange's approach, the torques."""
+    """The 7-dof arm's reach solved by iLQR: cost, flange approach and torques. The problem
+    (`mbjax._src.scenes.arm.reach_problem`) asks the flange 0.4 m sideways at rest after 1 s, in
+    100 knots of 0.01 s; iLQR (`mbjax.trajopt`) starts from the torques that hold the start
+    pose."""
     from mbjax_harness.plot.trajopt import reach_figure
     from mbjax._src.scenes import arm
     from mbjax._src.trajopt import ILQR, solve
@@ -462,7 +506,7 @@ def trajectory_optimisation_tour(out: Path, quick: bool) -> dict:
                        np.asarray(result.us),
                        f"arm reach by iLQR: {iterations} iterations in {timing.run_s:.2f} s, "
                        f"final error {error:.1e} m ({result.messages()[0]})")
-    fig.savefig(out / "trajectory-optimisation.png", dpi=110)
+    _save(fig, out, "trajectory-optimisation.png")
     animation = _animate(out, "trajectory-optimisation", problem.system, ts, result.qs,
                          "arm reach by iLQR", quick)
     return {"figure": "trajectory-optimisation.png", "animation": animation,
@@ -472,10 +516,10 @@ def trajectory_optimisation_tour(out: Path, quick: bool) -> dict:
 
 
 def floating_base_tour(out: Path, quick: bool) -> dict:
-    """Crocoddyl's quadrotor example (`mbjax_harness.crocoddyl_examples`: the hector quadrotor, a
-    free base driven by four thrusters through an actuation matrix, thrusts bounded to
-    [0.1, 5] N, flown 1 m over and 1 m up in 33 knots of 0.03 s) solved by iLQR on SE(3) from
-    hover: the cost per iteration, the base's path, the thrusts."""
+    """Crocoddyl's quadrotor solved by iLQR on SE(3): cost, path and thrusts. The hector
+    quadrotor (`mbjax_harness.crocoddyl_examples`) is a free base driven by four thrusters
+    through an actuation matrix, its thrusts bounded to [0.1, 5] N, flown from hover 1 m over
+    and 1 m up in 33 knots of 0.03 s."""
     from mbjax_harness.crocoddyl_examples import TARGET, hector, quadrotor_problem
     from mbjax_harness.plot.trajopt import floating_base_figure
     from mbjax._src.trajopt import ILQR, solve
@@ -496,7 +540,7 @@ def floating_base_tour(out: Path, quick: bool) -> dict:
         f"quadrotor by iLQR on SE(3): {iterations} iterations in {timing.run_s:.2f} s, "
         f"{np.linalg.norm(left[3:]):.1e} m and {np.linalg.norm(left[:3]):.1e} rad from the target "
         f"({result.messages()[0]})")
-    fig.savefig(out / "floating-base.png", dpi=110)
+    _save(fig, out, "floating-base.png")
     animation = _animate(out, "floating-base", problem.system, ts, result.qs,
                          "quadrotor by iLQR", quick)
     return {"figure": "floating-base.png", "animation": animation,
@@ -510,27 +554,36 @@ def floating_base_tour(out: Path, quick: bool) -> dict:
 
 
 def _model_peers() -> dict:
-    """The arm against Pinocchio from the same URDF (`mbjax_harness.reproduce.urdf_corpus`: forward and
-    inverse dynamics, mass matrix, frames) and against MuJoCo through MuJoCo's compiler and
-    `from_mujoco` (`mbjax_harness.reproduce.mjcf_corpus`: accelerations), each where installed."""
-    from mbjax_harness import peers
+    """{peer: record}: the arm against Pinocchio from the same URDF
+    (`mbjax_harness.reproduce.urdf_corpus`: forward and inverse dynamics, mass matrix, frames) and
+    against MuJoCo through MuJoCo's compiler and `from_mujoco` (`mbjax_harness.reproduce.mjcf_corpus`:
+    accelerations), each record with its status (`_peer`) and, where compared, the largest
+    relative difference."""
     from mbjax.data import ARM7
 
-    out = {}
-    if peers.available("pinocchio"):
+    def pinocchio():
         from mbjax_harness.reproduce import urdf_corpus
-        out["pinocchio"] = urdf_corpus.compare(ARM7, floating=False)["max_relative_difference"]
-    if peers.available("mujoco"):
+        return urdf_corpus.compare(ARM7, floating=False)["max_relative_difference"]
+
+    def mujoco():
         import mujoco
 
         from mbjax._src.model.mjcf import from_mujoco
         from mbjax_harness.reproduce import mjcf_corpus
         mj = mujoco.MjModel.from_xml_path(str(ARM7))
-        out["mujoco"] = mjcf_corpus.compare(mj, from_mujoco(mj))["qacc"]
+        return mjcf_corpus.compare(mj, from_mujoco(mj))["qacc"]
+
+    out = {}
+    for name, compares, compute in (
+            ("pinocchio", "forward and inverse dynamics, mass matrix, frames from the URDF", pinocchio),
+            ("mujoco", "accelerations through MuJoCo's compiler and from_mujoco", mujoco)):
+        value, record = _peer(name, compares, compute)
+        out[name] = {**record, "max_relative_difference": None if value is None else float(value)}
     return out
 
 
-# what a reader should look at in each scene's figure and tables (`summary.md`)
+# what a reader should look at in each scene's figure and tables (`summary.md`), for the scenes
+# that compare with no peer; `look_at` writes the others' from what ran
 LOOK_AT = {
     "torque-free-body": "at the same step RK4 and RKMK4 land within 1e-4 rad of the closed form "
                         "while both Euler methods are off by more than a radian; the error "
@@ -552,16 +605,39 @@ LOOK_AT = {
     "carpal-wrist": "the stability column against the step: the chapter's explicit Euler goes "
                     "unstable past its critical step (about 7 ms) while RK4 stays stable to "
                     "about 35 ms, as their linearizations predict (the critical steps below).",
-    "controls": "the servo catching the push within millimetres, the sampled-torque run on top "
-                "of MuJoCo's, and jax.grad agreeing with central differences.",
-    "models": "the arm loaded from a URDF agrees with MuJoCo and Pinocchio on its dynamics; the "
-              "unpowered arm falls through its joint limits and the status says so.",
     "trajectory-optimisation": "the cost falling over the iterations and the flange reaching its "
                                "target at rest.",
     "floating-base": "the quadrotor pitching forward to fly over and back level to stop at its "
                      "target, the thrusts held inside their bounds; the same problem in "
                      "Crocoddyl is `mbjax bench trajopt`'s quadrotor-bounded.",
 }
+
+
+
+def look_at(name: str, scene: dict) -> str | None:
+    """The "what to look at" sentence of scene `name` given its summary `scene`: `LOOK_AT`'s, or,
+    for a scene that compares with peers, one that describes the comparisons that ran and says
+    which did not, and why (`mbjax_harness.peers.note`)."""
+    records = scene.get("peers", {})
+    ran = [peers.TITLES[p] for p in ("mujoco", "pinocchio")
+           if records.get(p, {}).get("status") == "compared"]
+    not_run = "; ".join(peers.note(p, r["status"]) for p, r in records.items()
+                        if r.get("status") != "compared")
+    if name == "controls":
+        text = ("the servo catching the push within millimetres (middle panel) and jax.grad "
+                "agreeing with central differences (right panel)")
+        if ran:
+            return text + ("; the sampled-torque run ends where mujoco.rollout ends (its "
+                           "difference is in the title and the runs table).")
+        return text + f"; the sampled-torque run is not compared with MuJoCo ({not_run})."
+    if name == "models":
+        text = "the unpowered arm falls through its joint limits (left panel) and the status says so"
+        if not ran:
+            return text + f"; its dynamics are compared with no peer here ({not_run})."
+        return (text + f"; the arm loaded from a URDF agrees with {' and '.join(ran)} on its "
+                "dynamics (right panel)" + (f"; not compared: {not_run}." if not_run else "."))
+    return LOOK_AT.get(name)
+
 
 TOUR = {   # in the order the summary tells them
     "torque-free-body": torque_free_body_tour,
@@ -646,8 +722,12 @@ def _animate_tops(out: Path, runs: list[dict], quick: bool) -> str:
 
 
 def run_scene(name: str, out: Path, quick: bool) -> dict:
-    """The summary of scene `name`, with its wall time (compiling, running and drawing)."""
+    """The summary of scene `name`, with what to look at (`look_at`) and its wall time
+    (compiling, running and drawing)."""
     start = time.perf_counter()
     result = TOUR[name](out, quick)
+    sentence = look_at(name, result)
+    if sentence:
+        result["look_at"] = sentence
     result["wall_seconds"] = time.perf_counter() - start
     return result

@@ -1,4 +1,5 @@
-"""`mbjax bench compile`: what compiling costs a user (its targets: a cold quick tour in 60 s, warm in 15 s, a scene in 3 s).
+"""`mbjax bench compile`: what compiling costs a user, against its targets. Its targets: a cold
+quick tour in 60 s, warm in 15 s, a scene in 3 s.
 
 - the tour: `mbjax tour --quick` in a fresh process with an empty persistent cache (cold), then
   again with the cache it filled (warm), and the process's wall time from start to exit; once as

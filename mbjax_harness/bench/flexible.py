@@ -1,5 +1,5 @@
-"""`mbjax bench flexible`: work against precision on Anderson 1993's two flexible scenes, mbjax's modal
-bodies against geometrically nonlinear ANCF beams (mbjax's own and exudyn's), one run.
+"""`mbjax bench flexible`: work against precision on Anderson 1993's two flexible scenes. The
+modal bodies against geometrically nonlinear ANCF beams (mbjax's own and exudyn's), one run.
 
 Kane's spin-up beam (`mbjax._src.scenes.spin_up_beam`, 0-20 s; --quick 0-8 s), records with
 "scene": "spin-up":

@@ -22,6 +22,9 @@ from mbjax._src.integrate import INTEGRATORS, RKMK4, simulate, solve_reference
 from mbjax._src.scenes import heavy_top as top
 
 NAME = "integrators"
+# the peers compared with where installed, left out of the records where not: the
+# command's closing line names those missing (`mbjax_harness.cli._declared`)
+PEERS = ("mujoco",)
 
 
 def run(out: Path, quick: bool = False) -> list[dict]:

@@ -51,6 +51,9 @@ from mbjax._src.model.urdf import to_urdf
 from mbjax._src.rigid import TreeSystem, forward_dynamics
 
 NAME = "rigid"
+# the peers compared with where installed, left out of the records where not: the
+# command's closing line names those missing (`mbjax_harness.cli._declared`)
+PEERS = ("pinocchio", "mujoco")
 METHODS = ("recursive", "dense")
 # the strategy each method name stands for (the records keep the names)
 STRATEGY = {"recursive": Recursive(), "dense": Dense()}

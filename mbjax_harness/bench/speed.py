@@ -1,6 +1,6 @@
-"""`mbjax bench speed`: the cost users feel (one call, one trajectory, its gradient, a vmapped
-batch, the dynamics' derivatives, compile time) on chains and real robots, mbjax against
-Pinocchio, jaxsim, adam and frax in one run.
+"""`mbjax bench speed`: the cost users feel, on chains and real robots, against four peers.
+One call, one trajectory, its gradient, a vmapped batch, the dynamics' derivatives and compile
+time, against Pinocchio, jaxsim, adam and frax in one run.
 
 Robots: the regular 7- and 30-link chains (`mbjax.model.chain`, written with `to_urdf`), and from
 example-robot-data the Panda arm (7 dof, fixed base) and the Unitree G1 humanoid (floating base,
@@ -52,6 +52,9 @@ from mbjax._src.rigid import TreeSystem, forward_dynamics
 from mbjax_harness.timing import write_jsonl
 
 NAME = "speed"
+# the peers compared with where installed, left out of the records where not: the
+# command's closing line names those missing (`mbjax_harness.cli._declared`)
+PEERS = ("pinocchio",)
 STEPS, QUICK_STEPS = 1000, 100
 BATCH, QUICK_BATCH = 4096, 256
 MEMORY_STEPS = (256, 1024, 4096)            # horizons of `grad_memory` (powers of 2: sqrt exact)

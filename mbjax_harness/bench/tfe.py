@@ -1,5 +1,5 @@
-"""`mbjax bench tfe`: time finite elements against the step-by-step integrators, speed against
-accuracy on two scenes.
+"""`mbjax bench tfe`: time finite elements against the step-by-step integrators on two scenes.
+Speed against accuracy.
 
 - the torque-free body of Borri 1990 §8.1 (6 s), error against the closed form (eq 8.8);
 - the Simo-Wong heavy top (10 s, spinning at 50 rad/s), error against an adaptive Dopri8

@@ -1,5 +1,5 @@
-"""`mbjax bench throughput`: batched forward dynamics, rollouts and rollout gradients of revolute
-chains, mbjax against Pinocchio, MuJoCo and MJX in one run.
+"""`mbjax bench throughput`: batched dynamics, rollouts and their gradients on revolute chains.
+Forward dynamics, rollouts and rollout gradients, against Pinocchio, MuJoCo and MJX in one run.
 
 For regular n-link chains (`mbjax.model.chain(n)`, n = 7, 30, 100; float64 unless said, CPU):
 
@@ -48,6 +48,9 @@ from mbjax._src.model.urdf import to_urdf
 from mbjax._src.rigid import TreeSystem, batch_aba, forward_dynamics
 
 NAME = "throughput"
+# the peers compared with where installed, left out of the records where not: the
+# command's closing line names those missing (`mbjax_harness.cli._declared`)
+PEERS = ("pinocchio", "mujoco")
 NS, QUICK_NS = (7, 30, 100), (7,)
 BATCHES, QUICK_BATCHES = (1, 4, 16, 64, 256, 1024, 4096), (1, 64, 1024)
 DT = 1e-3

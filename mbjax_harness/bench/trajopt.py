@@ -1,5 +1,5 @@
-"""`mbjax bench trajopt`: trajectory optimisation, mbjax's iLQR against Crocoddyl's FDDP on
-identical problems, one at a time and 64 at once.
+"""`mbjax bench trajopt`: trajectory optimisation: mbjax's iLQR against Crocoddyl's FDDP.
+On identical problems, one at a time and 64 at once.
 
 Problems: `arm-reach`, the shipped 7-dof arm's flange moved 0.4 m, and `acrobot-swingup`, the
 double pendulum driven at its elbow to upright (`mbjax.scenes`); and Crocoddyl's own

@@ -2,7 +2,7 @@
 
 import numpy as np
 
-from mbjax_harness.plot.style import COLORS, Figure, label
+from mbjax_harness.plot.style import COLORS, Figure, label, note_in
 
 
 def error_history_figure(histories: dict, title: str) -> Figure:
@@ -42,8 +42,10 @@ def controls_figure(ts, dq, displacement, checks: dict, title: str) -> Figure:
     unpushed run; (c) jax.grad against central differences."""
     fig = Figure(figsize=(14, 4.2), layout="constrained")
     ax_q, ax_f, ax_g = fig.subplots(1, 3, width_ratios=(1, 1, 0.8))
-    ax_q.plot(ts, dq, lw=1)
+    for j in range(dq.shape[1]):
+        ax_q.plot(ts, dq[:, j], lw=1, label=f"joint {j + 1}")
     ax_q.set(xlabel="t [s]", ylabel="q - q_ref [rad]", title="pushed at the flange for 0.1 s")
+    ax_q.legend(fontsize=7, ncol=2)
     for i, axis in enumerate("xyz"):
         ax_f.plot(ts, displacement[:, i] * 1e3, label=axis)
     ax_f.axvspan(0.0, 0.1, color="0.9")
@@ -56,7 +58,8 @@ def controls_figure(ts, dq, displacement, checks: dict, title: str) -> Figure:
     ax_g.barh(y - 0.18, grads, height=0.35, label="jax.grad")
     ax_g.barh(y + 0.18, fds, height=0.35, label="central differences")
     ax_g.set(yticks=y, yticklabels=names, xscale="log", xlabel="|derivative|",
-             title="gradient of the reach loss")
+             title="gradient of the reach loss",      # bars from a decade below the smallest
+             xlim=(0.1 * min(grads + fds), 2 * max(grads + fds)))
     ax_g.legend(fontsize=8)
     for ax in (ax_q, ax_f, ax_g):
         ax.grid(alpha=0.3)
@@ -66,7 +69,11 @@ def controls_figure(ts, dq, displacement, checks: dict, title: str) -> Figure:
 
 def models_figure(ts, qs, lower, upper, flange, peers: dict, title: str) -> Figure:
     """(a) the falling arm's joint angles against their limits; (b) the flange's path, by name;
-    (c) forward dynamics against the peers."""
+    (c) forward dynamics against the peers: `peers` is {peer: {"status", "max_relative_difference"}}
+    (`mbjax_harness.tour._model_peers`), a bar for each peer compared, where a peer was not, what
+    to install (`mbjax_harness.peers.note`) in its place, or across the panel when none was."""
+    from mbjax_harness.peers import TITLES, note
+
     fig = Figure(figsize=(14, 4.2), layout="constrained")
     ax_q, ax_f, ax_p = fig.subplots(1, 3, width_ratios=(1.2, 1, 0.6))
     for j in range(qs.shape[1]):
@@ -80,12 +87,25 @@ def models_figure(ts, qs, lower, upper, flange, peers: dict, title: str) -> Figu
     ax_f.set(xlabel="x [m]", ylabel="z [m]", title='(b) frame_pose(model, q, "flange")',
              aspect="equal")
     ax_f.legend(fontsize=7)
-    names = list(peers) or ["(no peer installed)"]
-    values = [max(peers.get(n, 0.0), 1e-17) for n in names]
-    ax_p.bar(names, values, color="C0")
+    names = list(peers)
     ax_p.set_yscale("log")
     ax_p.set(ylim=(1e-17, 1e-6), ylabel="max relative difference",
              title="(c) forward dynamics vs peers")
+    compared = [n for n in names if peers[n]["status"] == "compared"]
+    if compared:
+        slots = range(len(names))
+        ax_p.bar([k for k in slots if names[k] in compared],
+                 [max(peers[n]["max_relative_difference"], 1e-17) for n in names if n in compared],
+                 color="C0")
+        ax_p.set_xticks(slots, [TITLES.get(n, n) for n in names])
+        ax_p.set_xlim(-0.6, len(names) - 0.4)
+        for k, n in enumerate(names):
+            if n not in compared:
+                ax_p.text(k, 1e-12, note(n, peers[n]["status"]).replace(": ", ":\n", 1),
+                          ha="center", va="center", fontsize=7, rotation=90, color="0.3")
+    else:
+        note_in(ax_p, "\n".join(note(n, peers[n]["status"]) for n in names)
+                or "no peer to compare with")
     for ax in (ax_q, ax_f, ax_p):
         ax.grid(alpha=0.3)
     fig.suptitle(f"ARM7 from URDF: {title}")

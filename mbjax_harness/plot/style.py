@@ -1,10 +1,12 @@
 """Shared look of mbjax figures: one colour and marker per integrator, everywhere; and `Figure`,
-whose `savefig` first makes the figure readable (`tidy`): log-axis labels that never collide,
-curves that would hide one another drawn apart."""
+whose `savefig` first makes the figure readable (`tidy`): log-axis labels that never collide and
+never fewer than two, curves that would hide one another drawn apart. `lint` says what would
+still make a figure hard to read (the tests apply it to the tour's figures); `note_in` fills a
+panel that has nothing to draw with why."""
 
 import matplotlib.figure
 import numpy as np
-from matplotlib.ticker import LogLocator, NullFormatter
+from matplotlib.ticker import LogFormatterSciNotation, LogLocator, NullFormatter
 
 COLORS = {
     "explicit_euler": "#d62728",
@@ -55,16 +57,18 @@ def tidy(fig) -> None:
 
 
 def _log_ticks(ax, which: str) -> None:
-    """A log axis spanning less than ~1.5 decades labels its minor ticks by default, and those
-    labels run into each other: label 1, 2 and 5 times powers of ten instead, and widen the view
-    to two such ticks when it holds fewer."""
+    """A log axis holding fewer than two powers of ten labels one tick, or (under ~1.5 decades)
+    its minor ticks, whose labels run into each other: label 1, 2 and 5 times powers of ten
+    instead, and widen the view to two such ticks when it holds fewer."""
     if (ax.get_xscale() if which == "x" else ax.get_yscale()) != "log":
         return
     axis = ax.xaxis if which == "x" else ax.yaxis
     lo, hi = sorted(axis.get_view_interval())
-    if lo <= 0 or hi / lo >= 30:
-        return
+    if lo <= 0 or not np.isfinite(hi) or np.floor(np.log10(hi)) - np.ceil(np.log10(lo)) >= 1:
+        return                                       # two powers of ten or more: labelled
     axis.set_major_locator(LogLocator(subs=(1.0, 2.0, 5.0)))
+    # every major tick labelled (by default only powers of ten are past a decade's span)
+    axis.set_major_formatter(LogFormatterSciNotation(minor_thresholds=(np.inf, np.inf)))
     axis.set_minor_formatter(NullFormatter())
     grid = np.array([m * 10.0**e for e in range(int(np.floor(np.log10(lo))) - 1,
                                                  int(np.ceil(np.log10(hi))) + 2) for m in (1, 2, 5)])
@@ -118,3 +122,73 @@ def _coincide(a, b, span) -> bool:
         if not both.any() or np.mean(close) < 0.9:
             return False
     return True
+
+
+# --- what `lint` checks, and `note_in` --------------------------------------------------------
+
+def note_in(ax, text: str) -> None:
+    """Write `text` across the middle of an axes that has nothing to draw (a peer not installed:
+    "MuJoCo not installed: pip install mujoco") instead of leaving it blank; its ticks go."""
+    ax.set_xscale("linear")
+    ax.set_yscale("linear")
+    ax.set(xticks=[], yticks=[], ylabel="")
+    ax.text(0.5, 0.5, text, transform=ax.transAxes, ha="center", va="center", fontsize=8,
+            color="0.3", wrap=True)
+
+
+def _labelled_ticks(ax, which: str) -> int:
+    """How many tick labels (major and minor) with text show inside the view of ax's x or y axis;
+    ax's figure drawn."""
+    axis = ax.xaxis if which == "x" else ax.yaxis
+    lo, hi = sorted(axis.get_view_interval())
+    count = 0
+    for minor in (False, True):
+        locs = axis.get_minorticklocs() if minor else axis.get_majorticklocs()
+        labels = axis.get_ticklabels(minor=minor)
+        count += sum(1 for loc, text in zip(locs, labels, strict=False)
+                     if lo * (1 - 1e-9) <= loc <= hi * (1 + 1e-9) and text.get_visible()
+                     and text.get_text().strip())
+    return count
+
+
+def _curves(ax) -> list:
+    """The lines of ax that are data curves: three or more points, neither coordinate constant
+    (not an axhline, an axvline or a marker)."""
+    def varies(values) -> bool:
+        values = values[np.isfinite(values)]
+        return len(values) > 1 and values.min() < values.max()
+
+    curves = []
+    for line in ax.get_lines():
+        x, y = (np.asarray(v, dtype=float).ravel() for v in line.get_data())
+        if len(x) >= 3 and varies(x) and varies(y):
+            curves.append(line)
+    return curves
+
+
+def lint(fig) -> list[str]:
+    """What makes fig hard to read, one line each (empty: nothing): a log axis showing tick
+    labels but fewer than two; an axes with several labelled artists (lines, bars, markers) or
+    several data curves (`_curves`) and no legend, on the axes or the figure. Draws the figure."""
+    fig.draw_without_rendering()
+    problems = []
+    for k, ax in enumerate(fig.axes):
+        if not ax.get_visible() or not ax.axison:
+            continue
+        name = f"axes {k} ({ax.get_title() or ax.get_ylabel() or 'untitled'})"
+        for which in ("x", "y"):
+            if (ax.get_xscale() if which == "x" else ax.get_yscale()) != "log":
+                continue
+            axis = ax.xaxis if which == "x" else ax.yaxis
+            if not any(t.get_visible() for t in axis.get_ticklabels()):
+                continue                             # labels hidden on purpose (shared axis)
+            n = _labelled_ticks(ax, which)
+            if n < 2:
+                problems.append(f"{name}: log {which} axis with {n} labelled tick{'s' * (n != 1)}")
+        if ax.get_legend() is None and not fig.legends:
+            handles, _ = ax.get_legend_handles_labels()
+            if len(handles) > 1:
+                problems.append(f"{name}: {len(handles)} labelled artists and no legend")
+            elif len(_curves(ax)) > 1:
+                problems.append(f"{name}: {len(_curves(ax))} curves and no legend")
+    return problems

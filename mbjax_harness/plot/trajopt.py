@@ -40,8 +40,10 @@ def reach_figure(costs, ts, flange, target, us, title: str) -> Figure:
     ax_c.set(xlabel="iteration", ylabel="cost", title="iLQR: cost after each iteration")
     ax_d.semilogy(ts, np.maximum(np.linalg.norm(flange - target, axis=1), 1e-12))
     ax_d.set(xlabel="t [s]", ylabel="|flange - target| [m]", title="the reach")
-    ax_u.step(ts[:-1], us, where="post", lw=1)
+    for j in range(us.shape[1]):
+        ax_u.step(ts[:-1], us[:, j], where="post", lw=1, label=f"joint {j + 1}")
     ax_u.set(xlabel="t [s]", ylabel="joint torque [N m]", title="controls, held over each step")
+    ax_u.legend(fontsize=7, ncol=2)
     for ax in (ax_c, ax_d, ax_u):
         ax.grid(alpha=0.3)
     fig.suptitle(title, fontsize=10)

@@ -1,5 +1,6 @@
-"""`mbjax reproduce carpal-wrist`: Canfield 1997's time response, its stated purpose (trajectory
-synthesis), and the Newton-Euler check, on the scene `mbjax._src.scenes.carpal_wrist`.
+"""`mbjax reproduce carpal-wrist`: Canfield 1997's Carpal Wrist: time response, synthesis, Newton-Euler.
+The time response, its stated purpose (trajectory synthesis), and the Newton-Euler check, on the
+scene `mbjax._src.scenes.carpal_wrist`.
 
 1. Integrators (§6.4). The chapter's scheme (eq 6.45, explicit Euler) and the foundation's
    semi-implicit Euler, RK4 and implicit midpoint, at each step dt of STEPS:

@@ -1,5 +1,5 @@
-"""`mbjax reproduce closed-chain`: a chain with both ends fixed, its loop held by each stabilization and
-where unstabilized integration fails (Anderson 1993 §3.3, Fig. 8).
+"""`mbjax reproduce closed-chain`: a chain with both ends fixed under each stabilization. Its loop
+is held by each stabilization, and unstabilized integration fails (Anderson 1993 §3.3, Fig. 8).
 
 The (n/2)-body chain with both ends fixed (`mbjax._src.scenes.closed_chain`), simulated (RK4, 1 ms;
 1 s for n <= 44, 0.1 s above, the time then scaled to 1 s) by Anderson 1993's O(n + m^3) route (`Stabilized()`: the O(n) recursion, m + 1

@@ -1,5 +1,6 @@
-"""`mbjax reproduce flexible-slider-crank`: a slider-crank's flexible rod, its midpoint deflection
-against a nonlinear ANCF rod over three crank turns (Anderson 1993 §3.1, Figs. 4-5).
+"""`mbjax reproduce flexible-slider-crank`: a slider-crank's flexible rod against an ANCF rod.
+Its midpoint deflection against a nonlinear ANCF rod over three crank turns (Anderson 1993 §3.1,
+Figs. 4-5).
 
 The slider-crank with a flexible connecting rod (`mbjax._src.scenes.flexible_slider_crank`: 6 in rigid
 crank at 125.6 rad/s, 12 in steel rod of 0.25 in diameter, massless slider), the rod modelled by

@@ -1,6 +1,6 @@
-"""`mbjax reproduce gradient-matrix`: `jax.grad` and `jax.jacfwd` through `simulate` for every
-system, every integrator and every loop method, projection included, against central finite
-differences.
+"""`mbjax reproduce gradient-matrix`: `jax.grad` and `jax.jacfwd` through `simulate`, checked.
+For every system, every integrator and every loop method, projection included, against central
+finite differences.
 
 Each cell differentiates one scalar of a short rollout (a smooth function of the final q and u)
 with respect to three parameters at once: p[0] perturbs the initial state, p[1] scales a control

@@ -1,5 +1,5 @@
-"""`mbjax reproduce model-corpus`: every real robot model we can find, loaded by mbjax and compared
-with the engine that owns its format.
+"""`mbjax reproduce model-corpus`: every robot model we can find, against its format's engine.
+Each model is loaded by mbjax and compared with the engine that owns its format.
 
 URDF: every robot of `example-robot-data`, fixed and floating base, against Pinocchio
 (`mbjax_harness.reproduce.urdf_corpus`). MJCF: every model shipped by dm_control, gymnasium and
@@ -17,6 +17,9 @@ import re
 from pathlib import Path
 
 NAME = "model-corpus"
+# the peers compared with where installed, left out of the records where not: the
+# command's closing line names those missing (`mbjax_harness.cli._declared`)
+PEERS = ("pinocchio", "mujoco")
 QUICK_URDF = ("panda/panda", "romeo/romeo_small", "go1/go1")
 
 

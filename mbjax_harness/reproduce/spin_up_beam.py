@@ -1,5 +1,6 @@
-"""`mbjax reproduce spin-up-beam`: Kane's spin-up beam, the modal tip with and without geometric
-stiffening against a nonlinear ANCF beam (Anderson 1993 §3.2, eq 109).
+"""`mbjax reproduce spin-up-beam`: Kane's spin-up beam, stiffened or not, against an ANCF beam.
+The modal tip with and without geometric stiffening against a nonlinear ANCF beam (Anderson 1993
+§3.2, eq 109).
 
 The hub-clamped cantilever (L = 10 m, `mbjax._src.scenes.spin_up_beam`) spun up in its own plane, omega
 rising from 0 to 6 rad/s over 15 s and held; omega passes the first bending frequency (3.8 rad/s)

@@ -1,5 +1,6 @@
-"""`mbjax reproduce top-long-run`: where the primal form fails and the mixed form does not (Borri 1990
-§6-8), as long runs of the vertical top.
+"""`mbjax reproduce top-long-run`: long vertical-top runs: the primal form fails, the mixed does not.
+Where the primal form fails and the mixed form does not (Borri 1990 §6-8), as long runs of the
+vertical top.
 
 The top (`mbjax._src.scenes.vertical_top`) spins at Omega = 1.01 Omega_c: a sleeping top, physically
 stable, a slightly tilted one nutates with a bounded tilt. Two-node elements 0.5 s long lie

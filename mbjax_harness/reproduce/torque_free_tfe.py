@@ -1,5 +1,5 @@
-"""`mbjax reproduce torque-free-tfe`: time finite elements on the torque-free body against its closed
-form (Borri 1990 §8.1, Fig. 1 a-e).
+"""`mbjax reproduce torque-free-tfe`: time elements on the torque-free body against its closed form.
+As in Borri 1990 §8.1, Fig. 1 a-e.
 
 The torque-free symmetric body (`mbjax._src.scenes.torque_free_body`: J_t / J_a = 1.875, 15 rad/s
 about the symmetry axis and 10 rad/s about a transverse one, 6 s, about 100 rad of rotation)

@@ -1,5 +1,5 @@
-"""`mbjax reproduce vertical-top`: the time elements' stability on a vertical top at its critical speed
-(Borri 1990 Tables 1-2, the boundaries of eq 7.10).
+"""`mbjax reproduce vertical-top`: time elements' stability on a vertical top at its critical speed.
+As in Borri 1990 Tables 1-2, with the boundaries of eq 7.10.
 
 The vertical top (`mbjax._src.scenes.vertical_top`, omega = 5/3) spins at its critical speed; each
 element's transition matrix about that steady motion (eqs 6.8, 6.12, from jacfwd of the full

@@ -60,9 +60,11 @@ def test_list_gives_one_line_per_name_saying_what_it_does(command, capsys):
     assert main([command, "--list"]) == 0
     lines = capsys.readouterr().out.strip().splitlines()
     assert [line.split()[0] for line in lines] == sorted(names)
-    for line in lines:
+    for line in lines:            # a whole sentence on a line of 100 characters (`describe`)
         _, description = line.split(maxsplit=1)
-        assert 10 < len(description) <= 100 and not description.startswith("`mbjax")
+        assert 10 < len(description) and len(line) <= 100 and not description.startswith("`mbjax")
+        assert description.endswith(".") and not description.endswith("..."), line
+        assert description[0].isupper() or description[0] == "`", line
 
 
 def test_a_command_names_the_files_it_wrote_and_the_peers_it_skipped(tmp_path, capsys):
@@ -239,6 +241,9 @@ def _check_time_elements(scenes):
     assert 1e-3 < controls["runs"]["pushed"]["peak_flange_displacement_m"] < 0.1
     if peers.available("mujoco"):
         assert controls["runs"]["sampled"]["max_abs_diff_mujoco_rad"] < 1e-9
+        assert controls["peers"]["mujoco"]["status"] == "compared"
+    else:
+        assert controls["peers"]["mujoco"]["status"] == "unavailable: mujoco is not installed"
     for row in controls["gradients"].values():
         assert row["relative_difference"] < 1e-6
 
@@ -253,9 +258,12 @@ def _check_carpal_wrist(scenes):
     models = scenes["models"]
     assert "flange" in models["frames"] and models["status"] == "limit exceeded"
     assert 0 < models["first_limit_exceeded_s"] < 0.6
-    for peer in ("pinocchio", "mujoco"):
+    for peer in ("pinocchio", "mujoco"):        # or, where not installed, says so
+        record = models["peers"][peer]
         if peers.available(peer):
-            assert models["peers_max_relative_difference"][peer] < 1e-12
+            assert record["status"] == "compared" and record["max_relative_difference"] < 1e-12
+        else:
+            assert record["status"] == peers.missing(peer)
     # trajectory optimisation: iLQR brings the arm's flange to its target
     reach = scenes["trajectory-optimisation"]["runs"]["ilqr"]
     assert reach["status"] == "success" and reach["final_error_m"] < 1e-5
