@@ -1,6 +1,7 @@
 """Ready-made scenes: the papers' mechanisms and the examples the tests, benchmarks, notebooks and
 the `mbjax` command share. Each is a module with `build(...)` returning (system, q0, u0) and the
-scene's constants."""
+scene's constants; the two built for trajectory optimisation only, `acrobot` and `slewing_beam`,
+have `model()` and a `Problem` builder instead."""
 
 from mbjax._src.scenes import acrobot as acrobot
 from mbjax._src.scenes import andrews_squeezer as andrews_squeezer

@@ -49,7 +49,7 @@ class AbstractControl(eqx.Module):
 
         Returns:
             The law itself for a law of continuous time; for a sampled one (`ZeroOrderHold`,
-            `SampleAndHold`) a `Constant` holding its value at the step's start.
+                `SampleAndHold`) a `Constant` holding its value at the step's start.
         """
         return self
 
@@ -64,7 +64,7 @@ class Constant(AbstractControl):
     """tau = value, whatever the time and state (what a constant `tau` given as a control means).
 
     Args:
-        value: the generalized forces, shape (n_actuated,) (or a scalar); a differentiable
+        value (Array): the generalized forces, shape (n_actuated,) (or a scalar); a differentiable
             leaf.
     """
 
@@ -84,8 +84,8 @@ class Sum(AbstractControl):
     as the term does.
 
     Args:
-        terms: the controls to add, a sequence of `AbstractControl`s, callables
-            (t, q, v) -> tau or constant arrays.
+        terms (Sequence[AbstractControl | Callable | Array]): the controls to add, a sequence of
+            `AbstractControl`s, callables (t, q, v) -> tau or constant arrays.
     """
 
     terms: tuple
@@ -134,10 +134,10 @@ class Saturated(AbstractControl):
     parameters needs no constraint.
 
     Args:
-        control: the control to saturate (an `AbstractControl`, a callable (t, q, v) -> tau or
-            a constant array).
-        limit: the saturation level, in the control's units (N or N m): a scalar or one per
-            actuated coordinate, shape (n_actuated,); must be positive.
+        control (AbstractControl | Callable | Array): the control to saturate (an `AbstractControl`,
+            a callable (t, q, v) -> tau or a constant array).
+        limit (float | Array): the saturation level, in the control's units (N or N m): a scalar or
+            one per actuated coordinate, shape (n_actuated,); must be positive.
     """
 
     control: AbstractControl

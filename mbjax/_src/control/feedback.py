@@ -30,17 +30,19 @@ class PD(AbstractControl):
     not resolve.
 
     Args:
-        kp: stiffness, a scalar, shape (m,) or a matrix (m, m) [N m / rad or N / m].
-        kd: damping, a scalar, shape (m,) or a matrix (m, m) [N m s / rad or N s / m].
-        q_ref: target configuration of the servoed coordinates, a scalar or shape (m,).
-        v_ref: target velocity, a scalar or shape (m,); 0 by default.
-        feedforward: force added to the feedback (a gravity torque, say), a scalar or shape
-            (m,); 0 by default.
-        q_index: the configuration coordinates the servo acts on, m indices; None (default)
-            for all of them. They differ from v_index where a joint's configuration and
-            velocity coordinates do (after a floating base's 7 and 6).
-        v_index: the velocity coordinates the servo acts on, m indices; given together with
-            q_index.
+        kp (float | Array): stiffness, a scalar, shape (m,) or a matrix (m, m) [N m / rad or N / m].
+        kd (float | Array): damping, a scalar, shape (m,) or a matrix (m, m)
+            [N m s / rad or N s / m].
+        q_ref (float | Array): target configuration of the servoed coordinates, a scalar or shape
+            (m,).
+        v_ref (float | Array): target velocity, a scalar or shape (m,); 0 by default.
+        feedforward (float | Array): force added to the feedback (a gravity torque, say), a scalar
+            or shape (m,); 0 by default.
+        q_index (Sequence[int] | None): the configuration coordinates the servo acts on, m indices;
+            None (default) for all of them. They differ from v_index where a joint's configuration
+            and velocity coordinates do (after a floating base's 7 and 6).
+        v_index (Sequence[int] | None): the velocity coordinates the servo acts on, m indices; given
+            together with q_index.
 
     Raises:
         ValueError: only one of q_index and v_index is given, or they differ in length; when
@@ -111,14 +113,14 @@ class MLPPolicy(AbstractControl):
     Args:
         n_in: the network's inputs, nq + nv of the system (time is added by `time=True`).
         n_out: its outputs, the number of actuated coordinates.
-        key: a `jax.random` key for the hidden layers' initialization.
+        key (Array): a `jax.random` key for the hidden layers' initialization.
         width: hidden layer width.
         depth: number of hidden layers.
-        scale: factor on the network's output, in the control's units (N m).
-        limit: saturation level, limit tanh(tau / limit), a scalar or shape (n_out,); None
-            for none.
+        scale (float): factor on the network's output, in the control's units (N m).
+        limit (float | Array | None): saturation level, limit tanh(tau / limit), a scalar or shape
+            (n_out,); None for none.
         time: whether the network also takes t as its first input.
-        activation: the hidden layers' activation function.
+        activation (Callable): the hidden layers' activation function.
 
     Raises:
         ValueError: when called on a state whose size does not match n_in.

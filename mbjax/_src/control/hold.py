@@ -37,7 +37,7 @@ class ZeroOrderHold(AbstractControl):
     differentiable leaf.
 
     Args:
-        values: the samples, shape (K, m) (a 1-D history of K samples is taken as (K, 1)); a
+        values (Array): the samples, shape (K, m) (a 1-D history of K samples is taken as (K, 1)); a
             history of wrenches for `external=` is (K, n_bodies, 6).
         dt: the sample interval [s], positive (normally the simulation's step).
         t0: the time [s] of the first sample, values[0].
@@ -72,7 +72,7 @@ class ZeroOrderHold(AbstractControl):
 
         Returns:
             k, clipped to 0 ... K - 1 (int32); times within 1e-6 of a step of a sample time
-            count as on it.
+                count as on it.
         """
         k = jnp.floor((t - self.t0) / self.dt + _GRID_TOLERANCE)
         return jnp.clip(k, 0, self.values.shape[0] - 1).astype(jnp.int32)
@@ -91,8 +91,8 @@ class SampleAndHold(AbstractControl):
     the law itself.
 
     Args:
-        control: the law to sample (an `AbstractControl`, a callable (t, q, v) -> tau or a
-            constant array).
+        control (AbstractControl | Callable | Array): the law to sample (an `AbstractControl`, a
+            callable (t, q, v) -> tau or a constant array).
     """
 
     control: AbstractControl

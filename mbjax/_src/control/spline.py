@@ -38,11 +38,11 @@ class CubicSpline(AbstractControl):
     values it passes through (`fit` finds the knots of given samples). It ignores the state.
 
     Args:
-        knots: the control points, shape (n_knots, m), n_knots >= 4 (a 1-D array is taken as
+        knots (Array): the control points, shape (n_knots, m), n_knots >= 4 (a 1-D array is taken as
             (n_knots, 1)); a differentiable leaf.
         duration: the span of the spline [s], positive.
-        limit: saturation level, a scalar or shape (m,), in the control's units; None for
-            none.
+        limit (float | Array | None): saturation level, a scalar or shape (m,), in the control's
+            units; None for none.
         t0: the start of the span [s].
 
     Raises:

@@ -59,12 +59,12 @@ class AncfBeam(eqx.Module):
     (x, y, dx/ds, dy/ds). Material parameters are array leaves (differentiable).
 
     Args:
-        length: length [m].
-        EA: axial stiffness [N].
-        EI: bending stiffness [N m^2].
-        rhoA: mass per length [kg/m].
-        n_elements: number of equal elements, >= 1; static.
-        n_gauss: Gauss points per element, >= 3; static.
+        length (float): length [m].
+        EA (float): axial stiffness [N].
+        EI (float): bending stiffness [N m^2].
+        rhoA (float): mass per length [kg/m].
+        n_elements (int): number of equal elements, >= 1; static.
+        n_gauss (int): Gauss points per element, >= 3; static.
 
     Raises:
         ValueError: n_elements < 1 or n_gauss < 3.
@@ -303,10 +303,11 @@ def simulate_ancf(beam: AncfBeam, e0, e_dot0, ts, *, prescribed=(), e_p: Callabl
 
     Args:
         beam: the beam.
-        e0: initial coordinates, shape (n_coordinates,) (prescribed entries ignored).
-        e_dot0: initial rates, shape (n_coordinates,) (prescribed entries ignored).
-        ts: save times [s], concrete and increasing, shape (n_saves,); the run starts at ts[0].
-        prescribed: static global indices of the prescribed coordinates.
+        e0 (Array): initial coordinates, shape (n_coordinates,) (prescribed entries ignored).
+        e_dot0 (Array): initial rates, shape (n_coordinates,) (prescribed entries ignored).
+        ts (Array): save times [s], concrete and increasing, shape (n_saves,); the run starts at
+            ts[0].
+        prescribed (Sequence[int]): static global indices of the prescribed coordinates.
         e_p: a differentiable callable t -> the prescribed coordinates' values, shape
             (len(prescribed),) (positions only; velocities and accelerations by jax.jvp);
             required when `prescribed` is not empty.
@@ -317,7 +318,7 @@ def simulate_ancf(beam: AncfBeam, e0, e_dot0, ts, *, prescribed=(), e_p: Callabl
 
     Returns:
         An `AncfSolution`: ts, e and e_dot at the save times (shape (n_saves, n_coordinates)),
-        `status` (NONFINITE where the run blew up) and the step dt used.
+            `status` (NONFINITE where the run blew up) and the step dt used.
 
     Raises:
         ValueError: prescribed indices repeated or outside the beam, or prescribed coordinates

@@ -66,17 +66,20 @@ class Beam(eqx.Module):
     sections.
 
     Args:
-        L: length [m].
-        E: Young's modulus [Pa].
-        G: shear modulus [Pa].
-        rho: density [kg/m^3].
-        A: cross-section area [m^2].
-        Iy: second moment of area about the section's y axis [m^4] (bending in the xz plane).
-        Iz: second moment of area about the section's z axis [m^4] (bending in the xy plane).
-        J: torsion constant [m^4].
-        n_elements: number of equal elements, an integer >= 1; static.
-        timoshenko: shear-deformable (Timoshenko) elements instead of Euler-Bernoulli; static.
-        kappa: shear correction factor (used with `timoshenko`).
+        L (float): length [m].
+        E (float): Young's modulus [Pa].
+        G (float): shear modulus [Pa].
+        rho (float): density [kg/m^3].
+        A (float): cross-section area [m^2].
+        Iy (float): second moment of area about the section's y axis [m^4] (bending in the xz
+            plane).
+        Iz (float): second moment of area about the section's z axis [m^4] (bending in the xy
+            plane).
+        J (float): torsion constant [m^4].
+        n_elements (int): number of equal elements, an integer >= 1; static.
+        timoshenko (bool): shear-deformable (Timoshenko) elements instead of Euler-Bernoulli;
+            static.
+        kappa (float): shear correction factor (used with `timoshenko`).
 
     Raises:
         ValueError: a parameter that is not positive and finite, or a bad n_elements.

@@ -29,13 +29,13 @@ def beam_body(beam: Beam, basis: ModalBasis, nodes=(), *, clamped_node: int = 0,
     Args:
         beam: the beam.
         basis: its modal basis (e.g. `craig_bampton(beam, ...)`), clamped at `clamped_node`.
-        nodes: beam nodes where child bodies, cut joints and markers attach: index i of
-            `nodes` is attachment point i (what `FlexibleModel`'s `attach` and `markers`
-            refer to).
+        nodes (Sequence[int]): beam nodes where child bodies, cut joints and markers attach: index i
+            of `nodes` is attachment point i (what `FlexibleModel`'s `attach` and `markers` refer
+            to).
         clamped_node: the node at the body frame's origin, the joint grid J^k.
         stiffening: include geometric stiffening; False leaves it out (the prematurely
             linearized model).
-        damping: modal damping, shape (mu, mu); None: none.
+        damping (Array | None): modal damping, shape (mu, mu); None: none.
 
     Returns:
         The `ModalBody`.

@@ -85,16 +85,16 @@ def craig_bampton(beam: Beam, *, clamped_node=0, interface_nodes=(), n_modes=Non
 
     Args:
         beam: the beam.
-        clamped_node: the node held as the body frame's joint grid J^k.
-        interface_nodes: nodes whose dofs get constraint modes (where other bodies or cut
-            joints attach).
-        n_modes: number of fixed-interface normal modes (0 allowed); give exactly one of
-            n_modes and cutoff.
-        cutoff: keep the normal modes with angular frequency <= cutoff [rad/s]; needs concrete
-            beam parameters, so use `n_modes` under jit/grad.
-        static_load_nodes: nodes whose free dofs get static-correction modes.
-        planar: None, "xy" or "xz": restrict the dofs as in `free_dofs`.
-        orthonormalize: rotate the assembled basis so that M_r = I and K_r =
+        clamped_node (int): the node held as the body frame's joint grid J^k.
+        interface_nodes (Sequence[int]): nodes whose dofs get constraint modes (where other bodies
+            or cut joints attach).
+        n_modes (int | None): number of fixed-interface normal modes (0 allowed); give exactly one
+            of n_modes and cutoff.
+        cutoff (float | None): keep the normal modes with angular frequency <= cutoff [rad/s]; needs
+            concrete beam parameters, so use `n_modes` under jit/grad.
+        static_load_nodes (Sequence[int]): nodes whose free dofs get static-correction modes.
+        planar (str | None): None, "xy" or "xz": restrict the dofs as in `free_dofs`.
+        orthonormalize (bool): rotate the assembled basis so that M_r = I and K_r =
             diag(frequencies^2), ascending (kinds then all "reduced").
 
     Returns:

@@ -42,9 +42,9 @@ class FlexibleModel(eqx.Module):
             at least one mode).
         attach: {child body: attachment-point index of its flexible parent's ModalBody} for
             every child of a flexible body.
-        markers: extra frames for cut joints and loads, ((body, point), ...): frame index
-            n + i is marker i, at attachment point `point` of flexible body `body`, or at the
-            body's own frame with point -1.
+        markers (Sequence[tuple[int, int]]): extra frames for cut joints and loads, ((body, point),
+            ...): frame index n + i is marker i, at attachment point `point` of flexible body
+            `body`, or at the body's own frame with point -1.
 
     Raises:
         TypeError: `model` not a `mbjax.Model`, or a flexible entry not a `ModalBody`.

@@ -29,28 +29,23 @@ class FlexibleSystem(AbstractTreeSystem):
     dynamics under gravity, elasticity, the control and the external wrenches.
 
     The state is (q, v) = (joint and modal coordinates, their rates), shapes (nq,) and (nv,).
-    The control drives joint and modal coordinates alike (`actuation` picks some). A load at a
-    marker on a grid point bends the body and stiffens it (Anderson 1993 eq 33,
-    `mbjax._src.flex.kinematics.grid_point`), as a cut joint's constraint load there does.
-
-    Geometric stiffening adds acceleration-dependent loads, so the equations are not
-    M v_dot + bias = 0 with a symmetric M (`symmetric_dynamics` is False): closed loops go
-    through `mbjax.loops.Stabilized`, on either route.
+    The control drives joint and modal coordinates alike (`actuation` picks some).
 
     Args:
         model: the flexible tree, a `FlexibleModel`.
-        control: a callable (t, q, v) -> generalized forces on the actuated coordinates (joint
-            forces, then modal forces), an `mbjax.control` module, a constant array, or None.
-        external: a callable (t, q, v) -> world-frame wrenches (torque [N m]; force [N]): one
-            per body, shape (n, 6), acting on the body's reference frame (the joint grid where
-            its modes are clamped, or `external_point`, a point fixed in that frame), as in
-            `mbjax.rigid.TreeSystem`; or one per frame, shape (n + markers, 6), the rows past n
+        control (Callable | Array | None): a callable (t, q, v) -> generalized forces on the
+            actuated coordinates (joint forces, then modal forces), an `mbjax.control` module, a
+            constant array, or None.
+        external (Callable | None): a callable (t, q, v) -> world-frame wrenches (torque [N m];
+            force [N]): one per body, shape (n, 6), acting on the body's reference frame (the joint
+            grid where its modes are clamped, or `external_point`, a point fixed in that frame), as
+            in `mbjax.rigid.TreeSystem`; or one per frame, shape (n + markers, 6), the rows past n
             acting at the model's markers (torque about the marker's origin, the force applied
             there); or None.
-        external_point: body-frame points where the bodies' external forces act [m], shape
-            (n, 3) or (3,); None: the bodies' frame origins.
-        actuation: the indices of the velocity coordinates the control drives (or a boolean
-            mask of length nv), or an (nv, nu) actuation matrix S of rank nu (generalized
+        external_point (Array | None): body-frame points where the bodies' external forces act [m],
+            shape (n, 3) or (3,); None: the bodies' frame origins.
+        actuation (Array | None): the indices of the velocity coordinates the control drives (or a
+            boolean mask of length nv), or an (nv, nu) actuation matrix S of rank nu (generalized
             force S u: thrusters, tendons); None: all of them. Stored as the matrix.
         method: `mbjax.Recursive()` (Anderson 1993's O(n) recursion), `mbjax.Dense()` (the
             Lagrangian, O(n^3); joints whose q is their own rate only) or `mbjax.Auto()` (the
@@ -59,6 +54,14 @@ class FlexibleSystem(AbstractTreeSystem):
     Raises:
         TypeError: `model` is not a `FlexibleModel`, or `method` is not a strategy instance.
         ValueError: malformed control, external, external_point or actuation.
+
+    Loads and stiffening:
+        A load at a marker on a grid point bends the body and stiffens it (Anderson 1993 eq 33,
+        `mbjax._src.flex.kinematics.grid_point`), as a cut joint's constraint load there does.
+
+        Geometric stiffening adds acceleration-dependent loads, so the equations are not
+        M v_dot + bias = 0 with a symmetric M (`symmetric_dynamics` is False): closed loops go
+        through `mbjax.loops.Stabilized`, on either route.
     """
 
     model: FlexibleModel
@@ -87,7 +90,7 @@ class FlexibleSystem(AbstractTreeSystem):
 
         Returns:
             (R, p): rotations, shape (n + markers, 3, 3), and origins [m], shape
-            (n + markers, 3).
+                (n + markers, 3).
         """
         R, p, R_markers, p_markers = body_and_marker_poses(self.model, q)
         return jnp.concatenate([R, R_markers]), jnp.concatenate([p, p_markers])

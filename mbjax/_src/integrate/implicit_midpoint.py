@@ -11,33 +11,36 @@ class ImplicitMidpoint(AbstractIntegrator):
     """The implicit midpoint rule y1 = y0 + dt f(t0 + dt/2, (y0 + y1)/2) for y = (q, u).
 
     Order 2, A-stable and symplectic; it conserves every quadratic invariant exactly (the norm
-    of a quaternion, the kinetic energy and angular momentum of a free rigid body).
-
-    The nonlinear equations are solved by a fixed number of Newton iterations (a `lax.scan`,
-    so reverse-mode differentiation passes through them). The step reports convergence when the
-    last Newton correction is below `rtol` (1 + |y1|).
-
-    - `simplified=False` (default): full Newton, the Jacobian at every iterate, started from an
-      explicit Euler predictor; with quadratic convergence the error left is of order rtol^2.
-    - `simplified=True`: simplified Newton, for stiff systems with few coordinates and dear
-      dynamics (modal flexible bodies: the axial and high modes that bound an explicit step):
-      the Jacobian of the dynamics once per step, at its start, by forward differences (the
-      dynamics at y0 and its m perturbations, m = len(q) + len(u)), and each iteration one
-      evaluation of the dynamics and a dense solve of size m. All m + 1 + newton_iterations
-      evaluations run as one scan, so the dynamics compile once: differences rather than
-      `jax.linearize`, whose tangent program compiles much more slowly than the dynamics (see
-      benchmarks/README.md), and simplified Newton needs no exact Jacobian. The first
-      iteration is the linearly implicit midpoint step, exact for the linear (elastic) part at
-      any step, so the stiff modes stay bounded however far dt is past their period; the later
-      ones converge linearly at a rate of order dt times the change of the Jacobian over the
-      step.
+    of a quaternion, the kinetic energy and angular momentum of a free rigid body). The
+    nonlinear equations are solved by a fixed number of Newton iterations, full or simplified.
 
     Args:
         newton_iterations: the number of Newton iterations per step (static).
         rtol: the convergence test's relative tolerance on the last Newton correction; None
             (default) for sqrt(eps) of the state's dtype.
         simplified: simplified Newton with a forward-difference Jacobian per step (see
-            above) instead of full Newton.
+            Newton iterations, below) instead of full Newton.
+
+    Newton iterations:
+        The nonlinear equations are solved by a fixed number of Newton iterations (a
+        `lax.scan`, so reverse-mode differentiation passes through them). The step reports
+        convergence when the last Newton correction is below `rtol` (1 + |y1|).
+
+        - `simplified=False` (default): full Newton, the Jacobian at every iterate, started from
+          an explicit Euler predictor; with quadratic convergence the error left is of order
+          rtol^2.
+        - `simplified=True`: simplified Newton, for stiff systems with few coordinates and dear
+          dynamics (modal flexible bodies: the axial and high modes that bound an explicit
+          step): the Jacobian of the dynamics once per step, at its start, by forward
+          differences (the dynamics at y0 and its m perturbations, m = len(q) + len(u)), and
+          each iteration one evaluation of the dynamics and a dense solve of size m. All
+          m + 1 + newton_iterations evaluations run as one scan, so the dynamics compile once:
+          differences rather than `jax.linearize`, whose tangent program compiles much more
+          slowly than the dynamics (see benchmarks/README.md), and simplified Newton needs no
+          exact Jacobian. The first iteration is the linearly implicit midpoint step, exact for
+          the linear (elastic) part at any step, so the stiff modes stay bounded however far dt
+          is past their period; the later ones converge linearly at a rate of order dt times the
+          change of the Jacobian over the step.
     """
 
     newton_iterations: int = eqx.field(default=6, static=True)

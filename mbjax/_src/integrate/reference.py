@@ -23,33 +23,36 @@ def solve_reference(system: AbstractSystem, q0: Array, u0: Array, ts, *, rtol: f
     projected (e.g. quaternions normalized) at the save times only, so the solver sees a
     smooth vector field.
 
-    Each interval between save times is one `diffeqsolve` (in a `lax.scan`), from the state the
-    previous one reached: saving at given times inside one solve holds run-time checks of those
-    times (host callbacks), which keep the compiled program out of the persistent compilation
-    cache; here `ts` is checked once, in NumPy.
-
-    Use it for references, not for rotation vectors through |r| = 2 pi: there the coordinate
-    rate Gamma^-1 is singular and only fixed-step drivers, which rescale after each step, pass.
-
     Args:
         system: the system to integrate, an `AbstractSystem`.
         q0: initial configuration, shape (nq,).
         u0: initial velocity coordinates, shape (nv,).
-        ts: save times [s], shape (T,), T >= 2, increasing; ts[0] is the initial time.
+        ts (Array): save times [s], shape (T,), T >= 2, increasing; ts[0] is the initial time.
         rtol: the step-size controller's relative tolerance.
         atol: its absolute tolerance, in the state's units.
-        solver: a diffrax solver; None for `diffrax.Dopri8()`.
+        solver (diffrax.AbstractSolver | None): a diffrax solver; None for `diffrax.Dopri8()`.
         max_steps: the most steps of each interval between save times.
         throw: raise an error naming the failure instead of returning its status (as
             `simulate`).
 
     Returns:
         A `Solution` with ts, qs (T, nq), us (T, nv) and the status SOLVER_FAILED where an
-        interval's solve failed (too many steps, say).
+            interval's solve failed (too many steps, say).
 
     Raises:
         ValueError: ts (when concrete) is not at least two increasing times.
         equinox.EquinoxRuntimeError: with throw=True, the solve failed.
+
+    Intervals:
+        Each interval between save times is one `diffeqsolve` (in a `lax.scan`), from the state
+        the previous one reached: saving at given times inside one solve holds run-time checks of
+        those times (host callbacks), which keep the compiled program out of the persistent
+        compilation cache; here `ts` is checked once, in NumPy.
+
+    Warning:
+        Use it for references, not for rotation vectors through |r| = 2 pi: there the coordinate
+        rate Gamma^-1 is singular and only fixed-step drivers, which rescale after each step,
+        pass.
     """
     if not isinstance(ts, jax.core.Tracer):
         times = np.asarray(ts, dtype=float)

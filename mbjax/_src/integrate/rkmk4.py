@@ -1,11 +1,4 @@
-"""Runge-Kutta-Munthe-Kaas of order 4: RK4 in a chart that moves with the solution.
-
-Each step integrates the local coordinate xi about the configuration q0 at the start of the step,
-xi_dot = local_rate(q0, xi, u) = dexp^-1_xi(velocity), from xi = 0, and maps back with
-q1 = retract(q0, xi1). For rotations dexp^-1 is Gamma^-T (Borri 1990 eqs 2.8, A.21), so this is
-RK4 on the incremental rotation vector of Borri 1990 §2: the configuration stays exactly on the
-rotation group and the chart never approaches the singularity of Gamma at |xi| = 2 pi.
-"""
+"""Runge-Kutta-Munthe-Kaas of order 4 (`RKMK4`, whose docstring describes the step)."""
 
 import jax.numpy as jnp
 
@@ -16,8 +9,16 @@ class RKMK4(AbstractIntegrator):
     """Runge-Kutta-Munthe-Kaas of order 4: RK4 in a chart that moves with the solution (Munthe-Kaas 1999).
 
     Each step integrates the local coordinate xi about the step's start configuration and
-    retracts (see the module): rotations stay exactly on the rotation group. Order 4; on
+    retracts (see The method, below): rotations stay exactly on the rotation group. Order 4; on
     Euclidean systems it is RK4. Takes no arguments.
+
+    The method:
+        Each step integrates the local coordinate xi about the configuration q0 at the start of the
+        step, xi_dot = local_rate(q0, xi, u) = dexp^-1_xi(velocity), from xi = 0, and maps back with
+        q1 = retract(q0, xi1). For rotations dexp^-1 is Gamma^-T (Borri 1990 eqs 2.8, A.21), so this
+        is RK4 on the incremental rotation vector of Borri 1990 §2: the configuration stays exactly
+        on the rotation group and the chart never approaches the singularity of Gamma at |xi| = 2
+        pi.
     """
 
     order = 4

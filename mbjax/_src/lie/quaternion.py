@@ -169,7 +169,7 @@ def quat_from_matrix(R: Array) -> Array:
 
     Returns:
         A unit quaternion (w, x, y, z) of R, shape (4,); its sign is that of the formula
-        chosen (q and -q are the same rotation).
+            chosen (q and -q are the same rotation).
 
     Raises:
         ValueError: R does not have shape (3, 3).

@@ -1,12 +1,5 @@
-"""The constraints of a closed mechanism at position, velocity and acceleration level (Anderson 1993
-eqs 87-88, Jerkovsky 1978 eq 85), all by autodiff of the holonomic residual Phi(q, t):
-
-    Phi(q, t) = 0,    A(q, t) v + B(q, t) = 0,    A(q, t) v_dot + b(q, v, t) = 0,
-
-with A = dPhi/dq . dq/dv (the velocity constraint operator, (m, nv)), B = dPhi/dt and
-b = d/dt (A v + B) at fixed v, the "A_dot u + B_dot" of Anderson 1993 eq 92. Derivatives follow q along
-q_dot = tree.q_dot(q, v), so quaternion joints need no special case.
-"""
+"""The constraints of a closed mechanism at position, velocity and acceleration level (`Loops`,
+whose docstring gives them)."""
 
 import equinox as eqx
 import jax
@@ -19,17 +12,29 @@ from mbjax._src.model.closures import GROUND, Coupling, CutJoint, Prescribed
 
 class Loops(eqx.Module):
     """A tree closed by cut joints and couplings and driven by prescribed motions: the
-    constraints Phi(q, t) = 0 at position, velocity and acceleration level (see the module
-    docstring). `ClosedSystem` holds one; the loop algorithms are functions of it.
+    constraints Phi(q, t) = 0 at position, velocity and acceleration level (see The constraints,
+    below). `ClosedSystem` holds one; the loop algorithms are functions of it.
 
     Args:
         tree: any `AbstractTreeSystem`: rigid, or flexible with markers as frames n, n + 1, ...
-        closures: `CutJoint`s, `Coupling`s and `Prescribed` motions, at least one.
+        closures (Sequence): `CutJoint`s, `Coupling`s and `Prescribed` motions, at least one.
 
     Raises:
         TypeError: `tree` is not a tree system, or a closure of another type.
         ValueError: no closures, or one that names a body or coordinate the tree lacks (a
             `Prescribed` motion also needs nq == nv).
+
+    The constraints:
+        The constraints of a closed mechanism at position, velocity and acceleration level (Anderson
+        1993 eqs 87-88, Jerkovsky 1978 eq 85), all by autodiff of the holonomic residual Phi(q, t):
+
+        ```text
+        Phi(q, t) = 0,    A(q, t) v + B(q, t) = 0,    A(q, t) v_dot + b(q, v, t) = 0,
+        ```
+
+        with A = dPhi/dq . dq/dv (the velocity constraint operator, (m, nv)), B = dPhi/dt and b =
+        d/dt (A v + B) at fixed v, the "A_dot u + B_dot" of Anderson 1993 eq 92. Derivatives follow
+        q along q_dot = tree.q_dot(q, v), so quaternion joints need no special case.
     """
 
     tree: AbstractTreeSystem

@@ -1,14 +1,5 @@
-"""Coupled free and constrained motion by Lagrange multipliers (Jerkovsky 1978 §VI, eqs 85-93, the
-velocity form), with optional Baumgarte stabilization.
-
-With nu = mu^-1 the inverse mass matrix, the unconstrained acceleration a_free = nu (K^a - Y)
-(= -nu bias, the tree's applied forces included) and the constraint rows A v_dot + b = 0
-(`mbjax._src.loops.constraints`), eqs 89-92 give the multipliers K_c from
-(A nu A^t) K_c = -(A a_free + b) and eq 93 the motion v_dot = a_free + nu A^t K_c. Baumgarte's
-stabilization adds 2 alpha (A v + B) + beta^2 Phi to b, so the constraint errors obey
-e_ddot + 2 alpha e_dot + beta^2 e = 0 instead of drifting. The mass matrix is dense here
-(O(n^3)); `mbjax._src.loops.stabilized` is Anderson 1993's O(n + m^3) route.
-"""
+"""Coupled free and constrained motion by Lagrange multipliers (`Coupled`, whose docstring gives
+the equations)."""
 
 import math
 import equinox as eqx
@@ -48,15 +39,28 @@ def _gains(gains) -> tuple:
 
 class Coupled(AbstractLoopMethod):
     """u = v; v_dot from the coupled Lagrange-multiplier equations (Jerkovsky 1978 eqs 89-93),
-    with optional Baumgarte stabilization (see the module docstring). Dense, O(n^3); needs a
+    with optional Baumgarte stabilization (see The method, below). Dense, O(n^3); needs a
     tree with a symmetric mass matrix (rigid trees).
 
     Args:
-        baumgarte: the gains (alpha [1/s], beta [1/s]), both >= 0: the constraint errors obey
-            e_ddot + 2 alpha e_dot + beta^2 e = 0; (0, 0), the default, for none. Static.
+        baumgarte (tuple[float, float]): the gains (alpha [1/s], beta [1/s]), both >= 0: the
+            constraint errors obey e_ddot + 2 alpha e_dot + beta^2 e = 0; (0, 0), the default, for
+            none. Static.
 
     Raises:
         ValueError: not two non-negative gains.
+
+    The method:
+        Coupled free and constrained motion by Lagrange multipliers (Jerkovsky 1978 §VI, eqs 85-93,
+        the velocity form), with optional Baumgarte stabilization.
+
+        With nu = mu^-1 the inverse mass matrix, the unconstrained acceleration a_free = nu (K^a -
+        Y) (= -nu bias, the tree's applied forces included) and the constraint rows A v_dot + b = 0
+        (`mbjax._src.loops.constraints`), eqs 89-92 give the multipliers K_c from (A nu A^t) K_c =
+        -(A a_free + b) and eq 93 the motion v_dot = a_free + nu A^t K_c. Baumgarte's stabilization
+        adds 2 alpha (A v + B) + beta^2 Phi to b, so the constraint errors obey e_ddot + 2 alpha
+        e_dot + beta^2 e = 0 instead of drifting. The mass matrix is dense here (O(n^3));
+        `mbjax._src.loops.stabilized` is Anderson 1993's O(n + m^3) route.
     """
 
     baumgarte: tuple = eqx.field(static=True, default=(0.0, 0.0), converter=_gains)

@@ -1,10 +1,5 @@
-"""Jerkovsky 1978's momentum formulation of a closed mechanism (eqs 95-98).
-
-The state is the generalized momentum G = mu v: G_dot = K^a - X + A^t K_c (eq 87), with
-X = Y - mu_dot v (eq 99), so K^a - X = -bias + mu_dot v, and the multipliers of eq 98,
-(A nu A^t) K_c = -(A nu (K^a - X) + b + A nu_dot G), nu_dot G = -nu mu_dot v; eq 99 makes them
-equal to eq 92's (`mbjax._src.loops.coupled`), which the tests check.
-"""
+"""Jerkovsky 1978's momentum formulation of a closed mechanism (`Momentum`, whose docstring gives
+the equations)."""
 
 import jax
 from jax import Array
@@ -35,6 +30,14 @@ class Momentum(AbstractLoopMethod):
     Jerkovsky 1978 eq 98. Needs a tree with a symmetric mass matrix (rigid trees).
 
     Takes no arguments: `method=Momentum()`.
+
+    The method:
+        Jerkovsky 1978's momentum formulation of a closed mechanism (eqs 95-98).
+
+        The state is the generalized momentum G = mu v: G_dot = K^a - X + A^t K_c (eq 87), with X =
+        Y - mu_dot v (eq 99), so K^a - X = -bias + mu_dot v, and the multipliers of eq 98, (A nu
+        A^t) K_c = -(A nu (K^a - X) + b + A nu_dot G), nu_dot G = -nu mu_dot v; eq 99 makes them
+        equal to eq 92's (`mbjax._src.loops.coupled`), which the tests check.
     """
 
     def validate(self, tree):

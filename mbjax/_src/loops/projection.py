@@ -44,12 +44,12 @@ def project_configuration(loops: Loops, q: Array, t=0.0, *,
     Args:
         loops: the tree and its closures (`ClosedSystem.loops`).
         q: configuration, shape (nq,).
-        t: time [s], a scalar.
+        t (float): time [s], a scalar.
         iterations: number of chord iterations; static.
 
     Returns:
         (q on the constraints, shape (nq,), with its quaternions normalized; |Phi| there, a
-        scalar).
+            scalar).
     """
     tree = loops.tree
     A = loops.jacobian(q, t)
@@ -127,10 +127,10 @@ def consistent_state(system, q, v, t=0.0, *, project: bool = True, tol: float = 
     `ClosedSystem.initial_state(q, v)`.
 
     Args:
-        system: a `ClosedSystem` or `Loops`.
-        q: configuration, shape (nq,).
-        v: joint velocities, shape (nv,).
-        t: time [s], a scalar.
+        system (ClosedSystem | Loops): a `ClosedSystem` or `Loops`.
+        q (Array): configuration, shape (nq,).
+        v (Array): joint velocities, shape (nv,).
+        t (float): time [s], a scalar.
         project: True: project q onto Phi = 0 (`iterations` full Gauss-Newton steps, then the
             chord projection) and v onto A v + B = 0 (the kinetic-energy-optimal correction);
             False: only check that (q, v) meet the constraints.

@@ -52,26 +52,25 @@ def _with_forces(tree: AbstractTreeSystem, control, external, external_point) ->
 class ClosedSystem(AbstractSystem):
     """A tree closed by `closures`, solved by a loop method, as a system for `mbjax.simulate`.
 
-    The configuration is the tree's q, shape (nq,). The velocity state u is the method's: the
-    joint velocities v (`Coupled`, `Stabilized()`), the momenta M v (`Momentum`), or v and the
-    loads (`Stabilized(epsilon > 0)`, shape (nv + m,)); make it with `initial_state(q, v)` and
-    read v back with `velocity(q, u)`. Put initial conditions on the constraints first with
-    `consistent_state`.
+    Its state is the tree's configuration q and the method's velocity state u (see The state,
+    below): make u with `initial_state(q, v)` after putting the initial conditions on the
+    constraints with `consistent_state`.
 
     Args:
         tree: the open tree (`mbjax.rigid.TreeSystem`, `mbjax.flex.FlexibleSystem`); it
             carries the applied forces.
-        closures: `CutJoint`s, `Coupling`s and `Prescribed` motions (at least one), e.g. a
-            loaded model's `model.closures`.
+        closures (Sequence): `CutJoint`s, `Coupling`s and `Prescribed` motions (at least one), e.g.
+            a loaded model's `model.closures`.
         method: an `AbstractLoopMethod` instance; None: `Coupled()` for trees with a symmetric
             mass matrix, `Stabilized()` otherwise.
         projection: after every step, project (q, v) onto Phi = 0 and A v + B = 0
             (differentiably; `mbjax._src.loops.projection`); static.
         tolerance: the residual |Phi| past which `check` reports
             `Status.CONSTRAINT_VIOLATED`; static.
-        control: the tree's control, if not given to the tree (as in `TreeSystem`).
-        external: the tree's external wrenches, if not given to the tree.
-        external_point: where the external forces act, if not given to the tree.
+        control (Callable | Array | None): the tree's control, if not given to the tree (as in
+            `TreeSystem`).
+        external (Callable | None): the tree's external wrenches, if not given to the tree.
+        external_point (Array | None): where the external forces act, if not given to the tree.
         iterations: chord iterations of each projection; static.
 
     Raises:
@@ -81,6 +80,13 @@ class ClosedSystem(AbstractSystem):
         ValueError: no closures, a closure that names a body or coordinate the tree lacks,
             a control or external load given both here and to the tree, tolerance <= 0 or
             iterations < 1.
+
+    The state:
+        The configuration is the tree's q, shape (nq,). The velocity state u is the method's:
+        the joint velocities v (`Coupled`, `Stabilized()`), the momenta M v (`Momentum`), or v
+        and the loads (`Stabilized(epsilon > 0)`, shape (nv + m,)); make it with
+        `initial_state(q, v)` and read v back with `velocity(q, u)`. Put initial conditions on
+        the constraints first with `consistent_state`.
     """
 
     loops: Loops
@@ -149,7 +155,7 @@ class ClosedSystem(AbstractSystem):
 
         Returns:
             u: v (`Coupled`, `Stabilized()`), M(q) v (`Momentum`), or (v, f_c), shape
-            (nv + m,) (`Stabilized(epsilon > 0)`).
+                (nv + m,) (`Stabilized(epsilon > 0)`).
         """
         q, v = jnp.asarray(q, float), jnp.asarray(v, float)
         self.loops.checked(q, v)
@@ -164,8 +170,8 @@ class ClosedSystem(AbstractSystem):
             u: the method's velocity state.
 
         Returns:
-            Shape (m,): `Coupled`, `Momentum`: the multipliers K_c, A^t K_c the generalized
-            constraint force; `Stabilized`: f_c = -K_c.
+            The loads, shape (m,). `Coupled`, `Momentum`: the multipliers K_c, A^t K_c the
+                generalized constraint force; `Stabilized`: f_c = -K_c.
         """
         return self.method.loads(self.loops, t, q, u)
 

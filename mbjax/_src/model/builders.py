@@ -35,11 +35,12 @@ def chain(n: int, *, joint_types="revolute", length: float = 0.3, mass: float = 
 
     Args:
         n: the number of links, at least 1.
-        joint_types: the joints' type, one string for all (default "revolute") or n of them.
+        joint_types (str | Sequence[str]): the joints' type, one string for all (default "revolute")
+            or n of them.
         length: link length [m] (with a seed, the scale of the random offsets).
         mass: each link's mass [kg] (regular chain only; random in [0.5, 2] with a seed).
         seed: None for the regular chain, or the random generator's seed.
-        gravity: the acceleration of gravity, shape (3,) [m/s^2].
+        gravity (Array): the acceleration of gravity, shape (3,) [m/s^2].
 
     Returns:
         The `Model` of the chain, body k hanging from body k - 1.
@@ -72,10 +73,10 @@ def random_tree(n: int, *, seed: int = 0, joint_types=("revolute", "prismatic"),
     Args:
         n: the number of bodies.
         seed: the random generator's seed.
-        joint_types: the joint types to draw from, or one string for all.
+        joint_types (str | Sequence[str]): the joint types to draw from, or one string for all.
         max_back: how far back a body's parent may be.
         length: the scale of the placements and centres of mass [m].
-        gravity: the acceleration of gravity, shape (3,) [m/s^2].
+        gravity (Array): the acceleration of gravity, shape (3,) [m/s^2].
 
     Returns:
         The random `Model`.

@@ -56,10 +56,12 @@ class CutJoint(eqx.Module):
             "point_on_plane"; static.
         body_a: the body (frame index) of frame A, >= 0; static.
         body_b: the body of frame B, or `GROUND` (-1); static.
-        origin_a: origin of frame A in body_a's frame [m], shape (3,).
-        origin_b: origin of frame B in body_b's frame (or the world) [m], shape (3,).
-        rotation_a: rotation of frame A in body_a's frame, shape (3, 3); None: the identity.
-        rotation_b: rotation of frame B in body_b's frame, shape (3, 3); None: the identity.
+        origin_a (Array): origin of frame A in body_a's frame [m], shape (3,).
+        origin_b (Array): origin of frame B in body_b's frame (or the world) [m], shape (3,).
+        rotation_a (Array | None): rotation of frame A in body_a's frame, shape (3, 3); None: the
+            identity.
+        rotation_b (Array | None): rotation of frame B in body_b's frame, shape (3, 3); None: the
+            identity.
 
     Raises:
         ValueError: an unknown kind, the same body twice, the ground as body_a, an origin not
@@ -144,8 +146,8 @@ class Prescribed(eqx.Module):
 
     Args:
         dof: the coordinate's index (in q, which must equal v's layout: nq == nv); static.
-        q0: its value at t = 0 [rad or m].
-        rate: its constant rate [rad/s or m/s].
+        q0 (float): its value at t = 0 [rad or m].
+        rate (float): its constant rate [rad/s or m/s].
         motion: a differentiable callable t -> the coordinate's value, replacing q0 + rate t;
             its velocity and acceleration terms come from autodiff in t.
 
@@ -188,8 +190,8 @@ class Coupling(eqx.Module):
     Args:
         coordinate: the index a of the coupled coordinate in q; static.
         reference: the index b of the coordinate it follows in q; static.
-        multiplier: the factor on q_b.
-        offset: the offset [rad or m].
+        multiplier (float): the factor on q_b.
+        offset (float): the offset [rad or m].
 
     Raises:
         ValueError: negative or non-int indices, or a coordinate coupled to itself.

@@ -1,30 +1,4 @@
-"""`load_urdf`: a `Model` from a URDF file or string.
-
-Links with <inertial> become bodies; revolute and continuous joints become revolute joints,
-prismatic joints prismatic ones and floating joints free joints; a fixed joint merges its child
-link (mass, centre of mass and inertia, and the placements of the joints beyond it) into the
-parent body, and keeps the link and the joint as named frames (`mbjax.rigid.frame_pose`). The root link
-is welded to the ground unless `floating_base=True` adds a free joint. Bodies are numbered
-depth-first from the root, as Pinocchio numbers its joints, so q and v line up with Pinocchio's.
-Pinocchio (through urdfdom, which keeps joints in a name-sorted map) visits the children of a link
-in order of joint name; that is the default here. `sibling_order="document"` visits them in
-document order instead, as MuJoCo's URDF import does.
-
-Masses and inertias are checked on the bodies after the merge, as MuJoCo checks them, so a dummy
-root, sensor and contact frames welded by fixed joints load whatever their data. Implausible but
-computable data (CAD inertias that break the triangle inequality, round-off negatives, a massless
-leaf on a moving joint) loads with a `ModelWarning` naming the link and the fix (`strict=True`:
-an error; `mbjax._src.model.checks`); non-finite or unparsable numbers are errors.
-
-Joint data: <limit> gives position (revolute, prismatic), effort and velocity limits (a revolute
-or prismatic joint without <limit>, which the specification requires, loads without position
-limits, as MuJoCo reads it, with a warning), <dynamics> damping (used by the dynamics) and
-friction (kept as data); `armature=` adds rotor inertia to every joint (URDF has no field for
-it). <mimic> joints load as independent joints, as Pinocchio
-and MuJoCo load them, with a warning; their couplings are the model's `closures`
-(`mbjax.loops.Coupling`s), which `mbjax.loops.ClosedSystem(TreeSystem(model), model.closures)`
-enforces.
-"""
+"""`load_urdf`: a `Model` from a URDF file or string (its docstring gives the mapping)."""
 
 import os
 import xml.etree.ElementTree as ET
@@ -142,19 +116,21 @@ def _armature(armature, nv: int) -> np.ndarray:
 def load_urdf(source: str | bytes | os.PathLike, *, floating_base: bool = False,
               gravity=(0.0, 0.0, -9.81), sibling_order: str = "name", armature=0.0,
               min_mass: float = 0.0, min_inertia: float = 0.0, strict: bool = False) -> Model:
-    """A `Model` from a URDF file or XML string (see the module docstring for the mapping).
+    """A `Model` from a URDF file or XML string.
 
-    The mimic joints' couplings are the model's `closures` (`mbjax.loops.Coupling`s), empty
-    without mimic joints.
+    Links with an `<inertial>` become bodies, numbered depth-first from the root as Pinocchio
+    numbers its joints, so q and v line up with Pinocchio's; fixed joints merge their child links
+    into their parents. The mimic joints' couplings are the model's `closures` (`mbjax.loops.Coupling`s),
+    empty without mimic joints.
 
     Args:
         source: a path, or an XML string (a string starting with '<' is read as XML).
         floating_base: add a free joint above the root link (else it is welded to the ground).
-        gravity: gravitational acceleration in the world frame [m/s^2], shape (3,).
-        sibling_order: "name" (Pinocchio's numbering) or "document" (MuJoCo's; see the
-            module).
-        armature: rotor inertia on every joint coordinate [kg m^2 or kg], a number or an
-            (nv,) array.
+        gravity (Array): gravitational acceleration in the world frame [m/s^2], shape (3,).
+        sibling_order: "name" (Pinocchio's numbering) or "document" (MuJoCo's; see The
+            mapping, below).
+        armature (float | Array): rotor inertia on every joint coordinate [kg m^2 or kg], a
+            number or an (nv,) array.
         min_mass: lower bound on every body's mass [kg] (MuJoCo's boundmass), a remedy for
             massless leaves on moving joints.
         min_inertia: lower bound on every body's principal moments [kg m^2] (MuJoCo's
@@ -170,6 +146,35 @@ def load_urdf(source: str | bytes | os.PathLike, *, floating_base: bool = False,
         ValueError: malformed XML or numbers, an unsupported joint type, a graph that is not a
             tree, no movable joint, an unknown sibling_order, or (strict=True) implausible
             inertial data.
+
+    The mapping:
+        Links with `<inertial>` become bodies; revolute and continuous joints become revolute
+        joints, prismatic joints prismatic ones and floating joints free joints; a fixed joint
+        merges its child link (mass, centre of mass and inertia, and the placements of the joints
+        beyond it) into the parent body, and keeps the link and the joint as named frames
+        (`mbjax.rigid.frame_pose`). The root link is welded to the ground unless
+        `floating_base=True` adds a free joint. Bodies are numbered depth-first from the root, as
+        Pinocchio numbers its joints, so q and v line up with Pinocchio's. Pinocchio (through
+        urdfdom, which keeps joints in a name-sorted map) visits the children of a link in order of
+        joint name; that is the default here. `sibling_order="document"` visits them in document
+        order instead, as MuJoCo's URDF import does.
+
+    Inertial data:
+        Masses and inertias are checked on the bodies after the merge, as MuJoCo checks them, so a
+        dummy root, sensor and contact frames welded by fixed joints load whatever their data.
+        Implausible but computable data (CAD inertias that break the triangle inequality, round-off
+        negatives, a massless leaf on a moving joint) loads with a `ModelWarning` naming the link
+        and the fix (`strict=True`: an error; `mbjax._src.model.checks`); non-finite or unparsable
+        numbers are errors.
+
+    Joint data:
+        `<limit>` gives position (revolute, prismatic), effort and velocity limits (a revolute or
+        prismatic joint without `<limit>`, which the specification requires, loads without position
+        limits, as MuJoCo reads it, with a warning), `<dynamics>` damping (used by the dynamics) and
+        friction (kept as data); `armature=` adds rotor inertia to every joint (URDF has no field
+        for it). `<mimic>` joints load as independent joints, as Pinocchio and MuJoCo load them,
+        with a warning; their couplings are the model's `closures` (`mbjax.loops.Coupling`s), which
+        `mbjax.loops.ClosedSystem(TreeSystem(model), model.closures)` enforces.
     """
     if sibling_order not in ("name", "document"):
         raise ValueError(f"sibling_order must be 'name' or 'document', got {sibling_order!r}")

@@ -36,25 +36,25 @@ class RigidBody(AbstractDrivenSystem):
     in the body frame. rot has 4 entries (quaternion) or 3 (rotation vector).
 
     Args:
-        mass: mass [kg], a positive scalar.
-        inertia: inertia in the body frame [kg m^2], shape (3, 3), symmetric positive-definite:
-            about the centre of mass (free body) or about the fixed point.
-        com: centre of mass in the body frame [m], shape (3,); must be 0 for a free body.
-        gravity: gravitational acceleration in the world frame [m/s^2], shape (3,).
+        mass (float): mass [kg], a positive scalar.
+        inertia (Array): inertia in the body frame [kg m^2], shape (3, 3), symmetric
+            positive-definite: about the centre of mass (free body) or about the fixed point.
+        com (Array): centre of mass in the body frame [m], shape (3,); must be 0 for a free body.
+        gravity (Array): gravitational acceleration in the world frame [m/s^2], shape (3,).
         fixed_point: whether the body turns about a fixed point at the origin; static.
         rotation: the rotation coordinates, `mbjax.lie.Quaternion()` (the default) or
             `mbjax.lie.RotationVector()`; static.
-        control: a callable (t, q, u) -> generalized forces on u = (Omega, v): a body-frame
-            torque [N m] (and, for a free body, a world-frame force [N]), or on the `actuation`
-            coordinates only; an `mbjax.control` module; a constant array (a constant control);
-            or None.
-        external: a callable (t, q, u) -> a world-frame wrench (torque [N m]; force [N]), shape
-            (1, 6), acting at the body's origin (its centre of mass; the fixed point) or at
-            `external_point`; or None.
-        external_point: where the external force acts, body-frame coordinates from that origin
-            [m], shape (1, 3) or (3,); None: the origin.
-        actuation: the indices of the velocity coordinates the control drives (or a boolean
-            mask of length nv), or an (nv, nu) actuation matrix S of rank nu (generalized
+        control (Callable | Array | None): a callable (t, q, u) -> generalized forces on u = (Omega,
+            v): a body-frame torque [N m] (and, for a free body, a world-frame force [N]), or on the
+            `actuation` coordinates only; an `mbjax.control` module; a constant array (a constant
+            control); or None.
+        external (Callable | None): a callable (t, q, u) -> a world-frame wrench (torque [N m];
+            force [N]), shape (1, 6), acting at the body's origin (its centre of mass; the fixed
+            point) or at `external_point`; or None.
+        external_point (Array | None): where the external force acts, body-frame coordinates from
+            that origin [m], shape (1, 3) or (3,); None: the origin.
+        actuation (Array | None): the indices of the velocity coordinates the control drives (or a
+            boolean mask of length nv), or an (nv, nu) actuation matrix S of rank nu (generalized
             force S u: thrusters, tendons); None: all of them. Stored as the matrix.
 
     Raises:
@@ -151,7 +151,7 @@ class RigidBody(AbstractDrivenSystem):
 
         Returns:
             (q0, u0): q0 = rot (fixed point) or (rot, x0) (free body) in the body's rotation
-            coordinates, and u0 = Omega0 or (Omega0, v0).
+                coordinates, and u0 = Omega0 or (Omega0, v0).
         """
         R0 = jnp.asarray(R0, dtype=float)
         rot = self.rotation.from_matrix(R0)

@@ -79,7 +79,7 @@ def constraint_forces(model: Model, q: Array, v: Array, a: Array) -> Array:
 
     Returns:
         One wrench per joint, shape (n, 6): (torque about the hinge [N m]; force [N]), ground
-        (world) frame components.
+            (world) frame components.
     """
     terms = operator_terms(model, q, v)
     W = _reactions(terms, v, a)

@@ -106,7 +106,7 @@ def mass_matrix(model: Model, q: Array) -> Array:
 
     Returns:
         M(q), symmetric positive-definite, shape (nv, nv) (kg m^2, kg or kg m by coordinate
-        pair), the joints' armature included.
+            pair), the joints' armature included.
 
     Raises:
         ValueError: q of the wrong shape.

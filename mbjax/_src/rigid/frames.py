@@ -51,7 +51,7 @@ def frame_pose(model: Model, q: Array, name: str) -> tuple[Array, Array]:
 
     Returns:
         (R, p): the frame's rotation (frame to world), shape (3, 3), and its origin in the
-        world [m], shape (3,).
+            world [m], shape (3,).
 
     Raises:
         KeyError: no frame, body or joint of that name (the message lists the model's names).

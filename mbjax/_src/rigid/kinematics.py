@@ -63,7 +63,7 @@ def forward_kinematics(model: Model, q: Array) -> tuple[Array, Array]:
 
     Returns:
         (R, p): each body's rotation (body to world), shape (n, 3, 3), and the origin of its
-        frame (its joint) in the world [m], shape (n, 3).
+            frame (its joint) in the world [m], shape (n, 3).
     """
     if fixed_in_body(model):
         return _poses(model, q)

@@ -94,7 +94,7 @@ def transformation_operator(model: Model, q: Array) -> tuple[Array, Array]:
 
     Returns:
         (A, A_hat_f): shapes (6n, 6n) and (6n, nv), rows body-major (omega_1, v_c1, omega_2,
-        ...), world-frame components.
+            ...), world-frame components.
     """
     terms = operator_terms(model, q, jnp.zeros(model.nv, q.dtype))
     n, w = model.n, model.width

@@ -53,15 +53,16 @@ class TreeSystem(AbstractTreeSystem):
 
     Args:
         model: the tree, a `mbjax.Model`.
-        control: a callable (t, q, v) -> forces on the actuated coordinates, shape
-            (n_controls,) (an `mbjax.control` module or any function), a constant array (a
-            constant tau [N m or N]), or None.
-        external: a callable (t, q, v) -> world-frame wrenches (torque [N m]; force [N]) on the
-            bodies, shape (n, 6), acting at their origins or at `external_point`; or None.
-        external_point: body-frame points where the external forces act [m], shape (n, 3) or
-            (3,) (the same for every body); None: the bodies' origins.
-        actuation: the indices of the velocity coordinates the control drives (or a boolean
-            mask of length nv), or an (nv, nu) actuation matrix S of rank nu (generalized
+        control (Callable | Array | None): a callable (t, q, v) -> forces on the actuated
+            coordinates, shape (n_controls,) (an `mbjax.control` module or any function), a constant
+            array (a constant tau [N m or N]), or None.
+        external (Callable | None): a callable (t, q, v) -> world-frame wrenches (torque [N m];
+            force [N]) on the bodies, shape (n, 6), acting at their origins or at `external_point`;
+            or None.
+        external_point (Array | None): body-frame points where the external forces act [m], shape
+            (n, 3) or (3,) (the same for every body); None: the bodies' origins.
+        actuation (Array | None): the indices of the velocity coordinates the control drives (or a
+            boolean mask of length nv), or an (nv, nu) actuation matrix S of rank nu (generalized
             force S u: thrusters, tendons); None: all of them. Stored as the matrix.
         method: `mbjax.Recursive()`, `mbjax.Dense()` or `mbjax.Auto()` (the default); static.
 
@@ -175,20 +176,22 @@ class TreeSystem(AbstractTreeSystem):
 class BatchTreeSystem(AbstractSystem):
     """B copies of a tree of revolute and prismatic joints in one system, batch last.
 
-    q and u are (nv, B) and u_dot = `batch_aba(model, q, u, tau)`. `simulate` integrates all of
-    them in one scan, with the throughput layout of `mbjax._src.rigid.batched` (the same
-    trajectories as `jax.vmap` of a `TreeSystem` simulation), and reports a status for each copy
-    (`Solution.status` of shape (B,)). Gravity comes from the model; no control or external
-    load; no invariants.
+    q and u are (nv, B) and u_dot = `batch_aba(model, q, u, tau)`; `simulate` integrates all of
+    them in one scan and reports a status for each copy (`Solution.status` of shape (B,)).
+    Gravity comes from the model; no control or external load; no invariants.
 
     Args:
         model: a tree of revolute and prismatic joints only.
-        tau: constant joint forces [N m or N], shape (nv,) (the same for every copy) or
-            (nv, B); None: zero.
+        tau (Array | None): constant joint forces [N m or N], shape (nv,) (the same for every copy)
+            or (nv, B); None: zero.
 
     Raises:
         ValueError: (when simulated) a joint that is not revolute or prismatic, or q not of
             shape (nv, B).
+
+    Throughput:
+        The one scan runs with the throughput layout of `mbjax._src.rigid.batched`: the same
+        trajectories as `jax.vmap` of a `TreeSystem` simulation.
     """
 
     model: Model
@@ -219,13 +222,14 @@ class MomentumSystem(AbstractDrivenSystem):
 
     Args:
         model: the tree, a `mbjax.Model`.
-        control: as for `TreeSystem`: a callable (t, q, v) -> forces on the actuated
-            coordinates (called with the velocities v, not the momenta), a constant array, or
+        control (Callable | Array | None): as for `TreeSystem`: a callable (t, q, v) -> forces on
+            the actuated coordinates (called with the velocities v, not the momenta), a constant
+            array, or None.
+        external (Callable | None): a callable (t, q, v) -> world-frame wrenches, shape (n, 6), or
             None.
-        external: a callable (t, q, v) -> world-frame wrenches, shape (n, 6), or None.
-        external_point: body-frame points where the external forces act [m], shape (n, 3) or
-            (3,); None: the bodies' origins.
-        actuation: the indices of the velocity coordinates the control drives, or an
+        external_point (Array | None): body-frame points where the external forces act [m], shape
+            (n, 3) or (3,); None: the bodies' origins.
+        actuation (Array | None): the indices of the velocity coordinates the control drives, or an
             (nv, nu) actuation matrix; None: all. Stored as the matrix.
 
     Raises:

@@ -28,7 +28,7 @@ def torque_free_motion(J_a, J_t, R0: Array, Omega0: Array, t: Array,
 
     Returns:
         (R(t), Omega(t)): the rotation, shape (3, 3), and the body-frame angular velocity
-        [rad/s], shape (3,).
+            [rad/s], shape (3,).
     """
     a = jnp.asarray(axis, dtype=float)
     a = a / jnp.linalg.norm(a)

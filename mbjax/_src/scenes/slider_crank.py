@@ -85,7 +85,7 @@ def joint_angles(theta):
 
     Returns:
         (crank angle [rad], rod angle relative to the crank [rad], slider position [m]),
-        shape (3,).
+            shape (3,).
     """
     x = slider_position(theta)
     phi = jnp.arctan2(-R_ * jnp.sin(theta), x - R_ * jnp.cos(theta))   # rod's absolute angle

@@ -26,8 +26,8 @@ class ToolPath(eqx.Module):
     quintic (minimum-jerk) profile, at rest at both ends.
 
     Args:
-        start: (plunge [m], slope shape (2,)) at t = 0.
-        goal: (plunge [m], slope shape (2,)) at t = duration.
+        start (tuple[float, Array]): (plunge [m], slope shape (2,)) at t = 0.
+        goal (tuple[float, Array]): (plunge [m], slope shape (2,)) at t = duration.
         duration: the blend's duration [s]; static.
     """
 
@@ -57,7 +57,7 @@ class ToolPath(eqx.Module):
 
         Returns:
             (theta [rad], theta_dot [rad/s], theta_ddot [rad/s^2], each shape (3,);
-            reachable, a boolean scalar).
+                reachable, a boolean scalar).
         """
         def theta(time):
             return kinematics.solve_inverse_kinematics(wrist, *self.chart(time))[0]

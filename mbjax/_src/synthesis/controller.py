@@ -48,9 +48,9 @@ class NeuralController(AbstractControl):
     `aimed_at`; train it with `train_controller`. A control for `WristSystem`.
 
     Args:
-        key: a `jax.random` key for the MLP's initial weights.
+        key (Array): a `jax.random` key for the MLP's initial weights.
         limit: the torque limit [N m].
-        theta_centre: the workspace's centre in input angles [rad], shape (3,) (also the
+        theta_centre (Array): the workspace's centre in input angles [rad], shape (3,) (also the
             initial target).
         width: the MLP's hidden width.
         depth: the MLP's number of hidden layers.
@@ -142,10 +142,10 @@ def make_episodes(wrist, key, n: int, plunge_range=(0.068, 0.082), max_slope: fl
     Poses are uniform in plunge and in the slope disk |g| <= max_slope.
 
     Args:
-        wrist: the `CarpalWrist`.
-        key: a `jax.random` key.
+        wrist (CarpalWrist): the `CarpalWrist`.
+        key (Array): a `jax.random` key.
         n: number of episodes.
-        plunge_range: (lowest, highest) plunge [m].
+        plunge_range (tuple[float, float]): (lowest, highest) plunge [m].
         max_slope: the largest slope |g|.
 
     Returns:

@@ -40,7 +40,7 @@ def grid(base: CarpalWrist, **axes) -> tuple[CarpalWrist, tuple[int, ...]]:
 
     Returns:
         (wrists, shape): one batched `CarpalWrist` whose leaves have a leading axis of
-        prod(shape) variants in C order, and the grid's shape (one length per field).
+            prod(shape) variants in C order, and the grid's shape (one length per field).
 
     Raises:
         ValueError: an unknown field.

@@ -106,7 +106,7 @@ def synthesize(wrist, theta0: Array, goal, *, duration: float, torque_limit: flo
 
     Returns:
         A `Synthesis`: the spline, the losses, the final state, the figures of merit and the
-        final rollout's status (a non-finite state, a singular configuration).
+            final rollout's status (a non-finite state, a singular configuration).
 
     Raises:
         equinox.EquinoxRuntimeError: with throw=True, the final rollout failed.

@@ -73,9 +73,9 @@ class Auto(AbstractForwardDynamics):
     The choice is made once, when the program is traced, from the model's static size.
 
     Args:
-        crossover_nv: the smallest tree, in velocity coordinates, run by the recursion. By default
-            0 where XLA compiles loops as one kernel (what `import mbjax` sets up), else 5
-            (`CROSSOVER_NV`, the crossover found by `mbjax bench rigid`).
+        crossover_nv (int | None): the smallest tree, in velocity coordinates, run by the recursion.
+            By default 0 where XLA compiles loops as one kernel (what `import mbjax` sets up), else
+            5 (`CROSSOVER_NV`, the crossover found by `mbjax bench rigid`).
     """
 
     crossover_nv: int = eqx.field(static=True, default_factory=_default_crossover)

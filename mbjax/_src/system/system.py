@@ -1,16 +1,5 @@
-"""What a time integrator needs from a mechanical system.
-
-A system has configuration coordinates q and velocities u with
-
-    q_dot = kinematics(q, u),        u_dot = acceleration(t, q, u).
-
-q may live on a manifold (a quaternion, a rotation vector), so a system also gives a local chart
-about any configuration q0: q = retract(q0, xi) with xi in R^dim(u), xi = 0 at q0, and the rate
-xi_dot = local_rate(q0, xi, u). For rotations this is Borri 1990's incremental rotation vector about a
-reference configuration (§2): R = R0 exp(xi), xi_dot = Gamma(xi)^-T Omega. Euclidean systems keep the
-defaults (retract(q0, xi) = q0 + xi). `difference` is the chart's inverse and `tangent` its rate at
-xi = 0, along which the Euler methods step.
-"""
+"""What a time integrator needs from a mechanical system (`AbstractSystem`, whose docstring
+describes it)."""
 
 import abc
 
@@ -28,8 +17,24 @@ class AbstractSystem(eqx.Module):
 
     Subclasses implement `kinematics` (q_dot) and `acceleration` (u_dot); a system whose
     configuration lives on a manifold also overrides the chart (`retract`, `local_rate`) and
-    `project` (see the module docstring). The other methods have defaults that suit an
+    `project` (see The interface, below). The other methods have defaults that suit an
     unconstrained, uncontrolled system. The abstract class takes no constructor arguments.
+
+    The interface:
+        What a time integrator needs from a mechanical system.
+
+        A system has configuration coordinates q and velocities u with
+
+        ```text
+        q_dot = kinematics(q, u),        u_dot = acceleration(t, q, u).
+        ```
+
+        q may live on a manifold (a quaternion, a rotation vector), so a system also gives a local
+        chart about any configuration q0: q = retract(q0, xi) with xi in R^dim(u), xi = 0 at q0, and
+        the rate xi_dot = local_rate(q0, xi, u). For rotations this is Borri 1990's incremental
+        rotation vector about a reference configuration (§2): R = R0 exp(xi), xi_dot = Gamma(xi)^-T
+        Omega. Euclidean systems keep the defaults (retract(q0, xi) = q0 + xi). `difference` is the
+        chart's inverse and `tangent` its rate at xi = 0, along which the Euler methods step.
     """
 
     @abc.abstractmethod
@@ -94,7 +99,7 @@ class AbstractSystem(eqx.Module):
 
         Returns:
             xi_dot at xi = 0, shape of the chart (the velocity's for a tree); kinematics(q, u)
-            by default.
+                by default.
         """
         return self.kinematics(q, u)
 

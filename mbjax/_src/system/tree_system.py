@@ -1,20 +1,5 @@
-"""What `simulate` and the closed loops of `mbjax.loops` need from an open tree, rigid or flexible.
-
-An `AbstractTreeSystem` integrates (q, v): configuration coordinates q (nq) and velocity
-coordinates v (nv), with q_dot = q_dot(q, v) and a chart (`retract`, `local_rate`) about any q
-for quaternion joints. It gives the poses of its frames (bodies, then markers), its energy, its
-mass matrix M(q) = d^2 T / dv^2, and the O(n) response of the recursion to m unit generalized
-loads at once (Anderson 1993 eqs 101-107: one triangularization, m + 1 force passes): what the
-O(n + m^3) loop route needs. Trees whose equations of motion are M(q) v_dot + bias(t, q, v) = 0
-with that symmetric M (`symmetric_dynamics`; rigid trees, not flexible ones, whose geometric
-stiffening adds acceleration-dependent loads) also serve the dense loop routes.
-
-Applied forces live on the tree: `control` (t, q, v) -> generalized forces on the `actuation`
-coordinates, `external` (t, q, v) -> one world-frame wrench (torque; force) per body at its
-origin or at `external_point`. A closed loop wrapped around the tree inherits them.
-
-Final implementations: `mbjax.rigid.TreeSystem`, `mbjax.flex.FlexibleSystem`.
-"""
+"""What `simulate` and the closed loops of `mbjax.loops` need from an open tree, rigid or flexible
+(`AbstractTreeSystem`, whose docstring describes it)."""
 
 import abc
 
@@ -32,8 +17,29 @@ class AbstractTreeSystem(AbstractDrivenSystem):
     Its `model` (a `mbjax.Model` or a `mbjax.flex.FlexibleModel`) gives the coordinates; the
     state is (q, v), q of shape (nq,) and v of shape (nv,). Final subclasses
     (`mbjax.rigid.TreeSystem`, `mbjax.flex.FlexibleSystem`) take the model, the control, the
-    external load and the forward-dynamics method in their constructors; see the module
-    docstring for what they must provide.
+    external load and the forward-dynamics method in their constructors; see The interface,
+    below, for what they must provide.
+
+    The interface:
+        What `simulate` and the closed loops of `mbjax.loops` need from an open tree, rigid or
+        flexible.
+
+        An `AbstractTreeSystem` integrates (q, v): configuration coordinates q (nq) and velocity
+        coordinates v (nv), with q_dot = q_dot(q, v) and a chart (`retract`, `local_rate`) about any
+        q for quaternion joints. It gives the poses of its frames (bodies, then markers), its
+        energy, its mass matrix M(q) = d^2 T / dv^2, and the O(n) response of the recursion to m
+        unit generalized loads at once (Anderson 1993 eqs 101-107: one triangularization, m + 1
+        force passes): what the O(n + m^3) loop route needs. Trees whose equations of motion are
+        M(q) v_dot + bias(t, q, v) = 0 with that symmetric M (`symmetric_dynamics`; rigid trees, not
+        flexible ones, whose geometric stiffening adds acceleration-dependent loads) also serve the
+        dense loop routes.
+
+        Applied forces live on the tree: `control` (t, q, v) -> generalized forces on the
+        `actuation` coordinates, `external` (t, q, v) -> one world-frame wrench (torque; force) per
+        body at its origin or at `external_point`. A closed loop wrapped around the tree inherits
+        them.
+
+        Final implementations: `mbjax.rigid.TreeSystem`, `mbjax.flex.FlexibleSystem`.
     """
 
     model: eqx.AbstractVar[object]
@@ -115,7 +121,7 @@ class AbstractTreeSystem(AbstractDrivenSystem):
 
         Returns:
             (R, p): rotations (body to world), shape (n_frames, 3, 3), and origins [m], shape
-            (n_frames, 3).
+                (n_frames, 3).
         """
 
     @abc.abstractmethod
@@ -184,8 +190,8 @@ class AbstractTreeSystem(AbstractDrivenSystem):
 
         Returns:
             (v_dot, responses): the accelerations under gravity, velocity terms, elasticity,
-            the control and the external wrenches, shape (nv,); and the accelerations of each
-            row of `loads`, shape (m, nv).
+                the control and the external wrenches, shape (nv,); and the accelerations of each
+                row of `loads`, shape (m, nv).
         """
 
     def bias(self, t: Array, q: Array, v: Array) -> Array:
@@ -220,7 +226,7 @@ class AbstractTreeSystem(AbstractDrivenSystem):
 
         Returns:
             World-frame wrenches (torque about each body's origin [N m]; force [N]), shape
-            (n, 6); or None without an external load.
+                (n, 6); or None without an external load.
         """
         f = self.external_wrenches(t, q, v)
         if f is None or self.external_point is None:

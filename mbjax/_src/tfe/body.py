@@ -29,14 +29,14 @@ class Body(eqx.Module):
 
     Quantities are referred to the body point O' and ordered (angular; linear). With
     fixed_point=True O' does not move and the coordinates are q = r_* (3 dof, a top about its
-    suspension point); otherwise q = (r_*, x_*) (6 dof), O' anywhere in the body.
+    suspension point); otherwise q = `(r_*, x_*)` (6 dof), O' anywhere in the body.
 
     Args:
-        mass: mass [kg], positive.
-        inertia: second moment about O' in the body frame (J_bar of eq 3.9), shape (3, 3)
+        mass (float): mass [kg], positive.
+        inertia (Array): second moment about O' in the body frame (J_bar of eq 3.9), shape (3, 3)
             [kg m^2]; symmetric, positive definite, satisfying the triangle inequality.
-        com: centre of mass relative to O' in the body frame (c_bar), shape (3,) [m].
-        gravity: acceleration of gravity in space, shape (3,) [m/s^2].
+        com (Array): centre of mass relative to O' in the body frame (c_bar), shape (3,) [m].
+        gravity (Array): acceleration of gravity in space, shape (3,) [m/s^2].
         fixed_point: whether O' is a fixed point (3 rotational dof) or free (6 dof).
 
     Raises:

@@ -52,10 +52,10 @@ def initial_state(body: Body, R0, Omega0, x0=(0.0, 0.0, 0.0), v0=(0.0, 0.0, 0.0)
 
     Args:
         body: the body.
-        R0: rotation body to space, shape (3, 3).
-        Omega0: angular velocity in the body frame, shape (3,) [rad/s].
-        x0: position of O', shape (3,) [m].
-        v0: velocity of O' in space, shape (3,) [m/s] (ignored about a fixed point).
+        R0 (Array): rotation body to space, shape (3, 3).
+        Omega0 (Array): angular velocity in the body frame, shape (3,) [rad/s].
+        x0 (Array): position of O', shape (3,) [m].
+        v0 (Array): velocity of O' in space, shape (3,) [m/s] (ignored about a fixed point).
 
     Returns:
         The `State` (R0, x0, p_hat).
@@ -275,30 +275,13 @@ def solve_tfe(body: Body, state0: State, *, dt, n_elements: int, form: AbstractF
     """March a body through `n_elements` time elements of a weak form (Borri 1990 §5).
 
     Each element spans (nodes - 1) dt; Newton solves its equations, differentiated by the
-    implicit function theorem. Jitted once per (form, element, n_elements, reference,
-    max_iter); dt, tol, the body and the state are traced, so sweeps over them do not recompile
-    and they can be differentiated.
-
-    The default accuracy check, always on: `drift`, the largest relative drift of the body's
-    invariants (`Body.invariants`: the energy, the momenta) over the boundaries, sets
-    INACCURATE above `DRIFT_LIMIT` (0.1); a single body's invariants cost little to evaluate.
-    (`mbjax.simulate`'s step ratio does not apply: an element's reference carries the rotation
-    exactly, and a conserved momentum's boundary values differ only by Newton's tolerance,
-    whose increments read as a motion on the element's scale.)
-
-    With a tolerance (rtol, atol, as `mbjax.simulate`'s) the solution carries `error`, a
-    step-doubling estimate of the final state's error (at up to `ERROR_SAMPLES` boundaries,
-    one element against two of half the spacing; their difference is taken as the element's
-    local error, the elements being of high order, and summed over the march; the rotation
-    matrix, position and momentum components together), the status INACCURATE where it
-    exceeds the tolerance (root mean square norm), and a positive rtol replaces `DRIFT_LIMIT`
-    as the drift's bound. The primal form past its stability boundary is caught this way
-    (tests/tfe/test_accuracy.py).
+    implicit function theorem. The solution holds the states at the elements' boundaries and a
+    status that flags an unconverged element, a non-finite state or an inaccurate run.
 
     Args:
         body: the body.
         state0: the initial state (`initial_state`).
-        dt: the node spacing [s].
+        dt (float): the node spacing [s].
         n_elements: the number of elements, a positive int.
         form: the weak form, a strategy (`Mixed()`, `PrimalUnsymmetric()`, ...).
         element: the time element (nodes and quadrature).
@@ -306,7 +289,7 @@ def solve_tfe(body: Body, state0: State, *, dt, n_elements: int, form: AbstractF
             each element from its initial state, or a `Reference` motion (from t = 0) followed
             by the whole march: the increments then carry over between elements, as in the
             linearized analysis of §6-7, and must stay below pi in rotation.
-        tol: Newton's tolerance on the step, relative to 1 + |U|.
+        tol (float): Newton's tolerance on the step, relative to 1 + |U|.
         max_iter: the most Newton iterations per element.
         rtol: relative tolerance on the final state's error and the invariants' drift.
         atol: absolute tolerance on the final state's error.
@@ -325,6 +308,29 @@ def solve_tfe(body: Body, state0: State, *, dt, n_elements: int, form: AbstractF
         TypeError: element is not an `Element`, form not a form instance, or state0 not a
             `State`.
         equinox.EquinoxRuntimeError: with throw=True, the march failed.
+
+    Compilation:
+        Jitted once per (form, element, n_elements, reference, max_iter); dt, tol, the body and
+        the state are traced, so sweeps over them do not recompile and they can be
+        differentiated.
+
+    Default accuracy check:
+        Always on: `drift`, the largest relative drift of the body's invariants
+        (`Body.invariants`: the energy, the momenta) over the boundaries, sets INACCURATE above
+        `DRIFT_LIMIT` (0.1); a single body's invariants cost little to evaluate.
+        (`mbjax.simulate`'s step ratio does not apply: an element's reference carries the
+        rotation exactly, and a conserved momentum's boundary values differ only by Newton's
+        tolerance, whose increments read as a motion on the element's scale.)
+
+    Accuracy with a tolerance:
+        With a tolerance (rtol, atol, as `mbjax.simulate`'s) the solution carries `error`, a
+        step-doubling estimate of the final state's error (at up to `ERROR_SAMPLES` boundaries,
+        one element against two of half the spacing; their difference is taken as the element's
+        local error, the elements being of high order, and summed over the march; the rotation
+        matrix, position and momentum components together), the status INACCURATE where it
+        exceeds the tolerance (root mean square norm), and a positive rtol replaces
+        `DRIFT_LIMIT` as the drift's bound. The primal form past its stability boundary is
+        caught this way (tests/tfe/test_accuracy.py).
     """
     prescribed = reference if isinstance(reference, Reference) else None
     if prescribed is not None:

@@ -31,7 +31,7 @@ class ThreeField(AbstractForm):
     name = "three_field"
 
     def pointwise(self, body: Body, ref: Reference, y: Array, t) -> tuple[Array, Array]:
-        """The (d*p, dq_hat) rows and the d*w row of eq B.45 at one time.
+        """The `(d*p, dq_hat)` rows and the `d*w` row of eq B.45 at one time.
 
         Args:
             body: the body.

@@ -1,34 +1,8 @@
 """A trajectory-optimisation problem for any system: its dynamics, controls, horizon, costs and
 control bounds.
 
-The unknowns are the controls u_0 ... u_{N-1}, one value per step of length dt held over the
-step (a zero-order hold, as a digital controller and MuJoCo's `ctrl` apply them), on the system's
-actuated velocity coordinates (its `actuation`, all of them by default). The state is
-x = (q, v), and the discrete problem is
-
-    minimize    sum_k running(q_k, v_k, u_k) dt + terminal(q_N, v_N)
-    subject to  x_{k+1} = step(x_k, u_k)       (one step of `integrator` from t_k = k dt)
-                lower <= u_k <= upper,
-
-where `step` runs the system with the constant control u_k, as `mbjax.simulate` would (its
-`hold`, and after the step its `constrain`: a closed loop's projection). Running costs are rates,
-weighted by dt as in Crocoddyl's integrated action models, so a problem's optimum does not
-depend on how finely its horizon is cut. Costs are any JAX functions: weights held in an
-equinox module are differentiable like the model's parameters.
-
-States live on the system's configuration manifold (a floating base's quaternion, a continuous
-joint's angle): second-order solvers linearize in its tangent space, a deviation being
-dx = difference(x_ref, x) = (system.difference(q_ref, q), v - v_ref), of length ndx = 2 nv for a
-tree (Crocoddyl's `StateMultibody`), and move along it with integrate(x, dx) = (retract(q, dq),
-v + dv). On Euclidean coordinates both are plain subtraction and addition.
-
-A cost function returns either a scalar, taken as it is, or a vector of residuals r, meaning the
-least-squares cost 1/2 |r|^2 (weights folded into r). The second form is what second-order
-solvers want: its Hessian is taken as J^T J with J = dr/d(x, u) (Gauss-Newton, as Crocoddyl's
-residual models do), positive semidefinite wherever the trajectory is, where a scalar cost's
-exact Hessian (an end-effector distance, say) can be indefinite far from the optimum. A tuple
-of cost functions is their sum (the residuals stacked). `mbjax.trajopt.state_residual`,
-`frame_residual` and `control_residual` write Crocoddyl's common costs.
+`Problem`'s docstring states the discrete problem, how states on a configuration manifold are
+differenced, and the two forms of a cost (a scalar, or residuals for Gauss-Newton).
 """
 
 from collections.abc import Callable
@@ -47,26 +21,69 @@ from mbjax._src.system.system import AbstractSystem
 
 
 class Problem(eqx.Module):
-    """A discrete optimal-control problem over a system's controls (see the module).
+    """A discrete optimal-control problem over a system's controls, to pass to `solve`.
+
+    The unknowns are the controls u_0 ... u_{N-1} on the system's actuated coordinates, one per
+    step of length dt, held over the step; the problem minimizes the running costs' sum times dt
+    plus the terminal cost, subject to the system's dynamics stepped by `integrator` and the
+    bounds on the controls.
 
     Args:
         system: any mbjax system with a control (`TreeSystem`, `FlexibleSystem`, `WristSystem`,
             `RigidBody`, a `ClosedSystem` of a tree, ...); its control is replaced by the
             unknowns u_k.
-        q0: initial configuration, shape (nq,).
-        v0: initial velocity, shape (nv,).
-        dt: the step and control interval, seconds.
-        horizon: the number of steps N.
+        q0 (Array): initial configuration, shape (nq,).
+        v0 (Array): initial velocity, shape (nv,).
+        dt: the step and control interval, seconds (keyword only).
+        horizon: the number of steps N (keyword only).
         running: cost rate running(q, v, u), a scalar or a vector of residuals; or a tuple of
-            such functions, their sum.
-        terminal: final cost terminal(q, v), likewise.
-        lower: lower bound on each actuated force, a scalar or shape (nu,); None for none.
-        upper: upper bound, likewise.
+            such functions, their sum (keyword only; see Costs, below).
+        terminal: final cost terminal(q, v), likewise (keyword only).
+        lower (float | Array | None): lower bound on each actuated force, a scalar or shape
+            (nu,); None for none.
+        upper (float | Array | None): upper bound, likewise.
         integrator: the step's integrator (`RK4()` by default).
 
     Raises:
-        TypeError, ValueError: naming the malformed argument (a system without a control, a
-            state of the wrong shape, a non-positive dt or horizon, lower above upper).
+        TypeError: naming the malformed argument: a system that is not an mbjax system or has
+            no control, an integrator that is not an instance, costs that are not callables.
+        ValueError: naming the malformed argument: a state of the wrong shape, a non-positive
+            dt or horizon, bounds of the wrong shape, lower above upper.
+
+    Formulation:
+        The unknowns are the controls u_0 ... u_{N-1}, one value per step of length dt held over
+        the step (a zero-order hold, as a digital controller and MuJoCo's `ctrl` apply them), on
+        the system's actuated velocity coordinates (its `actuation`, all of them by default). The
+        state is x = (q, v), and the discrete problem is
+
+        ```text
+        minimize    sum_k running(q_k, v_k, u_k) dt + terminal(q_N, v_N)
+        subject to  x_{k+1} = step(x_k, u_k)       (one step of `integrator` from t_k = k dt)
+                    lower <= u_k <= upper,
+        ```
+
+        where `step` runs the system with the constant control u_k, as `mbjax.simulate` would (its
+        `hold`, and after the step its `constrain`: a closed loop's projection). Running costs are
+        rates, weighted by dt as in Crocoddyl's integrated action models, so a problem's optimum
+        does not depend on how finely its horizon is cut. Costs are any JAX functions: weights held
+        in an equinox module are differentiable like the model's parameters.
+
+    Manifolds:
+        States live on the system's configuration manifold (a floating base's quaternion, a
+        continuous joint's angle): second-order solvers linearize in its tangent space, a deviation
+        being dx = difference(x_ref, x) = (system.difference(q_ref, q), v - v_ref), of length ndx =
+        2 nv for a tree (Crocoddyl's `StateMultibody`), and move along it with integrate(x, dx) =
+        (retract(q, dq), v + dv). On Euclidean coordinates both are plain subtraction and addition.
+
+    Costs:
+        A cost function returns either a scalar, taken as it is, or a vector of residuals r, meaning
+        the least-squares cost 1/2 |r|^2 (weights folded into r). The second form is what
+        second-order solvers want: its Hessian is taken as J^T J with J = dr/d(x, u) (Gauss-Newton,
+        as Crocoddyl's residual models do), positive semidefinite wherever the trajectory is, where
+        a scalar cost's exact Hessian (an end-effector distance, say) can be indefinite far from the
+        optimum. A tuple of cost functions is their sum (the residuals stacked).
+        `mbjax.trajopt.state_residual`, `frame_residual` and `control_residual` write Crocoddyl's
+        common costs.
     """
 
     system: AbstractSystem
@@ -229,7 +246,7 @@ class Problem(eqx.Module):
 
     def stage_expansion(self, x: Array, u: Array):
         """(l_x, l_u, l_xx, l_ux, l_uu) of the stage cost at (x, u) in the tangent space:
-        exact, or Gauss-Newton for residuals (see the module)."""
+        exact, or Gauss-Newton for residuals (see Costs, in `Problem`)."""
         zero_q, zero_v = jnp.zeros(self.ndq, x.dtype), jnp.zeros(self.nv, x.dtype)
         running = self._about(x, self.running)
         if _is_residual(running, zero_q, zero_v, u):

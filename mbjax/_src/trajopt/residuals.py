@@ -66,12 +66,13 @@ def state_residual(space, q_ref, v_ref=None, weight=1.0) -> eqx.Module:
     `ResidualModelState`.
 
     Args:
-        space: what measures the configuration's deviation: a `mbjax.Model` (its
-            `difference`, continuous joints wrapped) or a system (its chart's `difference`,
+        space (Model | AbstractSystem): what measures the configuration's deviation: a `mbjax.Model`
+            (its `difference`, continuous joints wrapped) or a system (its chart's `difference`,
             angles counting turns).
-        q_ref: the reference configuration, shape (nq,).
-        v_ref: the reference velocity, shape (nv,); zeros by default.
-        weight: w, a scalar or one per residual (nv + nv entries: the tangent of q, then v).
+        q_ref (Array): the reference configuration, shape (nq,).
+        v_ref (Array | None): the reference velocity, shape (nv,); zeros by default.
+        weight (float | Array): w, a scalar or one per residual (nv + nv entries: the tangent of q,
+            then v).
 
     Returns:
         The residual function r(q, v, u=None), shape (2 nv,) for a tree.
@@ -99,13 +100,13 @@ def frame_residual(model, frame: str, translation=None, rotation=None,
     only, r = sqrt(w) omega (`ResidualModelFrameRotation`).
 
     Args:
-        model: the `mbjax.Model`.
+        model (Model): the `mbjax.Model`.
         frame: the frame's, body's or joint's name (`mbjax.rigid.frame_pose`).
-        translation: the target origin in the world [m], shape (3,); None for a rotation
-            residual.
-        rotation: the target orientation (frame to world), shape (3, 3); None for a
+        translation (Array | None): the target origin in the world [m], shape (3,); None for a
+            rotation residual.
+        rotation (Array | None): the target orientation (frame to world), shape (3, 3); None for a
             translation residual.
-        weight: w, a scalar or one per residual (6 or 3).
+        weight (float | Array): w, a scalar or one per residual (6 or 3).
 
     Returns:
         The residual function r(q, v, u=None), shape (6,) or (3,).
@@ -127,9 +128,9 @@ def control_residual(nu: int, u_ref=None, weight=1.0) -> eqx.Module:
 
     Args:
         nu: the number of controls.
-        u_ref: the reference control, shape (nu,); zeros by default (a gravity-holding torque
-            is a common choice).
-        weight: w, a scalar or one per control.
+        u_ref (Array | None): the reference control, shape (nu,); zeros by default (a
+            gravity-holding torque is a common choice).
+        weight (float | Array): w, a scalar or one per control.
 
     Returns:
         The residual function r(q, v, u), shape (nu,).

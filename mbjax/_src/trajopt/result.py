@@ -17,10 +17,8 @@ from mbjax._src.trajopt.problem import Problem
 class Result(WithStatus):
     """The optimised trajectory that `mbjax.trajopt.solve` returns.
 
-    The status is success when the solver's convergence test passed, NOT_CONVERGED when it ran
-    out of iterations or could not make progress, NONFINITE when the cost or the trajectory
-    blew up (for `ILQR` also when it stopped unconverged after an iteration that a non-finite
-    cost kept from progressing). N is the problem's horizon, nx = nq + nv.
+    Its states, controls, costs and feedback gains, and a status that says whether the solver
+    converged (`ok`, `messages()`). N is the problem's horizon, nx = nq + nv.
 
     Args:
         qs: configurations, shape (N + 1, nq).
@@ -40,6 +38,12 @@ class Result(WithStatus):
             above 1 the discrete dynamics the solver optimised are far from the continuous
             ones (an optimum that exploits the integrator's error); NaN before the check.
         inaccurate_by: 1 where the resolution made it INACCURATE, else 0.
+
+    Status:
+        The status is success when the solver's convergence test passed, NOT_CONVERGED when it
+        ran out of iterations or could not make progress, NONFINITE when the cost or the
+        trajectory blew up (for `ILQR` also when it stopped unconverged after an iteration that a
+        non-finite cost kept from progressing).
     """
 
     qs: Array

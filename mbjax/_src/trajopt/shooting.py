@@ -1,22 +1,5 @@
-"""Single shooting: the controls are the unknowns, the objective is the problem's cost of their
-rollout, and its gradient is reverse mode through the rollout (`mbjax._src.rigid.adjoint` for trees:
-a few rollouts' cost, whatever the horizon).
-
-`Shooting("lbfgs")` takes optax's L-BFGS with its zoom line search (Nocedal and Wright, Alg. 3.5
-and 7.4); `Shooting("adam")`, optax's Adam with a cosine-decayed learning rate, is the
-first-order baseline. Control bounds are kept by projecting the controls onto them after every
-step (projected gradient for Adam; for L-BFGS a heuristic, sound where no bound is active: use
-`ILQR` for problems whose optimum lies on its bounds). The iterations are one
-`lax.while_loop`: success when the gradient's norm falls below `tolerance` times its first
-value (its projection on the box, for bounded controls), NOT_CONVERGED when `iterations` run out.
-
-Gauss-Newton on the controls of single shooting is not offered: with the costs' residuals
-stacked into one vector r(u), a dense Levenberg-Marquardt on all N nu controls converged far
-more slowly than iLQR on the benchmark problems (see benchmarks/README.md). The stage structure
-is what Gauss-Newton needs here: `ILQR` is Gauss-Newton on the controls with the step solved by
-a Riccati recursion and applied through a closed-loop rollout, and `MultipleShooting` is
-Gauss-Newton on the knots' states and controls.
-"""
+"""Single shooting: the controls are the unknowns, and the gradient is reverse mode through the
+rollout (`Shooting`, whose docstring describes the method)."""
 
 import equinox as eqx
 import jax
@@ -34,20 +17,42 @@ METHODS = ("lbfgs", "adam")
 class Shooting(AbstractSolver):
     """Single shooting: the controls are the unknowns, the gradient is reverse mode through the rollout.
 
-    A solver strategy for `mbjax.trajopt.solve` (see the module). It works for any system,
+    A solver strategy for `mbjax.trajopt.solve` (see The method, below). It works for any system,
     quaternion coordinates included; bounds are kept by projection, sound where none is active
     at the optimum.
 
     Args:
-        method: "lbfgs" (optax's L-BFGS with its zoom line search) or "adam" (static).
-        iterations: the most iterations (static).
-        tolerance: stop when the (projected) gradient's norm falls below this times its first
-            value.
-        learning_rate: Adam's, cosine-decayed to a tenth over `iterations`; L-BFGS takes its
+        method (str): "lbfgs" (optax's L-BFGS with its zoom line search) or "adam" (static).
+        iterations (int): the most iterations (static).
+        tolerance (float): stop when the (projected) gradient's norm falls below this times its
+            first value.
+        learning_rate (float): Adam's, cosine-decayed to a tenth over `iterations`; L-BFGS takes its
             steps from the line search.
 
     Raises:
         ValueError: method is not one of `METHODS`.
+
+    The method:
+        Single shooting: the controls are the unknowns, the objective is the problem's cost of their
+        rollout, and its gradient is reverse mode through the rollout (`mbjax._src.rigid.adjoint`
+        for trees: a few rollouts' cost, whatever the horizon).
+
+        `Shooting("lbfgs")` takes optax's L-BFGS with its zoom line search (Nocedal and Wright, Alg.
+        3.5 and 7.4); `Shooting("adam")`, optax's Adam with a cosine-decayed learning rate, is the
+        first-order baseline. Control bounds are kept by projecting the controls onto them after
+        every step (projected gradient for Adam; for L-BFGS a heuristic, sound where no bound is
+        active: use `ILQR` for problems whose optimum lies on its bounds). The iterations are one
+        `lax.while_loop`: success when the gradient's norm falls below `tolerance` times its first
+        value (its projection on the box, for bounded controls), NOT_CONVERGED when `iterations` run
+        out.
+
+    Gauss-Newton:
+        Gauss-Newton on the controls of single shooting is not offered: with the costs' residuals
+        stacked into one vector r(u), a dense Levenberg-Marquardt on all N nu controls converged far
+        more slowly than iLQR on the benchmark problems (see benchmarks/README.md). The stage
+        structure is what Gauss-Newton needs here: `ILQR` is Gauss-Newton on the controls with the
+        step solved by a Riccati recursion and applied through a closed-loop rollout, and
+        `MultipleShooting` is Gauss-Newton on the knots' states and controls.
     """
 
     method: str = eqx.field(static=True, default="lbfgs")

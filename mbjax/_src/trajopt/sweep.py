@@ -50,12 +50,13 @@ def sweep(fn, params, *, devices=None, trim: bool = True):
     """fn(p) for every variant p of a batch, as jit(vmap(fn)), optionally sharded over devices.
 
     Args:
-        fn: the function of one variant.
-        params: the batch, any pytree whose array leaves share a leading variant axis of n (a
-            dict of arrays, a batched model or wrist, a tuple).
-        devices: None (one device), or several devices (e.g. `jax.devices()`) to split the
-            variants over: they are padded with copies of the last one to a multiple of their
-            number, and the outputs computed and returned sharded over the devices.
+        fn (Callable): the function of one variant.
+        params (PyTree): the batch, any pytree whose array leaves share a leading variant axis of n
+            (a dict of arrays, a batched model or wrist, a tuple).
+        devices (Sequence[jax.Device] | None): None (one device), or several devices (e.g.
+            `jax.devices()`) to split the variants over: they are padded with copies of the last one
+            to a multiple of their number, and the outputs computed and returned sharded over the
+            devices.
         trim: with devices, return the n variants given (where padding was needed that slice
             is gathered onto every device: JAX shards only axes the devices divide); False
             keeps the padded outputs sharded, the first n rows the variants, for sharded work
@@ -63,7 +64,7 @@ def sweep(fn, params, *, devices=None, trim: bool = True):
 
     Returns:
         fn's outputs stacked along a leading variant axis (n rows, or the padded count with
-        trim=False).
+            trim=False).
 
     Raises:
         ValueError: params has no array leaves or they do not share a leading axis, or

@@ -22,8 +22,8 @@ class Topology:
     depth levels the tree passes are scheduled on. A `Model` holds one as its `topology`.
 
     Args:
-        parents: each body's parent, shape (n,): parents[k] < k (every body numbered higher than
-            its parent, Anderson 1993 §2.1 rule (i)), or -1 for a base body.
+        parents (Sequence[int]): each body's parent, shape (n,): parents[k] < k (every body numbered
+            higher than its parent, Anderson 1993 §2.1 rule (i)), or -1 for a base body.
 
     Raises:
         ValueError: parents is empty, not integers, out of range, or a body is numbered before
@@ -127,7 +127,7 @@ class Topology:
 
         Returns:
             rho, 1 on the diagonal and -1 at (i, parent of i), a NumPy int array of shape
-            (n, n).
+                (n, n).
         """
         rho = np.eye(self.n, dtype=np.int64)
         for i, p in enumerate(self.parents):

@@ -310,7 +310,7 @@ def pose_error(wrist, a: Pose, b: Pose) -> Array:
     [rad], |centre_a - centre_b| / link_length).
 
     Args:
-        wrist: the `CarpalWrist` (its link_length scales the distance).
+        wrist (CarpalWrist): the `CarpalWrist` (its link_length scales the distance).
         a: a tool pose.
         b: another tool pose.
 

@@ -44,14 +44,14 @@ class CarpalWrist(eqx.Module):
     Lagrangian (§6.3); `WristSystem` makes the wrist a system for `mbjax.simulate`.
 
     Args:
-        base_radius: radius rb of the base plate [m], positive.
-        link_length: leg length l from the base axis to the knee [m], positive.
-        phi0: azimuth of the first leg [rad].
-        tool_mass: mass of the rigid tool (distal plate and tool) [kg], positive.
-        tool_inertia: inertia of the tool about its centre of mass in the tool frame D
+        base_radius (float): radius rb of the base plate [m], positive.
+        link_length (float): leg length l from the base axis to the knee [m], positive.
+        phi0 (float): azimuth of the first leg [rad].
+        tool_mass (float): mass of the rigid tool (distal plate and tool) [kg], positive.
+        tool_inertia (Array): inertia of the tool about its centre of mass in the tool frame D
             [kg m^2], shape (3, 3), symmetric positive-definite.
-        tool_com: centre-of-mass offset from the distal-plate centre, in D [m], shape (3,).
-        gravity: gravitational acceleration along -e3 [m/s^2], a scalar.
+        tool_com (Array): centre-of-mass offset from the distal-plate centre, in D [m], shape (3,).
+        gravity (float): gravitational acceleration along -e3 [m/s^2], a scalar.
         rotation_model: "physical" (the mirror plate, R = Rz(alpha) Ry(beta) Rz(-alpha)) or
             "chapter" (Canfield 1997's printed R = Rz(alpha) Ry(beta), eq 6.2, for reproducing
             the chapter's equations only; see `kinematics.rotation_from_slope`); static.
@@ -108,7 +108,7 @@ class CarpalWrist(eqx.Module):
 
         Returns:
             Shape (3, 3, 3) [m]: [0] the base revolutes, [1] the knees, [2] the distal
-            revolutes; then leg, then coordinate.
+                revolutes; then leg, then coordinate.
         """
         return kinematics.leg_points(self, theta)
 
@@ -199,7 +199,7 @@ class CarpalWrist(eqx.Module):
 
         Returns:
             A, symmetric, shape (3, 3); positive-definite inside the workspace, singular at the
-            inverse singularity (the legs are massless).
+                inverse singularity (the legs are massless).
         """
         return dynamics.mass_matrix(self, theta)
 
@@ -212,7 +212,7 @@ class CarpalWrist(eqx.Module):
 
         Returns:
             (A, shape (3, 3); B, the velocity terms [N m], shape (3,); C, the gravity torques
-            [N m], shape (3,)).
+                [N m], shape (3,)).
         """
         return dynamics.eom_terms(self, theta, theta_dot)
 

@@ -23,17 +23,17 @@ class WristSystem(AbstractDrivenSystem):
 
     Args:
         model: the wrist, a `CarpalWrist`.
-        control: the motor torques [N m], a callable (t, theta, theta_dot) -> shape (3,) (or
-            (n_controls,) with `actuation`): a `mbjax.control` module such as a torque spline or
-            a servo (`mbjax.wrist.servo`), a controller from `mbjax.trajopt`, any callable, or a
-            constant array; None: unpowered motors.
-        external: a callable (t, theta, theta_dot) -> a world-frame wrench (torque [N m];
-            force [N]) on the tool, shape (1, 6), its force acting at the distal-plate centre or
-            at `external_point`; or None.
-        external_point: where the external force acts, in the tool frame D [m], shape (1, 3)
-            or (3,); None: the distal-plate centre.
-        actuation: the indices of the driven motors (or a boolean mask of length 3, or a
-            (3, nu) actuation matrix); None: all three. Stored as the matrix.
+        control (Callable | Array | None): the motor torques [N m], a callable (t, theta, theta_dot)
+            -> shape (3,) (or (n_controls,) with `actuation`): a `mbjax.control` module such as a
+            torque spline or a servo (`mbjax.wrist.servo`), a controller from `mbjax.trajopt`, any
+            callable, or a constant array; None: unpowered motors.
+        external (Callable | None): a callable (t, theta, theta_dot) -> a world-frame wrench (torque
+            [N m]; force [N]) on the tool, shape (1, 6), its force acting at the distal-plate centre
+            or at `external_point`; or None.
+        external_point (Array | None): where the external force acts, in the tool frame D [m], shape
+            (1, 3) or (3,); None: the distal-plate centre.
+        actuation (Array | None): the indices of the driven motors (or a boolean mask of length 3,
+            or a (3, nu) actuation matrix); None: all three. Stored as the matrix.
 
     Raises:
         TypeError: `model` is not a `CarpalWrist`.

@@ -14,10 +14,10 @@ def servo(wrist, theta_ref, stiffness, damping, gravity_feedforward: bool = True
     C(theta_ref) of eq 6.16 when `gravity_feedforward`.
 
     Args:
-        wrist: the `CarpalWrist`.
-        theta_ref: the input angles to hold [rad], shape (3,).
-        stiffness: proportional gain [N m/rad], a scalar or shape (3,).
-        damping: derivative gain [N m s/rad], a scalar or shape (3,).
+        wrist (CarpalWrist): the `CarpalWrist`.
+        theta_ref (Array): the input angles to hold [rad], shape (3,).
+        stiffness (float | Array): proportional gain [N m/rad], a scalar or shape (3,).
+        damping (float | Array): derivative gain [N m s/rad], a scalar or shape (3,).
         gravity_feedforward: add C(theta_ref), the torques that hold theta_ref against gravity.
 
     Returns:
