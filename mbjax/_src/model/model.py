@@ -76,43 +76,46 @@ class Model(eqx.Module):
     `strict=True` makes it an error.
 
     Args:
-        parents: each body's parent, shape (n,), parents[k] < k or -1 for a base body; or a
-            `Topology`.
-        joint_types: each joint's type, one of "revolute", "prismatic", "universal",
-            "spherical", "free" (a sequence of n, or one string for all).
-        mass: body masses, shape (n,) [kg].
-        inertia: inertias about each centre of mass in the body frame, shape (n, 3, 3)
+        parents (Sequence[int] | Topology): each body's parent, shape (n,), parents[k] < k or -1 for
+            a base body; or a `Topology`.
+        joint_types (str | Sequence[str]): each joint's type, one of "revolute", "prismatic",
+            "universal", "spherical", "free" (a sequence of n, or one string for all).
+        mass (ArrayLike): body masses, shape (n,) [kg].
+        inertia (ArrayLike): inertias about each centre of mass in the body frame, shape (n, 3, 3)
             [kg m^2].
-        com: centres of mass in the body frames, shape (n, 3) [m]; zeros by default.
-        axis: joint axes in the joint frames, shape (n, 3), normalized here; z by default.
-        axis2: the universal joints' second axes, shape (n, 3); y by default.
-        placement_rotation: joint k's frame in body parents[k]'s frame (the ground frame for a
-            base body), shape (n, 3, 3); identities by default.
-        placement_translation: the joint frames' origins in the parents' frames, shape (n, 3)
-            [m]; zeros by default.
-        gravity: the ground-frame acceleration of gravity, shape (3,) [m/s^2].
-        names: body names, n strings; "body0", "body1", ... by default.
-        joint_names: joint names, n strings; "joint0", ... by default.
-        lower: lower position limits, shape (nq,) [rad or m]; -inf (none) by default.
-        upper: upper position limits, shape (nq,); inf by default. A revolute joint without
-            limits is a URDF "continuous" joint.
-        velocity_limit: bounds on |v|, shape (nv,); inf (none) by default.
-        effort_limit: bounds on |tau|, shape (nv,) [N m or N]; inf by default.
-        damping: viscous joint damping, a force -damping * v in the dynamics, shape (nv,).
-        armature: rotor inertia reflected to the joint, added to the mass matrix diagonal
-            (Featherstone's ABA adds it to D; MuJoCo's and Pinocchio's armature), shape (nv,).
-        friction: dry friction, shape (nv,), kept as data (not used by the dynamics).
-        frame_names: names of extra frames fixed to bodies (URDF links merged through fixed
-            joints, fixed joints, MJCF sites), m strings; see `mbjax.rigid.frame_pose` and
-            `mbjax.rigid.frame_jacobian`.
-        frame_parents: the body each frame is fixed to (-1: the ground), m ints.
-        frame_rotation: each frame's orientation in its body, shape (m, 3, 3).
-        frame_translation: each frame's origin in its body, shape (m, 3) [m].
-        closures: the loop-closing constraints the model file declares (a URDF's mimic joints
-            as `mbjax.loops.Coupling`s, an MJCF's connect and weld equalities as
+        com (ArrayLike): centres of mass in the body frames, shape (n, 3) [m]; zeros by default.
+        axis (ArrayLike): joint axes in the joint frames, shape (n, 3), normalized here; z by
+            default.
+        axis2 (ArrayLike): the universal joints' second axes, shape (n, 3); y by default.
+        placement_rotation (ArrayLike): joint k's frame in body parents[k]'s frame (the ground frame
+            for a base body), shape (n, 3, 3); identities by default.
+        placement_translation (ArrayLike): the joint frames' origins in the parents' frames, shape
+            (n, 3) [m]; zeros by default.
+        gravity (ArrayLike): the ground-frame acceleration of gravity, shape (3,) [m/s^2].
+        names (Sequence[str] | None): body names, n strings; "body0", "body1", ... by default.
+        joint_names (Sequence[str] | None): joint names, n strings; "joint0", ... by default.
+        lower (ArrayLike): lower position limits, shape (nq,) [rad or m]; -inf (none) by default.
+        upper (ArrayLike): upper position limits, shape (nq,); inf by default. A revolute joint
+            without limits is a URDF "continuous" joint.
+        velocity_limit (ArrayLike): bounds on |v|, shape (nv,); inf (none) by default.
+        effort_limit (ArrayLike): bounds on |tau|, shape (nv,) [N m or N]; inf by default.
+        damping (ArrayLike): viscous joint damping, a force -damping * v in the dynamics, shape
+            (nv,).
+        armature (ArrayLike): rotor inertia reflected to the joint, added to the mass matrix
+            diagonal (Featherstone's ABA adds it to D; MuJoCo's and Pinocchio's armature), shape
+            (nv,).
+        friction (ArrayLike): dry friction, shape (nv,), kept as data (not used by the dynamics).
+        frame_names (Sequence[str]): names of extra frames fixed to bodies (URDF links merged
+            through fixed joints, fixed joints, MJCF sites), m strings; see `mbjax.rigid.frame_pose`
+            and `mbjax.rigid.frame_jacobian`.
+        frame_parents (Sequence[int]): the body each frame is fixed to (-1: the ground), m ints.
+        frame_rotation (ArrayLike): each frame's orientation in its body, shape (m, 3, 3).
+        frame_translation (ArrayLike): each frame's origin in its body, shape (m, 3) [m].
+        closures (tuple): the loop-closing constraints the model file declares (a URDF's mimic
+            joints as `mbjax.loops.Coupling`s, an MJCF's connect and weld equalities as
             `mbjax.loops.CutJoint`s); `TreeSystem(model)` leaves them out and
             `ClosedSystem(TreeSystem(model), model.closures)` enforces them.
-        strict: turn the mass-data warnings into errors.
+        strict (bool): turn the mass-data warnings into errors.
 
     Raises:
         ValueError: an invalid parents array, unknown joint type, wrong number of names, an
