@@ -28,14 +28,26 @@ def cache_folder() -> Path:
 
 
 def use_compilation_cache(folder: str | os.PathLike | None = None) -> Path | None:
-    """Turn on JAX's persistent compilation cache (see the module).
+    """Turn on JAX's persistent compilation cache.
+
+    On by default in the `mbjax` command and the notebooks (not in `mbjax bench`, whose compile
+    times must be compiles).
 
     Args:
         folder: where to keep compiled programs; None for JAX_COMPILATION_CACHE_DIR, else
-            `cache_folder()`. Created if missing.
+            `cache_folder()`: $XDG_CACHE_HOME/mbjax/jax (~/.cache/mbjax/jax). Created if missing.
 
     Returns:
         The folder in use, or None where MBJAX_NO_CACHE is set (the cache stays off).
+
+    The cache:
+        Compiling dominates a first run (a scene compiles for seconds and runs for
+        milliseconds); with the cache, a second run loads the compiled programs from disk.
+        MBJAX_NO_CACHE=1 (or `mbjax --no-cache ...`) leaves JAX's default, no cache, in place. A
+        cached program is the same binary XLA would compile. An entry that cannot be read
+        (truncated, overwritten) is removed, with a warning, when it fails to load, so that the
+        program compiled in its place is written anew: JAX itself warns, recompiles, and never
+        replaces an existing entry, so a corrupt one would cost a compile on every run.
     """
     if os.environ.get("MBJAX_NO_CACHE", "") not in ("", "0"):
         return None

@@ -22,9 +22,10 @@ def beam_body(beam: Beam, basis: ModalBasis, nodes=(), *, clamped_node: int = 0,
               stiffening: bool = True, damping=None) -> ModalBody:
     """The modal body of `beam` in `basis`, ready for a `FlexibleModel`.
 
-    Chains the structural side (see the module docstring): the reduced stiffness, the
-    mass-point cloud, the geometric-stiffening matrices (Anderson 1993 eq 33, Table 1) and the
-    shapes at the attachment points.
+    Chains the structural side (Anderson 1993 §2.2 and the Appendix): the reduced stiffness
+    phi^T K phi, the mass-point cloud of the modal shapes, the 21 inertial and the distal
+    unit-load geometric stiffness matrices (Anderson 1993 eq 33, Table 1) and the shapes at the
+    grid points where other bodies or cut joints attach.
 
     Args:
         beam: the beam.

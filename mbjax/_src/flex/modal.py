@@ -37,8 +37,17 @@ class ModalBasis(eqx.Module):
         shapes: phi in full beam dofs (zero on held dofs), shape (6N, mu).
         frequencies: angular frequency of each column [rad/s], shape (mu,) (nan for constraint
             and static columns that were not orthonormalized).
-        kinds: per column "normal", "constraint", "static" or "reduced" (see the module
-            docstring); static.
+        kinds: per column "normal", "constraint", "static" or "reduced" (the kinds below);
+            static.
+
+    Kinds:
+        "normal": a fixed-interface normal mode; "constraint": a constraint mode; "static": a
+        static-correction mode (`craig_bampton` describes each). With `orthonormalize=True`
+        (`craig_bampton`'s default) the assembled basis is rotated by the eigenvectors of the
+        reduced problem, and `kinds` is then "reduced" for every column (a column mixes
+        origins); when the basis holds only normal modes no rotation is needed or done (kinds
+        "normal"). With `orthonormalize=False` the columns keep their origin in `kinds` and
+        `frequencies` is nan for constraint and static columns.
     """
 
     shapes: jax.Array
@@ -80,8 +89,7 @@ def craig_bampton(beam: Beam, *, clamped_node=0, interface_nodes=(), n_modes=Non
     """Craig-Bampton basis of `beam` clamped at `clamped_node` (Anderson 1993 sec. 2.2, eq (10)).
 
     The columns are the fixed-interface normal modes, then the constraint modes of the
-    interface nodes, then the static-correction modes of `static_load_nodes` (see the module
-    docstring).
+    interface nodes, then the static-correction modes of `static_load_nodes` (the basis below).
 
     Args:
         beam: the beam.
@@ -103,6 +111,26 @@ def craig_bampton(beam: Beam, *, clamped_node=0, interface_nodes=(), n_modes=Non
     Raises:
         ValueError: both or neither of n_modes and cutoff, nodes outside the beam or repeated,
             an empty basis, no interior dofs, or (orthonormalized) linearly dependent columns.
+
+    The basis:
+        The body frame is clamped at the joint grid J^k (`clamped_node`), so rigid motion stays
+        in the joint coordinates and the modal basis holds deformation only (Anderson 1993 eqs
+        (5)-(7) measure phi relative to J^k; here phi is zero at J^k by construction). The
+        basis columns are, in this order:
+
+        - fixed-interface normal modes (J^k and all interface-node dofs held), the lowest
+          `n_modes` or those with angular frequency <= `cutoff`;
+        - constraint modes: static shape for a unit displacement of each free dof of each
+          interface node, the other interface dofs held (Craig and Bampton 1968);
+        - static-correction modes: static shape for a unit load at each free dof of each
+          `static_load_nodes` node, interface held (Anderson 1993 sec. 2.2).
+
+        With `orthonormalize=True` (default) the assembled basis is rotated by the eigenvectors
+        of the reduced problem (phi^T K phi, phi^T M phi), so M_r = I and
+        K_r = diag(frequencies^2), sorted ascending; `kinds` is then "reduced" for every column
+        (a column mixes origins). When the basis holds only normal modes no rotation is needed
+        or done (kinds "normal"). With `orthonormalize=False` the columns keep their origin in
+        `kinds` and `frequencies` is nan for constraint and static columns.
     """
     if (n_modes is None) == (cutoff is None):
         raise ValueError("craig_bampton: give exactly one of n_modes or cutoff")

@@ -29,7 +29,9 @@ class FlexibleModel(eqx.Module):
     """A rigid `model` with some bodies made flexible.
 
     q = (the rigid model's joint coordinates, the flexible bodies' modal coordinates in body
-    order), v likewise (see the module docstring). A flexible body's mass, centre of mass and
+    order), v likewise (u^{B^k} = q_dot^{B^k}, Anderson 1993 eq 19). Per body the modal
+    coordinates are padded to the largest count mu, so every body is a (6 + mu)-block of one
+    stacked `ModalBody`. A flexible body's mass, centre of mass and
     inertia are its ModalBody's (its rigid-body terms); the rigid `model`'s values for that body
     are not used. A rigid part that moves with the body (a hub at the clamp) goes into the
     ModalBody (`rotary`, as `mbjax._src.scenes.slewing_beam` does); a rigid mass that differs
@@ -51,6 +53,15 @@ class FlexibleModel(eqx.Module):
         ValueError: no flexible body or no modes, a body or attachment point that does not
             exist, a child of a flexible body without `attach`, or an `attach` for a child of a
             rigid body.
+
+    The tree (Anderson 1993 §2.1, Figs. 1-2):
+        The tree, its joints and placements and the rigid bodies' inertia are a
+        `mbjax.model.Model`; the flexible bodies are `ModalBody`s that replace the inertia of
+        theirs. A flexible body's frame is its joint grid J^k (the modes are clamped there, as
+        `mbjax.flex.craig_bampton` builds them); a body hanging from a flexible body is attached
+        at one of its parent's grid points (`attach`), whose translation phi_h q and rotation
+        exp(psi_h q) carry the child's joint (eqs 5-8, 20-23). Cut joints of `mbjax.loops`
+        reach grid points of flexible bodies through `markers`.
     """
 
     model: Model

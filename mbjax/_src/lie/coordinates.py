@@ -17,11 +17,18 @@ from mbjax._src.lie import rotation_vector as rv
 
 
 class AbstractRotation(eqx.Module):
-    """How a body's orientation is written in its configuration q (a strategy; see the module).
+    """How a body's orientation is written in its configuration q (a strategy).
 
     Passed as `rotation=` to the systems that carry an orientation (`mbjax.rigid.RigidBody`,
     the scenes' `build`); the concrete strategies `Quaternion()` and `RotationVector()` take
     no arguments. The class attribute `size` is the number of coordinates.
+
+    The strategies:
+        `Quaternion()`: unit quaternions (w, x, y, z), rot_dot = rot * (0, Omega) / 2,
+        normalized after a step. `RotationVector()`: Borri 1990's rotation vector r,
+        r_dot = Gamma(r)^-T Omega (eqs 2.8, A.21, A.24), rescaled to |r| <= pi after a step
+        (eq A.29). Both give the chart about a configuration that implicit integrators use:
+        R = R0 exp(xi), a body-frame increment (`retract`, and `difference` its inverse).
     """
 
     size: eqx.AbstractClassVar[int]

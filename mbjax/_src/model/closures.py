@@ -46,10 +46,11 @@ def _vee_antisym(R: Array) -> Array:
 
 class CutJoint(eqx.Module):
     """A joint between frame A in body `body_a` and frame B in body `body_b` (-1: the ground),
-    cut to make the mechanism a tree; see the module docstring for the residual of each kind.
+    cut to make the mechanism a tree; its residual Phi(q, t) = 0 per kind is listed below.
 
-    Each frame is a placement in its body's frame; the joint's axis is the frame's z axis. For a
-    flexible tree, `body_a` and `body_b` may also be marker frames (n, n + 1, ...).
+    A closed chain is modelled as a spanning tree (`mbjax.model.Model`) plus cut joints. Each
+    frame is a placement (rotation, origin) in its body's frame; the joint's axis is the frame's
+    z axis. For a flexible tree, `body_a` and `body_b` may also be marker frames (n, n + 1, ...).
 
     Args:
         kind: "spherical", "revolute", "universal", "weld", "prismatic", "point_on_line" or
@@ -67,6 +68,21 @@ class CutJoint(eqx.Module):
         ValueError: an unknown kind, the same body twice, the ground as body_a, an origin not
             of shape (3,), or a rotation that is not one (orthonormal within 1e-6, det +1).
         TypeError: body indices that are not ints.
+
+    Residuals:
+        Holonomic constraints Phi(q, t) = 0 (Jerkovsky 1978 eq 85, Anderson 1993 eq 87), from
+        the poses of the two frames (ground components), with their number of equations:
+
+            spherical      p_A - p_B                                                     3
+            revolute       p_A - p_B, z_A . x_B, z_A . y_B                                5
+            universal      p_A - p_B, x_A . y_B          (cross axes x_A and y_B)         4
+            weld           p_A - p_B, vee(R_B^T R_A - R_A^T R_B) / 2                      6
+            prismatic      (p_A - p_B) . x_B, (p_A - p_B) . y_B, vee(...) / 2  (along z_B) 5
+            point_on_line  (p_A - p_B) . x_B, (p_A - p_B) . y_B  (p_A on the line z_B)   2
+            point_on_plane (p_A - p_B) . z_B                     (p_A on the plane z_B)  1
+
+        Planar mechanisms built from revolute cut joints carry redundant equations (a planar
+        loop needs only two); the solvers detect the rank and report it.
     """
 
     kind: str = eqx.field(static=True)

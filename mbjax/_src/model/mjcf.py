@@ -220,7 +220,7 @@ def from_mujoco(mjmodel, *, strict: bool = False) -> Model:
         per_dof["damping"][iv:iv + nv_j] = (m.dof_damping[dofs] + act_damping[j]) * damper
         per_dof["armature"][iv:iv + nv_j] = m.dof_armature[dofs] + act_armature[j]
         if kind == "free" and per_dof["armature"][iv + 3:iv + 6].any():
-            per_dof["armature"][iv + 3:iv + 6] = 0.0       # see the module docstring
+            per_dof["armature"][iv + 3:iv + 6] = 0.0       # see load_mjcf's docstring
             free_armature += 1
         per_dof["friction"][iv:iv + nv_j] = m.dof_frictionloss[dofs]
         if m.jnt_actfrclimited[j]:

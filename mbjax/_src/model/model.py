@@ -64,10 +64,11 @@ class Model(eqx.Module):
     Build it with `Model(parents, joint_types, ...)`, the builders `mbjax.model.chain` and
     `mbjax.model.random_tree`, or the loaders `mbjax.load_urdf` and `mbjax.load_mjcf`. Body k
     hangs from body parents[k] (-1: the ground) through joint k; q (nq,) and v (nv,) are the
-    joints' own coordinates concatenated in body order (see the module). Topology, joint types
-    and names are static; every array is a leaf that can be differentiated, vmapped and swept.
-    Per-body arrays have a leading axis of n bodies; a per-body argument given for one body is
-    broadcast to all of them.
+    joints' own coordinates concatenated in body order (the loaders number bodies depth-first,
+    children in document order, as Pinocchio does). Topology, joint types and names
+    are static (hashable; changing them recompiles); every array is a leaf that can be
+    differentiated, vmapped and swept without recompiling. Per-body arrays have a leading axis
+    of n bodies; a per-body argument given for one body is broadcast to all of them.
 
     Limits are data (bounds for trajectory optimisation, `mbjax._src.model.limits.excess`,
     checked by `TreeSystem.check` in `simulate`'s status), not contact forces. Bodies with

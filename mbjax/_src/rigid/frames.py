@@ -39,10 +39,13 @@ def frame_placement(model: Model, name: str) -> tuple[int, Array, Array]:
 
 
 def frame_pose(model: Model, q: Array, name: str) -> tuple[Array, Array]:
-    """World pose of the frame, body or joint called `name` (looked up as the module says).
+    """World pose of the frame, body or joint called `name`.
 
-    The name is resolved to its body and placement before tracing, so one compiled program
-    serves every frame of a model.
+    A name is looked up among the model's named frames (URDF links merged through fixed joints
+    and the fixed joints themselves, MJCF sites: `Model.frame_names`), then its bodies
+    (`Model.names`, the URDF links or MJCF bodies) and its joints (`Model.joint_names`, whose
+    frame is the body's). The name is resolved to its body and placement before tracing, so one
+    compiled program serves every frame of a model.
 
     Args:
         model: the tree.

@@ -85,7 +85,7 @@ def transformation_operator(model: Model, q: Array) -> tuple[Array, Array]:
 
     sigma = A sigma_bar maps the relative velocities at the hinges to the bodies' primitive
     velocities (omega; v_c), and sigma_bar = A_hat_f v the joint rates to the relative
-    velocities (see the module docstring). For display and checks: the dynamics use the block
+    velocities (the formulation below). For display and checks: the dynamics use the block
     form (`operator_terms`).
 
     Args:
@@ -95,6 +95,26 @@ def transformation_operator(model: Model, q: Array) -> tuple[Array, Array]:
     Returns:
         (A, A_hat_f): shapes (6n, 6n) and (6n, nv), rows body-major (omega_1, v_c1, omega_2,
             ...), world-frame components.
+
+    The formulation (Jerkovsky 1978 §§III-V):
+        Primitive variables (§III): per body the angular velocity omega and the velocity of the
+        centre of mass v_c, sigma = (omega; v_c) (eq 6, stored body by body rather than all
+        omegas first); the primitive mass mu = diag(I_c, M 1) (eq 7a, world-frame inertia about
+        the centre of mass).
+
+        Transformed variables (§IV): the relative velocities sigma_bar = (Omega^j; U^j) at the
+        hinge h_j (eqs 12-13, 16). The transformation operator A (eq 17) follows from the path
+        matrix pi (eq 14):
+
+            omega_k = sum_j pi_kj Omega^j,   v_ck = sum_j pi_kj (Omega^j x R_{c_k h_j} + U^j),
+
+        so its (k, j) block is pi_kj [[1, 0], [-R~_{c_k h_j}, 1]]. The induced mass is
+        mu_bar = A^T mu A (eq 18; its blocks are eq 22's composite inertias).
+
+        Free/constrained split (§V): sigma_bar = A_hat_f sigma_hat_f + A_hat_c sigma_hat_c
+        (eq 49) with A_hat_f the joint axes (Gamma_f, Delta_f of eq 43) in world coordinates;
+        the joint rates are the free velocities sigma_hat_f and sigma_hat_c = 0 for a tree. The
+        generalized mass is mu_hat_ff = A_hat_f^T mu_bar A_hat_f (eq 55).
     """
     terms = operator_terms(model, q, jnp.zeros(model.nv, q.dtype))
     n, w = model.n, model.width

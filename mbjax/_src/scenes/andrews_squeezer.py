@@ -245,7 +245,7 @@ class Squeezer(NamedTuple):
 
 
 def build() -> Squeezer:
-    """Andrews' squeezing mechanism of the IVP test set (see the module).
+    """Andrews' squeezing mechanism of the IVP test set (see `mbjax.scenes.andrews_squeezer`).
 
     Returns:
         A `Squeezer` (tree, closures, spring, tau, q0, v0); `.system()` closes it.

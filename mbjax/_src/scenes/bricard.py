@@ -78,7 +78,8 @@ def model(section=SECTION) -> Model:
 
 
 def joint_angles(phi):
-    """The tree coordinates on the mechanism's motion at parameter phi (closed form, see the module).
+    """The tree coordinates on the mechanism's motion at parameter phi (closed form, see
+    `mbjax.scenes.bricard`).
 
     Args:
         phi: the angle of the joints at P1, P3 and P5 [rad]; sin(phi) > -1/2.

@@ -195,7 +195,15 @@ def train_controller(controller: NeuralController, wrist, episodes: Episodes, *,
                      effort_weight: float = 0.1, gradient: str = "reverse", end_power: float = 2.0,
                      robust: bool = True):
     """Train the controller's MLP through the simulator: Adam on the batch mean of the episode
-    cost J (see the module docstring).
+    cost J (the cost below).
+
+    Canfield 1997 §6.1: 'the simulation environment can be used to train a neural network
+    control system'. Training rolls out a batch of random (start, target) pairs with `simulate`
+    (vmapped), and descends with optax's Adam on the mean over episodes of log(1 + J)
+    (robust=True; the plain mean of J with robust=False). The controller's PD part keeps the
+    open-loop unstable wrist (an inverted pendulum with massless legs) inside its workspace
+    from the first iteration, so gradients exist; the network learns what the soft servo lacks
+    (speed, the coupling of the legs, gravity away from theta*).
 
     Reverse-mode gradients by default: the network's weights outnumber what forward mode does
     cheaply (see `mbjax._src.trajopt.descent.adam_descent`). The whole descent is one jitted
@@ -222,6 +230,21 @@ def train_controller(controller: NeuralController, wrist, episodes: Episodes, *,
 
     Raises:
         ValueError: gradient is neither "forward" nor "reverse".
+
+    The episode cost:
+        J is the tracking cost
+
+            J = sum_k (t_k / T)^e |y(t_k) - y*|^2 / (tol^2 sum_k (t_k / T)^e)
+                + |theta_dot(T)|^2 / omega_tol^2 + w mean_k |tau(t_k)|^2 / limit^2,
+
+        y = (p / l, g) the pose in the midplane chart, t_k the saved times, weighted towards
+        the end by (t_k / T)^e, e = end_power = 2 (the start is far from the target by
+        construction). The logarithm keeps a few far-off episodes from dominating the mean,
+        which otherwise trades the many near misses for them (training results in
+        benchmarks/README.md). The reverse-mode gradient (`jax.value_and_grad`) costs a few
+        forward passes for the network's hundred-odd weights, where `jax.jacfwd` would carry
+        one tangent per weight. Success on held-out targets (`evaluate_controller`): the final
+        pose within `kinematics.pose_error` < `success_tolerance`.
     """
     weights, rebuild = jax.flatten_util.ravel_pytree(eqx.filter(controller.mlp, eqx.is_inexact_array))
     static_mlp = eqx.filter(controller.mlp, eqx.is_inexact_array, inverse=True)

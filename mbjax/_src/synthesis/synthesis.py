@@ -77,10 +77,17 @@ def synthesize(wrist, theta0: Array, goal, *, duration: float, torque_limit: flo
                pose_tolerance: float = 1e-3, speed_tolerance: float = 1e-2, effort_weight: float = 0.1,
                integrator=RK4(), init: CubicSpline | None = None, throw: bool = False) -> Synthesis:
     """Torque splines that move the wrist from rest at theta0 to rest at goal = (plunge, slope)
-    in `duration` with least effort, |tau_i| <= torque_limit; see the module docstring.
+    in `duration` with least effort, |tau_i| <= torque_limit (the objective below).
 
-    The gradient is forward mode (`jax.jacfwd` over the 3 n_knots spline values): for a few dozen
-    parameters it compiles several times faster than reverse mode through the rollout's scan.
+    Gradient-based trajectory synthesis, Canfield 1997's stated purpose (§6.1: 'use the
+    simulation environment as part of an optimization routine solving trajectory synthesis
+    problems'). The unknowns are the motors' torque histories, cubic B-splines saturated at the
+    torque limit (`mbjax.control.CubicSpline` with a limit). Each evaluation of the objective J
+    runs the simulator (`mbjax.simulate`, RK4 by default); optax's Adam takes the steps, and
+    the whole descent is one `lax.scan`, so `synthesize` compiles once. The gradient is forward
+    mode through the rollout's `lax.scan` (`jax.jacfwd` over the 3 n_knots spline values): for
+    a few dozen parameters it compiles several times faster than reverse mode through the
+    rollout's scan.
     The result's figures come from the same discrete rollout; re-simulate `spline` with a finer
     or higher-order integrator to see the continuous-time miss (`mbjax reproduce carpal-wrist`).
 
@@ -110,6 +117,15 @@ def synthesize(wrist, theta0: Array, goal, *, duration: float, torque_limit: flo
 
     Raises:
         equinox.EquinoxRuntimeError: with throw=True, the final rollout failed.
+
+    The objective:
+        The effort int |tau|^2 dt plus penalties that bring the tool to the goal pose at rest
+        at t = duration:
+
+            J = |(p(T) - p*) / l|^2 / tol^2 + |g(T) - g*|^2 / tol^2
+                + |theta_dot(T)|^2 / omega_tol^2 + w int |tau|^2 dt / (limit^2 T),
+
+        with (p, g) the midplane chart of the final pose.
     """
     theta0 = jnp.asarray(theta0, dtype=float)
     goal_p, goal_g = (jnp.asarray(x, dtype=float) for x in goal)

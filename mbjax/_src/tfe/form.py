@@ -49,7 +49,20 @@ class AbstractForm(eqx.Module):
     A strategy passed to `solve_tfe` (`Mixed()`, `PrimalUnsymmetric()`, ...). It turns the
     element's weak form into a square nonlinear system residual(U; z_1) = 0 in its unknowns U,
     given the state at the element's start z_1 = (p_1, q_1), and gives the end state
-    z_2 = final(U; z_1) once converged (see the module). The concrete forms take no arguments.
+    z_2 = final(U; z_1) once converged (the system below). The concrete forms take no
+    arguments.
+
+    The system:
+        In the unknowns U, given the state at the element's start z_1 = (p_1, q_1):
+
+            residual(U; z_1) = 0    (the test rows of the initial and interior nodes, eqs 5.3,
+                                     5.8),
+            z_2 = final(U; z_1)     (the end state from the last test row, once converged).
+
+        p is the momentum conjugate to the form's test function: p_hat = (h, l) for the forms
+        tested by the virtual rotation theta_delta, p = X^T p_hat (eq 3.17) for the symmetric
+        primal form tested by delta q. `to_form`/`from_form` convert. Integrals over the
+        element are Gauss sums.
     """
 
     name: eqx.AbstractClassVar[str]

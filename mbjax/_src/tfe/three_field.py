@@ -24,8 +24,21 @@ from mbjax._src.tfe.reference import Reference, X_inverse, configuration, w_n
 class ThreeField(AbstractForm):
     """The three-field form (Borri 1990 eqs 3.34, B.42-B.45): q, w and p_hat independent.
 
-    The unknowns are the n - 1 trial nodes of (p_hat, q, w) (see the module). Takes no
-    arguments.
+    The Hu-Washizu form of rigid-body dynamics: coordinates q, velocity w and momentum p_hat
+    all independent. The unknowns are the n - 1 trial nodes of (p_hat, q, w) (the form below).
+    Takes no arguments.
+
+    The form:
+            int [ dq_hat . (f_hat - S_1(w) M6 w) + d*w . (M6 w - p_hat) - d*p . X^-1 (w - w_n)
+                  + d/dt(d*p, dq_hat) . I_S (p_hat, q) ] dt
+                = (d*p, dq_hat) . I_S (p_b, q_b) |_t1^t2
+
+        (dL/dw = M6 w for the kinetic Lagrangian, eq B.47). The fields (p_hat, q, w) share the
+        n - 1 trial functions of the mixed form (eq 5.7); (d*p, dq_hat) take the n test
+        functions and the virtual velocity d*w the trial functions, so that the constitutive
+        law is a Galerkin projection. The (d*p, dq_hat) rows are those of the mixed form with w
+        in place of M6^-1 p_hat; the d*w rows are interior equations. Eighteen unknowns per
+        trial node for a free body, as the paper notes.
     """
 
     name = "three_field"
