@@ -4,15 +4,8 @@
 A closed chain is modelled as a spanning tree (`mbjax.model.Model`) plus cut joints. A cut joint
 ties a frame A fixed in body `body_a` to a frame B fixed in body `body_b` (or in the ground,
 body_b = -1); each frame is a placement (rotation, origin) in its body's frame, and the joint's
-axis is the frame's z axis. Its residual, from the poses of the two frames (ground components):
-
-    spherical      p_A - p_B                                                     3
-    revolute       p_A - p_B, z_A . x_B, z_A . y_B                                5
-    universal      p_A - p_B, x_A . y_B          (cross axes x_A and y_B)         4
-    weld           p_A - p_B, vee(R_B^T R_A - R_A^T R_B) / 2                      6
-    prismatic      (p_A - p_B) . x_B, (p_A - p_B) . y_B, vee(...) / 2  (along z_B) 5
-    point_on_line  (p_A - p_B) . x_B, (p_A - p_B) . y_B  (p_A on the line z_B)   2
-    point_on_plane (p_A - p_B) . z_B                     (p_A on the plane z_B)  1
+axis is the frame's z axis. Its residual for each kind, with its number of equations, is in
+`CutJoint`'s docstring.
 
 A `Coupling` ties one configuration coordinate to another, q_a = multiplier q_b + offset (URDF's
 mimic joints, which `load_urdf` returns in `Model.closures`; the form of MJCF's joint equality,
@@ -21,8 +14,8 @@ q_j = q0 + rate t (a rheonomic constraint,
 e.g. a crank turning at constant speed), or q_j = motion(t) for any differentiable motion (a
 spin-up profile): its velocity and acceleration terms come from autodiff in t.
 
-Planar mechanisms built from revolute cut joints carry redundant equations (a planar loop needs
-only two); the solvers detect the rank and report it, see `mbjax._src.loops.coupled`.
+Planar mechanisms' redundant equations are detected and reported by the solvers
+(`mbjax._src.loops.coupled`).
 """
 
 from collections.abc import Callable
