@@ -8,12 +8,13 @@ concurrency scheduling, the classic fusion emitter, synchronous dispatch (MBJAX_
 turns them off).
 
 The names below are the everyday ones; each topic has its namespace: `mbjax.lie`, `mbjax.model`,
-`mbjax.control`, `mbjax.rigid`, `mbjax.flex`, `mbjax.loops`, `mbjax.tfe`, `mbjax.wrist`,
+`mbjax.control`, `mbjax.contact`, `mbjax.rigid`, `mbjax.flex`, `mbjax.loops`, `mbjax.tfe`, `mbjax.wrist`,
 `mbjax.integrate`, `mbjax.trajopt`, `mbjax.scenes`, `mbjax.data`.
 """
 
 from mbjax._src import runtime as _runtime  # first: it sets XLA_FLAGS before JAX starts its backend
 
+from mbjax import contact as contact
 from mbjax import control as control
 from mbjax import data as data
 from mbjax import flex as flex

@@ -26,14 +26,15 @@ LAYERS = (
     {"rigid", "wrist"},
     {"flex"},                         # flexible bodies reuse the rigid kinematics
     {"loops", "tfe"},
+    {"contact"},                      # contacts with the ground: closures of a legged robot
     {"integrate"},
     {"trajopt"},
     {"synthesis", "scenes"},          # the Carpal Wrist's synthesis; the ready-made scenes
 )
 RANK = {name: rank for rank, names in enumerate(LAYERS) for name in names}
 NAMESPACES = ("lie", "model", "control", "integrate", "rigid", "flex", "loops", "tfe", "wrist",
-              "trajopt", "scenes", "data")
-MAX_PUBLIC_NAMES = 150
+              "trajopt", "scenes", "data", "contact")
+MAX_PUBLIC_NAMES = 160       # 150, and the contact namespace (legged robots)
 
 
 def _imports(path: Path):

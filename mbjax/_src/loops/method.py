@@ -58,6 +58,12 @@ class AbstractLoopMethod(eqx.Module):
         """The constraint loads on the rows of A at (t, q, u), shape (m,) (arguments as
         `acceleration`)."""
 
+    def multipliers(self, loops, t: Array, q: Array, u: Array) -> Array:
+        """The Lagrange multipliers K_c of the rows of A at (t, q, u), shape (m,), whatever the
+        method's own sign of `loads`: A^t K_c is the generalized constraint force (Jerkovsky
+        1978 eq 93). `loads` by default (arguments as `acceleration`)."""
+        return self.loads(loops, t, q, u)
+
 
 def require_symmetric(method: str, tree) -> None:
     """The dense routes need M(q) v_dot + bias = 0 with a symmetric M."""

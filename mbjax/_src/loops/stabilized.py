@@ -135,3 +135,7 @@ class Stabilized(AbstractLoopMethod):
         if self.epsilon == 0.0:
             return stabilized_acceleration(loops, q, self.velocity(loops, q, u), t)[1]
         return u[loops.tree.nv:]
+
+    def multipliers(self, loops, t, q, u):
+        """K_c = -f_c."""
+        return -self.loads(loops, t, q, u)

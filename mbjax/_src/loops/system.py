@@ -175,6 +175,21 @@ class ClosedSystem(AbstractSystem):
         """
         return self.method.loads(self.loops, t, q, u)
 
+    def multipliers(self, t, q: Array, u: Array) -> Array:
+        """The Lagrange multipliers K_c of the rows of A at a state, for every method alike.
+
+        Args:
+            t: time [s], a scalar.
+            q: configuration, shape (nq,).
+            u: the method's velocity state.
+
+        Returns:
+            K_c, shape (m,): A^t K_c is the generalized constraint force (Jerkovsky 1978 eq 93);
+                for a closure on the ground whose residual is a point's position in world
+                components, its three multipliers are the force on that point.
+        """
+        return self.method.multipliers(self.loops, t, q, u)
+
     # -- AbstractSystem ---------------------------------------------------------------------------
 
     def kinematics(self, q, u):

@@ -1,0 +1,1 @@
+"""Contacts with the ground: holding feet as closures, their wrenches, impulses."""

@@ -1,0 +1,58 @@
+"""The impulse at touchdown: the velocity jump that brings contacts that start to rest."""
+
+from collections.abc import Sequence
+
+import jax
+import jax.numpy as jnp
+from jax import Array
+
+from mbjax._src.contact.contact import AbstractContact
+from mbjax._src.contact.stance import _contacts
+from mbjax._src.loops.constraints import Loops
+from mbjax._src.loops.multipliers import multipliers
+from mbjax._src.model.model import Model
+from mbjax._src.rigid.system import TreeSystem
+
+
+@jax.jit
+def _impulse(model: Model, q: Array, v: Array, contacts: tuple) -> tuple[Array, Array]:
+    closures = tuple(c.closure(model, q) for c in contacts)
+    tree = TreeSystem(model)
+    A = Loops(tree, closures).jacobian(q)
+    factor = jax.scipy.linalg.cho_factor(tree.mass_matrix(q))
+    nu_At = jax.scipy.linalg.cho_solve(factor, A.T)
+    # (A M^-1 A^t) Lambda = -A v-: the impulses that leave A v+ = 0
+    Lambda, _ = multipliers(A @ nu_At, -(A @ v))
+    starts = [sum(c.size for c in contacts[:i]) for i in range(len(contacts))]
+    wrenches = jnp.stack([c.wrench(Lambda[s:s + c.size], j.rotation_b)
+                          for c, j, s in zip(contacts, closures, starts, strict=True)])
+    return v + nu_At @ Lambda, wrenches
+
+
+def impulse(model: Model, q: Array, v: Array, contacts: Sequence[AbstractContact]) -> tuple[Array, Array]:
+    """The velocity just after contacts start, and the ground's impulses that make it.
+
+    A perfectly inelastic touchdown of rigid bodies: the contacts' frames stop at once, in
+    the impulse map v+ = v- + M^-1 A^t Lambda with A v+ = 0 (Crocoddyl's
+    `ActionModelImpulseFwdDynamics`, Pinocchio's `impulseDynamics` with no restitution), where A
+    is the contacts' constraint Jacobian and Lambda their impulses. The configuration does not
+    move. Redundant contacts (more constraints than the motion has) get the least-squares
+    impulses.
+
+    Args:
+        model: the robot.
+        q: the configuration at touchdown, shape (nq,).
+        v: the velocity just before, shape (nv,).
+        contacts: every contact held after the touchdown (those already on the ground too,
+            whose frames are at rest).
+
+    Returns:
+        (v_plus, impulses): the velocity after, shape (nv,); and the ground's impulse on each
+        contact's frame, (angular; linear) in world components at its origin [N m s; N s],
+        shape (len(contacts), 6).
+
+    Raises:
+        TypeError: contacts are not contacts.
+        KeyError: a contact's frame is not in the model.
+    """
+    return _impulse(model, jnp.asarray(q, float), jnp.asarray(v, float), _contacts(contacts))

@@ -1,0 +1,18 @@
+"""Contacts with the ground (legged robots): a frame held on the ground is a closure with the
+ground (Jerkovsky 1978 §VI), so a contact phase is a `mbjax.loops.ClosedSystem`:
+
+    phase = stance(TreeSystem(model), q, [PointContact("LF_FOOT"), ...])
+
+`contact_wrenches` gives the ground's reactions, `impulse` the velocity jump at touchdown.
+"""
+
+from mbjax._src.contact.contact import AbstractContact as AbstractContact
+from mbjax._src.contact.contact import PointContact as PointContact
+from mbjax._src.contact.contact import SurfaceContact as SurfaceContact
+from mbjax._src.contact.impulse import impulse as impulse
+from mbjax._src.contact.stance import contact_wrenches as contact_wrenches
+from mbjax._src.contact.stance import stance as stance
+
+__all__ = [
+    "AbstractContact", "PointContact", "SurfaceContact", "stance", "contact_wrenches", "impulse",
+]

@@ -1,0 +1,131 @@
+"""Contacts with the ground (issue 45) against Pinocchio's `constraintDynamics` and
+`impulseDynamics` on robots no one here wrote: ANYmal on its four feet (point contacts) and
+Talos on its two soles (surface contacts), both from example-robot-data, with Crocoddyl's
+Baumgarte gains (Kp, Kd) = (0, 50) in both engines; the O(n + m^3) route against the dense one."""
+
+import jax
+import jax.numpy as jnp
+import numpy as np
+import pytest
+
+import mbjax
+from mbjax._src.contact.stance import CROCODDYL_GAINS
+from mbjax.contact import PointContact, SurfaceContact, contact_wrenches, impulse, stance
+from mbjax.control import Constant
+from mbjax.loops import Coupled, Stabilized
+from mbjax.model import state_to_pinocchio
+from mbjax.rigid import TreeSystem, frame_jacobian
+
+pin = pytest.importorskip("pinocchio")
+
+ANYMAL = ("anymal_b_simple/anymal", ["LF_FOOT", "LH_FOOT", "RF_FOOT", "RH_FOOT"], PointContact)
+TALOS = ("talos_data/talos_reduced", ["left_sole_link", "right_sole_link"], SurfaceContact)
+
+
+def _path(name: str):
+    from mbjax_harness.reproduce import urdf_corpus
+    try:
+        paths = urdf_corpus.corpus_paths()
+    except Exception as err:          # PackageNotFoundError
+        pytest.skip(f"example-robot-data is not installed ({err})")
+    return next(p for p in paths if urdf_corpus.name(p) == name)
+
+
+def _pinocchio(path, feet, kind, q_pin, v_pin, tau_pin, gains, v_before):
+    """Pinocchio's constrained accelerations and contact forces (LOCAL_WORLD_ALIGNED, (f; tau)
+    per contact) at (q, v), and its impulse map's velocity and impulses from v_before."""
+    pm = pin.buildModelFromUrdf(str(path), pin.JointModelFreeFlyer())
+    pd = pm.createData()
+    contact_type = pin.ContactType.CONTACT_3D if kind is PointContact else pin.ContactType.CONTACT_6D
+    models = []
+    for foot in feet:
+        frame = pm.frames[pm.getFrameId(foot)]
+        model = pin.RigidConstraintModel(contact_type, pm, frame.parentJoint, frame.placement,
+                                         pin.ReferenceFrame.LOCAL_WORLD_ALIGNED)
+        model.setBaumgarteCorrectorParameters(pin.BaumgarteCorrectorParameters(*gains))
+        models.append(model)
+    models = pin.StdVec_RigidConstraintModel(models)
+    datas = pin.StdVec_RigidConstraintData([m.createData() for m in models])
+    settings = pin.ProximalSettings(1e-14, 1e-14, 1)
+    pin.initConstraintDynamics(pm, pd, models, datas)
+    a = pin.constraintDynamics(pm, pd, q_pin, v_pin, tau_pin, models, datas, settings).copy()
+    forces = pd.lambda_c.copy()
+    pin.initConstraintDynamics(pm, pd, models, datas)
+    v_plus = pin.impulseDynamics(pm, pd, q_pin, v_before, models, datas, 0.0, settings).copy()
+    return a, forces, v_plus, pd.impulse_c.copy()
+
+
+def _world_pairs(wrenches, size):
+    """mbjax's (torque; force) per contact as Pinocchio's (f; tau), or (f) for a point."""
+    w = np.asarray(wrenches)
+    return (w[:, 3:] if size == 3 else np.concatenate([w[:, 3:], w[:, :3]], 1)).ravel()
+
+
+def _rel(a, b):
+    return float(np.max(np.abs(np.asarray(a) - np.asarray(b))) / max(1.0, np.max(np.abs(b))))
+
+
+@pytest.mark.parametrize("robot", [ANYMAL, TALOS], ids=["anymal", "talos"])
+def test_contact_dynamics_agree_with_pinocchio(robot):
+    """At a random configuration, velocity and torque: the accelerations and the ground's
+    reactions of `stance` (Coupled, Crocoddyl's gains) equal Pinocchio's `constraintDynamics` on
+    the same contacts; the impulse map equals its `impulseDynamics`. At a state on the contacts
+    (velocity in A's null space) the O(n + m^3) route gives the same motion and reactions."""
+    name, feet, kind = robot
+    path = _path(name)
+    model = mbjax.load_urdf(path, floating_base=True)
+    rng = np.random.default_rng(0)
+    q = model.normalize(jnp.clip(model.home() + jnp.asarray(rng.uniform(-0.2, 0.2, model.nq)),
+                                 model.lower, model.upper))
+    v, tau = jnp.asarray(rng.normal(size=model.nv)), jnp.asarray(rng.normal(size=model.nv))
+    contacts = [kind(foot) for foot in feet]
+    v_before = v
+    v_plus, impulses = impulse(model, q, v_before, contacts)
+    if kind is SurfaceContact:
+        # a moving sole's constraint acceleration is a convention: Pinocchio's 6-D contact holds
+        # the frame's spatial acceleration at zero, a weld its classical one (they differ by
+        # omega x v); on the ground, where the sole is at rest, they are one
+        v = v_plus
+    phase = stance(TreeSystem(model, Constant(tau)), q, contacts)
+    a = phase.acceleration(0.0, q, v)
+    wrenches = contact_wrenches(phase, contacts, 0.0, q, v)
+
+    q_pin, v_pin = (np.asarray(x) for x in state_to_pinocchio(model, q, v))
+    P = np.asarray(jax.jacfwd(lambda v_: state_to_pinocchio(model, q, v_)[1])(v))   # v_pin = P v
+    a_pin, forces, v_plus_pin, impulses_pin = _pinocchio(
+        path, feet, kind, q_pin, v_pin, P @ np.asarray(tau - model.damping * v),   # URDF damping:
+        (0.0, 2 * CROCODDYL_GAINS[0]), P @ np.asarray(v_before))                  # Pinocchio's none
+    assert _rel(P @ np.asarray(a), a_pin) < 1e-9
+    assert _rel(_world_pairs(wrenches, kind.size), forces) < 1e-9
+    assert _rel(P @ np.asarray(v_plus), v_plus_pin) < 1e-9
+    assert _rel(_world_pairs(impulses, kind.size), impulses_pin) < 1e-9
+    # after the impulse every contact frame is at rest
+    for foot in feet:
+        rows = slice(3, 6) if kind is PointContact else slice(0, 6)
+        assert np.abs(np.asarray(frame_jacobian(model, q, foot) @ v_plus)[rows]).max() < 1e-9
+
+    # on the contacts, the O(n + m^3) route equals the dense one (no stabilization acts)
+    coupled = stance(TreeSystem(model, Constant(tau)), q, contacts, method=Coupled())
+    recursive = stance(TreeSystem(model, Constant(tau)), q, contacts, method=Stabilized())
+    on = v_plus
+    a_dense = coupled.acceleration(0.0, q, on)
+    np.testing.assert_allclose(recursive.acceleration(0.0, q, on), a_dense, rtol=1e-8,
+                               atol=1e-8 * float(jnp.abs(a_dense).max()))
+    w_dense = contact_wrenches(coupled, contacts, 0.0, q, on)
+    np.testing.assert_allclose(contact_wrenches(recursive, contacts, 0.0, q, on), w_dense,
+                               rtol=1e-8, atol=1e-8 * float(jnp.abs(w_dense).max()))
+
+
+def test_bad_contacts_are_refused_by_name():
+    model = mbjax.load_urdf(mbjax.data.ARM7)
+    q = model.home()
+    with pytest.raises(KeyError, match="no frame, body or joint named 'toe'"):
+        stance(TreeSystem(model), q, [PointContact("toe")])
+    with pytest.raises(ValueError, match="normal must be a nonzero vector"):
+        PointContact("flange", normal=(0.0, 0.0, 0.0))
+    with pytest.raises(ValueError, match="normal"):
+        SurfaceContact("flange", normal=(0.0, float("nan"), 1.0))
+    with pytest.raises(TypeError, match="contacts must be one or more PointContact"):
+        stance(TreeSystem(model), q, [])
+    with pytest.raises(TypeError, match="tree must be a rigid tree system"):
+        stance(model, q, [PointContact("flange")])
