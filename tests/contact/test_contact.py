@@ -129,3 +129,27 @@ def test_bad_contacts_are_refused_by_name():
         stance(TreeSystem(model), q, [])
     with pytest.raises(TypeError, match="tree must be a rigid tree system"):
         stance(model, q, [PointContact("flange")])
+
+
+def test_anymal_stands_on_its_four_feet():
+    """ANYmal with its legs servoed to a pose, simulated for 1 s on its four feet: the run
+    succeeds, the feet stay where they were (the stabilized closures), and once it has settled
+    the ground carries its weight, the vertical reactions summing to m g (the whole robot's
+    momentum balance, an identity no part of the stance computes)."""
+    from mbjax.control import PD
+    from mbjax.integrate import RK4
+    model = mbjax.load_urdf(_path(ANYMAL[0]), floating_base=True)
+    q0, v0 = model.home().at[2].set(0.5), jnp.zeros(model.nv)
+    feet = [PointContact(foot) for foot in ANYMAL[1]]
+    legs = PD(kp=200.0, kd=10.0, q_ref=q0[7:], q_index=range(7, 19), v_index=range(6, 18))
+    phase = stance(TreeSystem(model, legs, actuation=range(6, 18)), q0, feet)
+    sol = mbjax.simulate(phase, RK4(), q0, v0, dt=1e-3, t1=1.0, saveat=[1.0])
+    assert sol.messages() == ["success"]
+    for foot in feet:
+        moved = (mbjax.rigid.frame_pose(model, sol.qs[-1], foot.frame)[1]
+                 - mbjax.rigid.frame_pose(model, q0, foot.frame)[1])
+        assert float(jnp.abs(moved).max()) < 1e-8
+    wrenches = contact_wrenches(phase, feet, 1.0, sol.qs[-1], sol.us[-1])
+    weight = float(model.mass.sum()) * 9.81
+    assert float(wrenches[:, 5].sum()) == pytest.approx(weight, rel=1e-6)
+    assert np.all(np.asarray(wrenches[:, :3]) == 0.0)       # a point contact carries no torque
