@@ -133,3 +133,11 @@ class SurfaceContact(AbstractContact):
         # relative angular velocity in the ground frame B's components: their multipliers are
         # a torque in B's components
         return jnp.concatenate([rotation @ multipliers[3:6], multipliers[:3]])
+
+
+def wrenches(contacts, closures, multipliers: Array) -> Array:
+    """Each contact's wrench (`AbstractContact.wrench`) from the stacked multipliers of its
+    closure, in order: shape (len(contacts), 6)."""
+    starts = np.cumsum([0] + [c.size for c in contacts])
+    return jnp.stack([c.wrench(multipliers[s:s + c.size], j.rotation_b)
+                      for c, j, s in zip(contacts, closures, starts, strict=False)])

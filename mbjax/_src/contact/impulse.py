@@ -6,7 +6,7 @@ import jax
 import jax.numpy as jnp
 from jax import Array
 
-from mbjax._src.contact.contact import AbstractContact
+from mbjax._src.contact.contact import AbstractContact, wrenches
 from mbjax._src.contact.stance import _contacts
 from mbjax._src.loops.constraints import Loops
 from mbjax._src.loops.multipliers import multipliers
@@ -23,10 +23,7 @@ def _impulse(model: Model, q: Array, v: Array, contacts: tuple) -> tuple[Array, 
     nu_At = jax.scipy.linalg.cho_solve(factor, A.T)
     # (A M^-1 A^t) Lambda = -A v-: the impulses that leave A v+ = 0
     Lambda, _ = multipliers(A @ nu_At, -(A @ v))
-    starts = [sum(c.size for c in contacts[:i]) for i in range(len(contacts))]
-    wrenches = jnp.stack([c.wrench(Lambda[s:s + c.size], j.rotation_b)
-                          for c, j, s in zip(contacts, closures, starts, strict=True)])
-    return v + nu_At @ Lambda, wrenches
+    return v + nu_At @ Lambda, wrenches(contacts, closures, Lambda)
 
 
 def impulse(model: Model, q: Array, v: Array, contacts: Sequence[AbstractContact]) -> tuple[Array, Array]:

@@ -5,7 +5,7 @@ from collections.abc import Sequence
 import jax.numpy as jnp
 from jax import Array
 
-from mbjax._src.contact.contact import AbstractContact
+from mbjax._src.contact.contact import AbstractContact, wrenches
 from mbjax._src.loops.coupled import Coupled
 from mbjax._src.loops.method import AbstractLoopMethod
 from mbjax._src.loops.system import ClosedSystem
@@ -84,7 +84,4 @@ def contact_wrenches(system: ClosedSystem, contacts: Sequence[AbstractContact], 
             (c.size, j.kind) not in ((3, "spherical"), (6, "weld"))
             for c, j in zip(contacts, closures, strict=False)):
         raise ValueError("system must be the stance of these contacts (stance(tree, q, contacts))")
-    K = system.multipliers(t, q, u)
-    starts = [sum(c.size for c in contacts[:i]) for i in range(len(contacts))]
-    return jnp.stack([c.wrench(K[s:s + c.size], j.rotation_b)
-                      for c, j, s in zip(contacts, closures, starts, strict=True)])
+    return wrenches(contacts, closures, system.multipliers(t, q, u))
