@@ -46,13 +46,15 @@ def _free_compiled_code():
     jax.clear_caches()
 
 
-# The longest modules (the notebooks, then the CLI's tour) go first, so the two xdist workers
-# (`-n 2 --dist loadgroup` in pyproject.toml) start on them and fill in with the short ones,
-# instead of finishing on a long module while the other idles. Each module is one xdist group (its
+# The longest modules (the notebooks, the README's blocks and the guide, then the CLI's tour) go
+# first, so the two xdist workers (`-n 2 --dist loadgroup --no-loadscope-reorder` in
+# pyproject.toml: xdist's own reorder, by the number of tests in a group, put these one-test groups
+# last) start on them and fill in with the short ones, instead of finishing on a long module while
+# the other idles. Each module is one xdist group (its
 # compiled programs shared by its tests), except the notebooks and the README's blocks, whose
 # every test runs in a process of its own and may go to either worker.
 _SHARED_OUT = ("test_notebooks.py", "test_readme.py")
-_LONG_FIRST = ("test_notebooks.py", "test_cli.py")
+_LONG_FIRST = ("test_notebooks.py", "test_readme.py", "test_cli.py")
 
 
 @pytest.hookimpl(tryfirst=True)     # before xdist's own, which reads the groups to schedule them

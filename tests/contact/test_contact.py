@@ -15,6 +15,7 @@ from mbjax.control import Constant
 from mbjax.loops import Coupled, Stabilized
 from mbjax.model import state_to_pinocchio
 from mbjax.rigid import TreeSystem, frame_jacobian
+from tests.conftest import example_robots
 
 pin = pytest.importorskip("pinocchio")
 
@@ -23,12 +24,7 @@ TALOS = ("talos_data/talos_reduced", ["left_sole_link", "right_sole_link"], Surf
 
 
 def _path(name: str):
-    from mbjax_harness.reproduce import urdf_corpus
-    try:
-        paths = urdf_corpus.corpus_paths()
-    except Exception as err:          # PackageNotFoundError
-        pytest.skip(f"example-robot-data is not installed ({err})")
-    return next(p for p in paths if urdf_corpus.name(p) == name)
+    return example_robots([name])[0]
 
 
 def _pinocchio(path, feet, kind, q_pin, v_pin, tau_pin, gains, v_before):

@@ -13,6 +13,7 @@ from mbjax.integrate import RK4
 from mbjax.model import chain
 from mbjax.rigid import TreeSystem
 from mbjax.trajopt import Problem
+from tests.conftest import example_robots
 
 LIMIT = 0.5
 
@@ -78,11 +79,8 @@ def test_home_lies_inside_every_limit_of_every_example_robot():
     import warnings
 
     from mbjax.model import load_urdf
-    try:
-        from mbjax_harness.reproduce import urdf_corpus
-        paths = urdf_corpus.corpus_paths()
-    except Exception as err:          # PackageNotFoundError
-        pytest.skip(f"example-robot-data is not installed ({err})")
+    from mbjax_harness.reproduce import urdf_corpus
+    paths = example_robots()
     moved = []
     for path in paths:
         with warnings.catch_warnings():
