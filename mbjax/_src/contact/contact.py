@@ -32,13 +32,29 @@ class AbstractContact(eqx.Module):
     made at a configuration by `closure`: the frame is held where it is there. Its
     multipliers are the ground's reaction on the frame (`contact_wrenches`).
 
+    Args:
+        frame (str): the frame held (a named frame, a body or a joint of the model, as
+            `mbjax.rigid.frame_pose` takes it).
+        normal (ArrayLike): the ground's normal, world components, shape (3,); z by default.
+            Normalized.
+
+    Raises:
+        TypeError: frame is not a name.
+        ValueError: the normal is not a finite nonzero 3-vector.
+
     Attributes:
         size: the number of constraints (3 for a point, 6 for a surface).
     """
 
-    frame: eqx.AbstractVar[str]
-    normal: eqx.AbstractVar[Array]
+    frame: str = eqx.field(static=True)
+    normal: Array
     size: ClassVar[int]
+
+    def __init__(self, frame: str, normal=(0.0, 0.0, 1.0)):
+        if not isinstance(frame, str):
+            raise TypeError(f"frame must be a frame's name, got {type(frame).__name__}")
+        self.frame = frame
+        self.normal = _normal(normal)
 
     @abc.abstractmethod
     def closure(self, model: Model, q: Array) -> CutJoint:
@@ -83,15 +99,7 @@ class PointContact(AbstractContact):
         ValueError: the normal is not a finite nonzero 3-vector.
     """
 
-    frame: str = eqx.field(static=True)
-    normal: Array
     size: ClassVar[int] = 3
-
-    def __init__(self, frame: str, normal=(0.0, 0.0, 1.0)):
-        if not isinstance(frame, str):
-            raise TypeError(f"frame must be a frame's name, got {type(frame).__name__}")
-        self.frame = frame
-        self.normal = _normal(normal)
 
     def closure(self, model, q):
         body, R_f, p_f = frame_placement(model, self.frame)
@@ -112,15 +120,7 @@ class SurfaceContact(AbstractContact):
         ValueError: the normal is not a finite nonzero 3-vector.
     """
 
-    frame: str = eqx.field(static=True)
-    normal: Array
     size: ClassVar[int] = 6
-
-    def __init__(self, frame: str, normal=(0.0, 0.0, 1.0)):
-        if not isinstance(frame, str):
-            raise TypeError(f"frame must be a frame's name, got {type(frame).__name__}")
-        self.frame = frame
-        self.normal = _normal(normal)
 
     def closure(self, model, q):
         body, R_f, p_f = frame_placement(model, self.frame)
