@@ -1,7 +1,6 @@
 """A contact with the ground held fixed: a cut joint between a frame of the robot and the
 ground (Jerkovsky 1978 §VI), in the two kinds Crocoddyl and Pinocchio use for legged robots."""
 
-import abc
 from typing import ClassVar
 
 import equinox as eqx
@@ -44,11 +43,13 @@ class AbstractContact(eqx.Module):
 
     Attributes:
         size: the number of constraints (3 for a point, 6 for a surface).
+        kind: the kind of its cut joint ("spherical" for a point, "weld" for a surface).
     """
 
     frame: str = eqx.field(static=True)
     normal: Array
     size: ClassVar[int]
+    kind: ClassVar[str]
 
     def __init__(self, frame: str, normal=(0.0, 0.0, 1.0)):
         if not isinstance(frame, str):
@@ -56,7 +57,6 @@ class AbstractContact(eqx.Module):
         self.frame = frame
         self.normal = _normal(normal)
 
-    @abc.abstractmethod
     def closure(self, model: Model, q: Array) -> CutJoint:
         """The cut joint that holds the frame at its pose in configuration q.
 
@@ -70,6 +70,10 @@ class AbstractContact(eqx.Module):
         Raises:
             KeyError: the model has no frame, body or joint called `frame`.
         """
+        body, R_f, p_f = frame_placement(model, self.frame)
+        R, p = frame_pose(model, q, self.frame)
+        return CutJoint(self.kind, int(body), GROUND, origin_a=p_f, origin_b=p, rotation_a=R_f,
+                        rotation_b=R)
 
     def wrench(self, multipliers: Array, rotation: Array) -> Array:
         """The ground's wrench on the frame from this contact's multipliers, in world
@@ -100,11 +104,7 @@ class PointContact(AbstractContact):
     """
 
     size: ClassVar[int] = 3
-
-    def closure(self, model, q):
-        body, R_f, p_f = frame_placement(model, self.frame)
-        _, p = frame_pose(model, q, self.frame)
-        return CutJoint("spherical", int(body), GROUND, origin_a=p_f, origin_b=p)
+    kind: ClassVar[str] = "spherical"
 
 
 class SurfaceContact(AbstractContact):
@@ -121,12 +121,7 @@ class SurfaceContact(AbstractContact):
     """
 
     size: ClassVar[int] = 6
-
-    def closure(self, model, q):
-        body, R_f, p_f = frame_placement(model, self.frame)
-        R, p = frame_pose(model, q, self.frame)
-        return CutJoint("weld", int(body), GROUND, origin_a=p_f, origin_b=p, rotation_a=R_f,
-                        rotation_b=R)
+    kind: ClassVar[str] = "weld"
 
     def wrench(self, multipliers, rotation):
         # the weld's rotation rows are vee(R_B^T R_A - R_A^T R_B) / 2, whose rate is the

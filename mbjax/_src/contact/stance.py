@@ -81,7 +81,6 @@ def contact_wrenches(system: ClosedSystem, contacts: Sequence[AbstractContact], 
     contacts = _contacts(contacts)
     closures = system.closures[:len(contacts)]
     if len(closures) < len(contacts) or any(
-            (c.size, j.kind) not in ((3, "spherical"), (6, "weld"))
-            for c, j in zip(contacts, closures, strict=False)):
+            c.kind != j.kind for c, j in zip(contacts, closures, strict=False)):
         raise ValueError("system must be the stance of these contacts (stance(tree, q, contacts))")
     return wrenches(contacts, closures, system.multipliers(t, q, u))
