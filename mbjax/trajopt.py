@@ -1,6 +1,8 @@
-"""Trajectory optimisation for any system: a `Problem`, `solve` with a solver strategy (`ILQR`,
-`MultipleShooting`, `Shooting`), its `Result`, residuals for the common costs, `optimal_cost` for
-co-design, and `sweep` for batches of problems or parameters."""
+"""Trajectory optimisation for any system: a `Problem` (one system, or `Knot`s and `Impulse`s
+through contact phases), `solve` with a solver strategy (`ILQR`, `MultipleShooting`,
+`Shooting`), its `Result`, residuals for the common costs (contact forces and friction cones
+too), a `quasi_static` first guess, `optimal_cost` for co-design, and `sweep` for batches of
+problems or parameters."""
 
 from mbjax._src.trajopt.problem import Problem as Problem
 from mbjax._src.trajopt.solve import solve as solve
@@ -14,8 +16,20 @@ from mbjax._src.trajopt.sweep import sweep as sweep
 from mbjax._src.trajopt.residuals import state_residual as state_residual
 from mbjax._src.trajopt.residuals import frame_residual as frame_residual
 from mbjax._src.trajopt.residuals import control_residual as control_residual
+from mbjax._src.trajopt.residuals import com_residual as com_residual
+from mbjax._src.trajopt.residuals import friction_cone_residual as friction_cone_residual
+from mbjax._src.trajopt.residuals import contact_force_residual as contact_force_residual
+from mbjax._src.trajopt.residuals import barrier_residual as barrier_residual
+from mbjax._src.trajopt.residuals import wrench_cone_residual as wrench_cone_residual
+from mbjax._src.trajopt.knots import AbstractKnot as AbstractKnot
+from mbjax._src.trajopt.knots import Knot as Knot
+from mbjax._src.trajopt.knots import Impulse as Impulse
+from mbjax._src.trajopt.quasi_static import quasi_static as quasi_static
 
 __all__ = [
     "Problem", "solve", "AbstractSolver", "Result", "ILQR", "MultipleShooting", "Shooting",
-    "optimal_cost", "sweep", "state_residual", "frame_residual", "control_residual"
+    "optimal_cost", "sweep", "state_residual", "frame_residual", "control_residual",
+    "com_residual", "friction_cone_residual", "contact_force_residual", "barrier_residual",
+    "wrench_cone_residual",
+    "AbstractKnot", "Knot", "Impulse", "quasi_static",
 ]

@@ -44,6 +44,8 @@ class Example:
     solver: str                 # Crocoddyl's solver: "SolverFDDP" or "SolverBoxDDP"
     to_crocoddyl: Callable      # mbjax states (N + 1, nx) -> Crocoddyl's (N + 1, nx_pin)
     final_error: Callable | None = None     # mbjax q -> the task's remaining error [m]
+    # Crocoddyl's problem -> (mbjax controls (N, nu) -> Crocoddyl's list, an impulse's empty)
+    controls: Callable | None = None
 
 
 def _robot(name: str):

@@ -14,8 +14,8 @@ from mbjax._src.model.model import Model
 from mbjax._src.rigid.system import TreeSystem
 
 
-@jax.jit
-def _impulse(model: Model, q: Array, v: Array, contacts: tuple) -> tuple[Array, Array]:
+def impulse_map(model: Model, q: Array, v: Array, contacts: tuple) -> tuple[Array, Array]:
+    """`impulse` without its checks, to trace inside other programs."""
     closures = tuple(c.closure(model, q) for c in contacts)
     tree = TreeSystem(model)
     A = Loops(tree, closures).jacobian(q)
@@ -53,3 +53,6 @@ def impulse(model: Model, q: Array, v: Array, contacts: Sequence[AbstractContact
         KeyError: a contact's frame is not in the model.
     """
     return _impulse(model, jnp.asarray(q, float), jnp.asarray(v, float), _contacts(contacts))
+
+
+_impulse = jax.jit(impulse_map)

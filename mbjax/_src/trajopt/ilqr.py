@@ -108,7 +108,7 @@ class ILQR(AbstractIterativeSolver):
         1.  linearize about the current trajectory in the state's tangent space (deviations
             dx = difference(x_k, x), so a floating base's quaternion needs nothing special):
             A_k = df/dx, B_k = df/du by `jax.jacfwd` of the problem's integrator step
-            (`Problem.step_jacobians`), and the costs' gradients and Hessians (Gauss-Newton for
+            (`Problem.linearize`), and the costs' gradients and Hessians (Gauss-Newton for
             residual costs, `Problem`), all vmapped over time;
 
         2.  a backward Riccati pass (`lax.scan`, reversed) from V = the terminal cost's expansion:
@@ -246,9 +246,8 @@ class ILQR(AbstractIterativeSolver):
     def _linearize(problem: Problem, xs: Array, us: Array) -> tuple:
         """The dynamics' and costs' expansion about (xs, us): (A, B, l_x, l_u, l_xx, l_ux, l_uu)
         per step and the terminal (V_x, V_xx)."""
-        steps = jnp.arange(problem.horizon)
-        A, B, _ = jax.vmap(problem.step_jacobians)(xs[:-1], us, steps, xs[1:])
-        return (A, B, *jax.vmap(problem.stage_expansion)(xs[:-1], us)), problem.final_expansion(xs[-1])
+        (A, B, _), costs = problem.linearize(xs, us)
+        return (A, B, *costs), problem.final_expansion(xs[-1])
 
     def _backward(self, problem: Problem, expansion: tuple, us: Array, mu: Array):
         """(k, K, (sum k^T Q_u, sum 1/2 k^T Q_uu k), ok): the Riccati pass over an `expansion`

@@ -92,13 +92,11 @@ class MultipleShooting(AbstractSolver):
             The `Result`: the rollout of the final controls, `costs` the merit after each
                 inner iteration.
         """
-        steps = jnp.arange(problem.horizon)
         alphas = jnp.asarray(STEPS, us.dtype)
         nx = problem.ndx
 
         def defects(xs, us):
-            return jax.vmap(lambda x, u, k, y: problem.difference(y, problem.step(x, u, k)))(
-                xs[:-1], us, steps, xs[1:])
+            return problem.defects(xs, us)
 
         def merit(xs, us, lam, rho):
             e = defects(xs, us)
@@ -106,8 +104,7 @@ class MultipleShooting(AbstractSolver):
 
         def direction(xs, us, lam, rho, mu):
             """The Gauss-Newton step (dxs, dus) of the merit, and whether it is finite."""
-            A, B, e = jax.vmap(problem.step_jacobians)(xs[:-1], us, steps, xs[1:])
-            lx, lu, lxx, lux, luu = jax.vmap(problem.stage_expansion)(xs[:-1], us)
+            (A, B, e), (lx, lu, lxx, lux, luu) = problem.linearize(xs, us)
             vx, Vxx = problem.final_expansion(xs[-1])
             eye_x = jnp.eye(nx, dtype=us.dtype)
 

@@ -13,11 +13,12 @@ import jax.numpy as jnp
 import numpy as np
 from jax import Array
 
-from mbjax._src.control import Constant
 from mbjax._src.integrate import RK4
 from mbjax._src.integrate.base import AbstractIntegrator
 from mbjax._src.lie.inputs import check_unit_quaternions
 from mbjax._src.system.system import AbstractSystem
+from mbjax._src.trajopt.costs import _value, as_cost
+from mbjax._src.trajopt.knots import Knot, Schedule
 
 
 class Problem(eqx.Module):
@@ -90,6 +91,7 @@ class Problem(eqx.Module):
     q0: Array
     v0: Array
     running: Callable
+    knots: Schedule | None
     terminal: Callable
     lower: Array
     upper: Array
@@ -99,12 +101,30 @@ class Problem(eqx.Module):
     ndq: int = eqx.field(static=True)   # a configuration deviation's length (nv for a tree)
     bounded: bool = eqx.field(static=True)   # whether lower or upper was given
 
-    def __init__(self, system: AbstractSystem, q0, v0, *, dt: float, horizon: int,
-                 running: Callable, terminal: Callable, lower=None, upper=None,
+    def __init__(self, system, q0, v0, *, dt: float, horizon: int | None = None,
+                 running: Callable | None = None, terminal: Callable, lower=None, upper=None,
                  integrator: AbstractIntegrator = RK4()):
+        self.knots = None
+        if isinstance(system, list | tuple):
+            if running is not None:
+                raise ValueError("running: each knot of a multi-phase problem carries its own "
+                                 "running cost (Knot(system, running)); pass running=None")
+            if horizon is not None and horizon != len(system):
+                raise ValueError(f"horizon must be the number of knots ({len(system)}) or None, "
+                                 f"got {horizon!r}")
+            self.knots = Schedule(system, dt)
+            steps = [k for k in system if isinstance(k, Knot)]
+            if not steps:
+                raise ValueError("knots must include at least one Knot(system, running): a "
+                                 "problem of impulses alone has nothing to control")
+            sizes = {k.system.n_controls for k in steps}
+            if len(sizes) > 1:
+                raise ValueError(f"knots: every Knot's system must have the same number of "
+                                 f"controls, got {sorted(sizes)}")
+            system, running, horizon = steps[0].system, steps[0].running, len(system)
         if not isinstance(system, AbstractSystem):
-            raise TypeError(f"system must be an mbjax system (TreeSystem, ...), got "
-                            f"{type(system).__name__}")
+            raise TypeError(f"system must be an mbjax system (TreeSystem, ...) or a sequence of "
+                            f"knots (Knot, Impulse), got {type(system).__name__}")
         if not isinstance(integrator, AbstractIntegrator):
             raise TypeError(f"integrator must be an instance such as RK4(), got {integrator!r}")
         if not (isinstance(horizon, int | np.integer) and horizon >= 1):
@@ -113,11 +133,7 @@ class Problem(eqx.Module):
                 and not isinstance(dt, bool) and np.ndim(dt) == 0
                 and np.isrealobj(dt) and float(dt) > 0 and np.isfinite(dt)):
             raise ValueError(f"dt must be a positive number, finite, got {dt!r}")
-        running, terminal = (Sum(tuple(c)) if isinstance(c, list | tuple) else c
-                             for c in (running, terminal))
-        if not (callable(running) and callable(terminal)):
-            raise TypeError("running(q, v, u) and terminal(q, v) must be callables returning "
-                            "a scalar cost or a vector of residuals")
+        running, terminal = as_cost(running, "running(q, v, u)"), as_cost(terminal, "terminal(q, v)")
         self.system = system
         self.q0, self.v0 = jnp.asarray(q0, dtype=float), jnp.asarray(v0, dtype=float)
         if self.q0.ndim != 1 or self.v0.ndim != 1:
@@ -176,13 +192,35 @@ class Problem(eqx.Module):
         return x[..., :self.nq], x[..., self.nq:]
 
     def step(self, x: Array, u: Array, k) -> Array:
-        """x_{k+1}: one step of the integrator from t_k = k dt with the control held at u."""
+        """x_{k+1}: knot k's transition from x_k under the control u (a step of the integrator
+        from t_k with the control held at u, or a knot's impulse)."""
+        if self.knots is None:
+            return self._transition(self._knot(), x, u, jnp.asarray(k, x.dtype) * self.dt)
+        t = jnp.asarray(self.knots.times, x.dtype)[k]
+        return self.knots.switch(k, self._transition, x, u, t)
+
+    def _knot(self) -> Knot:
+        """The knot every step of a one-phase problem is."""
+        return Knot(self.system, self.running)
+
+    def _transition(self, knot, x: Array, u: Array, t) -> Array:
         q, v = self.split(x)
-        t = jnp.asarray(k, x.dtype) * self.dt
-        system = self.system.with_control(Constant(u)).hold(t, q, v)
-        q1, v1, _ = self.integrator.step(system, t, q, v, jnp.asarray(self.dt, x.dtype))
-        q1, v1 = system.constrain(t + self.dt, q1, v1)
+        q1, v1 = knot.transition(self.integrator, t, q, v, u, jnp.asarray(self.dt, x.dtype))
         return jnp.concatenate([q1, v1])
+
+    def _map(self, fn: Callable, *args):
+        """fn(knot k, *args[k]) for every knot k, vmapped (over each phase's knots in turn for a
+        multi-phase problem, so that each phase compiles once)."""
+        if self.knots is None:
+            knot = self._knot()
+            return jax.vmap(lambda *a: fn(knot, *a))(*args)
+        return self.knots.map(fn, *args)
+
+    def times(self, dtype=float) -> Array:
+        """Each knot's time t_k, shape (N,): k dt, an impulse taking none."""
+        if self.knots is None:
+            return jnp.arange(self.horizon, dtype=dtype) * self.dt
+        return jnp.asarray(self.knots.times, dtype)
 
     @property
     def ndx(self) -> int:
@@ -216,25 +254,67 @@ class Problem(eqx.Module):
         (q0, v0), (q1, v1) = self.split(x0), self.split(x1)
         return jnp.concatenate([self.system.difference(q0, q1), v1 - v0])
 
-    def step_jacobians(self, x: Array, u: Array, k, x_next: Array):
-        """(A, B, e): the step's Jacobians in the tangent spaces, and its gap.
+    def linearize(self, xs: Array, us: Array) -> tuple:
+        """The dynamics' and running costs' expansion about a trajectory, in the tangent space.
 
-        With F(dx, u) = difference(x_next, step(x (+) dx, u)), A = dF/ddx and B = dF/du at
-        dx = 0 and e = F(0, u), the step's defect against the knot x_next (zero along a
-        rollout). One forward-mode pass for both: one pass per argument would trace the step
+        Per step k: A = dF/ddx and B = dF/du at dx = 0, with F(dx, u) = difference(x_{k+1},
+        step(x_k (+) dx, u)), and the gap e = F(0, u_k) (zero along a rollout); and the stage
+        cost's (l_x, l_u, l_xx, l_ux, l_uu), exact or Gauss-Newton for residuals (see Costs, in
+        `Problem`). One forward-mode pass for A and B: one per argument would trace the step
         twice, which costs more compilation than it saves (see benchmarks/README.md).
+
+        Args:
+            xs: states, shape (N + 1, nx).
+            us: controls, shape (N, nu).
+
+        Returns:
+            ((A, B, e), (l_x, l_u, l_xx, l_ux, l_uu)), each with a first axis of N.
         """
+        return self._map(self._stage, xs[:-1], us, self.times(xs.dtype), xs[1:])
+
+    def _stage(self, knot, x: Array, u: Array, t, x_next: Array):
+        """A knot's ((A, B, e), (l_x, l_u, l_xx, l_ux, l_uu)). A knot's residual costs may
+        depend on its dynamics (a stance's contact forces in a friction cone): in a multi-phase
+        problem the step and the residuals are differentiated in one forward-mode pass, so the
+        dynamics are traced once for both (a phase compiles in a quarter of the time)."""
+        zero_q, zero_v = jnp.zeros(self.ndq, x.dtype), jnp.zeros(self.nv, x.dtype)
+        running = self._about(x, knot.running)
+        if self.knots is None or not _is_residual(running, zero_q, zero_v, u):
+            return self._jacobians(knot, x, u, t, x_next), self._expansion(knot, x, u)
+
+        def both(dx, u):
+            gap = self.difference(x_next, self._transition(knot, self.integrate(x, dx), u, t))
+            out = (gap, running(dx[:self.ndq], dx[self.ndq:], u))
+            return out, out
+
+        ((A, B), (Jx, Ju)), (e, r) = jax.jacfwd(both, argnums=(0, 1), has_aux=True)(
+            jnp.zeros(self.ndx, x.dtype), u)
+        dt = self._weight(knot, x.dtype)
+        return (A, B, e), (Jx.T @ r * dt, Ju.T @ r * dt, Jx.T @ Jx * dt, Ju.T @ Jx * dt,
+                           Ju.T @ Ju * dt)
+
+    def defects(self, xs: Array, us: Array) -> Array:
+        """Each step's gap e_k = difference(x_{k+1}, step(x_k, u_k)), shape (N, ndx): zero along
+        a rollout, a multiple-shooting iterate's defects elsewhere."""
+        return self._map(lambda knot, x, u, t, y: self.difference(
+            y, self._transition(knot, x, u, t)), xs[:-1], us, self.times(xs.dtype), xs[1:])
+
+    def _jacobians(self, knot, x: Array, u: Array, t, x_next: Array):
         def gap(dx, u):
-            out = self.difference(x_next, self.step(self.integrate(x, dx), u, k))
+            out = self.difference(x_next, self._transition(knot, self.integrate(x, dx), u, t))
             return out, out
 
         (A, B), e = jax.jacfwd(gap, argnums=(0, 1), has_aux=True)(
             jnp.zeros(self.ndx, x.dtype), u)
         return A, B, e
 
-    def stage_cost(self, x: Array, u: Array) -> Array:
-        """running(q, v, u) dt (1/2 |r|^2 dt for residuals r)."""
-        return _value(self.running(*self.split(x), u)) * self.dt
+    def _weight(self, knot, dtype):
+        """A knot's running cost weight: dt for a rate, 1 for an impulse's cost."""
+        return jnp.asarray(self.dt if knot.rate else 1.0, dtype)
+
+    def _stage_cost(self, knot, x: Array, u: Array) -> Array:
+        """running(q, v, u) dt (1/2 |r|^2 dt for residuals r); an impulse's not times dt."""
+        return _value(knot.running(*self.split(x), u)) * self._weight(knot, x.dtype)
 
     def final_cost(self, x: Array) -> Array:
         return _value(self.terminal(*self.split(x)))
@@ -244,18 +324,17 @@ class Problem(eqx.Module):
         q, v = self.split(x)
         return lambda dq, dv, *rest: fn(self.system.retract(q, dq), v + dv, *rest)
 
-    def stage_expansion(self, x: Array, u: Array):
-        """(l_x, l_u, l_xx, l_ux, l_uu) of the stage cost at (x, u) in the tangent space:
-        exact, or Gauss-Newton for residuals (see Costs, in `Problem`)."""
+    def _expansion(self, knot, x: Array, u: Array):
+        """(l_x, l_u, l_xx, l_ux, l_uu) of a knot's stage cost at (x, u) in the tangent space."""
         zero_q, zero_v = jnp.zeros(self.ndq, x.dtype), jnp.zeros(self.nv, x.dtype)
-        running = self._about(x, self.running)
+        running, dt = self._about(x, knot.running), self._weight(knot, x.dtype)
         if _is_residual(running, zero_q, zero_v, u):
             (Jq, Jv, Ju), r = _jacobian_and_value(running, zero_q, zero_v, u)
-            Jx, dt = jnp.concatenate([Jq, Jv], axis=1), self.dt
+            Jx = jnp.concatenate([Jq, Jv], axis=1)
             return (Jx.T @ r * dt, Ju.T @ r * dt, Jx.T @ Jx * dt, Ju.T @ Jx * dt, Ju.T @ Ju * dt)
 
         def cost(dx, u):
-            return _value(running(dx[:self.ndq], dx[self.ndq:], u)) * self.dt
+            return _value(running(dx[:self.ndq], dx[self.ndq:], u)) * dt
 
         dx = jnp.zeros(self.ndx, x.dtype)
         (lx, lu), ((lxx, _), (lux, luu)) = (jax.grad(cost, argnums=(0, 1))(dx, u),
@@ -263,7 +342,7 @@ class Problem(eqx.Module):
         return lx, lu, lxx, lux, luu
 
     def final_expansion(self, x: Array):
-        """(V_x, V_xx) of the terminal cost at x in the tangent space, as `stage_expansion`."""
+        """(V_x, V_xx) of the terminal cost at x in the tangent space, as `linearize`."""
         zero_q, zero_v = jnp.zeros(self.ndq, x.dtype), jnp.zeros(self.nv, x.dtype)
         terminal = self._about(x, self.terminal)
         if _is_residual(terminal, zero_q, zero_v):
@@ -295,7 +374,7 @@ class Problem(eqx.Module):
 
     def cost(self, xs: Array, us: Array) -> Array:
         """The objective of a trajectory (xs from `rollout`)."""
-        return jnp.sum(jax.vmap(self.stage_cost)(xs[:-1], us)) + self.final_cost(xs[-1])
+        return jnp.sum(self._map(self._stage_cost, xs[:-1], us)) + self.final_cost(xs[-1])
 
     def objective(self, us: Array) -> Array:
         """The objective as a function of the controls alone (single shooting).
@@ -331,14 +410,6 @@ class Problem(eqx.Module):
         return xs.at[0].set(self.x0)
 
 
-def _value(c: Array) -> Array:
-    """A cost function's output as a cost: itself, or 1/2 |r|^2 for residuals r."""
-    c = jnp.asarray(c)
-    if c.ndim > 1:
-        raise ValueError(f"a cost must return a scalar or a vector of residuals, got shape {c.shape}")
-    return 0.5 * c @ c if c.ndim == 1 else c
-
-
 def _is_residual(fn: Callable, *args) -> bool:
     return len(jax.eval_shape(fn, *args).shape) == 1
 
@@ -354,16 +425,3 @@ def _jacobian_and_value(fn: Callable, *args):
         return jax.jacfwd(partial, has_aux=True)(args[i])
     jacobians, values = zip(*(with_value(i) for i in range(len(args))), strict=True)
     return jacobians, values[0]
-
-
-class Sum(eqx.Module):
-    """A sum of cost functions: their residuals stacked where each returns residuals, else the
-    sum of their values (a residual vector r counting 1/2 |r|^2)."""
-
-    terms: tuple
-
-    def __call__(self, *args) -> Array:
-        values = [jnp.asarray(term(*args)) for term in self.terms]
-        if all(v.ndim == 1 for v in values):
-            return jnp.concatenate(values)
-        return sum(_value(v) for v in values)

@@ -11,9 +11,15 @@ reuses the compiled solve. A tuple of them is their sum (`Problem`'s running and
 
 import equinox as eqx
 import jax.numpy as jnp
+import numpy as np
 from jax import Array
 
+from mbjax._src.contact.contact import wrenches
+from mbjax._src.contact.stance import _contacts
+from mbjax._src.control import Constant
 from mbjax._src.lie import gamma_inv, log
+from mbjax._src.lie.inputs import check_point
+from mbjax._src.rigid.centre import center_of_mass
 from mbjax._src.rigid.frames import frame_pose
 
 
@@ -137,3 +143,248 @@ def control_residual(nu: int, u_ref=None, weight=1.0) -> eqx.Module:
     """
     u_ref = jnp.zeros(nu) if u_ref is None else jnp.asarray(u_ref, dtype=float)
     return _Control(u_ref, _root(weight))
+
+
+class _CoM(eqx.Module):
+    model: eqx.Module
+    target: Array
+    root: Array
+
+    def __call__(self, q: Array, v: Array, u: Array | None = None) -> Array:
+        return self.root * (center_of_mass(self.model, q) - self.target)
+
+
+def com_residual(model, target, weight=1.0) -> eqx.Module:
+    """The centre of mass against a target: r = sqrt(w) (c(q) - c_ref) (Crocoddyl's
+    `ResidualModelCoMPosition`).
+
+    Args:
+        model (Model): the `mbjax.Model`.
+        target (Array): the target position in the world [m], shape (3,).
+        weight (float | Array): w, a scalar or one per component.
+
+    Returns:
+        The residual function r(q, v, u=None), shape (3,).
+    """
+    return _CoM(model, check_point(target, "target", "the centre of mass's target"),
+                _root(weight))
+
+
+class _Forces(eqx.Module):
+    """The ground's force on each of a stance's contacts at (q, v, u), world components."""
+
+    phase: eqx.Module
+    contacts: tuple
+
+    def __call__(self, q: Array, v: Array, u: Array) -> Array:
+        system = self.phase.with_control(Constant(u)).hold(0.0, q, v)
+        return wrenches(self.contacts, system.closures[:len(self.contacts)],
+                        system.multipliers(0.0, q, v))
+
+
+def _phase_contacts(phase, contacts) -> tuple:
+    contacts = _contacts(contacts)
+    closures = getattr(phase, "closures", ())
+    if len(closures) < len(contacts) or any(
+            c.kind != j.kind for c, j in zip(contacts, closures, strict=False)):
+        raise ValueError("phase must be the stance of these contacts (stance(tree, q, contacts))")
+    return contacts
+
+
+class _Cone(eqx.Module):
+    forces: _Forces
+    A: Array                       # facets' rows, then the normal's, per contact
+    root: Array
+
+    def __call__(self, q: Array, v: Array, u: Array) -> Array:
+        r = jnp.einsum("kij,kj->ki", self.A, self.forces(q, v, u)[:, 3:])
+        # Crocoddyl's quadratic barrier: the facets' rows above 0, the normal's below 0
+        return self.root * jnp.concatenate([jnp.maximum(r[:, :-1], 0.0),
+                                            jnp.minimum(r[:, -1:], 0.0)], axis=1).ravel()
+
+
+def friction_cone_residual(phase, contacts, mu=0.7, facets: int = 4, weight=1.0) -> eqx.Module:
+    """Each point contact's force outside its linearised friction cone, with a bounded
+    activation: zero inside (Crocoddyl's `ResidualModelContactFrictionCone` with
+    `ActivationModelQuadraticBarrier`, its gait examples' cost).
+
+    The cone of a contact of normal n, tangents t_i at angles 2 pi i / facets about n (the
+    world's x and y first for n = z), bounds the force f by the facets (t_i - mu n) . f <= 0 and
+    n . f >= 0; the residual is each row's excess, sqrt(w) max((t_i - mu n) . f, 0) and
+    sqrt(w) min(n . f, 0), so that 1/2 |r|^2 is zero wherever the contact holds without slipping
+    or pulling.
+
+    Args:
+        phase: the stance, as `mbjax.contact.stance` made it from the same contacts.
+        contacts: its contacts (point contacts; a surface contact's force is coned alike).
+        mu: the friction coefficient, positive.
+        facets: the cone's facets (static).
+        weight (float | Array): w.
+
+    Returns:
+        The residual function r(q, v, u), shape (len(contacts) (facets + 1),).
+
+    Raises:
+        ValueError: mu is not positive, facets < 3, or the phase is not the contacts' stance.
+    """
+    if not (np.ndim(mu) == 0 and float(mu) > 0 and np.isfinite(float(mu))):
+        raise ValueError(f"mu must be a positive friction coefficient, got {mu!r}")
+    if int(facets) < 3:
+        raise ValueError(f"facets must be at least 3, got {facets!r}")
+    contacts = _phase_contacts(phase, contacts)
+    A = jnp.stack([cone_rows(c.normal, mu, int(facets)) for c in contacts])
+    return _Cone(_Forces(phase, contacts), A, _root(weight))
+
+
+def ground_frame(normal: Array) -> Array:
+    """The ground's frame (t1, t2, n) as columns: n the unit normal, t1 the world's x made
+    normal to it (y where x is nearly along n), t2 = n x t1; the identity for n = z."""
+    n = normal / jnp.linalg.norm(normal)
+    helper = jnp.where(jnp.abs(n[0]) < 0.9, jnp.array([1.0, 0.0, 0.0]), jnp.array([0.0, 1.0, 0.0]))
+    t1 = helper - (helper @ n) * n
+    t1 = t1 / jnp.linalg.norm(t1)
+    return jnp.stack([t1, jnp.cross(n, t1), n], axis=1)
+
+
+def cone_rows(normal: Array, mu, facets: int) -> Array:
+    """The linearised cone's rows, (t_i - mu n) for each facet then n, shape (facets + 1, 3)."""
+    t1, t2, n = ground_frame(normal).T
+    angles = 2 * np.pi * np.arange(facets) / facets
+    tangents = np.cos(angles)[:, None] * t1 + np.sin(angles)[:, None] * t2
+    return jnp.concatenate([tangents - mu * n, n[None]])
+
+
+class _Force(eqx.Module):
+    forces: _Forces
+    reference: Array
+    root: Array
+
+    def __call__(self, q: Array, v: Array, u: Array) -> Array:
+        return self.root * (self.forces(q, v, u) - self.reference).ravel()
+
+
+def contact_force_residual(phase, contacts, reference=None, weight=1.0) -> eqx.Module:
+    """The contacts' wrenches against a reference (Crocoddyl's `ResidualModelContactForce`):
+    r = sqrt(w) (w_c - w_ref), each contact's (torque; force) in world components at its frame
+    (`mbjax.contact.contact_wrenches`).
+
+    Args:
+        phase: the stance, as `mbjax.contact.stance` made it from the same contacts.
+        contacts: its contacts.
+        reference (Array | None): the reference wrenches, shape (len(contacts), 6); zeros by
+            default.
+        weight (float | Array): w, a scalar or one per residual.
+
+    Returns:
+        The residual function r(q, v, u), shape (6 len(contacts),).
+
+    Raises:
+        ValueError: the phase is not the contacts' stance, or a reference of the wrong shape.
+    """
+    contacts = _phase_contacts(phase, contacts)
+    shape = (len(contacts), 6)
+    reference = jnp.zeros(shape) if reference is None else jnp.asarray(reference, dtype=float)
+    if reference.shape != shape:
+        raise ValueError(f"reference must have shape {shape}, got {reference.shape}")
+    return _Force(_Forces(phase, contacts), reference, _root(weight))
+
+
+class _Barrier(eqx.Module):
+    residual: eqx.Module
+    lower: Array
+    upper: Array
+    root: Array
+
+    def __call__(self, q: Array, v: Array, u: Array | None = None) -> Array:
+        r = self.residual(q, v, u)
+        return self.root * (jnp.minimum(r - self.lower, 0.0) + jnp.maximum(r - self.upper, 0.0))
+
+
+def barrier_residual(residual, lower=-jnp.inf, upper=jnp.inf, weight=1.0) -> eqx.Module:
+    """A residual outside bounds: r = sqrt(w) (min(r0 - lower, 0) + max(r0 - upper, 0)), zero
+    within them (Crocoddyl's `ActivationModelQuadraticBarrier`), e.g. joint limits on a
+    `state_residual`.
+
+    Args:
+        residual: the residual function r0(q, v, u=None).
+        lower (float | Array): the lower bounds, a scalar or one per component; -inf for none.
+        upper (float | Array): the upper bounds, likewise.
+        weight (float | Array): w.
+
+    Returns:
+        The residual function r(q, v, u=None), r0's shape.
+    """
+    return _Barrier(residual, jnp.asarray(lower, dtype=float), jnp.asarray(upper, dtype=float),
+                    _root(weight))
+
+
+class _WrenchCone(eqx.Module):
+    forces: _Forces
+    A: Array                       # rows on the ground-frame wrench (torque; force), per contact
+    rotations: Array               # each ground frame (t1, t2, n) in world components
+    root: Array
+
+    def __call__(self, q: Array, v: Array, u: Array) -> Array:
+        w = self.forces(q, v, u)
+        local = jnp.concatenate([jnp.einsum("kji,kj->ki", self.rotations, w[:, :3]),
+                                 jnp.einsum("kji,kj->ki", self.rotations, w[:, 3:])], axis=1)
+        r = jnp.einsum("kij,kj->ki", self.A, local)
+        # the normal force's row (the fifth) bounded below by 0, every other row above by 0
+        return self.root * jnp.concatenate([jnp.maximum(r[:, :4], 0.0),
+                                            jnp.minimum(r[:, 4:5], 0.0),
+                                            jnp.maximum(r[:, 5:], 0.0)], axis=1).ravel()
+
+
+def wrench_cone_rows(mu, length, width, inner: bool = True) -> np.ndarray:
+    """The contact wrench cone of a rectangular sole (Caron, Pham and Nakamura 2015, eqs 13-17,
+    in Crocoddyl's `WrenchCone` order), rows on the ground-frame wrench (torque; force), shape
+    (17, 6): four friction facets, the normal force (bounded below), four centre-of-pressure
+    rows and eight yaw-torque rows, each bounded above by 0 but the normal's."""
+    m = mu / np.sqrt(2.0) if inner else mu
+    X, Y = length / 2, width / 2
+    rows = [[1, 0, -m, 0, 0, 0], [-1, 0, -m, 0, 0, 0], [0, 1, -m, 0, 0, 0], [0, -1, -m, 0, 0, 0],
+            [0, 0, 1, 0, 0, 0],
+            [0, 0, -Y, 1, 0, 0], [0, 0, -Y, -1, 0, 0], [0, 0, -X, 0, 1, 0], [0, 0, -X, 0, -1, 0]]
+    for yaw in (-1, 1):
+        for sx, sy in ((1, 1), (1, -1), (-1, 1), (-1, -1)):
+            rows.append([sx * Y, sy * X, -m * (X + Y), yaw * sx * m, yaw * sy * m, yaw])
+    rows = np.asarray(rows, dtype=float)                # on (force; torque)
+    return np.concatenate([rows[:, 3:], rows[:, :3]], axis=1)
+
+
+def wrench_cone_residual(phase, contacts, mu=0.7, length=0.1, width=0.05, weight=1.0,
+                         inner: bool = True) -> eqx.Module:
+    """Each surface contact's wrench outside the contact wrench cone of its rectangular sole,
+    with a bounded activation (Crocoddyl's `ResidualModelContactWrenchCone` with
+    `ActivationModelQuadraticBarrier`, its biped examples' cost): no slipping (a linearised
+    friction cone), no pulling, the centre of pressure within the sole and a yaw torque that
+    friction can carry (Caron, Pham and Nakamura 2015).
+
+    Args:
+        phase: the stance, as `mbjax.contact.stance` made it from the same contacts.
+        contacts: its surface contacts; each sole's rectangle is centred at its frame, its
+            length along the ground's first tangent and its width along the second
+            (`ground_frame`: the world's x and y on a ground of normal z, as Crocoddyl's
+            `WrenchCone` with its surface rotation), the wrench taken in those axes.
+        mu: the friction coefficient, positive.
+        length: the sole's length [m].
+        width: the sole's width [m].
+        weight (float | Array): w.
+        inner: the friction pyramid inscribed in the cone (mu / sqrt(2) on each side), as
+            Crocoddyl's default; else circumscribed.
+
+    Returns:
+        The residual function r(q, v, u), shape (17 len(contacts),).
+
+    Raises:
+        ValueError: mu, length or width is not positive, or the phase is not the contacts'
+            stance.
+    """
+    for name, x in (("mu", mu), ("length", length), ("width", width)):
+        if not (np.ndim(x) == 0 and float(x) > 0 and np.isfinite(float(x))):
+            raise ValueError(f"{name} must be positive, got {x!r}")
+    contacts = _phase_contacts(phase, contacts)
+    A = jnp.asarray(np.stack([wrench_cone_rows(float(mu), float(length), float(width), inner)]
+                             * len(contacts)))
+    rotations = jnp.stack([ground_frame(c.normal) for c in contacts])
+    return _WrenchCone(_Forces(phase, contacts), A, rotations, _root(weight))

@@ -1,0 +1,217 @@
+"""The knots of a multi-phase problem: each step's own system and running cost, and the
+impulse of a touchdown; grouped into phases so that each distinct phase compiles once."""
+
+import abc
+from collections.abc import Callable, Sequence
+from typing import ClassVar
+
+import equinox as eqx
+import jax
+import jax.numpy as jnp
+import numpy as np
+from jax import Array
+
+from mbjax._src.contact.contact import AbstractContact
+from mbjax._src.contact.impulse import impulse_map
+from mbjax._src.control import Constant
+from mbjax._src.model.model import Model
+from mbjax._src.rigid.frames import frame_placement
+from mbjax._src.rigid.system import TreeSystem
+from mbjax._src.system.system import AbstractSystem
+from mbjax._src.trajopt.costs import as_cost
+
+
+class AbstractKnot(eqx.Module):
+    """One knot of a multi-phase `Problem`: how the state moves on to the next knot, and the
+    running cost there.
+
+    Attributes:
+        rate: whether the running cost is a rate, weighted by the step dt (a step), or a
+            cost taken as it is (an impulse, which takes no time).
+    """
+
+    running: eqx.AbstractVar[Callable]
+    rate: ClassVar[bool]
+
+    @abc.abstractmethod
+    def transition(self, integrator, t, q: Array, v: Array, u: Array, dt) -> tuple[Array, Array]:
+        """(q, v) at the next knot from (q, v) at time t under the control u."""
+
+    @abc.abstractmethod
+    def space(self) -> AbstractSystem:
+        """The system whose configuration manifold the states live on."""
+
+    def duration(self, dt: float) -> float:
+        """The time from this knot to the next."""
+        return dt if self.rate else 0.0
+
+
+class Knot(AbstractKnot):
+    """A step of a system under a control held over it: a knot of a contact phase (its
+    `mbjax.contact.stance`), of a flight, or of any system.
+
+    Args:
+        system: the system stepped (its control is the problem's unknown u_k).
+        running: the cost rate running(q, v, u) at this knot, a scalar or residuals, or a
+            tuple of such functions (as `Problem`'s running).
+    """
+
+    system: AbstractSystem
+    running: Callable
+    rate: ClassVar[bool] = True
+
+    def __init__(self, system: AbstractSystem, running: Callable):
+        if not isinstance(system, AbstractSystem):
+            raise TypeError(f"system must be an mbjax system (TreeSystem, stance(...), ...), got "
+                            f"{type(system).__name__}")
+        self.system, self.running = system, as_cost(running, "running(q, v, u)")
+
+    def transition(self, integrator, t, q, v, u, dt):
+        system = self.system.with_control(Constant(u)).hold(t, q, v)
+        q1, v1, _ = integrator.step(system, t, q, v, dt)
+        return system.constrain(t + dt, q1, v1)
+
+    def space(self):
+        return self.system
+
+
+class Impulse(AbstractKnot):
+    """A touchdown: the contacts that start stop their frames at once (`mbjax.contact.impulse`),
+    in no time, and the control is idle (Crocoddyl's `ActionModelImpulseFwdDynamics`).
+
+    Args:
+        model: the robot.
+        contacts: the contacts whose frames the impulse stops (Crocoddyl's examples pass the
+            feet that land).
+        running: the cost running(q, v, u) at the impulse's knot, taken as it is (not a rate:
+            the impulse takes no time); u is the problem's control there, which moves nothing.
+    """
+
+    model: Model
+    contacts: tuple
+    running: Callable
+    rate: ClassVar[bool] = False
+
+    def __init__(self, model: Model, contacts: Sequence[AbstractContact], running: Callable):
+        if not isinstance(model, Model):
+            raise TypeError(f"model must be a mbjax.Model, got {type(model).__name__}")
+        self.model, self.contacts, self.running = model, tuple(contacts), as_cost(running, "running(q, v, u)")
+        for c in self.contacts:
+            if not isinstance(c, AbstractContact):
+                raise TypeError(f"contacts must be PointContact(...) or SurfaceContact(...), got "
+                                f"{c!r}")
+            frame_placement(model, c.frame)          # a KeyError names a frame the model lacks
+
+    def transition(self, integrator, t, q, v, u, dt):
+        return q, impulse_map(self.model, q, v, self.contacts)[0]
+
+    def space(self):
+        return TreeSystem(self.model)
+
+
+class Schedule(eqx.Module):
+    """A sequence of knots grouped into phases: knots alike but for their arrays (a stance's
+    anchors, a cost's targets) make one phase, whose arrays are stacked along a first axis, so
+    a solver compiles each phase's step and expansion once and runs it over the phase's knots.
+
+    Args:
+        knots: one `AbstractKnot` per step.
+
+    Raises:
+        TypeError: an entry that is not a knot.
+        ValueError: no knots, or knots with different numbers of controls.
+    """
+
+    templates: tuple = eqx.field(static=True)   # each phase's knots without their arrays
+    arrays: tuple                               # each phase's knots' arrays, stacked
+    axes: tuple = eqx.field(static=True)        # 0 for a stacked array, None for a shared one
+    phase: tuple = eqx.field(static=True)       # each knot's phase
+    index: tuple = eqx.field(static=True)       # each knot's place in its phase
+    times: tuple = eqx.field(static=True)       # each knot's time, from the step dt
+
+    def __init__(self, knots: Sequence[AbstractKnot], dt: float):
+        knots = tuple(knots)
+        if not knots:
+            raise ValueError("knots must hold one knot per step, got none")
+        for i, knot in enumerate(knots):
+            if not isinstance(knot, AbstractKnot):
+                raise TypeError(f"knots[{i}] must be a Knot(...) or an Impulse(...), got "
+                                f"{type(knot).__name__}")
+        templates, members, phase, index = [], [], [], []
+        for knot in knots:
+            arrays, template = eqx.partition(knot, eqx.is_array)
+            shapes = jax.tree.map(lambda a: (a.shape, a.dtype), arrays)
+            for p, (other, other_shapes) in enumerate(templates):
+                if other_shapes == shapes and _same(other, template):
+                    break
+            else:
+                p = len(templates)
+                templates.append((template, shapes))
+                members.append([])
+            phase.append(p)
+            index.append(len(members[p]))
+            members[p].append(arrays)
+        self.templates = tuple(t for t, _ in templates)
+        # an array every knot of a phase holds (the model, a weight) is kept once, not stacked
+        self.axes = tuple(jax.tree.map(lambda *a: None if all(x is a[0] for x in a) else 0, *m)
+                          for m in members)
+        self.arrays = tuple(jax.tree.map(lambda axis, *a: a[0] if axis is None else jnp.stack(a),
+                                         axes, *m, is_leaf=_none)
+                            for axes, m in zip(self.axes, members, strict=True))
+        self.phase, self.index = tuple(phase), tuple(index)
+        self.times = tuple(float(t) for t in np.cumsum([0.0] + [k.duration(dt) for k in knots])[:-1])
+
+    def __len__(self) -> int:
+        return len(self.phase)
+
+    def knot(self, p: int, j) -> AbstractKnot:
+        """The j-th knot of phase p (j may be traced)."""
+        arrays = jax.tree.map(lambda axis, a: a if axis is None else a[j], self.axes[p],
+                              self.arrays[p], is_leaf=_none)
+        return eqx.combine(arrays, self.templates[p])
+
+    def members(self, p: int) -> np.ndarray:
+        """The knots of phase p, in order."""
+        return np.flatnonzero(np.asarray(self.phase) == p)
+
+    def switch(self, k, fn: Callable, *args):
+        """fn(knot k, *args) for a traced knot index k: one branch per phase."""
+        phase, index = jnp.asarray(self.phase)[k], jnp.asarray(self.index)[k]
+        branches = [lambda j, *a, p=p: fn(self.knot(p, j), *a) for p in range(len(self.templates))]
+        if len(branches) == 1:
+            return branches[0](index, *args)
+        return jax.lax.switch(phase, branches, index, *args)
+
+    def map(self, fn: Callable, *args):
+        """fn(knot k, *args[k]) for every knot k, vmapped over each phase's knots: each phase
+        compiles once. args are arrays with a first axis of one entry per knot."""
+        outs, order = [], []
+        for p, template in enumerate(self.templates):
+            ks = self.members(p)
+            outs.append(jax.vmap(lambda arrays, *a, t=template: fn(eqx.combine(arrays, t), *a),
+                                 in_axes=(self.axes[p], *(0 for _ in args)))(
+                self.arrays[p], *(a[ks] for a in args)))
+            order.append(ks)
+        if len(outs) == 1:
+            return outs[0]
+        inverse = np.argsort(np.concatenate(order))
+        return jax.tree.map(lambda *o: jnp.concatenate(o)[inverse], *outs)
+
+
+def _none(x) -> bool:
+    return x is None
+
+
+def _same(a, b) -> bool:
+    """Whether two knots stripped of their arrays are the same phase."""
+    if jax.tree.structure(a) != jax.tree.structure(b):
+        return False
+    return all(x is y or _equal(x, y) for x, y in zip(jax.tree.leaves(a), jax.tree.leaves(b),
+                                                       strict=True))
+
+
+def _equal(x, y) -> bool:
+    try:
+        return bool(x == y)
+    except Exception:          # objects without a truth value of ==: the same only if identical
+        return False

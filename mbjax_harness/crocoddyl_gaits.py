@@ -1,0 +1,225 @@
+"""Crocoddyl's legged examples, each built twice from the same example-robot-data URDF, contact
+schedule, weights, step (semi-implicit Euler) and first guess (the quasi-static controls): as a
+multi-phase `mbjax.trajopt.Problem` of `Knot`s and `Impulse`s, and as Crocoddyl's shooting
+problem from its own builder.
+
+    anymal-walk     `examples/quadrupedal_gaits_fwddyn.py`'s walk: ANYmal, one cycle of
+                    `SimpleQuadrupedalGaitProblem.createWalkingProblem` (step 0.25 m, height
+                    0.15 m, dt 1e-2 s, 25 knots a step, 2 of double support): 108 knots
+    talos-step      `examples/bipedal_gaits_fwddyn.py`'s walk: Talos's legs (its upper body
+                    locked at half-sitting in both libraries), one step of each foot, `SimpleBipedGaitProblem.createWalkingProblem` (step
+                    0.6 m, height 0.1 m, dt 3e-2 s, 15 knots a step, 4 of double support):
+                    39 knots and the left foot's impulse model as the terminal cost
+
+Both sides write Crocoddyl's costs term by term (`mbjax_harness/crocoddyl_examples.py` says how
+weights fold into residuals): its state and control regularisation, centre-of-mass and swing-foot
+tracking, friction cones with its quadratic barrier, the state bounds' barrier; an impulse
+knot's costs are not weighted by dt, as Crocoddyl's impulse models' are not.
+"""
+
+import equinox as eqx
+import jax.numpy as jnp
+import numpy as np
+
+from mbjax.contact import PointContact, SurfaceContact, stance
+from mbjax.loops import Coupled
+from mbjax._src.integrate import SemiImplicitEuler
+from mbjax._src.model.states import state_from_pinocchio
+from mbjax.rigid import TreeSystem, center_of_mass, frame_pose
+from mbjax.trajopt import (Impulse, Knot, Problem, barrier_residual, com_residual,
+                           control_residual, frame_residual, friction_cone_residual,
+                           quasi_static, state_residual, wrench_cone_residual)
+from mbjax_harness.crocoddyl_examples import Example, _converter, _load, _robot
+
+MU = 0.7                     # the examples' friction coefficient
+FEET = ("LF_FOOT", "RF_FOOT", "LH_FOOT", "RH_FOOT")
+SOLES = ("right_sole_link", "left_sole_link")
+SOLE = (0.1, 0.05)           # the biped's sole, length and width [m] (its wrench cone's box)
+
+
+def _controls(croc_problem):
+    """mbjax's controls (N, nu) as Crocoddyl's list: an impulse model takes none."""
+    sizes = [m.nu for m in croc_problem.runningModels]
+    return lambda us: [np.asarray(u, float)[:n] for u, n in zip(us, sizes, strict=True)]
+
+
+class _Gait:
+    """The pieces of Crocoddyl's gait builders in mbjax: its models' costs, knot by knot.
+
+    Args:
+        model, q0: the robot and its standing configuration (the state costs' reference).
+        kind: `PointContact` (a quadruped's feet: friction cones, translations tracked) or
+            `SurfaceContact` (a biped's soles: wrench cones, placements tracked).
+        weights: the state weights of a step's knot and of an impulse's, mbjax's tangent order.
+        bounds: (lower, upper) of the state barrier, or None.
+        gain: the contacts' Baumgarte Kd (Crocoddyl's (0, Kd)).
+        impulse_track: the weight of an impulse's foot tracking.
+    """
+
+    def __init__(self, model, q0, kind, weights, bounds, gain, impulse_track):
+        self.model, self.q0, self.kind = model, q0, kind
+        self.tree = TreeSystem(model, actuation=range(6, model.nv))
+        self.nu = model.nv - 6
+        self.state_weights, self.impulse_weights = weights
+        self.method = Coupled(baumgarte=(gain / 2, 0.0))
+        self.impulse_track = impulse_track
+        self.bounds = () if bounds is None else (barrier_residual(
+            state_residual(model, model.neutral()), *bounds, weight=1e3),)
+
+    def regularisation(self, weights):
+        return state_residual(self.model, self.q0, weight=10.0 * np.asarray(weights) ** 2)
+
+    def track(self, foot, target, weight):
+        rotation = None if self.kind is PointContact else np.eye(3)
+        return frame_residual(self.model, foot, target, rotation, weight=weight)
+
+    def knot(self, support, com=None, swing=()):
+        """`createSwingFootModel`: the support feet held, the swing feet and CoM tracked."""
+        contacts = [self.kind(f) for f in support]
+        phase = stance(self.tree, self.q0, contacts, method=self.method)
+        costs = [friction_cone_residual(phase, contacts, MU, weight=10.0)
+                 if self.kind is PointContact else
+                 wrench_cone_residual(phase, contacts, MU, *SOLE, weight=10.0)]
+        if com is not None:
+            costs.append(com_residual(self.model, com, weight=1e6))
+        costs += [self.track(f, p, 1e6) for f, p in swing]
+        costs += [self.regularisation(self.state_weights),
+                  control_residual(self.nu, weight=0.1), *self.bounds]
+        return Knot(phase, tuple(costs))
+
+    def impulse_costs(self, swing):
+        return (*(self.track(f, p, self.impulse_track) for f, p in swing),
+                self.regularisation(self.impulse_weights))
+
+    def impulse(self, landing, swing):
+        """`createImpulseModel`: the landing feet stopped, still tracked."""
+        return Impulse(self.model, [self.kind(f) for f in landing], self.impulse_costs(swing))
+
+    def footsteps(self, com, feet, length, height, knots, support, swing):
+        """`createFootstepModels`: a step's knots, then its impulse; com and feet move on.
+        Returns the knots and the last swing task."""
+        out, fraction, half = [], len(swing) / (len(support) + len(swing)), knots / 2
+        for k in range(knots):
+            z = height * k / half if k < half else height * (1 - (k - half) / half)
+            dp = np.array([length * (k + 1) / knots, 0.0, z])
+            task = [(f, feet[f] + dp) for f in swing]
+            out.append(self.knot(support, com + np.array([length * (k + 1) / knots, 0, 0])
+                                 * fraction, task))
+        out.append(self.impulse(swing, task))
+        com += np.array([length * fraction, 0.0, 0.0])
+        for f in swing:
+            feet[f] = feet[f] + np.array([length, 0.0, 0.0])
+        return out, task
+
+
+def _start(robot, configuration, feet, locked=()):
+    """mbjax's model (the `locked` joints fixed at the configuration), its standing state, the
+    feet's positions and the gait's CoM reference (the feet's mean at the CoM's height), as the
+    builders compute them."""
+    model = _load(robot, floating_base=True)
+    q_pin0 = robot.model.referenceConfigurations[configuration].copy()
+    q0, v0 = state_from_pinocchio(model, q_pin0, np.zeros(robot.model.nv))
+    if locked:
+        model = model.locked(locked, q0)
+        q_pin0 = q_pin0[:model.nq]                   # the legs come first in Pinocchio's order
+        q0, v0 = state_from_pinocchio(model, q_pin0, np.zeros(model.nv))
+    # the rotors' inertias, which example-robot-data reads from the SRDF into Pinocchio's
+    # model (0.1 kg m^2 on each of Talos's leg joints) and a URDF does not hold
+    armature = np.asarray(robot.model.armature)[:model.nv]
+    model = eqx.tree_at(lambda m: m.armature, model, jnp.asarray(armature))
+    positions = {f: np.asarray(frame_pose(model, q0, f)[1]) for f in feet}
+    com = np.mean([positions[f] for f in feet], axis=0)
+    com[2] = float(center_of_mass(model, q0)[2])
+    return model, q_pin0, q0, v0, positions, com
+
+
+def _talos_legs(robot):
+    """Talos with its upper body locked at half-sitting, in Pinocchio (`buildReducedModel`):
+    the legs its only joints, as mbjax's `Model.locked` makes it. (example-robot-data's
+    `talos_legs` drops the upper body's mass instead, which no URDF describes.)"""
+    import pinocchio as pin
+
+    full = robot.model
+    upper = [n for n in full.names[2:] if not n.startswith("leg_")]
+    q = full.referenceConfigurations["half_sitting"]
+    legs = pin.buildReducedModel(full, [full.getJointId(n) for n in upper], q)
+    legs.referenceConfigurations["half_sitting"] = q[:legs.nq].copy()
+    return legs, upper
+
+
+def _weights(base, joints, velocity, nv):
+    """Crocoddyl's state weights (base linear, base angular, joints; then the velocity's)
+    in mbjax's tangent order (the base's angular part first)."""
+    nj = nv - 6
+    w = np.r_[base, [joints] * nj, velocity]
+    return w[np.r_[3:6, 0:3, 6:2 * nv]]
+
+
+def anymal_walk(step_length=0.25, step_height=0.15, dt=1e-2, step_knots=25,
+                support_knots=2) -> Example:
+    robot = _robot("anymal")
+    model, q_pin0, q0, v0, feet, com = _start(robot, "standing", FEET)
+    nv, nj = model.nv, model.nv - 6
+    weights = (_weights([0.0] * 3 + [500.0] * 3, 0.01, [10.0] * 6 + [1.0] * nj, nv),
+               _weights([1.0] * 6, 10.0, [10.0] * nv, nv))
+    lower = np.r_[[-np.inf] * 6, [-9.42] * nj, [-np.inf] * 6, [-15.0] * nj]
+    gait = _Gait(model, q0, PointContact, weights, (lower, -lower), 50.0, 1e7)
+    lf, rf, lh, rh = FEET
+    support = [gait.knot(FEET) for _ in range(support_knots)]
+    knots = list(support)
+    for length, legs, foot in ((0.5 * step_length, [lf, rf, lh], rh),
+                               (0.5 * step_length, [lf, lh, rh], rf), None,
+                               (step_length, [lf, rf, rh], lh), (step_length, [rf, lh, rh], lf)):
+        if foot is None:
+            knots += support
+            continue
+        knots += gait.footsteps(com, feet, length, step_height, step_knots, legs, [foot])[0]
+    # the last double-support model is the terminal one: its state costs alone
+    terminal = (gait.regularisation(gait.state_weights), *gait.bounds)
+    problem = Problem(knots, q0, v0, dt=dt, terminal=terminal, integrator=SemiImplicitEuler())
+
+    def crocoddyl():
+        from crocoddyl.utils.quadruped import SimpleQuadrupedalGaitProblem
+
+        builder = SimpleQuadrupedalGaitProblem(robot.model, *FEET)
+        x0 = np.concatenate([q_pin0, np.zeros(robot.model.nv)])
+        return builder.createWalkingProblem(x0, step_length, step_height, dt, step_knots,
+                                            support_knots)
+
+    return Example(problem, np.asarray(quasi_static(problem)), crocoddyl, "SolverFDDP",
+                   _converter(model), controls=_controls)
+
+
+def talos_step(step_length=0.6, step_height=0.1, dt=3e-2, step_knots=15,
+               support_knots=4) -> Example:
+    robot = _robot("talos")
+    pin_model, upper = _talos_legs(robot)
+    model, q_pin0, q0, v0, feet, com = _start(robot, "half_sitting", SOLES, upper)
+    nv = model.nv
+    weights = (_weights([0.0] * 3 + [500.0] * 3, 0.01, [10.0] * nv, nv),
+               _weights([1.0] * 6, 0.1, [10.0] * nv, nv))
+    gait = _Gait(model, q0, SurfaceContact, weights, None, 30.0, 1e8)
+    right, left = SOLES
+    support = [gait.knot(SOLES) for _ in range(support_knots)]
+    knots = support + gait.footsteps(com, feet, 0.5 * step_length, step_height, step_knots,
+                                     [left], [right])[0]
+    steps, task = gait.footsteps(com, feet, step_length, step_height, step_knots, [right],
+                                 [left])
+    knots += support + steps[:-1]
+    # the left foot's impulse model is the terminal one: its costs at the last state
+    problem = Problem(knots, q0, v0, dt=dt, terminal=gait.impulse_costs(task),
+                      integrator=SemiImplicitEuler())
+
+    def crocoddyl():
+        from crocoddyl.utils.biped import SimpleBipedGaitProblem
+
+        builder = SimpleBipedGaitProblem(pin_model, *SOLES)
+        x0 = np.concatenate([q_pin0, np.zeros(pin_model.nv)])
+        return builder.createWalkingProblem(x0, step_length, step_height, dt, step_knots,
+                                            support_knots)
+
+    return Example(problem, np.asarray(quasi_static(problem)), crocoddyl, "SolverFDDP",
+                   _converter(model), controls=_controls)
+
+
+GAITS = {"anymal-walk": anymal_walk, "talos-step": talos_step}

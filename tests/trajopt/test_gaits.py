@@ -1,0 +1,133 @@
+"""Multi-phase problems through contact (issue 45): knots that carry their own system, impulse
+knots at touchdown, the contact costs and the quasi-static guess, against Crocoddyl's own gait
+builder (`crocoddyl.utils.quadruped.SimpleQuadrupedalGaitProblem`) on example-robot-data's
+ANYmal (`mbjax_harness.crocoddyl_gaits`), and a multi-phase problem of one phase against the
+one-system problem it restates."""
+
+import equinox as eqx
+import jax
+import jax.numpy as jnp
+import numpy as np
+import pytest
+
+import mbjax
+from mbjax.contact import PointContact, stance
+from mbjax.rigid import TreeSystem
+from mbjax.trajopt import (ILQR, Impulse, Knot, Problem, control_residual, friction_cone_residual,
+                           solve, state_residual)
+from mbjax_harness import peers
+from tests.conftest import example_robots
+
+WHY = peers.crocoddyl_working()
+crocoddyl_only = pytest.mark.skipif(WHY is not None, reason=str(WHY))
+
+
+def _rollout(problem, us):
+    return eqx.filter_jit(lambda p, u: p.rollout(u))(problem, us)
+
+
+def _cost(problem, xs, us):
+    return float(eqx.filter_jit(lambda p, x, u: p.cost(x, u))(problem, xs, us))
+
+
+def test_knots_of_one_system_restate_the_one_system_problem():
+    """A problem written knot by knot with one system and per-knot targets: one phase (one
+    compiled step), and its rollout, cost and expansion are those of the one-system problem with
+    the same costs, knot for knot."""
+    model = mbjax.model.chain(3)
+    system = TreeSystem(model)
+    q0, v0 = jnp.zeros(3), jnp.zeros(3)
+    targets = np.linspace(0.0, 1.0, 6)[:, None] * np.ones(3)
+    knots = [Knot(system, (state_residual(model, t), control_residual(3, weight=1e-2)))
+             for t in targets]
+    multi = Problem(knots, q0, v0, dt=0.05, terminal=state_residual(model, targets[-1]))
+    assert len(multi.knots.templates) == 1 and multi.horizon == 6
+    us = jnp.asarray(np.random.default_rng(0).normal(size=(6, 3)))
+    xs = _rollout(multi, us)
+    for k, t in enumerate(targets):          # each knot's cost is its own target's
+        one = Problem(system, q0, v0, dt=0.05, horizon=6,
+                      running=(state_residual(model, t), control_residual(3, weight=1e-2)),
+                      terminal=state_residual(model, targets[-1]))
+        np.testing.assert_allclose(xs, _rollout(one, us), rtol=1e-14, atol=1e-14)
+        got = jax.tree.map(lambda a: a[k], multi.linearize(xs, us))
+        want = jax.tree.map(lambda a: a[k], one.linearize(xs, us))
+        jax.tree.map(lambda a, b: np.testing.assert_allclose(a, b, rtol=1e-12, atol=1e-12), got,
+                     want)
+
+
+def test_bad_multi_phase_input_is_refused_by_name():
+    model = mbjax.model.chain(3)
+    system = TreeSystem(model)
+    knot = Knot(system, control_residual(3))
+    q0, v0 = jnp.zeros(3), jnp.zeros(3)
+    with pytest.raises(ValueError, match="horizon must be the number of knots"):
+        Problem([knot] * 4, q0, v0, dt=0.1, horizon=5, terminal=control_residual(3))
+    with pytest.raises(ValueError, match="running: each knot"):
+        Problem([knot] * 4, q0, v0, dt=0.1, running=control_residual(3),
+                terminal=control_residual(3))
+    with pytest.raises(ValueError, match="same number of controls"):
+        Problem([knot, Knot(TreeSystem(model, actuation=[0]), control_residual(1))], q0, v0,
+                dt=0.1, terminal=control_residual(3))
+    with pytest.raises(TypeError, match=r"knots\[1\] must be a Knot"):
+        Problem([knot, system], q0, v0, dt=0.1, terminal=control_residual(3))
+    with pytest.raises(KeyError, match="no frame, body or joint named 'toe'"):
+        Impulse(model, [PointContact("toe")], control_residual(3))
+    phase = stance(system, q0, [PointContact("body2")])
+    for mu in (0.0, -0.5, float("nan")):
+        with pytest.raises(ValueError, match="mu must be a positive friction coefficient"):
+            friction_cone_residual(phase, [PointContact("body2")], mu)
+    with pytest.raises(ValueError, match="phase must be the stance of these contacts"):
+        friction_cone_residual(phase, [PointContact("body2"), PointContact("body1")])
+
+
+@crocoddyl_only
+def test_short_walk_is_crocoddyls_problem():
+    """ANYmal's walk with short steps, built in both libraries: the quasi-static guess is
+    Crocoddyl's `quasiStatic` (to 1e-10 N m), and under perturbed controls (feet pushing,
+    pulling and slipping: every cone, tracking and impulse cost active) each of Crocoddyl's
+    steps and impulses from mbjax's state lands on mbjax's next state and the two costs agree
+    to 1e-10."""
+    example_robots(["anymal_b_simple/anymal"])          # skips without example-robot-data
+    from mbjax_harness.crocoddyl_gaits import anymal_walk
+
+    example = anymal_walk(step_knots=4, support_knots=1)
+    problem = example.problem
+    assert problem.horizon == 22 and len(problem.knots.templates) == 9
+    croc = example.crocoddyl()
+    to_croc = example.controls(croc)
+    guess = croc.quasiStatic([croc.x0] * croc.T)
+    for mine, theirs in zip(to_croc(example.us0), guess, strict=True):
+        np.testing.assert_allclose(mine, theirs, atol=1e-10)
+    us = jnp.asarray(example.us0 + np.random.default_rng(1).normal(scale=3.0,
+                                                                     size=example.us0.shape))
+    xs = _rollout(problem, us)
+    xs_croc, us_croc = example.to_crocoddyl(xs), to_croc(us)
+    for k, model in enumerate(croc.runningModels):
+        data = model.createData()
+        model.calc(data, xs_croc[k], us_croc[k])
+        np.testing.assert_allclose(data.xnext, xs_croc[k + 1], atol=1e-10)
+    np.testing.assert_allclose(_cost(problem, xs, us), croc.calc(list(xs_croc), us_croc),
+                               rtol=1e-10)
+
+
+@crocoddyl_only
+@pytest.mark.slow
+def test_anymal_walk_reaches_fddps_optimum():
+    """Crocoddyl's ANYmal walk (108 knots, 9 phases): iLQR from the quasi-static guess ends
+    within 1e-3 of FDDP's optimum, and its controls, rolled out in Crocoddyl's dynamics, cost
+    there what they cost here (feasible in Crocoddyl's problem)."""
+    from mbjax._src.trajopt.ilqr import CROCODDYL_SCHEDULE
+    from mbjax_harness.bench.trajopt import CrocoddylSolver
+    from mbjax_harness.crocoddyl_gaits import anymal_walk
+
+    example = anymal_walk()
+    croc_problem = example.crocoddyl()
+    to_croc = example.controls(croc_problem)
+    result = solve(example.problem, ILQR(**CROCODDYL_SCHEDULE), jnp.asarray(example.us0))
+    assert result.messages() == ["success"]
+    croc = CrocoddylSolver(croc_problem, to_croc(example.us0))
+    croc.solve(100)
+    assert float(result.cost) <= croc.solver.cost * (1 + 1e-3)
+    us = to_croc(result.us)
+    np.testing.assert_allclose(croc_problem.calc(croc_problem.rollout(us), us), result.cost,
+                               rtol=1e-6)
