@@ -3,7 +3,9 @@ ground (Jerkovsky 1978 §VI), so a contact phase is a `mbjax.loops.ClosedSystem`
 
     phase = stance(TreeSystem(model), q, [PointContact("LF_FOOT"), ...])
 
-`contact_wrenches` gives the ground's reactions, `impulse` the velocity jump at touchdown.
+`contact_wrenches` gives the ground's reactions, `impulse` the velocity jump at touchdown,
+`simulate_schedule` runs a robot through a sequence of phases (with `mu`, a foot that pulls or
+slips fails the run: `Status.PULLING`, `Status.SLIPPING`).
 """
 
 from mbjax._src.contact.contact import AbstractContact as AbstractContact
@@ -12,7 +14,10 @@ from mbjax._src.contact.contact import SurfaceContact as SurfaceContact
 from mbjax._src.contact.impulse import impulse as impulse
 from mbjax._src.contact.stance import contact_wrenches as contact_wrenches
 from mbjax._src.contact.stance import stance as stance
+from mbjax._src.contact.schedule import ContactSolution as ContactSolution
+from mbjax._src.contact.schedule import simulate_schedule as simulate_schedule
 
 __all__ = [
     "AbstractContact", "PointContact", "SurfaceContact", "stance", "contact_wrenches", "impulse",
+    "simulate_schedule", "ContactSolution",
 ]

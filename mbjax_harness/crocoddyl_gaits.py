@@ -168,12 +168,12 @@ def anymal_walk(step_length=0.25, step_height=0.15, dt=1e-2, step_knots=25,
     support = [gait.knot(FEET) for _ in range(support_knots)]
     knots = list(support)
     for length, legs, foot in ((0.5 * step_length, [lf, rf, lh], rh),
-                               (0.5 * step_length, [lf, lh, rh], rf), None,
+                               (0.5 * step_length, [lf, lh, rh], rf), (None, None, None),
                                (step_length, [lf, rf, rh], lh), (step_length, [rf, lh, rh], lf)):
-        if foot is None:
+        if length is None:
             knots += support
-            continue
-        knots += gait.footsteps(com, feet, length, step_height, step_knots, legs, [foot])[0]
+        else:
+            knots += gait.footsteps(com, feet, length, step_height, step_knots, legs, [foot])[0]
     # the last double-support model is the terminal one: its state costs alone
     terminal = (gait.regularisation(gait.state_weights), *gait.bounds)
     problem = Problem(knots, q0, v0, dt=dt, terminal=terminal, integrator=SemiImplicitEuler())

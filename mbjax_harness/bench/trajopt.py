@@ -5,7 +5,11 @@ Problems: `arm-reach`, the shipped 7-dof arm's flange moved 0.4 m, and `acrobot-
 double pendulum driven at its elbow to upright (`mbjax.scenes`); and Crocoddyl's own
 contact-free examples (`mbjax_harness.crocoddyl_examples`): `kinova-reach`, `double-pendulum`,
 `quadrotor` (a free base driven by four thrusters through an actuation matrix) and
-`quadrotor-bounded` (thrusts in [0.1, 5] N, Crocoddyl's BoxDDP). Each is built twice, as an
+`quadrotor-bounded` (thrusts in [0.1, 5] N, Crocoddyl's BoxDDP); and its legged gaits through
+contact (`mbjax_harness.crocoddyl_gaits`): `anymal-walk` (its quadrupedal walk, 108 knots of
+contact phases and impulses) and `talos-step` (a step of each foot of Talos's legs), whose
+records also hold mbjax's solution (`xs` in Pinocchio's state layout, `us` in Crocoddyl's
+control order, empty at an impulse). Each is built twice, as an
 `mbjax.trajopt.Problem` and as a Crocoddyl shooting problem (Pinocchio models of the same URDF,
 the same residuals and weights, the same horizon and step), both with semi-implicit Euler steps
 (Crocoddyl's `IntegratedActionModelEuler`), both from the same first guess and its rollout. The
@@ -53,6 +57,7 @@ import numpy as np
 
 from mbjax_harness import peers
 from mbjax_harness.crocoddyl_examples import EXAMPLES, Example
+from mbjax_harness.crocoddyl_gaits import GAITS
 from mbjax._src.integrate import SemiImplicitEuler
 from mbjax_harness.timing import in_turns, measure, write_jsonl
 from mbjax._src.trajopt import ILQR, solve
@@ -122,7 +127,8 @@ def acrobot_example() -> Example:
                    _identity, lambda q: float(jnp.linalg.norm(acrobot.tip(model, q) - goal)))
 
 
-PROBLEMS = {"arm-reach": arm_example, "acrobot-swingup": acrobot_example, **EXAMPLES}
+PROBLEMS = {"arm-reach": arm_example, "acrobot-swingup": acrobot_example, **EXAMPLES, **GAITS}
+GAIT_TIMED_RUNS = 3     # a gait's solve takes seconds: fewer turns
 
 
 def _to_tolerance(costs, best: float) -> int | None:
@@ -171,20 +177,31 @@ class CrocoddylSolver:
         return measure(self.solve, iterations, repeats=repeats)[1].run_s
 
 
+def _controls(example: Example, croc_problem):
+    """(to Crocoddyl: mbjax's (N, nu) -> Crocoddyl's list, an impulse model's empty; back:
+    Crocoddyl's list -> (N, nu), zeros where a model takes none)."""
+    if example.controls is None:
+        return (lambda us: [np.asarray(u, float) for u in us]), np.asarray
+    to = example.controls(croc_problem)
+    nu = example.problem.nu
+    return to, lambda us: np.stack([np.pad(np.asarray(u, float), (0, nu - len(u))) for u in us])
+
+
 def agreement(example: Example, croc_problem) -> dict:
     """That the two are one problem: the first guess's one-step states (each of Crocoddyl's
     knots stepped from mbjax's state, largest difference in Crocoddyl's layout) and the guess's
     cost in both (relative)."""
     problem, us0 = example.problem, np.asarray(example.us0, float)
+    to_croc, _ = _controls(example, croc_problem)
     xs = problem.rollout(jnp.asarray(us0))
-    xs_croc = example.to_crocoddyl(xs)
+    xs_croc, us_croc = example.to_crocoddyl(xs), to_croc(us0)
     step = 0.0
     for k, model in enumerate(croc_problem.runningModels):
         data = model.createData()
-        model.calc(data, xs_croc[k], us0[k])
+        model.calc(data, xs_croc[k], us_croc[k])
         step = max(step, float(np.max(np.abs(np.asarray(data.xnext) - xs_croc[k + 1]))))
     cost_mbjax = float(problem.cost(xs, jnp.asarray(us0)))
-    cost_croc = croc_problem.calc(list(xs_croc), list(us0))
+    cost_croc = croc_problem.calc(list(xs_croc), us_croc)
     return {"one_step_agreement": step,
             "cost_agreement": abs(cost_croc - cost_mbjax) / abs(cost_mbjax)}
 
@@ -211,15 +228,20 @@ def single(name: str, repeats: int, common: dict) -> list[dict]:
         best = mbjax["cost"]
     else:
         croc_problem = example.crocoddyl()
-        croc = CrocoddylSolver(croc_problem, example.us0, example.solver)
+        to_croc, from_croc = _controls(example, croc_problem)
+        croc = CrocoddylSolver(croc_problem, to_croc(example.us0), example.solver)
         checks = agreement(example, croc_problem)
         history = croc.history()
         converged = croc.solve(ITERATIONS)
-        us_croc = np.array(croc.solver.us)
+        us_croc = from_croc(croc.solver.us)
         q_end = problem.split(problem.rollout(jnp.asarray(us_croc))[-1])[0]
-        us_mbjax = [np.asarray(u) for u in result.us]
+        us_mbjax = to_croc(result.us)
         mbjax["cost_in_other_engine"] = croc_problem.calc(croc_problem.rollout(us_mbjax),
                                                           us_mbjax)
+        if name in GAITS:      # the solution, in Pinocchio's state layout and Crocoddyl's controls
+            mbjax["xs"] = example.to_crocoddyl(
+                jnp.concatenate([result.qs, result.vs], axis=1)).tolist()
+            mbjax["us"] = [u.tolist() for u in us_mbjax]
         records.append({
             **common, "kind": "single", "problem": name, "engine": "crocoddyl",
             "solver": example.solver, "iterations": int(croc.solver.iter),
@@ -238,7 +260,7 @@ def single(name: str, repeats: int, common: dict) -> list[dict]:
         runs["mbjax"] = lambda: jax.block_until_ready(solve(problem, stopped, us0).us)
     if why is None and records[-1]["iterations_to_tolerance"] is not None:
         runs["crocoddyl"] = partial(croc.solve, max(records[-1]["iterations_to_tolerance"], 1))
-    seconds = in_turns(runs, TIMED_RUNS)
+    seconds = in_turns(runs, GAIT_TIMED_RUNS if name in GAITS else TIMED_RUNS)
     for r in records:
         if "skipped" not in r:
             r["seconds_to_tolerance"] = seconds.get(r["engine"])

@@ -149,3 +149,35 @@ def test_anymal_stands_on_its_four_feet():
     weight = float(model.mass.sum()) * 9.81
     assert float(wrenches[:, 5].sum()) == pytest.approx(weight, rel=1e-6)
     assert np.all(np.asarray(wrenches[:, :3]) == 0.0)       # a point contact carries no torque
+
+
+def test_a_schedule_flags_a_foot_that_pulls():
+    """ANYmal servoed to a pose, on four feet and then on three: on four the run succeeds and
+    the lifted foot carries nothing afterwards; on three, with the pose held, the diagonal
+    foot must pull on the ground to keep the body up (its centre of mass lies outside the
+    support triangle: it first pushes, then pulls), which the friction watch reports as
+    PULLING in that phase alone; at
+    the touchdown of the next phase the landing foot stops at once (the impulse)."""
+    from mbjax.contact import simulate_schedule
+    from mbjax.control import PD
+    from mbjax import Status
+    from mbjax.integrate import RK4
+    model = mbjax.load_urdf(_path(ANYMAL[0]), floating_base=True)
+    q0, v0 = model.home().at[2].set(0.5), jnp.zeros(model.nv)
+    feet = [PointContact(foot) for foot in ANYMAL[1]]
+    legs = PD(kp=200.0, kd=10.0, q_ref=q0[7:], q_index=range(7, 19), v_index=range(6, 18))
+    tree = TreeSystem(model, legs, actuation=range(6, 18))
+    lifted = feet[3]                                                  # RH_FOOT
+    sol = simulate_schedule(tree, RK4(), q0, v0, [(feet, 0.1), (feet[:3], 0.2), (feet, 0.02)],
+                            dt=2e-3, mu=0.7)
+    codes = [int(c) for c in sol.phase_status]
+    assert codes[0] == 0 and codes[1] & Status.PULLING and not sol.ok
+    assert "pulling (in phase 1" in sol.messages()[0]
+    off = np.asarray(sol.phases) == 1
+    assert np.all(np.asarray(sol.wrenches)[off, sol.frames.index(lifted.frame)] == 0.0)
+    diagonal = np.asarray(sol.wrenches)[off][:, sol.frames.index("LF_FOOT"), 5]
+    assert diagonal[0] > 0.0 and diagonal.min() < 0.0               # first pushes, then pulls
+    # the landing foot is at rest right after its touchdown
+    first = int(np.flatnonzero(np.asarray(sol.phases) == 2)[0])
+    J = frame_jacobian(model, sol.qs[first], lifted.frame)
+    assert float(jnp.abs(J[3:] @ sol.vs[first]).max()) < 1e-2

@@ -130,9 +130,12 @@ class SurfaceContact(AbstractContact):
         return jnp.concatenate([rotation @ multipliers[3:6], multipliers[:3]])
 
 
-def wrenches(contacts, closures, multipliers: Array) -> Array:
+def wrenches(contacts, closures, multipliers: Array, rotations=None) -> Array:
     """Each contact's wrench (`AbstractContact.wrench`) from the stacked multipliers of its
-    closure, in order: shape (len(contacts), 6)."""
+    closure, in order: shape (len(contacts), 6). The closures' ground-frame orientations are
+    read from `closures`, or given as `rotations` (len(contacts), 3, 3)."""
     starts = np.cumsum([0] + [c.size for c in contacts])
-    return jnp.stack([c.wrench(multipliers[s:s + c.size], j.rotation_b)
-                      for c, j, s in zip(contacts, closures, starts, strict=False)])
+    if rotations is None:
+        rotations = [j.rotation_b for j in closures]
+    return jnp.stack([c.wrench(multipliers[s:s + c.size], R)
+                      for c, R, s in zip(contacts, rotations, starts, strict=False)])

@@ -2,7 +2,10 @@
 
 from collections.abc import Sequence
 
+import equinox as eqx
+import jax
 import jax.numpy as jnp
+import numpy as np
 from jax import Array
 
 from mbjax._src.contact.contact import AbstractContact, wrenches
@@ -10,6 +13,7 @@ from mbjax._src.loops.coupled import Coupled
 from mbjax._src.loops.method import AbstractLoopMethod
 from mbjax._src.loops.system import ClosedSystem
 from mbjax._src.model.model import Model
+from mbjax._src.system.status import Status
 from mbjax._src.system.tree_system import AbstractTreeSystem
 
 # Crocoddyl's contact models stabilize with Baumgarte gains (Kp, Kd) = (0, 50): the contact's
@@ -26,8 +30,29 @@ def _contacts(contacts) -> tuple[AbstractContact, ...]:
     return contacts
 
 
+class Grip(eqx.Module):
+    """A stance's watch (`ClosedSystem`'s `watch`): `Status.PULLING` where a contact's normal
+    force is negative, `Status.SLIPPING` where its tangential force exceeds mu times the normal
+    one (the exact cone), each beyond round-off (1e-9 of the force)."""
+
+    contacts: tuple
+    rotations: Array               # each closure's ground frame orientation
+    mu: Array
+
+    def __call__(self, multipliers: Array) -> Array:
+        w = wrenches(self.contacts, (), multipliers, self.rotations)
+        normals = jnp.stack([c.normal for c in self.contacts])
+        f = w[:, 3:]
+        fn = jnp.sum(f * normals, axis=1)
+        ft = jnp.linalg.norm(f - fn[:, None] * normals, axis=1)
+        slack = 1e-9 * jnp.linalg.norm(f, axis=1)
+        return (jnp.where(jnp.any(fn < -slack), int(Status.PULLING), 0)
+                | jnp.where(jnp.any(ft > self.mu * fn + slack), int(Status.SLIPPING), 0))
+
+
 def stance(tree: AbstractTreeSystem, q: Array, contacts: Sequence[AbstractContact], *,
-           method: AbstractLoopMethod | None = None, projection: bool = False) -> ClosedSystem:
+           method: AbstractLoopMethod | None = None, projection: bool = False,
+           mu=None) -> ClosedSystem:
     """A contact phase: `tree` with each contact's frame held where it is in configuration q.
 
     Each contact becomes a cut joint with the ground (`AbstractContact.closure`), and the phase
@@ -42,6 +67,10 @@ def stance(tree: AbstractTreeSystem, q: Array, contacts: Sequence[AbstractContac
             stabilization of Crocoddyl's contact models, (Kp, Kd) = (0, 50). `Stabilized()` is
             Anderson 1993's O(n + m^3) route.
         projection: project (q, v) onto the contacts after each step.
+        mu (float | None): the friction coefficient: `mbjax.simulate` then flags a saved state
+            where a contact pulls on the ground (`Status.PULLING`) or its force leaves the
+            friction cone (`Status.SLIPPING`), failures both, the contact model's assumptions
+            broken; None for no watch.
 
     Returns:
         The phase, a `ClosedSystem`.
@@ -49,6 +78,7 @@ def stance(tree: AbstractTreeSystem, q: Array, contacts: Sequence[AbstractContac
     Raises:
         TypeError: tree is not a rigid tree system, or contacts are not contacts.
         KeyError: a contact's frame is not in the model.
+        ValueError: mu is not positive.
     """
     if not (isinstance(tree, AbstractTreeSystem) and isinstance(getattr(tree, "model", None), Model)):
         raise TypeError(f"tree must be a rigid tree system such as TreeSystem(model), got "
@@ -56,7 +86,20 @@ def stance(tree: AbstractTreeSystem, q: Array, contacts: Sequence[AbstractContac
     contacts = _contacts(contacts)
     closures = tuple(c.closure(tree.model, jnp.asarray(q, float)) for c in contacts)
     method = Coupled(baumgarte=CROCODDYL_GAINS) if method is None else method
-    return ClosedSystem(tree, closures, method, projection)
+    watch = None
+    if mu is not None:
+        watch = Grip(contacts, jnp.stack([j.rotation_b for j in closures]), friction(mu))
+    return ClosedSystem(tree, closures, method, projection, watch=watch)
+
+
+def friction(mu) -> Array:
+    """mu as an array, or a ValueError naming it where it is concrete and not positive."""
+    mu = jnp.asarray(mu, dtype=float)
+    if mu.ndim != 0:
+        raise ValueError(f"mu must be a scalar friction coefficient, got shape {mu.shape}")
+    if not isinstance(mu, jax.core.Tracer) and not (float(mu) > 0 and np.isfinite(float(mu))):
+        raise ValueError(f"mu must be a positive friction coefficient, got {float(mu)!r}")
+    return mu
 
 
 def contact_wrenches(system: ClosedSystem, contacts: Sequence[AbstractContact], t, q: Array,

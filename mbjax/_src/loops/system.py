@@ -13,6 +13,8 @@ when the constraint Jacobian has lost rank (redundant closures, a singular confi
 least-squares loads of `mbjax._src.loops.multipliers` keep the run finite).
 """
 
+from collections.abc import Callable
+
 import equinox as eqx
 import jax.numpy as jnp
 from jax import Array
@@ -72,6 +74,9 @@ class ClosedSystem(AbstractSystem):
         external (Callable | None): the tree's external wrenches, if not given to the tree.
         external_point (Array | None): where the external forces act, if not given to the tree.
         iterations: chord iterations of each projection; static.
+        watch (Callable | None): a check of the loads: watch(multipliers) -> `Status` flags
+            (int32), OR-ed into `check` (`mbjax.contact.stance` watches its contacts for a
+            pulling or slipping foot).
 
     Raises:
         TypeError: `tree` is not a tree system, `method` is a class or not a loop method, the
@@ -94,10 +99,12 @@ class ClosedSystem(AbstractSystem):
     projection: bool = eqx.field(static=True)
     tolerance: float = eqx.field(static=True)
     iterations: int = eqx.field(static=True)
+    watch: Callable | None
 
     def __init__(self, tree: AbstractTreeSystem, closures, method: AbstractLoopMethod | None = None,
                  projection: bool = False, tolerance: float = TOLERANCE, *, control=None,
-                 external=None, external_point=None, iterations: int = ITERATIONS):
+                 external=None, external_point=None, iterations: int = ITERATIONS,
+                 watch: Callable | None = None):
         if isinstance(method, type):
             raise TypeError(f"method must be an instance, e.g. {method.__name__}(), "
                             "not the class")
@@ -118,6 +125,9 @@ class ClosedSystem(AbstractSystem):
         self.projection = bool(projection)
         self.tolerance = float(tolerance)
         self.iterations = int(iterations)
+        if watch is not None and not callable(watch):
+            raise TypeError(f"watch must be a callable of the multipliers, got {watch!r}")
+        self.watch = watch
 
     @property
     def tree(self) -> AbstractTreeSystem:
@@ -252,12 +262,15 @@ class ClosedSystem(AbstractSystem):
 
     def check(self, t, q, u):
         """`Status.CONSTRAINT_VIOLATED` where |Phi| > tolerance, `Status.REDUNDANT` where the
-        constraint Jacobian has lost rank, and the tree's own flags; an int32 scalar."""
+        constraint Jacobian has lost rank, the `watch`'s flags and the tree's own; an int32
+        scalar."""
         violated = jnp.linalg.norm(self.loops.phi(q, t)) > self.tolerance
         A = self.loops.jacobian(q, t)
         redundant = numerical_rank(A @ A.T) < self.loops.m
+        watched = (0 if self.watch is None
+                   else self.watch(self.multipliers(t, q, u)).astype(jnp.int32))
         return (jnp.where(violated, int(Status.CONSTRAINT_VIOLATED), 0)
-                | jnp.where(redundant, int(Status.REDUNDANT), 0)
+                | jnp.where(redundant, int(Status.REDUNDANT), 0) | watched
                 | self.tree.check(t, q, self.velocity(q, u))).astype(jnp.int32)
 
     # -- invariants -------------------------------------------------------------------------------

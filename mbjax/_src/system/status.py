@@ -33,6 +33,9 @@ class Status(enum.IntFlag):
         SINGULAR: a saved state at (or within the system's tolerance of) a singular
             configuration, where the dynamics are not defined (the Carpal Wrist's inverse or
             direct singularity: `WristSystem.check`).
+        PULLING: a contact held on the ground pulls on it (a negative normal force): the foot
+            would have lifted off (`mbjax.contact.stance` with a friction coefficient).
+        SLIPPING: a contact's force leaves its friction cone: the foot would have slipped.
     """
 
     SUCCESS = 0
@@ -44,6 +47,8 @@ class Status(enum.IntFlag):
     LIMIT_EXCEEDED = 32
     INACCURATE = 64
     SINGULAR = 128
+    PULLING = 256
+    SLIPPING = 512
 
     @classmethod
     def failures(cls) -> int:
@@ -53,7 +58,7 @@ class Status(enum.IntFlag):
             The failure flags OR-ed into one int mask.
         """
         return (cls.NONFINITE | cls.NOT_CONVERGED | cls.SOLVER_FAILED | cls.CONSTRAINT_VIOLATED
-                | cls.INACCURATE | cls.SINGULAR)
+                | cls.INACCURATE | cls.SINGULAR | cls.PULLING | cls.SLIPPING)
 
 
 # the flags in order: `flagged_at` keeps the time each was first raised

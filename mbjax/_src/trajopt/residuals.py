@@ -15,7 +15,7 @@ import numpy as np
 from jax import Array
 
 from mbjax._src.contact.contact import wrenches
-from mbjax._src.contact.stance import _contacts
+from mbjax._src.contact.stance import _contacts, friction
 from mbjax._src.control import Constant
 from mbjax._src.lie import gamma_inv, log
 from mbjax._src.lie.inputs import check_point
@@ -227,8 +227,7 @@ def friction_cone_residual(phase, contacts, mu=0.7, facets: int = 4, weight=1.0)
     Raises:
         ValueError: mu is not positive, facets < 3, or the phase is not the contacts' stance.
     """
-    if not (np.ndim(mu) == 0 and float(mu) > 0 and np.isfinite(float(mu))):
-        raise ValueError(f"mu must be a positive friction coefficient, got {mu!r}")
+    mu = friction(mu)
     if int(facets) < 3:
         raise ValueError(f"facets must be at least 3, got {facets!r}")
     contacts = _phase_contacts(phase, contacts)
