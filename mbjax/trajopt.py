@@ -21,7 +21,6 @@ from mbjax._src.trajopt.residuals import friction_cone_residual as friction_cone
 from mbjax._src.trajopt.residuals import contact_force_residual as contact_force_residual
 from mbjax._src.trajopt.residuals import barrier_residual as barrier_residual
 from mbjax._src.trajopt.residuals import wrench_cone_residual as wrench_cone_residual
-from mbjax._src.trajopt.knots import AbstractKnot as AbstractKnot
 from mbjax._src.trajopt.knots import Knot as Knot
 from mbjax._src.trajopt.knots import Impulse as Impulse
 from mbjax._src.trajopt.quasi_static import quasi_static as quasi_static
@@ -31,5 +30,5 @@ __all__ = [
     "optimal_cost", "sweep", "state_residual", "frame_residual", "control_residual",
     "com_residual", "friction_cone_residual", "contact_force_residual", "barrier_residual",
     "wrench_cone_residual",
-    "AbstractKnot", "Knot", "Impulse", "quasi_static",
+    "Knot", "Impulse", "quasi_static",
 ]

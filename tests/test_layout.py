@@ -26,15 +26,17 @@ LAYERS = (
     {"rigid", "wrist"},
     {"flex"},                         # flexible bodies reuse the rigid kinematics
     {"loops", "tfe"},
-    {"contact"},                      # contacts with the ground: closures of a legged robot
     {"integrate"},
+    {"contact"},                      # contacts with the ground: closures of a legged robot,
+                                      # simulated through a schedule
     {"trajopt"},
     {"synthesis", "scenes"},          # the Carpal Wrist's synthesis; the ready-made scenes
 )
 RANK = {name: rank for rank, names in enumerate(LAYERS) for name in names}
 NAMESPACES = ("lie", "model", "control", "integrate", "rigid", "flex", "loops", "tfe", "wrist",
               "trajopt", "scenes", "data", "contact")
-MAX_PUBLIC_NAMES = 160       # 150, and the contact namespace (legged robots)
+MAX_PUBLIC_NAMES = 170       # 150, the contact namespace (legged robots), multi-phase problems
+                             # and contact costs (issue 45)
 
 
 def _imports(path: Path):

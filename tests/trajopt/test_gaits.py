@@ -131,3 +131,34 @@ def test_anymal_walk_reaches_fddps_optimum():
     us = to_croc(result.us)
     np.testing.assert_allclose(croc_problem.calc(croc_problem.rollout(us), us), result.cost,
                                rtol=1e-6)
+
+
+@crocoddyl_only
+@pytest.mark.slow
+def test_short_talos_step_is_crocoddyls_problem():
+    """Talos's legs (upper body locked in both libraries) stepping with each foot, soles held
+    as surface contacts with wrench-cone costs: the quasi-static guess is Crocoddyl's, and under
+    perturbed controls each step and impulse of Crocoddyl from mbjax's state lands on mbjax's
+    next state and the costs agree (1e-6: a weld's rotation rows and Crocoddyl's 6-D contact
+    hold the sole's classical and spatial accelerations, which differ by omega x v, second order
+    in the sole's tiny velocity)."""
+    example_robots(["talos_data/talos_reduced"])
+    from mbjax_harness.crocoddyl_gaits import talos_step
+
+    example = talos_step(step_knots=4, support_knots=1)
+    problem = example.problem
+    croc = example.crocoddyl()
+    to_croc = example.controls(croc)
+    for mine, theirs in zip(to_croc(example.us0), croc.quasiStatic([croc.x0] * croc.T),
+                            strict=True):
+        np.testing.assert_allclose(mine, theirs, atol=1e-9)
+    us = jnp.asarray(example.us0 + np.random.default_rng(0).normal(scale=0.3,
+                                                                     size=example.us0.shape))
+    xs = _rollout(problem, us)
+    xs_croc, us_croc = example.to_crocoddyl(xs), to_croc(us)
+    for k, model in enumerate(croc.runningModels):
+        data = model.createData()
+        model.calc(data, xs_croc[k], us_croc[k])
+        np.testing.assert_allclose(data.xnext, xs_croc[k + 1], atol=1e-6)
+    np.testing.assert_allclose(_cost(problem, xs, us), croc.calc(list(xs_croc), us_croc),
+                               rtol=1e-6)

@@ -30,15 +30,17 @@ class Problem(eqx.Module):
     bounds on the controls.
 
     Args:
-        system: any mbjax system with a control (`TreeSystem`, `FlexibleSystem`, `WristSystem`,
-            `RigidBody`, a `ClosedSystem` of a tree, ...); its control is replaced by the
-            unknowns u_k.
+        system (AbstractSystem | Sequence[Knot | Impulse]): any mbjax system with a control
+            (`TreeSystem`, `FlexibleSystem`, `WristSystem`, `RigidBody`, a `ClosedSystem` of a
+            tree, ...), whose control is replaced by the unknowns u_k; or one knot per step, a
+            multi-phase problem (see Phases, below).
         q0 (Array): initial configuration, shape (nq,).
         v0 (Array): initial velocity, shape (nv,).
         dt: the step and control interval, seconds (keyword only).
-        horizon: the number of steps N (keyword only).
+        horizon: the number of steps N (keyword only); None for the number of knots.
         running: cost rate running(q, v, u), a scalar or a vector of residuals; or a tuple of
-            such functions, their sum (keyword only; see Costs, below).
+            such functions, their sum (keyword only; see Costs, below); None with knots, which
+            carry their own.
         terminal: final cost terminal(q, v), likewise (keyword only).
         lower (float | Array | None): lower bound on each actuated force, a scalar or shape
             (nu,); None for none.
@@ -47,9 +49,12 @@ class Problem(eqx.Module):
 
     Raises:
         TypeError: naming the malformed argument: a system that is not an mbjax system or has
-            no control, an integrator that is not an instance, costs that are not callables.
+            no control, a knot that is not a `Knot` or `Impulse`, an integrator that is not an
+            instance, costs that are not callables.
         ValueError: naming the malformed argument: a state of the wrong shape, a non-positive
-            dt or horizon, bounds of the wrong shape, lower above upper.
+            dt or horizon, a horizon other than the number of knots, a running cost beside
+            knots, knots of different numbers of controls, bounds of the wrong shape, lower
+            above upper.
 
     Formulation:
         The unknowns are the controls u_0 ... u_{N-1}, one value per step of length dt held over
@@ -75,6 +80,20 @@ class Problem(eqx.Module):
         being dx = difference(x_ref, x) = (system.difference(q_ref, q), v - v_ref), of length ndx =
         2 nv for a tree (Crocoddyl's `StateMultibody`), and move along it with integrate(x, dx) =
         (retract(q, dq), v + dv). On Euclidean coordinates both are plain subtraction and addition.
+
+    Phases:
+        A legged robot's problem changes its dynamics along the horizon: each contact phase is
+        its own system (`mbjax.contact.stance` of the feet on the ground), and where a foot lands
+        an impulse stops it (Crocoddyl's shooting problem of action models, one per knot). Such
+        a problem is written knot by knot: `Knot(system, running)` for a step of its system
+        under the held control, weighted by dt, and `Impulse(model, contacts, running)` for a
+        touchdown, which takes no time, moves nothing through the control and whose cost is not
+        weighted. Knots alike but for their arrays (a stance's anchors, a target) form one phase:
+        each phase's step and expansion are compiled once and vmapped over its knots, and the
+        rollout takes each knot's branch (`lax.switch`), so compilation grows with the number of
+        distinct phases, not of knots. Costs that depend on the contact forces (a friction cone)
+        are differentiated together with the step, the dynamics traced once for both.
+        `mbjax.trajopt.quasi_static` gives Crocoddyl's first guess.
 
     Costs:
         A cost function returns either a scalar, taken as it is, or a vector of residuals r, meaning
