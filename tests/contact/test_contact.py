@@ -151,6 +151,7 @@ def test_anymal_stands_on_its_four_feet():
     assert np.all(np.asarray(wrenches[:, :3]) == 0.0)       # a point contact carries no torque
 
 
+@pytest.mark.slow
 def test_a_schedule_flags_a_foot_that_pulls():
     """ANYmal servoed to a pose, on four feet and then on three: on four the run succeeds and
     the lifted foot carries nothing afterwards; on three, with the pose held, the diagonal

@@ -219,7 +219,7 @@ def test_costs_that_are_not_scalars_or_vectors_are_named(which, shape):
 @FEW
 @given(st.sampled_from([3.0, "cost", None]))
 def test_costs_that_are_not_callable_are_named(cost):
-    with pytest.raises(TypeError, match=r"running\(q, v, u\) and terminal\(q, v\) must be callables"):
+    with pytest.raises(TypeError, match=r"running\(q, v, u\) must be a callable"):
         problem(running=cost)
 
 

@@ -16,7 +16,6 @@ from mbjax._src.contact.impulse import impulse_map
 from mbjax._src.control import Constant
 from mbjax._src.model.model import Model
 from mbjax._src.rigid.frames import frame_placement
-from mbjax._src.rigid.system import TreeSystem
 from mbjax._src.system.system import AbstractSystem
 from mbjax._src.trajopt.costs import as_cost
 
@@ -36,10 +35,6 @@ class AbstractKnot(eqx.Module):
     @abc.abstractmethod
     def transition(self, integrator, t, q: Array, v: Array, u: Array, dt) -> tuple[Array, Array]:
         """(q, v) at the next knot from (q, v) at time t under the control u."""
-
-    @abc.abstractmethod
-    def space(self) -> AbstractSystem:
-        """The system whose configuration manifold the states live on."""
 
     def duration(self, dt: float) -> float:
         """The time from this knot to the next."""
@@ -70,9 +65,6 @@ class Knot(AbstractKnot):
         system = self.system.with_control(Constant(u)).hold(t, q, v)
         q1, v1, _ = integrator.step(system, t, q, v, dt)
         return system.constrain(t + dt, q1, v1)
-
-    def space(self):
-        return self.system
 
 
 class Impulse(AbstractKnot):
@@ -105,9 +97,6 @@ class Impulse(AbstractKnot):
     def transition(self, integrator, t, q, v, u, dt):
         return q, impulse_map(self.model, q, v, self.contacts)[0]
 
-    def space(self):
-        return TreeSystem(self.model)
-
 
 class Schedule(eqx.Module):
     """A sequence of knots grouped into phases: knots alike but for their arrays (a stance's
@@ -116,6 +105,7 @@ class Schedule(eqx.Module):
 
     Args:
         knots: one `AbstractKnot` per step.
+        dt: the problem's step, for each knot's time.
 
     Raises:
         TypeError: an entry that is not a knot.

@@ -92,7 +92,7 @@ class Problem(eqx.Module):
         each phase's step and expansion are compiled once and vmapped over its knots, and the
         rollout takes each knot's branch (`lax.switch`), so compilation grows with the number of
         distinct phases, not of knots. Costs that depend on the contact forces (a friction cone)
-        are differentiated together with the step, the dynamics traced once for both.
+        are differentiated in the step's forward-mode pass.
         `mbjax.trajopt.quasi_static` gives Crocoddyl's first guess.
 
     Costs:
@@ -294,8 +294,8 @@ class Problem(eqx.Module):
     def _stage(self, knot, x: Array, u: Array, t, x_next: Array):
         """A knot's ((A, B, e), (l_x, l_u, l_xx, l_ux, l_uu)). A knot's residual costs may
         depend on its dynamics (a stance's contact forces in a friction cone): in a multi-phase
-        problem the step and the residuals are differentiated in one forward-mode pass, so the
-        dynamics are traced once for both (a phase compiles in a quarter of the time)."""
+        problem the step and the residuals are differentiated in one forward-mode pass over
+        (dx, u), rather than one pass for the step and one per argument for the costs."""
         zero_q, zero_v = jnp.zeros(self.ndq, x.dtype), jnp.zeros(self.nv, x.dtype)
         running = self._about(x, knot.running)
         if self.knots is None or not _is_residual(running, zero_q, zero_v, u):
