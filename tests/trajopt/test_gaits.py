@@ -81,6 +81,7 @@ def test_bad_multi_phase_input_is_refused_by_name():
 
 
 @crocoddyl_only
+@pytest.mark.slow
 def test_short_walk_is_crocoddyls_problem():
     """ANYmal's walk with short steps, built in both libraries: the quasi-static guess is
     Crocoddyl's `quasiStatic` (to 1e-10 N m), and under perturbed controls (feet pushing,

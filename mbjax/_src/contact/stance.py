@@ -121,9 +121,17 @@ def contact_wrenches(system: ClosedSystem, contacts: Sequence[AbstractContact], 
     Raises:
         ValueError: the system's first closures do not match the contacts' sizes.
     """
+    contacts = stance_contacts(system, contacts, "system")
+    return wrenches(contacts, system.closures, system.multipliers(t, q, u))
+
+
+def stance_contacts(system, contacts, name: str) -> tuple[AbstractContact, ...]:
+    """The contacts as a tuple, or a ValueError naming `name` where `system`'s first closures
+    are not theirs (a stance made from other contacts)."""
     contacts = _contacts(contacts)
-    closures = system.closures[:len(contacts)]
+    closures = getattr(system, "closures", ())
     if len(closures) < len(contacts) or any(
             c.kind != j.kind for c, j in zip(contacts, closures, strict=False)):
-        raise ValueError("system must be the stance of these contacts (stance(tree, q, contacts))")
-    return wrenches(contacts, closures, system.multipliers(t, q, u))
+        raise ValueError(f"{name} must be the stance of these contacts (stance(tree, q, "
+                         "contacts))")
+    return contacts

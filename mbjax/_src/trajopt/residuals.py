@@ -14,8 +14,7 @@ import jax.numpy as jnp
 import numpy as np
 from jax import Array
 
-from mbjax._src.contact.contact import wrenches
-from mbjax._src.contact.stance import _contacts, friction
+from mbjax._src.contact.stance import contact_wrenches, friction, stance_contacts
 from mbjax._src.control import Constant
 from mbjax._src.lie import gamma_inv, log
 from mbjax._src.lie.inputs import check_point
@@ -178,17 +177,11 @@ class _Forces(eqx.Module):
 
     def __call__(self, q: Array, v: Array, u: Array) -> Array:
         system = self.phase.with_control(Constant(u)).hold(0.0, q, v)
-        return wrenches(self.contacts, system.closures[:len(self.contacts)],
-                        system.multipliers(0.0, q, v))
+        return contact_wrenches(system, self.contacts, 0.0, q, v)
 
 
 def _phase_contacts(phase, contacts) -> tuple:
-    contacts = _contacts(contacts)
-    closures = getattr(phase, "closures", ())
-    if len(closures) < len(contacts) or any(
-            c.kind != j.kind for c, j in zip(contacts, closures, strict=False)):
-        raise ValueError("phase must be the stance of these contacts (stance(tree, q, contacts))")
-    return contacts
+    return stance_contacts(phase, contacts, "phase")
 
 
 class _Cone(eqx.Module):
