@@ -30,6 +30,27 @@ def _cost(problem, xs, us):
     return float(eqx.filter_jit(lambda p, x, u: p.cost(x, u))(problem, xs, us))
 
 
+def _agrees_with_crocoddyl(example, scale, seed, guess, tolerance):
+    """The quasi-static guess is Crocoddyl's `quasiStatic` (to `guess`), and under the guess
+    perturbed by normal noise of `scale` N m each of Crocoddyl's steps and impulses from mbjax's
+    state lands on mbjax's next state (to `tolerance`) and the two costs agree (relative)."""
+    problem, croc = example.problem, example.crocoddyl()
+    to_croc = example.controls(croc)
+    for mine, theirs in zip(to_croc(example.us0), croc.quasiStatic([croc.x0] * croc.T),
+                            strict=True):
+        np.testing.assert_allclose(mine, theirs, atol=guess)
+    noise = np.random.default_rng(seed).normal(scale=scale, size=example.us0.shape)
+    us = jnp.asarray(example.us0 + noise)
+    xs = _rollout(problem, us)
+    xs_croc, us_croc = example.to_crocoddyl(xs), to_croc(us)
+    for k, model in enumerate(croc.runningModels):
+        data = model.createData()
+        model.calc(data, xs_croc[k], us_croc[k])
+        np.testing.assert_allclose(data.xnext, xs_croc[k + 1], atol=tolerance)
+    np.testing.assert_allclose(_cost(problem, xs, us), croc.calc(list(xs_croc), us_croc),
+                               rtol=tolerance)
+
+
 def test_knots_of_one_system_restate_the_one_system_problem():
     """A problem written knot by knot with one system and per-knot targets: one phase (one
     compiled step), and its rollout, cost and expansion are those of the one-system problem with
@@ -94,21 +115,7 @@ def test_short_walk_is_crocoddyls_problem():
     example = anymal_walk(step_knots=4, support_knots=1)
     problem = example.problem
     assert problem.horizon == 22 and len(problem.knots.templates) == 9
-    croc = example.crocoddyl()
-    to_croc = example.controls(croc)
-    guess = croc.quasiStatic([croc.x0] * croc.T)
-    for mine, theirs in zip(to_croc(example.us0), guess, strict=True):
-        np.testing.assert_allclose(mine, theirs, atol=1e-10)
-    us = jnp.asarray(example.us0 + np.random.default_rng(1).normal(scale=3.0,
-                                                                     size=example.us0.shape))
-    xs = _rollout(problem, us)
-    xs_croc, us_croc = example.to_crocoddyl(xs), to_croc(us)
-    for k, model in enumerate(croc.runningModels):
-        data = model.createData()
-        model.calc(data, xs_croc[k], us_croc[k])
-        np.testing.assert_allclose(data.xnext, xs_croc[k + 1], atol=1e-10)
-    np.testing.assert_allclose(_cost(problem, xs, us), croc.calc(list(xs_croc), us_croc),
-                               rtol=1e-10)
+    _agrees_with_crocoddyl(example, scale=3.0, seed=1, guess=1e-10, tolerance=1e-10)
 
 
 @crocoddyl_only
@@ -155,19 +162,4 @@ def test_short_talos_step_is_crocoddyls_problem():
     from mbjax_harness.crocoddyl_gaits import talos_step
 
     example = talos_step(step_knots=4, support_knots=1)
-    problem = example.problem
-    croc = example.crocoddyl()
-    to_croc = example.controls(croc)
-    for mine, theirs in zip(to_croc(example.us0), croc.quasiStatic([croc.x0] * croc.T),
-                            strict=True):
-        np.testing.assert_allclose(mine, theirs, atol=1e-9)
-    us = jnp.asarray(example.us0 + np.random.default_rng(0).normal(scale=0.3,
-                                                                     size=example.us0.shape))
-    xs = _rollout(problem, us)
-    xs_croc, us_croc = example.to_crocoddyl(xs), to_croc(us)
-    for k, model in enumerate(croc.runningModels):
-        data = model.createData()
-        model.calc(data, xs_croc[k], us_croc[k])
-        np.testing.assert_allclose(data.xnext, xs_croc[k + 1], atol=1e-6)
-    np.testing.assert_allclose(_cost(problem, xs, us), croc.calc(list(xs_croc), us_croc),
-                               rtol=1e-6)
+    _agrees_with_crocoddyl(example, scale=0.3, seed=0, guess=1e-9, tolerance=1e-6)
