@@ -151,9 +151,6 @@ class Schedule(eqx.Module):
         self.phase, self.index = tuple(phase), tuple(index)
         self.times = tuple(float(t) for t in np.cumsum([0.0] + [k.duration(dt) for k in knots])[:-1])
 
-    def __len__(self) -> int:
-        return len(self.phase)
-
     def knot(self, p: int, j) -> AbstractKnot:
         """The j-th knot of phase p (j may be traced)."""
         arrays = jax.tree.map(lambda axis, a: a if axis is None else a[j], self.axes[p],
