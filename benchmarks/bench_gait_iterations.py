@@ -1,7 +1,7 @@
 """Crocoddyl's ANYmal walk (`mbjax_harness.crocoddyl_gaits.anymal_walk`), mbjax's iLQR with
 Crocoddyl's schedule against Crocoddyl's FDDP from the same quasi-static guess, mbjax's
-iterations driven one jitted `ILQR.step` at a time from Python (issue 45: the whole solve as
-one program stalled in XLA's CPU runtime on the 9-phase problem; see benchmarks/README.md).
+iterations driven one jitted `ILQR.step` at a time from Python, so that each iteration's wall
+time shows (`mbjax bench trajopt` times the whole solve as one program).
 
     python benchmarks/bench_gait_iterations.py [STEP_KNOTS] [SUPPORT_KNOTS]
 

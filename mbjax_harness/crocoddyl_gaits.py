@@ -6,8 +6,11 @@ problem from its own builder.
     anymal-walk     `examples/quadrupedal_gaits_fwddyn.py`'s walk: ANYmal, one cycle of
                     `SimpleQuadrupedalGaitProblem.createWalkingProblem` (step 0.25 m, height
                     0.15 m, dt 1e-2 s, 25 knots a step, 2 of double support): 108 knots
+    anymal-trot     its trot (`createTrottingProblem`, the same defaults): the diagonal pairs
+                    step in turn, 56 knots (the tour's scene, shorter)
     talos-step      `examples/bipedal_gaits_fwddyn.py`'s walk: Talos's legs (its upper body
-                    locked at half-sitting in both libraries), one step of each foot, `SimpleBipedGaitProblem.createWalkingProblem` (step
+                    locked at half-sitting in both libraries), one step of each foot,
+                    `SimpleBipedGaitProblem.createWalkingProblem` (step
                     0.6 m, height 0.1 m, dt 3e-2 s, 15 knots a step, 4 of double support):
                     39 knots and the left foot's impulse model as the terminal cost
 
@@ -46,18 +49,25 @@ def _controls(croc_problem):
 class _Gait:
     """The pieces of Crocoddyl's gait builders in mbjax: its models' costs, knot by knot.
 
+    Every knot is written over all the feet, so that the gait is two phases, whatever its
+    schedule (`mbjax.trajopt.Problem` compiles each distinct phase once): each stance holds the
+    support feet and has the others in the air (`active=False`), and a task that Crocoddyl's
+    model of that knot lacks (the CoM of a double support, a foot not swinging) is there with
+    the weight 0, which adds nothing to the cost.
+
     Args:
         model, q0: the robot and its standing configuration (the state costs' reference).
         kind: `PointContact` (a quadruped's feet: friction cones, translations tracked) or
             `SurfaceContact` (a biped's soles: wrench cones, placements tracked).
+        feet: the feet's frames and their positions at q0, a dict.
         weights: the state weights of a step's knot and of an impulse's, mbjax's tangent order.
         bounds: (lower, upper) of the state barrier, or None.
         gain: the contacts' Baumgarte Kd (Crocoddyl's (0, Kd)).
         impulse_track: the weight of an impulse's foot tracking.
     """
 
-    def __init__(self, model, q0, kind, weights, bounds, gain, impulse_track):
-        self.model, self.q0, self.kind = model, q0, kind
+    def __init__(self, model, q0, kind, feet, weights, bounds, gain, impulse_track):
+        self.model, self.q0, self.kind, self.feet = model, q0, kind, dict(feet)
         self.tree = TreeSystem(model, actuation=range(6, model.nv))
         self.nu = model.nv - 6
         self.state_weights, self.impulse_weights = weights
@@ -69,31 +79,38 @@ class _Gait:
     def regularisation(self, weights):
         return state_residual(self.model, self.q0, weight=10.0 * np.asarray(weights) ** 2)
 
-    def track(self, foot, target, weight):
+    def contacts(self, down):
+        """Every foot, those in `down` on the ground and the others in the air."""
+        return [self.kind(f, active=f in down) for f in self.feet]
+
+    def tracks(self, swing, weight):
+        """`createSwingFootModel`'s foot tasks: each foot of `swing` (pairs (frame, target))
+        tracked with `weight`, the others with 0."""
         rotation = None if self.kind is PointContact else np.eye(3)
-        return frame_residual(self.model, foot, target, rotation, weight=weight)
+        targets = dict(swing)
+        return [frame_residual(self.model, f, targets.get(f, p), rotation,
+                               weight=weight if f in targets else 0.0)
+                for f, p in self.feet.items()]
 
     def knot(self, support, com=None, swing=()):
         """`createSwingFootModel`: the support feet held, the swing feet and CoM tracked."""
-        contacts = [self.kind(f) for f in support]
+        contacts = self.contacts(support)
         phase = stance(self.tree, self.q0, contacts, method=self.method)
         costs = [friction_cone_residual(phase, contacts, MU, weight=10.0)
                  if self.kind is PointContact else
-                 wrench_cone_residual(phase, contacts, MU, *SOLE, weight=10.0)]
-        if com is not None:
-            costs.append(com_residual(self.model, com, weight=1e6))
-        costs += [self.track(f, p, 1e6) for f, p in swing]
-        costs += [self.regularisation(self.state_weights),
-                  control_residual(self.nu, weight=0.1), *self.bounds]
+                 wrench_cone_residual(phase, contacts, MU, *SOLE, weight=10.0),
+                 com_residual(self.model, np.zeros(3) if com is None else com,
+                              weight=0.0 if com is None else 1e6),
+                 *self.tracks(swing, 1e6), self.regularisation(self.state_weights),
+                 control_residual(self.nu, weight=0.1), *self.bounds]
         return Knot(phase, tuple(costs))
 
     def impulse_costs(self, swing):
-        return (*(self.track(f, p, self.impulse_track) for f, p in swing),
-                self.regularisation(self.impulse_weights))
+        return (*self.tracks(swing, self.impulse_track), self.regularisation(self.impulse_weights))
 
     def impulse(self, landing, swing):
         """`createImpulseModel`: the landing feet stopped, still tracked."""
-        return Impulse(self.model, [self.kind(f) for f in landing], self.impulse_costs(swing))
+        return Impulse(self.model, self.contacts(landing), self.impulse_costs(swing))
 
     def footsteps(self, com, feet, length, height, knots, support, swing):
         """`createFootstepModels`: a step's knots, then its impulse; com and feet move on.
@@ -155,25 +172,23 @@ def _weights(base, joints, velocity, nv):
     return w[np.r_[3:6, 0:3, 6:2 * nv]]
 
 
-def anymal_walk(step_length=0.25, step_height=0.15, dt=1e-2, step_knots=25,
-                support_knots=2) -> Example:
+def _anymal(schedule, builder: str, step_length, step_height, dt, step_knots,
+            support_knots) -> Example:
+    """ANYmal's gait of `schedule(gait, com, feet, support, lengths)` (the knots after the
+    first double support), with `SimpleQuadrupedalGaitProblem`'s `builder` as Crocoddyl's."""
     robot = _robot("anymal")
     model, q_pin0, q0, v0, feet, com = _start(robot, "standing", FEET)
     nv, nj = model.nv, model.nv - 6
     weights = (_weights([0.0] * 3 + [500.0] * 3, 0.01, [10.0] * 6 + [1.0] * nj, nv),
                _weights([1.0] * 6, 10.0, [10.0] * nv, nv))
     lower = np.r_[[-np.inf] * 6, [-9.42] * nj, [-np.inf] * 6, [-15.0] * nj]
-    gait = _Gait(model, q0, PointContact, weights, (lower, -lower), 50.0, 1e7)
-    lf, rf, lh, rh = FEET
+    gait = _Gait(model, q0, PointContact, feet, weights, (lower, -lower), 50.0, 1e7)
     support = [gait.knot(FEET) for _ in range(support_knots)]
-    knots = list(support)
-    for length, legs, foot in ((0.5 * step_length, [lf, rf, lh], rh),
-                               (0.5 * step_length, [lf, lh, rh], rf), (None, None, None),
-                               (step_length, [lf, rf, rh], lh), (step_length, [rf, lh, rh], lf)):
-        if length is None:
-            knots += support
-        else:
-            knots += gait.footsteps(com, feet, length, step_height, step_knots, legs, [foot])[0]
+
+    def steps(length, legs, swing):
+        return gait.footsteps(com, feet, length, step_height, step_knots, legs, swing)[0]
+
+    knots = support + schedule(support, steps, step_length)
     # the last double-support model is the terminal one: its state costs alone
     terminal = (gait.regularisation(gait.state_weights), *gait.bounds)
     problem = Problem(knots, q0, v0, dt=dt, terminal=terminal, integrator=SemiImplicitEuler())
@@ -181,13 +196,38 @@ def anymal_walk(step_length=0.25, step_height=0.15, dt=1e-2, step_knots=25,
     def crocoddyl():
         from crocoddyl.utils.quadruped import SimpleQuadrupedalGaitProblem
 
-        builder = SimpleQuadrupedalGaitProblem(robot.model, *FEET)
         x0 = np.concatenate([q_pin0, np.zeros(robot.model.nv)])
-        return builder.createWalkingProblem(x0, step_length, step_height, dt, step_knots,
-                                            support_knots)
+        return getattr(SimpleQuadrupedalGaitProblem(robot.model, *FEET), builder)(
+            x0, step_length, step_height, dt, step_knots, support_knots)
 
     return Example(problem, np.asarray(quasi_static(problem)), crocoddyl, "SolverFDDP",
                    _converter(model), controls=_controls)
+
+
+def anymal_walk(step_length=0.25, step_height=0.15, dt=1e-2, step_knots=25,
+                support_knots=2) -> Example:
+    """Crocoddyl's walk: each foot steps in turn, RH, RF, LH, LF, the first two half steps."""
+    lf, rf, lh, rh = FEET
+
+    def schedule(support, steps, length):
+        return (steps(0.5 * length, [lf, rf, lh], [rh]) + steps(0.5 * length, [lf, lh, rh], [rf])
+                + support + steps(length, [lf, rf, rh], [lh]) + steps(length, [rf, lh, rh], [lf]))
+
+    return _anymal(schedule, "createWalkingProblem", step_length, step_height, dt, step_knots,
+                   support_knots)
+
+
+def anymal_trot(step_length=0.25, step_height=0.15, dt=1e-2, step_knots=25,
+                support_knots=2) -> Example:
+    """Crocoddyl's trot (`createTrottingProblem`): the diagonal pairs RF-LH (a half step) and
+    LF-RH step in turn."""
+    lf, rf, lh, rh = FEET
+
+    def schedule(support, steps, length):
+        return steps(0.5 * length, [lf, rh], [rf, lh]) + support + steps(length, [rf, lh], [lf, rh])
+
+    return _anymal(schedule, "createTrottingProblem", step_length, step_height, dt, step_knots,
+                   support_knots)
 
 
 def talos_step(step_length=0.6, step_height=0.1, dt=3e-2, step_knots=15,
@@ -198,7 +238,7 @@ def talos_step(step_length=0.6, step_height=0.1, dt=3e-2, step_knots=15,
     nv = model.nv
     weights = (_weights([0.0] * 3 + [500.0] * 3, 0.01, [10.0] * nv, nv),
                _weights([1.0] * 6, 0.1, [10.0] * nv, nv))
-    gait = _Gait(model, q0, SurfaceContact, weights, None, 30.0, 1e8)
+    gait = _Gait(model, q0, SurfaceContact, feet, weights, None, 30.0, 1e8)
     right, left = SOLES
     support = [gait.knot(SOLES) for _ in range(support_knots)]
     knots = support + gait.footsteps(com, feet, 0.5 * step_length, step_height, step_knots,

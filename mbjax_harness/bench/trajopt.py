@@ -177,24 +177,6 @@ class CrocoddylSolver:
         return measure(self.solve, iterations, repeats=repeats)[1].run_s
 
 
-_init = eqx.filter_jit(lambda solver, problem, us: solver.init(problem, us))
-_step = eqx.filter_jit(lambda solver, problem, state: solver.step(problem, state))
-_result = eqx.filter_jit(lambda solver, problem, state: solver.result(problem, state))
-
-
-def _stepwise(problem, solver, us0, iterations: int | None = None):
-    """`solve(problem, solver, us0)` with the iterations driven from Python, one jitted
-    `solver.step` each (at most `iterations` of them), for the gaits: their whole solve as one
-    program stalled in XLA's CPU runtime (issue 45). The same iterations; each call's dispatch
-    (microseconds) is added to iterations of tenths of a second."""
-    state = _init(solver, problem, us0)
-    taken = 0
-    while bool(solver.running(state)) and (iterations is None or taken < iterations):
-        state = _step(solver, problem, state)
-        taken += 1
-    return _result(solver, problem, state)
-
-
 def _controls(example: Example, croc_problem):
     """(to Crocoddyl: mbjax's (N, nu) -> Crocoddyl's list, an impulse model's empty; back:
     Crocoddyl's list -> (N, nu), zeros where a model takes none)."""
@@ -231,8 +213,7 @@ def single(name: str, repeats: int, common: dict) -> list[dict]:
     problem, us0 = example.problem, jnp.asarray(example.us0)
     final_error = example.final_error or (lambda q: None)
     ilqr = ILQR(iterations=ITERATIONS, **CROCODDYL_SCHEDULE)
-    run = _stepwise if name in GAITS else solve
-    result, timing = measure(run, problem, ilqr, us0, repeats=repeats)
+    result, timing = measure(solve, problem, ilqr, us0, repeats=repeats)
     iterations = int(result.iterations)
     costs = np.asarray(result.costs)[:iterations + 1]
     mbjax = {**common, "kind": "single", "problem": name, "engine": "mbjax", "solver": "ILQR",
@@ -275,12 +256,8 @@ def single(name: str, repeats: int, common: dict) -> list[dict]:
     # the solves stopped at the tolerance, timed in turns
     runs = {}
     if k is not None:
-        if name in GAITS:
-            runs["mbjax"] = lambda: jax.block_until_ready(
-                _stepwise(problem, ilqr, us0, max(k, 1)).us)
-        else:
-            stopped = ILQR(iterations=max(k, 1), **CROCODDYL_SCHEDULE)
-            runs["mbjax"] = lambda: jax.block_until_ready(solve(problem, stopped, us0).us)
+        stopped = ILQR(iterations=max(k, 1), **CROCODDYL_SCHEDULE)
+        runs["mbjax"] = lambda: jax.block_until_ready(solve(problem, stopped, us0).us)
     if why is None and records[-1]["iterations_to_tolerance"] is not None:
         runs["crocoddyl"] = partial(croc.solve, max(records[-1]["iterations_to_tolerance"], 1))
     seconds = in_turns(runs, GAIT_TIMED_RUNS if name in GAITS else TIMED_RUNS)

@@ -100,6 +100,21 @@ def test_contact_dynamics_agree_with_pinocchio(robot):
         rows = slice(3, 6) if kind is PointContact else slice(0, 6)
         assert np.abs(np.asarray(frame_jacobian(model, q, foot) @ v_plus)[rows]).max() < 1e-9
 
+    # the first foot in the air (active=False): Pinocchio's dynamics on the other feet alone,
+    # and a zero wrench on the lifted one
+    lifted = [kind(foot, active=i > 0) for i, foot in enumerate(feet)]
+    phase = stance(TreeSystem(model, Constant(tau)), q, lifted)
+    a_pin, forces, v_plus_pin, impulses_pin = _pinocchio(
+        path, feet[1:], kind, q_pin, v_pin, P @ np.asarray(tau - model.damping * v),
+        (0.0, 2 * CROCODDYL_GAINS[0]), P @ np.asarray(v_before))
+    wrenches = contact_wrenches(phase, lifted, 0.0, q, v)
+    v_up, impulses_up = impulse(model, q, v_before, lifted)
+    assert _rel(P @ np.asarray(phase.acceleration(0.0, q, v)), a_pin) < 1e-9
+    assert _rel(_world_pairs(wrenches[1:], kind.size), forces) < 1e-9
+    assert _rel(P @ np.asarray(v_up), v_plus_pin) < 1e-9
+    assert _rel(_world_pairs(impulses_up[1:], kind.size), impulses_pin) < 1e-9
+    assert not np.any(np.asarray(wrenches[0])) and not np.any(np.asarray(impulses_up[0]))
+
     # on the contacts, the O(n + m^3) route equals the dense one (no stabilization acts)
     coupled = stance(TreeSystem(model, Constant(tau)), q, contacts, method=Coupled())
     recursive = stance(TreeSystem(model, Constant(tau)), q, contacts, method=Stabilized())
@@ -121,6 +136,8 @@ def test_bad_contacts_are_refused_by_name():
         PointContact("flange", normal=(0.0, 0.0, 0.0))
     with pytest.raises(ValueError, match="normal"):
         SurfaceContact("flange", normal=(0.0, float("nan"), 1.0))
+    with pytest.raises(ValueError, match="active must be True or False, got 0.5"):
+        PointContact("flange", active=0.5)
     with pytest.raises(TypeError, match="contacts must be one or more PointContact"):
         stance(TreeSystem(model), q, [])
     with pytest.raises(TypeError, match="tree must be a rigid tree system"):

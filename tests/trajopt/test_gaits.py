@@ -14,7 +14,7 @@ import mbjax
 from mbjax.contact import PointContact, stance
 from mbjax.rigid import TreeSystem
 from mbjax.trajopt import (ILQR, Impulse, Knot, Problem, control_residual, friction_cone_residual,
-                           state_residual)
+                           solve, state_residual)
 from mbjax_harness import peers
 from tests.conftest import example_robots
 
@@ -114,18 +114,17 @@ def test_short_walk_is_crocoddyls_problem():
 
     example = anymal_walk(step_knots=4, support_knots=1)
     problem = example.problem
-    assert problem.horizon == 22 and len(problem.knots.templates) == 9
+    # every stance holds the four feet, some in the air: one stance phase and one impulse phase
+    assert problem.horizon == 22 and len(problem.knots.templates) == 2
     _agrees_with_crocoddyl(example, scale=3.0, seed=1, guess=1e-10, tolerance=1e-10)
 
 
 @crocoddyl_only
 @pytest.mark.slow
 def test_anymal_walk_reaches_fddps_optimum():
-    """Crocoddyl's ANYmal walk (108 knots, 9 phases): iLQR with Crocoddyl's schedule, from the
+    """Crocoddyl's ANYmal walk (108 knots, 2 phases): iLQR with Crocoddyl's schedule, from the
     quasi-static guess, ends within 1e-6 of FDDP's optimum, and its controls, rolled out in
-    Crocoddyl's dynamics, cost there what they cost here (feasible in Crocoddyl's problem).
-    The iterations are `ILQR`'s own `init` and `step`, each one jitted call: the whole solve as
-    one program stalled in XLA's CPU runtime on this problem (issue 45's note)."""
+    Crocoddyl's dynamics, cost there what they cost here (feasible in Crocoddyl's problem)."""
     from mbjax._src.trajopt.ilqr import CROCODDYL_SCHEDULE
     from mbjax_harness.bench.trajopt import CrocoddylSolver
     from mbjax_harness.crocoddyl_gaits import anymal_walk
@@ -133,13 +132,8 @@ def test_anymal_walk_reaches_fddps_optimum():
     example = anymal_walk()
     croc_problem = example.crocoddyl()
     to_croc = example.controls(croc_problem)
-    solver = ILQR(iterations=100, **CROCODDYL_SCHEDULE)
-    step = eqx.filter_jit(lambda p, s: solver.step(p, s))
-    state = eqx.filter_jit(lambda p, u: solver.init(p, u))(example.problem,
-                                                             jnp.asarray(example.us0))
-    while bool(solver.running(state)):
-        state = step(example.problem, state)
-    result = solver.result(example.problem, state)
+    result = solve(example.problem, ILQR(iterations=100, **CROCODDYL_SCHEDULE),
+                   jnp.asarray(example.us0))
     assert result.messages() == ["success"]
     croc = CrocoddylSolver(croc_problem, to_croc(example.us0))
     croc.solve(100)

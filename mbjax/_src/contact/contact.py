@@ -10,7 +10,7 @@ import numpy as np
 from jax import Array
 
 from mbjax._src.lie.inputs import check_point
-from mbjax._src.model.closures import GROUND, CutJoint
+from mbjax._src.model.closures import GROUND, CutJoint, held
 from mbjax._src.model.model import Model
 from mbjax._src.rigid.frames import frame_placement, frame_pose
 
@@ -36,10 +36,14 @@ class AbstractContact(eqx.Module):
             `mbjax.rigid.frame_pose` takes it).
         normal (ArrayLike): the ground's normal, world components, shape (3,); z by default.
             Normalized.
+        active (ArrayLike): True (the default) for a frame on the ground, False for one in
+            the air: its constraint rows vanish and its wrench is zero. An array, so that the
+            stances of a gait made of the same contacts, some in the air, share one compiled
+            program (`mbjax.trajopt.Problem` compiles each distinct phase once).
 
     Raises:
         TypeError: frame is not a name.
-        ValueError: the normal is not a finite nonzero 3-vector.
+        ValueError: the normal is not a finite nonzero 3-vector, or active is not a boolean.
 
     Attributes:
         size: the number of constraints (3 for a point, 6 for a surface).
@@ -48,14 +52,16 @@ class AbstractContact(eqx.Module):
 
     frame: str = eqx.field(static=True)
     normal: Array
+    active: Array
     size: ClassVar[int]
     kind: ClassVar[str]
 
-    def __init__(self, frame: str, normal=(0.0, 0.0, 1.0)):
+    def __init__(self, frame: str, normal=(0.0, 0.0, 1.0), active=True):
         if not isinstance(frame, str):
             raise TypeError(f"frame must be a frame's name, got {type(frame).__name__}")
         self.frame = frame
         self.normal = _normal(normal)
+        self.active = held(active, "active")
 
     def closure(self, model: Model, q: Array) -> CutJoint:
         """The cut joint that holds the frame at its pose in configuration q.
@@ -73,7 +79,7 @@ class AbstractContact(eqx.Module):
         body, R_f, p_f = frame_placement(model, self.frame)
         R, p = frame_pose(model, q, self.frame)
         return CutJoint(self.kind, int(body), GROUND, origin_a=p_f, origin_b=p, rotation_a=R_f,
-                        rotation_b=R)
+                        rotation_b=R, active=self.active)
 
     def wrench(self, multipliers: Array, rotation: Array) -> Array:
         """The ground's wrench on the frame from this contact's multipliers, in world
@@ -98,9 +104,11 @@ class PointContact(AbstractContact):
             `mbjax.rigid.frame_pose` takes it), e.g. "LF_FOOT".
         normal (ArrayLike): the ground's normal, world components, shape (3,); z by default.
             Normalized. The friction cone and the normal force are measured along it.
+        active (ArrayLike): True (the default) for a foot on the ground, False for one in the
+            air (see `AbstractContact`).
 
     Raises:
-        ValueError: the normal is not a finite nonzero 3-vector.
+        ValueError: the normal is not a finite nonzero 3-vector, or active is not a boolean.
     """
 
     size: ClassVar[int] = 3
@@ -115,9 +123,11 @@ class SurfaceContact(AbstractContact):
     Args:
         frame (str): the frame held, e.g. "left_sole_link".
         normal (ArrayLike): the ground's normal, world components, shape (3,); z by default.
+        active (ArrayLike): True (the default) for a sole on the ground, False for one in the
+            air (see `AbstractContact`).
 
     Raises:
-        ValueError: the normal is not a finite nonzero 3-vector.
+        ValueError: the normal is not a finite nonzero 3-vector, or active is not a boolean.
     """
 
     size: ClassVar[int] = 6

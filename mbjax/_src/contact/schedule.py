@@ -73,8 +73,8 @@ def simulate_schedule(tree: AbstractTreeSystem, integrator: AbstractIntegrator, 
         q0: initial configuration, shape (nq,).
         v0: initial velocity, shape (nv,).
         schedule: the phases in order, each a pair (contacts, duration [s]): the
-            `PointContact`s and `SurfaceContact`s held, for a whole number of steps; an empty
-            contact list for a flight.
+            `PointContact`s and `SurfaceContact`s held, for a whole number of steps (those
+            made with active=False are in the air); an empty contact list for a flight.
         dt: the step [s].
         mu (float | None): the friction coefficient of the watch (`stance`); None for none.
 
@@ -96,6 +96,7 @@ def simulate_schedule(tree: AbstractTreeSystem, integrator: AbstractIntegrator, 
             raise TypeError(f"schedule[{i}] must be a pair (contacts, duration), got {phase!r}")
         contacts, duration = phase
         contacts = _contacts(contacts) if len(contacts) else ()
+        contacts = tuple(c for c in contacts if bool(c.active))      # those in the air: none
         steps = float(duration) / dt
         if not (steps >= 1 and abs(steps - round(steps)) < 1e-9 * max(1.0, steps)):
             raise ValueError(f"schedule[{i}]: the duration must be a positive whole number of "

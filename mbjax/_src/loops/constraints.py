@@ -74,6 +74,11 @@ class Loops(eqx.Module):
         """Number of scalar constraint equations (redundant ones included)."""
         return sum(c.size for c in self.closures)
 
+    def held(self) -> Array:
+        """The number of equations held: `m` less those of cut joints let go (`CutJoint`'s
+        `active`), a traced scalar."""
+        return sum(c.rows if isinstance(c, CutJoint) else c.size for c in self.closures)
+
     def checked(self, q: Array, v: Array | None = None) -> None:
         """An error naming q or v where its shape is not the tree's (nq,) or (nv,)."""
         for name, x, n in (("q", q, self.tree.nq), ("v", v, self.tree.nv)):

@@ -266,7 +266,7 @@ class ClosedSystem(AbstractSystem):
         scalar."""
         violated = jnp.linalg.norm(self.loops.phi(q, t)) > self.tolerance
         A = self.loops.jacobian(q, t)
-        redundant = numerical_rank(A @ A.T) < self.loops.m
+        redundant = numerical_rank(A @ A.T) < self.loops.held()
         watched = (0 if self.watch is None
                    else self.watch(self.multipliers(t, q, u)).astype(jnp.int32))
         return (jnp.where(violated, int(Status.CONSTRAINT_VIOLATED), 0)

@@ -21,6 +21,7 @@ Planar mechanisms' redundant equations are detected and reported by the solvers
 from collections.abc import Callable
 
 import equinox as eqx
+import jax
 import jax.numpy as jnp
 import numpy as np
 from jax import Array
@@ -35,6 +36,17 @@ SIZES = {"spherical": 3, "revolute": 5, "universal": 4, "weld": 6, "prismatic": 
 def _vee_antisym(R: Array) -> Array:
     """vee((R - R^T) / 2): sin(angle) * axis, zero at R = I."""
     return 0.5 * jnp.array([R[2, 1] - R[1, 2], R[0, 2] - R[2, 0], R[1, 0] - R[0, 1]])
+
+
+def held(active, name: str) -> Array:
+    """A joint's `active` flag as a float scalar array (1.0 held, 0.0 let go), or a ValueError
+    naming it where it is concrete and not a boolean scalar."""
+    value = jnp.asarray(active, dtype=float)
+    if value.ndim != 0:
+        raise ValueError(f"{name} must be True or False, got shape {value.shape}")
+    if not isinstance(value, jax.core.Tracer) and float(value) not in (0.0, 1.0):
+        raise ValueError(f"{name} must be True or False, got {float(value)!r}")
+    return value
 
 
 class CutJoint(eqx.Module):
@@ -56,10 +68,16 @@ class CutJoint(eqx.Module):
             identity.
         rotation_b (Array | None): rotation of frame B in body_b's frame, shape (3, 3); None: the
             identity.
+        active (ArrayLike): True (the default) to hold the joint, False to let it go: its
+            residual is multiplied by it, so its rows of the constraint Jacobian vanish and its
+            multipliers are zero. An array, not a static flag: systems that differ only in
+            which joints hold (the stances of a gait, a foot in the air) share one compiled
+            program.
 
     Raises:
         ValueError: an unknown kind, the same body twice, the ground as body_a, an origin not
-            of shape (3,), or a rotation that is not one (orthonormal within 1e-6, det +1).
+            of shape (3,), a rotation that is not one (orthonormal within 1e-6, det +1), or an
+            `active` that is not a boolean scalar.
         TypeError: body indices that are not ints.
 
     Residuals:
@@ -85,9 +103,10 @@ class CutJoint(eqx.Module):
     origin_a: Array
     rotation_b: Array
     origin_b: Array
+    active: Array
 
     def __init__(self, kind: str, body_a: int, body_b: int = GROUND, *, origin_a=(0.0, 0.0, 0.0),
-                 origin_b=(0.0, 0.0, 0.0), rotation_a=None, rotation_b=None):
+                 origin_b=(0.0, 0.0, 0.0), rotation_a=None, rotation_b=None, active=True):
         if kind not in SIZES:
             raise ValueError(f"cut joint kind must be one of {sorted(SIZES)}, got {kind!r}")
         if not (isinstance(body_a, int | np.integer) and isinstance(body_b, int | np.integer)):
@@ -104,14 +123,20 @@ class CutJoint(eqx.Module):
         self.origin_a, self.origin_b = (check_point(x, f"cut joint {kind!r}: {name}", "a point")
                                         for x, name in ((origin_a, "origin_a"),
                                                         (origin_b, "origin_b")))
+        self.active = held(active, f"cut joint {kind!r}: active")
 
     @property
     def size(self) -> int:
         """Number of scalar constraint equations."""
         return SIZES[self.kind]
 
+    @property
+    def rows(self) -> Array:
+        """The number of equations held: `size`, or 0 where the joint is let go (`active`)."""
+        return self.size * self.active
+
     def residual(self, R: Array, p: Array, q: Array, t) -> Array:
-        """Phi of this joint from the frames' world poses.
+        """Phi of this joint from the frames' world poses (zero where it is let go).
 
         Args:
             R: rotations of the tree's frames, shape (n_frames, 3, 3).
@@ -122,6 +147,9 @@ class CutJoint(eqx.Module):
         Returns:
             The residual, shape (size,).
         """
+        return self._residual(R, p) * self.active
+
+    def _residual(self, R: Array, p: Array) -> Array:
         RA = R[self.body_a] @ self.rotation_a
         pA = p[self.body_a] + R[self.body_a] @ self.origin_a
         if self.body_b == GROUND:

@@ -170,19 +170,33 @@ class Schedule(eqx.Module):
         return jax.lax.switch(phase, branches, index, *args)
 
     def map(self, fn: Callable, *args):
-        """fn(knot k, *args[k]) for every knot k, vmapped over each phase's knots: each phase
-        compiles once. args are arrays with a first axis of one entry per knot."""
+        """fn(knot k, *args[k]) for every knot k, a loop (`lax.map`) over each phase's knots:
+        each phase compiles once. args are arrays with a first axis of one entry per knot.
+
+        A loop, not a `vmap`: vmapped over knots, a stance's Cholesky factors and solves become
+        batched LAPACK calls, which jaxlib 0.10.2 splits over XLA's CPU thread pool and waits
+        for; two at once on a two-thread pool wait for each other forever (the ANYmal walk's
+        iterations hung so). The loop also compiles faster (benchmarks/README.md)."""
         outs, order = [], []
         for p, template in enumerate(self.templates):
             ks = self.members(p)
-            outs.append(jax.vmap(lambda arrays, *a, t=template: fn(eqx.combine(arrays, t), *a),
-                                 in_axes=(self.axes[p], *(0 for _ in args)))(
-                self.arrays[p], *(a[ks] for a in args)))
+            shared, stacked = _split(self.arrays[p], self.axes[p])
+            outs.append(jax.lax.map(
+                lambda xs, t=template, shared=shared: fn(
+                    eqx.combine(eqx.combine(shared, xs[0]), t), *xs[1:]),
+                (stacked, *(a[ks] for a in args))))
             order.append(ks)
         if len(outs) == 1:
             return outs[0]
         inverse = np.argsort(np.concatenate(order))
         return jax.tree.map(lambda *o: jnp.concatenate(o)[inverse], *outs)
+
+
+def _split(arrays, axes):
+    """(shared, stacked): a phase's arrays kept once, and those stacked along a first axis."""
+    shared = jax.tree.map(lambda axis, a: a if axis is None else None, axes, arrays, is_leaf=_none)
+    stacked = jax.tree.map(lambda axis, a: None if axis is None else a, axes, arrays, is_leaf=_none)
+    return shared, stacked
 
 
 def _none(x) -> bool:

@@ -89,7 +89,7 @@ class Problem(eqx.Module):
         under the held control, weighted by dt, and `Impulse(model, contacts, running)` for a
         touchdown, which takes no time, moves nothing through the control and whose cost is not
         weighted. Knots alike but for their arrays (a stance's anchors, a target) form one phase:
-        each phase's step and expansion are compiled once and vmapped over its knots, and the
+        each phase's step and expansion are compiled once and mapped over its knots, and the
         rollout takes each knot's branch (`lax.switch`), so compilation grows with the number of
         distinct phases, not of knots. Costs that depend on the contact forces (a friction cone)
         are differentiated in the step's forward-mode pass.
@@ -228,8 +228,8 @@ class Problem(eqx.Module):
         return jnp.concatenate([q1, v1])
 
     def _map(self, fn: Callable, *args):
-        """fn(knot k, *args[k]) for every knot k, vmapped (over each phase's knots in turn for a
-        multi-phase problem, so that each phase compiles once)."""
+        """fn(knot k, *args[k]) for every knot k: vmapped, or for a multi-phase problem mapped
+        over each phase's knots in turn, so that each phase compiles once (`Schedule.map`)."""
         if self.knots is None:
             knot = self._knot()
             return jax.vmap(lambda *a: fn(knot, *a))(*args)
