@@ -1,7 +1,7 @@
 """Trajectory optimisation for any system: a `Problem` (one system, or `Knot`s and `Impulse`s
 through contact phases), `solve` with a solver strategy (`ILQR`, `MultipleShooting`,
 `Shooting`), its `Result`, residuals for the common costs (contact forces and friction cones
-too), a `quasi_static` first guess, `optimal_cost` for co-design, and `sweep` for batches of
+too), a `quasi_static` first guess, the contact wrenches along a solution (`knot_wrenches`), `optimal_cost` for co-design, and `sweep` for batches of
 problems or parameters."""
 
 from mbjax._src.trajopt.problem import Problem as Problem
@@ -24,11 +24,12 @@ from mbjax._src.trajopt.residuals import wrench_cone_residual as wrench_cone_res
 from mbjax._src.trajopt.knots import Knot as Knot
 from mbjax._src.trajopt.knots import Impulse as Impulse
 from mbjax._src.trajopt.quasi_static import quasi_static as quasi_static
+from mbjax._src.trajopt.wrenches import knot_wrenches as knot_wrenches
 
 __all__ = [
     "Problem", "solve", "AbstractSolver", "Result", "ILQR", "MultipleShooting", "Shooting",
     "optimal_cost", "sweep", "state_residual", "frame_residual", "control_residual",
     "com_residual", "friction_cone_residual", "contact_force_residual", "barrier_residual",
     "wrench_cone_residual",
-    "Knot", "Impulse", "quasi_static",
+    "Knot", "Impulse", "quasi_static", "knot_wrenches",
 ]

@@ -18,6 +18,7 @@ MUJOCO_INTEGRATORS = ("Euler", "RK4", "implicit", "implicitfast")
 
 # the package that installs each peer, where its name differs from the module's
 PIP_NAMES = {"pinocchio": "pin", "mujoco.mjx": "mujoco-mjx", "adam": "adam-robotics",
+             "example_robot_data": "example-robot-data",
              "dm_control": "dm_control"}
 
 

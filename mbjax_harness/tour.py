@@ -553,6 +553,97 @@ def floating_base_tour(out: Path, quick: bool) -> dict:
                               "cost": float(result.cost), "status": result.messages()[0]}}}
 
 
+def legged_gait_tour(out: Path, quick: bool) -> dict:
+    """ANYmal trotting through contact by iLQR: forces, friction cones and Crocoddyl's FDDP.
+    Crocoddyl's trot (`mbjax_harness.crocoddyl_gaits.anymal_trot`: the diagonal pairs of feet
+    step 0.25 m in turn, a multi-phase problem of stances and touchdown impulses) solved from
+    its quasi-static guess; the ground's force on each foot along the solution; the same
+    problem solved by Crocoddyl's FDDP from the same guess where Crocoddyl is installed."""
+    from mbjax._src.trajopt import ILQR, solve
+    from mbjax._src.trajopt.ilqr import CROCODDYL_SCHEDULE
+    from mbjax.contact import PointContact
+    from mbjax.trajopt import knot_wrenches
+    from mbjax_harness.crocoddyl_gaits import FEET, MU, anymal_trot
+    from mbjax_harness.plot.animate import gait_animation
+    from mbjax_harness.plot.trajopt import gait_figure
+
+    # ANYmal's URDF and its standing pose (SRDF) come from example-robot-data, through Pinocchio
+    needs = {name: peers.missing(name) for name in ("example_robot_data", "pinocchio")}
+    if any(needs.values()):
+        return _without_robot(out, {name: {"status": why, "compares": "ANYmal's URDF and pose"}
+                                    for name, why in needs.items() if why})
+    example = anymal_trot(step_knots=10 if quick else 25)
+    problem, us0 = example.problem, jnp.asarray(example.us0)
+    result, timing = measure(partial(solve, problem, ILQR(iterations=100, **CROCODDYL_SCHEDULE),
+                                     us0), repeats=1)
+    iterations = int(result.iterations)
+    xs = jnp.concatenate([result.qs, result.vs], axis=1)
+    forces = np.asarray(knot_wrenches(problem, xs, result.us,
+                                      [PointContact(f) for f in FEET]))[..., 3:]
+    ts = np.asarray(problem.times())
+    histories = {"mbjax iLQR": np.asarray(result.costs)[:iterations + 1]}
+
+    def fddp():
+        import crocoddyl
+
+        croc = example.crocoddyl()
+        to_croc = example.controls(croc)
+        guess = to_croc(example.us0)
+        solver = crocoddyl.SolverFDDP(croc)
+        costs = []
+
+        class Log(crocoddyl.CallbackAbstract):
+            def __call__(self, s):
+                costs.append(float(s.cost))
+
+        solver.setCallbacks([Log()])
+        start = time.perf_counter()
+        solver.solve(croc.rollout(guess), guess, 100, True)
+        seconds = time.perf_counter() - start
+        us = to_croc(result.us)
+        return {"iterations": int(solver.iter), "seconds": seconds, "cost": float(solver.cost),
+                "history": [float(croc.calc(croc.rollout(guess), guess)), *costs],
+                "mbjax_cost_in_crocoddyl": float(croc.calc(croc.rollout(us), us))}
+
+    peer, record = _peer("crocoddyl", "FDDP on the same trot from the same guess", fddp)
+    if peer is not None:
+        histories["Crocoddyl FDDP"] = np.asarray(peer.pop("history"))
+        record.update(peer, relative_cost=(float(result.cost) - peer["cost"]) / peer["cost"])
+    title = (f"ANYmal's trot by iLQR: {iterations} iterations in {timing.run_s:.1f} s "
+             f"(compiled in {timing.compile_s:.0f} s), cost {float(result.cost):.6g}"
+             + (f", FDDP's {peer['cost']:.6g}" if peer is not None
+                else f"; {peers.note('crocoddyl', record['status'])}"))
+    _save(gait_figure(histories, ts, forces, MU, FEET, title), out, "legged-gait.png")
+    animation = gait_animation(out / "legged-gait.gif", problem.knots.knot(0, 0).system.tree,
+                               ts, result.qs[:-1], FEET, forces, MU,
+                               title="ANYmal trotting", frames=30 if quick else 60)
+    normal = forces[..., 2]
+    return {"figure": "legged-gait.png", "animation": Path(animation).name,
+            "peers": {"crocoddyl": record},
+            "runs": {"ilqr": {"knots": problem.horizon, "phases": len(problem.knots.templates),
+                              "iterations": iterations, "seconds": timing.run_s,
+                              "compile_seconds": timing.compile_s, "cost": float(result.cost),
+                              "status": result.messages()[0],
+                              "largest_normal_force_n": float(normal.max()),
+                              "least_normal_force_on_the_ground_n":
+                                  float(normal[normal > 0].min())}}}
+
+
+def _without_robot(out: Path, records: dict) -> dict:
+    """The legged-gait scene where ANYmal's model cannot be had: a figure that says what to
+    install, the missing packages recorded as skipped peers."""
+    from mbjax_harness.plot.style import Figure
+
+    fig = Figure(figsize=(8, 2.5), layout="constrained")
+    ax = fig.add_subplot()
+    ax.axis("off")
+    ax.text(0.5, 0.5, "ANYmal's trot needs its model: "
+            + "; ".join(peers.note(name, r["status"]) for name, r in records.items()),
+            ha="center", va="center", wrap=True)
+    _save(fig, out, "legged-gait.png")
+    return {"figure": "legged-gait.png", "peers": records}
+
+
 def _model_peers() -> dict:
     """{peer: record}: the arm against Pinocchio from the same URDF
     (`mbjax_harness.reproduce.urdf_corpus`: forward and inverse dynamics, mass matrix, frames) and
@@ -630,6 +721,17 @@ def look_at(name: str, scene: dict) -> str | None:
             return text + ("; the sampled-torque run ends where mujoco.rollout ends (its "
                            "difference is in the title and the runs table).")
         return text + f"; the sampled-torque run is not compared with MuJoCo ({not_run})."
+    if name == "legged-gait":
+        if "runs" not in scene:
+            return f"nothing: ANYmal's model is not here ({not_run})."
+        text = ("the feet taking turns on the ground in diagonal pairs, each pushing inside the "
+                "cost's friction cone (right panel at or below 1) except where it barely touches "
+                "(the cone is a soft barrier, in Crocoddyl's problem too)")
+        record = records.get("crocoddyl", {})
+        if record.get("status") == "compared":
+            return text + (f"; Crocoddyl's FDDP on the same problem reaches the same cost "
+                           f"(relative difference {record['relative_cost']:.1e}).")
+        return text + f"; not compared with Crocoddyl ({peers.note('crocoddyl', record['status'])})."
     if name == "models":
         text = "the unpowered arm falls through its joint limits (left panel) and the status says so"
         if not ran:
@@ -651,13 +753,14 @@ TOUR = {   # in the order the summary tells them
     "models": models_tour,
     "trajectory-optimisation": trajectory_optimisation_tour,
     "floating-base": floating_base_tour,
+    "legged-gait": legged_gait_tour,
 }
 
 # Each scene's wall time in a quick tour from a cold cache, one scene at a time (benchmarks/README
 # compile section): `mbjax tour` starts the longest first, which balances its workers best.
 COST = {"time-elements": 17.0, "floating-base": 12.3, "flexible-bodies": 12.8, "carpal-wrist": 12.2,
         "closed-loops": 11.5, "rigid-chain": 10.4, "controls": 7.7, "trajectory-optimisation": 5.8,
-        "torque-free-body": 5.4, "heavy-top": 4.6, "models": 4.2}
+        "torque-free-body": 5.4, "heavy-top": 4.6, "models": 4.2, "legged-gait": 90.0}
 
 
 def _animate(out: Path, name: str, system, ts, qs, title: str, quick: bool) -> str:

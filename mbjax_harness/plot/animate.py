@@ -23,7 +23,8 @@ from PIL import Image
 from mbjax.wrist import WristSystem
 from mbjax_harness.progress import step
 
-__all__ = ["animate", "frames_along", "stick_animation", "wrist_animation", "write_gif"]
+__all__ = ["animate", "frames_along", "gait_animation", "stick_animation", "wrist_animation",
+           "write_gif"]
 
 AXIS_COLORS = ("#d62728", "#2ca02c", "#1f77b4")     # x, y, z
 
@@ -105,6 +106,78 @@ def stick_animation(path: Path, ts, R, p, parents, *, title: str = "",
                 *paths.values(), label]
 
     return write_gif(path, fig, draw, len(keep), fps)
+
+
+def gait_animation(path: Path, tree, ts, qs, feet: Sequence[str], forces, mu: float, *,
+                   title: str = "", frames: int = 60, reach: float = 0.3) -> Path:
+    """Write a GIF of a legged robot walking: its bodies as sticks down to its feet (the
+    floating base a dot), and at each foot on the ground the ground's force as an arrow (the
+    largest `reach` metres long) inside its friction cone (half-angle arctan mu about the
+    vertical).
+
+    ts (T,): times; qs (T, nq): configurations; feet: the feet's frame names; forces (T, F, 3):
+    the ground's force on each foot [N], zero where the foot is in the air."""
+    from mbjax.rigid import frame_placement, frame_pose
+
+    step(f"animation {Path(path).name}")
+    ts, forces = np.asarray(ts), np.asarray(forces)
+    model = tree.model
+    R, p = frames_along(tree, qs)
+    parents = np.asarray(model.topology.parents, dtype=int)
+    n = len(parents)
+    p = np.asarray(p)[:, :n]
+    holders = [int(frame_placement(model, f)[0]) for f in feet]
+    feet = np.asarray(jax.jit(jax.vmap(lambda q: jax.numpy.stack(
+        [frame_pose(model, q, f)[1] for f in feet])))(qs))
+    keep = np.unique(np.linspace(0, len(ts) - 1, min(frames, len(ts))).round().astype(int))
+    limits = _limits(np.concatenate([p.reshape(-1, 3), feet.reshape(-1, 3)]))
+    scale = reach / max(float(np.linalg.norm(forces, axis=-1).max()), 1e-12)
+    ground = float(feet[..., 2].min())
+    height = 0.6 * reach
+    circle = np.linspace(0.0, 2 * np.pi, 25)
+
+    fig = Figure(figsize=(5.2, 5.2), layout="constrained")
+    ax = fig.add_subplot(projection="3d")
+    ax.set(xlim=limits[0], ylim=limits[1], zlim=limits[2], xlabel="x [m]", ylabel="y [m]",
+           zlabel="z [m]")
+    ax.set_box_aspect((1, 1, 1))
+    for axis in (ax.xaxis, ax.yaxis, ax.zaxis):
+        axis.set_major_locator(MaxNLocator(4))
+    for x in np.linspace(*limits[0], 5):        # the ground
+        ax.plot([x, x], limits[1], [ground, ground], color="0.8", lw=0.6)
+    for y in np.linspace(*limits[1], 5):
+        ax.plot(limits[0], [y, y], [ground, ground], color="0.8", lw=0.6)
+    sticks = [ax.plot([], [], [], "-o", color="0.25", lw=2.5, ms=3)[0]
+              for _ in range(n + len(holders))]
+    arrows = [ax.plot([], [], [], color="#d62728", lw=2)[0] for _ in range(feet.shape[1])]
+    cones = [[ax.plot([], [], [], color="#1f77b4", lw=0.8, alpha=0.7)[0] for _ in range(5)]
+             for _ in range(feet.shape[1])]
+    label = ax.set_title("")
+
+    def draw(i):
+        k = keep[i]
+        ends = [(p[k, parents[b]] if parents[b] >= 0 else p[k, b], p[k, b]) for b in range(n)]
+        ends += [(p[k, b], feet[k, i]) for i, b in enumerate(holders)]
+        for stick, seg in zip(sticks, ends, strict=True):
+            seg = np.stack(seg)
+            stick.set_data_3d(seg[:, 0], seg[:, 1], seg[:, 2])
+        for foot, (arrow, cone) in enumerate(zip(arrows, cones, strict=True)):
+            apex, f = feet[k, foot], forces[k, foot]
+            if not np.any(f):                     # in the air: nothing drawn
+                for line in (arrow, *cone):
+                    line.set_data_3d([], [], [])
+                continue
+            seg = np.stack([apex, apex + scale * f])
+            arrow.set_data_3d(seg[:, 0], seg[:, 1], seg[:, 2])
+            rim = apex + np.stack([mu * height * np.cos(circle), mu * height * np.sin(circle),
+                                   np.full_like(circle, height)], axis=1)
+            cone[0].set_data_3d(rim[:, 0], rim[:, 1], rim[:, 2])
+            for line, j in zip(cone[1:], (0, 6, 12, 18), strict=True):
+                line.set_data_3d([apex[0], rim[j, 0]], [apex[1], rim[j, 1]], [apex[2], rim[j, 2]])
+        label.set_text(f"{title}  t = {ts[k]:.2f} s".strip())
+        return [*sticks, *arrows, *(line for cone in cones for line in cone), label]
+
+    return write_gif(path, fig, draw, len(keep), fps=15)
 
 
 def write_gif(path: Path, fig: Figure, draw, frames: int, fps: int, dpi: int = 72) -> Path:

@@ -75,3 +75,35 @@ def floating_base_figure(costs, ts, positions, angles, us, bounds, target, title
         ax.grid(alpha=0.3)
     fig.suptitle(title, fontsize=10)
     return fig
+
+
+def gait_figure(histories: dict, ts, forces, mu: float, feet, title: str) -> Figure:
+    """(a) the cost after each iteration of each solver (histories: name -> costs); (b) the
+    ground's normal force on each foot over the gait; (c) how much of the cost's friction cone
+    (its four facets |f_x|, |f_y| <= mu f_n, `friction_cone_residual`) each foot on the ground
+    uses, max(|f_x|, |f_y|) / (mu f_n), 1 on the cone (forces (N, F, 3) [N], zero for a foot in
+    the air)."""
+    fig = Figure(figsize=(14, 4.2), layout="constrained")
+    ax_c, ax_n, ax_f = fig.subplots(1, 3)
+    for (name, costs), style in zip(histories.items(), ("o-", "s--"), strict=False):
+        ax_c.semilogy(np.arange(len(costs)), costs, style, ms=3, label=name)
+    ax_c.set(xlabel="iteration", ylabel="cost", title="cost after each iteration")
+    ax_c.legend(fontsize=8)
+    normal = forces[..., 2]
+    tangential = np.abs(forces[..., :2]).max(axis=-1)
+    down = normal > 0
+    use = np.where(down, tangential / np.where(down, mu * normal, 1.0), np.nan)
+    for i, foot in enumerate(feet):
+        ax_n.step(ts, normal[:, i], where="post", lw=1.2, label=foot)
+        ax_f.plot(ts, use[:, i], ".-", ms=3, lw=1, label=foot)
+    ax_n.set(xlabel="t [s]", ylabel="normal force [N]",
+             title="the ground's push on each foot (0: in the air)")
+    ax_f.axhline(1.0, color="k", ls="--", lw=0.8, label="the cone")
+    ax_f.set(xlabel="t [s]", ylabel="max(|f_x|, |f_y|) / (mu f_n)",
+             title=f"friction used, the cost's cone at 1 (mu = {mu:g})")
+    for ax in (ax_n, ax_f):
+        ax.legend(fontsize=8, ncol=2)
+    for ax in (ax_c, ax_n, ax_f):
+        ax.grid(alpha=0.3)
+    fig.suptitle(title, fontsize=10)
+    return fig

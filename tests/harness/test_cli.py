@@ -4,6 +4,7 @@ import json
 import math
 import shutil
 import subprocess
+import sys
 
 import numpy as np
 import pytest
@@ -126,6 +127,7 @@ TOUR_GROUPS = {
     "rigid": ("torque-free-body", "heavy-top", "rigid-chain", "closed-loops", "floating-base"),
     "time-elements": ("time-elements", "flexible-bodies", "controls"),
     "carpal-wrist": ("carpal-wrist", "models", "trajectory-optimisation"),
+    "legged-gait": ("legged-gait",),
 }
 
 
@@ -138,7 +140,7 @@ def test_tour_groups_cover_every_scene():
     assert sorted(s for group in TOUR_GROUPS.values() for s in group) == sorted(TOUR)
     assert set(TOUR) == {"torque-free-body", "heavy-top", "rigid-chain", "time-elements",
                          "closed-loops", "flexible-bodies", "carpal-wrist", "controls", "models",
-                         "trajectory-optimisation", "floating-base"}
+                         "trajectory-optimisation", "floating-base", "legged-gait"}
 
 
 def test_tour_rejects_an_unknown_scene(capsys):
@@ -151,6 +153,18 @@ def test_tour_rejects_jobs_below_one(capsys):
     with pytest.raises(SystemExit) as exit_info:
         main(["tour", "--jobs", "0"])
     assert exit_info.value.code == 2 and "--jobs: must be at least 1" in capsys.readouterr().err
+
+
+def test_the_gait_scene_says_what_to_install_without_the_robot(tmp_path, monkeypatch):
+    """Without example-robot-data (a test extra, not a dependency) the legged-gait scene writes
+    a figure that says what to install, and the summary names it as a skipped peer."""
+    from mbjax_harness.tour import legged_gait_tour, look_at
+
+    monkeypatch.setitem(sys.modules, "example_robot_data", None)
+    scene = legged_gait_tour(tmp_path, quick=True)
+    assert (tmp_path / scene["figure"]).stat().st_size > 5_000 and "runs" not in scene
+    assert scene["peers"]["example_robot_data"]["status"].startswith("unavailable")
+    assert "pip install example-robot-data" in look_at("legged-gait", scene)
 
 
 def test_tour_in_workers(tmp_path):
@@ -269,8 +283,23 @@ def _check_carpal_wrist(scenes):
     assert reach["status"] == "success" and reach["final_error_m"] < 1e-5
 
 
+def _check_legged_gait(scenes):
+    # ANYmal's trot: iLQR solves it in two compiled phases, every foot on the ground pushing;
+    # Crocoddyl's FDDP on the same problem reaches the same optimum (or, not installed, says so)
+    scene = scenes["legged-gait"]
+    run = scene["runs"]["ilqr"]
+    assert run["status"] == "success" and run["phases"] == 2
+    assert run["least_normal_force_on_the_ground_n"] > 0
+    record = scene["peers"]["crocoddyl"]
+    if peers.crocoddyl_working() is None:
+        assert record["status"] == "compared" and abs(record["relative_cost"]) < 1e-6
+        assert abs(record["mbjax_cost_in_crocoddyl"] - run["cost"]) < 1e-8 * run["cost"]
+    else:
+        assert record["status"] != "compared"
+
+
 TOUR_CHECKS = {"rigid": _check_rigid, "time-elements": _check_time_elements,
-               "carpal-wrist": _check_carpal_wrist}
+               "carpal-wrist": _check_carpal_wrist, "legged-gait": _check_legged_gait}
 
 
 @pytest.mark.slow     # a benchmark script: the library is tested in tests/wrist

@@ -14,7 +14,7 @@ import mbjax
 from mbjax.contact import PointContact, stance
 from mbjax.rigid import TreeSystem
 from mbjax.trajopt import (ILQR, Impulse, Knot, Problem, control_residual, friction_cone_residual,
-                           solve, state_residual)
+                           knot_wrenches, solve, state_residual)
 from mbjax_harness import peers
 from tests.conftest import example_robots
 
@@ -117,6 +117,21 @@ def test_short_walk_is_crocoddyls_problem():
     # every stance holds the four feet, some in the air: one stance phase and one impulse phase
     assert problem.horizon == 22 and len(problem.knots.templates) == 2
     _agrees_with_crocoddyl(example, scale=3.0, seed=1, guess=1e-10, tolerance=1e-10)
+    # the quasi-static guess holds the robot at rest at x0: on every stance knot the ground
+    # carries its weight (the momentum balance, which no part of the stance computes), and a
+    # foot in the air, or an impulse's knot, carries nothing
+    feet = ["LF_FOOT", "RF_FOOT", "LH_FOOT", "RH_FOOT"]
+    wrenches = np.asarray(knot_wrenches(problem, jnp.broadcast_to(problem.x0, (22, problem.nx)),
+                                        example.us0, [PointContact(f) for f in feet]))
+    model = problem.knots.knot(0, 0).system.tree.model
+    weight = float(model.mass.sum()) * 9.81
+    impulses = [k for k in range(22) if problem.knots.phase[k] == 1]
+    stances = [k for k in range(22) if k not in impulses]
+    np.testing.assert_allclose(wrenches[stances, :, 5].sum(axis=1), weight, rtol=1e-9)
+    assert not np.any(wrenches[impulses])
+    swing = problem.knots.knot(0, 2).system.closures        # the first step's knots: RH lifted
+    assert [float(j.active) for j in swing] == [1.0, 1.0, 1.0, 0.0]
+    assert not np.any(wrenches[2, 3])
 
 
 @crocoddyl_only
