@@ -116,17 +116,21 @@ def sustained(ratios: jax.Array) -> jax.Array:
     return held
 
 
-def resolution(*parts: jax.Array) -> jax.Array:
+def resolution(*parts: jax.Array, jumps=None) -> jax.Array:
     """The largest sustained step ratio along a state sequence given by its parts (T, n_i)
     (configurations, velocities): `step_ratio` between every three consecutive states, held
-    for `SUSTAINED` steps."""
+    for `SUSTAINED` steps. `jumps` (T - 1,) marks the transitions that are discontinuous by
+    design (an impulse at touchdown: the velocity jumps in no time); a ratio whose three states
+    span one is not a step's error and counts 0."""
     parts = tuple(jax.lax.stop_gradient(x) for x in parts)
     d = tuple(jnp.diff(x, axis=0) for x in parts)
+    across = (jnp.zeros(len(parts[0]) - 2, bool) if jumps is None
+              else jnp.asarray(jumps[:-1]) | jnp.asarray(jumps[1:]))
 
     def one(moved, k):
         ratio, moved = step_ratio(tuple(x[k] for x in d), tuple(x[k + 1] for x in d),
                                   tuple(x[k + 1] for x in parts), moved)
-        return moved, ratio
+        return moved, jnp.where(across[k], 0.0, ratio)
 
     zeros = tuple(jnp.zeros((), int) for _ in parts)
     _, ratios = jax.lax.scan(one, zeros, jnp.arange(len(parts[0]) - 2))

@@ -235,6 +235,13 @@ class Problem(eqx.Module):
             return jax.vmap(lambda *a: fn(knot, *a))(*args)
         return self.knots.map(fn, *args)
 
+    def jumps(self) -> np.ndarray | None:
+        """Which steps jump by design, one bool per knot: an `Impulse` (the velocity changes in
+        no time); None for a problem of one system."""
+        if self.knots is None:
+            return None
+        return np.asarray([not self.knots.templates[p].rate for p in self.knots.phase])
+
     def times(self, dtype=float) -> Array:
         """Each knot's time t_k, shape (N,): k dt, an impulse taking none."""
         if self.knots is None:

@@ -34,7 +34,8 @@ class Result(WithStatus):
         status: the `Status` flags; `mbjax.trajopt.solve` adds INACCURATE where the
             trajectory's steps do not resolve its motion (`resolution` above 1).
         resolution: the step times the trajectory's fastest rate, from consecutive increments
-            of its states, held over 3 steps (`mbjax.integrate.Solution`'s default check):
+            of its states, held over 3 steps (`mbjax.integrate.Solution`'s default check; the
+            increments across an `Impulse` knot, a jump by design, left out):
             above 1 the discrete dynamics the solver optimised are far from the continuous
             ones (an optimum that exploits the integrator's error); NaN before the check.
         inaccurate_by: 1 where the resolution made it INACCURATE, else 0.
@@ -69,10 +70,11 @@ def cost_floor(dtype) -> float:
     return float((1e3 * jnp.finfo(dtype).eps) ** 2)
 
 
-def checked(result: Result) -> Result:
+def checked(result: Result, jumps=None) -> Result:
     """The result with the default accuracy check: INACCURATE where its steps do not resolve
-    its motion (`mbjax._src.system.accuracy.resolution` over the states)."""
-    resolution = accuracy_resolution(result.qs, result.vs)
+    its motion (`mbjax._src.system.accuracy.resolution` over the states; `jumps`, one per
+    step, marks an impulse's knot, whose jump is the model's, not a step's error)."""
+    resolution = accuracy_resolution(result.qs, result.vs, jumps=jumps)
     over = resolution > RESOLUTION_LIMIT
     return eqx.tree_at(lambda r: (r.status, r.resolution, r.inaccurate_by), result,
                        (result.status | jnp.where(over, int(Status.INACCURATE), 0).astype(

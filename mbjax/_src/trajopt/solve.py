@@ -88,7 +88,7 @@ def solve(problem: Problem, solver: AbstractSolver = ILQR(), us0: Array | None =
 def _solve(problem: Problem, solver: AbstractSolver, us0: Array | None, states0: Array | None,
            throw: bool) -> Result:
     result = solver.solve(problem, problem.initial_controls(us0), states0)
-    return raise_on_failure(checked(result), throw, "mbjax._src.trajopt.solve")
+    return raise_on_failure(checked(result, problem.jumps()), throw, "mbjax._src.trajopt.solve")
 
 
 @eqx.filter_jit
@@ -107,7 +107,9 @@ def _solve_batch(problems: Problem, solver: AbstractSolver, us0: Array | None,
     else:
         result = jax.vmap(lambda p, u, x: solver.solve(eqx.combine(p, static), u, x),
                           in_axes=(0, 0, None if states0 is None else 0))(params, us, states0)
-    return raise_on_failure(jax.vmap(checked)(result), throw, "mbjax._src.trajopt.solve")
+    jumps = problems.jumps()
+    return raise_on_failure(jax.vmap(lambda r: checked(r, jumps))(result), throw,
+                            "mbjax._src.trajopt.solve")
 
 
 def _split(fn, params, us: Array):
