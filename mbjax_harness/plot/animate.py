@@ -117,7 +117,8 @@ def gait_animation(path: Path, tree, ts, qs, feet: Sequence[str], forces, mu: fl
 
     ts (T,): times; qs (T, nq): configurations; feet: the feet's frame names; forces (T, F, 3):
     the ground's force on each foot [N], zero where the foot is in the air."""
-    from mbjax.rigid import frame_placement, frame_pose
+    from mbjax._src.rigid.frames import frame_placement
+    from mbjax.rigid import frame_pose
 
     step(f"animation {Path(path).name}")
     ts, forces = np.asarray(ts), np.asarray(forces)
