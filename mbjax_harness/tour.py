@@ -554,11 +554,11 @@ def floating_base_tour(out: Path, quick: bool) -> dict:
 
 
 def legged_gait_tour(out: Path, quick: bool) -> dict:
-    """ANYmal trotting through contact by iLQR: forces, friction cones and Crocoddyl's FDDP.
-    Crocoddyl's trot (`mbjax_harness.crocoddyl_gaits.anymal_trot`: the diagonal pairs of feet
-    step 0.25 m in turn, a multi-phase problem of stances and touchdown impulses) solved from
-    its quasi-static guess; the ground's force on each foot along the solution; the same
-    problem solved by Crocoddyl's FDDP from the same guess where Crocoddyl is installed."""
+    """ANYmal's trot by iLQR through contact: forces in their cones, and FDDP. The
+    trot of Crocoddyl's example (`mbjax_harness.crocoddyl_gaits.anymal_trot`: the diagonal
+    pairs of feet step 0.25 m in turn, a multi-phase problem of stances and touchdown impulses)
+    solved from its quasi-static guess; the ground's force on each foot along the solution; the
+    same problem solved by Crocoddyl's FDDP from the same guess where Crocoddyl is installed."""
     from mbjax._src.trajopt import ILQR, solve
     from mbjax._src.trajopt.ilqr import CROCODDYL_SCHEDULE
     from mbjax.contact import PointContact

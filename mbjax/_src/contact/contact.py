@@ -10,7 +10,7 @@ import numpy as np
 from jax import Array
 
 from mbjax._src.lie.inputs import check_point
-from mbjax._src.model.closures import GROUND, CutJoint, held
+from mbjax._src.model.closures import GROUND, CutJoint, active_flag
 from mbjax._src.model.model import Model
 from mbjax._src.rigid.frames import frame_placement, frame_pose
 
@@ -61,7 +61,7 @@ class AbstractContact(eqx.Module):
             raise TypeError(f"frame must be a frame's name, got {type(frame).__name__}")
         self.frame = frame
         self.normal = _normal(normal)
-        self.active = held(active, "active")
+        self.active = active_flag(active, "active")
 
     def closure(self, model: Model, q: Array) -> CutJoint:
         """The cut joint that holds the frame at its pose in configuration q.

@@ -38,7 +38,7 @@ def _vee_antisym(R: Array) -> Array:
     return 0.5 * jnp.array([R[2, 1] - R[1, 2], R[0, 2] - R[2, 0], R[1, 0] - R[0, 1]])
 
 
-def held(active, name: str) -> Array:
+def active_flag(active, name: str) -> Array:
     """A joint's `active` flag as a float scalar array (1.0 held, 0.0 let go), or a ValueError
     naming it where it is concrete and not a boolean scalar."""
     value = jnp.asarray(active, dtype=float)
@@ -123,7 +123,7 @@ class CutJoint(eqx.Module):
         self.origin_a, self.origin_b = (check_point(x, f"cut joint {kind!r}: {name}", "a point")
                                         for x, name in ((origin_a, "origin_a"),
                                                         (origin_b, "origin_b")))
-        self.active = held(active, f"cut joint {kind!r}: active")
+        self.active = active_flag(active, f"cut joint {kind!r}: active")
 
     @property
     def size(self) -> int:
