@@ -14,7 +14,7 @@ import mbjax
 from mbjax.contact import PointContact, stance
 from mbjax.rigid import TreeSystem
 from mbjax.trajopt import (ILQR, Impulse, Knot, Problem, control_residual, friction_cone_residual,
-                           knot_wrenches, solve, state_residual)
+                           knot_wrenches, optimal_cost, solve, state_residual)
 from mbjax_harness import peers
 from tests.conftest import example_robots
 
@@ -175,3 +175,31 @@ def test_short_talos_step_is_crocoddyls_problem():
 
     example = talos_step(step_knots=4, support_knots=1)
     _agrees_with_crocoddyl(example, scale=0.3, seed=0, guess=1e-9, tolerance=1e-6)
+
+
+@crocoddyl_only
+@pytest.mark.slow
+def test_the_trots_optimal_cost_is_differentiable_in_the_trunks_mass():
+    """Co-design through contact: on Crocoddyl's trot, `optimal_cost`'s gradient with respect to
+    the trunk's mass and inertia scale (the envelope theorem, one reverse pass through every
+    stance and impulse) equals central differences of gaits re-solved at scale 1 +- 1e-3."""
+    from mbjax._src.trajopt.ilqr import CROCODDYL_SCHEDULE
+    from mbjax_harness.crocoddyl_gaits import anymal_trot
+
+    example = anymal_trot()
+    problem, us0 = example.problem, jnp.asarray(example.us0)
+    model = problem.knots.knot(0, 0).system.tree.model
+    mass0, inertia0 = model.mass, model.inertia
+
+    def build(scale):               # every knot's model shares these two arrays
+        mass, inertia = mass0.at[0].multiply(scale), inertia0.at[0].multiply(scale)
+        return jax.tree.map(lambda x: mass if x is mass0 else inertia if x is inertia0 else x,
+                            problem)
+
+    solver = ILQR(iterations=200, tolerance=1e-12, **CROCODDYL_SCHEDULE)
+    slope = jax.grad(lambda s: optimal_cost(build, s, solver, us0, throw=False))(1.0)
+    h = 1e-3
+    central = (float(optimal_cost(build, 1.0 + h, solver, us0, throw=False))
+               - float(optimal_cost(build, 1.0 - h, solver, us0, throw=False))) / (2 * h)
+    assert abs(central) > 1.0                     # the design matters
+    assert abs(float(slope) - central) < 1e-5 * abs(central)
