@@ -584,25 +584,18 @@ def legged_gait_tour(out: Path, quick: bool) -> dict:
     histories = {"mbjax iLQR": np.asarray(result.costs)[:iterations + 1]}
 
     def fddp():
-        import crocoddyl
+        from mbjax_harness.bench.trajopt import CrocoddylSolver
 
         croc = example.crocoddyl()
         to_croc = example.controls(croc)
-        guess = to_croc(example.us0)
-        solver = crocoddyl.SolverFDDP(croc)
-        costs = []
-
-        class Log(crocoddyl.CallbackAbstract):
-            def __call__(self, s):
-                costs.append(float(s.cost))
-
-        solver.setCallbacks([Log()])
+        solver = CrocoddylSolver(croc, to_croc(example.us0))
+        history = solver.history()
         start = time.perf_counter()
-        solver.solve(croc.rollout(guess), guess, 100, True)
+        solver.solve(100)
         seconds = time.perf_counter() - start
         us = to_croc(result.us)
-        return {"iterations": int(solver.iter), "seconds": seconds, "cost": float(solver.cost),
-                "history": [float(croc.calc(croc.rollout(guess), guess)), *costs],
+        return {"iterations": int(solver.solver.iter), "seconds": seconds,
+                "cost": float(solver.solver.cost), "history": history,
                 "mbjax_cost_in_crocoddyl": float(croc.calc(croc.rollout(us), us))}
 
     peer, record = _peer("crocoddyl", "FDDP on the same trot from the same guess", fddp)
