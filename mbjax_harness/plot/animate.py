@@ -42,6 +42,18 @@ def _limits(points: np.ndarray):
     return [(c - half, c + half) for c in centre]
 
 
+def _scene(limits):
+    """A figure and its 3-D axes over `limits` ((x, y, z) ranges [m]), equal scales."""
+    fig = Figure(figsize=(5.2, 5.2), layout="constrained")
+    ax = fig.add_subplot(projection="3d")
+    ax.set(xlim=limits[0], ylim=limits[1], zlim=limits[2], xlabel="x [m]", ylabel="y [m]",
+           zlabel="z [m]")
+    ax.set_box_aspect((1, 1, 1))
+    for axis in (ax.xaxis, ax.yaxis, ax.zaxis):
+        axis.set_major_locator(MaxNLocator(4))      # tick labels that never run into each other
+    return fig, ax
+
+
 def stick_animation(path: Path, ts, R, p, parents, *, title: str = "",
                     trace: int | Sequence[int] | None = None, axis_length: float | None = None,
                     frames: int = 60, fps: int = 15, triads: bool | Sequence[int] = True,
@@ -70,13 +82,7 @@ def stick_animation(path: Path, ts, R, p, parents, *, title: str = "",
     traced = [n - 1] if trace is None else list(np.atleast_1d(trace))
     with_triads = range(p.shape[1]) if triads is True else [] if triads is False else list(triads)
 
-    fig = Figure(figsize=(5.2, 5.2), layout="constrained")
-    ax = fig.add_subplot(projection="3d")
-    ax.set(xlim=limits[0], ylim=limits[1], zlim=limits[2], xlabel="x [m]", ylabel="y [m]",
-           zlabel="z [m]")
-    ax.set_box_aspect((1, 1, 1))
-    for axis in (ax.xaxis, ax.yaxis, ax.zaxis):
-        axis.set_major_locator(MaxNLocator(4))      # tick labels that never run into each other
+    fig, ax = _scene(limits)
     if view is not None:
         ax.view_init(*view)
         if abs(view[0]) == 90:          # looking along z: its ticks would pile up on one corner
@@ -137,13 +143,7 @@ def gait_animation(path: Path, tree, ts, qs, feet: Sequence[str], forces, mu: fl
     height = 0.6 * reach
     circle = np.linspace(0.0, 2 * np.pi, 25)
 
-    fig = Figure(figsize=(5.2, 5.2), layout="constrained")
-    ax = fig.add_subplot(projection="3d")
-    ax.set(xlim=limits[0], ylim=limits[1], zlim=limits[2], xlabel="x [m]", ylabel="y [m]",
-           zlabel="z [m]")
-    ax.set_box_aspect((1, 1, 1))
-    for axis in (ax.xaxis, ax.yaxis, ax.zaxis):
-        axis.set_major_locator(MaxNLocator(4))
+    fig, ax = _scene(limits)
     for x in np.linspace(*limits[0], 5):        # the ground
         ax.plot([x, x], limits[1], [ground, ground], color="0.8", lw=0.6)
     for y in np.linspace(*limits[1], 5):
