@@ -203,3 +203,23 @@ def test_the_trots_optimal_cost_is_differentiable_in_the_trunks_mass():
                - float(optimal_cost(build, 1.0 - h, solver, us0, throw=False))) / (2 * h)
     assert abs(central) > 1.0                     # the design matters
     assert abs(float(slope) - central) < 1e-5 * abs(central)
+
+
+@crocoddyl_only
+@pytest.mark.slow
+def test_multiple_shooting_reaches_fddps_optimum_on_the_short_walk():
+    """`MultipleShooting` over a multi-phase problem (the knots' states as unknowns, the
+    defects across stances and impulses by its augmented Lagrangian): from the quasi-static
+    guess it ends at the optimum of Crocoddyl's FDDP on the same short walk."""
+    example_robots(["anymal_b_simple/anymal"])
+    from mbjax.trajopt import MultipleShooting
+    from mbjax_harness.bench.trajopt import CrocoddylSolver
+    from mbjax_harness.crocoddyl_gaits import anymal_walk
+
+    example = anymal_walk(step_knots=4, support_knots=1)
+    result = solve(example.problem, MultipleShooting(), jnp.asarray(example.us0))
+    assert result.messages() == ["success"]
+    croc_problem = example.crocoddyl()
+    croc = CrocoddylSolver(croc_problem, example.controls(croc_problem)(example.us0))
+    croc.solve(100)
+    assert abs(float(result.cost) - croc.solver.cost) < 1e-8 * croc.solver.cost
