@@ -182,8 +182,7 @@ class Schedule(eqx.Module):
             ks = self.members(p)
             shared, stacked = _split(self.arrays[p], self.axes[p])
             outs.append(jax.lax.map(
-                lambda xs, t=template, shared=shared: fn(
-                    eqx.combine(eqx.combine(shared, xs[0]), t), *xs[1:]),
+                lambda xs, t=template, shared=shared: fn(eqx.combine(shared, xs[0], t), *xs[1:]),
                 (stacked, *(a[ks] for a in args))))
             order.append(ks)
         if len(outs) == 1:
