@@ -14,14 +14,16 @@ import jax
 import jax.numpy as jnp
 from jax import Array
 
-# largest block written out; larger ones go to LAPACK (the written-out graph grows like w^3)
+# largest block written out; larger ones loop over their columns (the written-out graph grows
+# like w^3)
 UNROLL = 6
 
 
 def spd_solve(A: Array, b: Array, unroll: int = UNROLL) -> Array:
     """A^-1 b for a symmetric positive-definite A.
 
-    A division for w = 1, Cholesky written out for w <= unroll, else LAPACK's Cholesky.
+    A division for w = 1, Cholesky written out for w <= unroll, else `cholesky` and
+    `cho_solve` (a loop over the columns, no LAPACK call).
 
     Args:
         A: symmetric positive-definite matrices, shape (..., w, w).
@@ -37,7 +39,7 @@ def spd_solve(A: Array, b: Array, unroll: int = UNROLL) -> Array:
     if b.ndim < A.ndim:                          # a vector
         return spd_solve(A, b[..., None], unroll)[..., 0]
     if w > unroll:
-        return jax.scipy.linalg.cho_solve(jax.scipy.linalg.cho_factor(A), b)
+        return cho_solve(cholesky(A), b)
     L = [[None] * w for _ in range(w)]
     for j in range(w):                           # A = L L^T, column by column
         L[j][j] = jnp.sqrt(A[..., j, j] - sum(L[j][k] ** 2 for k in range(j)))
@@ -92,3 +94,66 @@ def unrolled_dot(a: Array, b: Array) -> Array:
     if b.ndim == a.ndim - 1:
         return sum(a[..., i] * b[..., i, None] for i in range(a.shape[-1]))
     return sum(a[..., :, i, None] * b[..., None, i, :] for i in range(a.shape[-1]))
+
+
+def cholesky(A: Array) -> Array:
+    """The lower Cholesky factor L of symmetric positive-definite matrices, A = L L^T, by a loop
+    over the columns (L[:, j] = (A[:, j] - L L[j]^T) / sqrt(.)), with no LAPACK call.
+
+    Under `jax.vmap` a LAPACK factorization or triangular solve becomes one batched library call,
+    which jaxlib 0.10.2 splits over XLA's CPU thread pool and waits for: two such calls at once
+    on a two-thread pool wait for each other forever (benchmarks/README.md, the gaits' hang).
+    This loop batches into elementwise operations instead. A zero pivot (a column of zeros, a
+    constraint let go) gives a zero column, not NaN, so the solves below leave its unknowns 0.
+
+    Args:
+        A: symmetric positive-(semi)definite matrices, shape (..., n, n).
+
+    Returns:
+        L, lower triangular, shape (..., n, n).
+    """
+    n = A.shape[-1]
+    index = jnp.arange(n)
+
+    def column(j, L):
+        c = jnp.take(A, j, axis=-1) - (L * jnp.take(L, j, axis=-2)[..., None, :]).sum(-1)
+        pivot = jnp.take(c, j, axis=-1)[..., None]
+        root = jnp.sqrt(jnp.where(pivot > 0, pivot, 1.0))
+        col = jnp.where((index > j) & (pivot > 0), c / root, 0.0)
+        col = jnp.where(index == j, jnp.where(pivot > 0, root, 0.0), col)
+        return jax.lax.dynamic_update_index_in_dim(jnp.swapaxes(L, -1, -2), col, j, -2).swapaxes(-1, -2)
+
+    return jax.lax.fori_loop(0, n, column, jnp.zeros_like(A))
+
+
+def cho_solve(L: Array, b: Array) -> Array:
+    """(L L^T)^-1 b from `cholesky`'s factor by forward and back substitution, a loop over the
+    rows with no LAPACK call; unknowns of a zero pivot are 0 (the least-norm answer where a
+    column of A was zero).
+
+    Args:
+        L: lower Cholesky factors, shape (..., n, n).
+        b: right-hand sides, shape (..., n) or (..., n, k).
+
+    Returns:
+        The solution, b's shape.
+    """
+    if b.ndim < L.ndim:
+        return cho_solve(L, b[..., None])[..., 0]
+    n = L.shape[-1]
+    diagonal = jnp.diagonal(L, axis1=-2, axis2=-1)[..., None]
+    inverse = jnp.where(diagonal > 0, 1.0 / jnp.where(diagonal > 0, diagonal, 1.0), 0.0)
+
+    def forward(i, y):
+        row = jnp.take(L, i, axis=-2)[..., :, None]
+        value = (jnp.take(b, i, axis=-2) - (row * y).sum(-2)) * jnp.take(inverse, i, axis=-2)
+        return jax.lax.dynamic_update_index_in_dim(y, value, i, -2)
+
+    def backward(k, x):
+        i = n - 1 - k
+        col = jnp.take(L, i, axis=-1)[..., :, None]
+        value = (jnp.take(y, i, axis=-2) - (col * x).sum(-2)) * jnp.take(inverse, i, axis=-2)
+        return jax.lax.dynamic_update_index_in_dim(x, value, i, -2)
+
+    y = jax.lax.fori_loop(0, n, forward, jnp.zeros_like(b))
+    return jax.lax.fori_loop(0, n, backward, jnp.zeros_like(b))

@@ -9,7 +9,7 @@ from jax import Array
 from mbjax._src.contact.contact import AbstractContact, wrenches
 from mbjax._src.contact.stance import _contacts
 from mbjax._src.loops.constraints import Loops
-from mbjax._src.loops.multipliers import multipliers
+from mbjax._src.loops.kkt import implicit_kkt
 from mbjax._src.model.model import Model
 from mbjax._src.rigid.system import TreeSystem
 
@@ -17,13 +17,22 @@ from mbjax._src.rigid.system import TreeSystem
 def impulse_map(model: Model, q: Array, v: Array, contacts: tuple) -> tuple[Array, Array]:
     """`impulse` without its checks, to trace inside other programs."""
     closures = tuple(c.closure(model, q) for c in contacts)
-    tree = TreeSystem(model)
-    A = Loops(tree, closures).jacobian(q)
-    factor = jax.scipy.linalg.cho_factor(tree.mass_matrix(q))
-    nu_At = jax.scipy.linalg.cho_solve(factor, A.T)
-    # (A M^-1 A^t) Lambda = -A v-: the impulses that leave A v+ = 0
-    Lambda, _ = multipliers(A @ nu_At, -(A @ v))
-    return v + nu_At @ Lambda, wrenches(contacts, closures, Lambda)
+    loops = Loops(TreeSystem(model), closures)
+    v_plus, Lambda = implicit_kkt((loops, q, v), _matrices, _residual)
+    return v_plus, wrenches(contacts, closures, Lambda)
+
+
+def _matrices(theta) -> tuple[Array, Array]:
+    loops, q, _ = theta
+    return loops.tree.mass_matrix(q), loops.jacobian(q)
+
+
+def _residual(theta, v_plus: Array, Lambda: Array) -> tuple[Array, Array]:
+    """The impulse map as a residual of (v+, Lambda) (`mbjax._src.loops.kkt`): (M (v+ - v) -
+    A^t Lambda, A v+), the impulses that leave A v+ = 0."""
+    loops, q, v = theta
+    rate, impulse_force = jax.vjp(lambda v_: loops.rate(q, v_), v_plus)
+    return loops.tree.mass_matrix(q) @ (v_plus - v) - impulse_force(Lambda)[0], rate
 
 
 def impulse(model: Model, q: Array, v: Array, contacts: Sequence[AbstractContact]) -> tuple[Array, Array]:

@@ -2,31 +2,63 @@
 the equations)."""
 
 import math
+
 import equinox as eqx
 import jax
+import jax.numpy as jnp
 from jax import Array
 
+from mbjax._src.linalg import cho_solve, cholesky
 from mbjax._src.loops.constraints import Loops
+from mbjax._src.loops.kkt import implicit_kkt
 from mbjax._src.loops.method import AbstractLoopMethod, require_symmetric
-from mbjax._src.loops.multipliers import multipliers
+from mbjax._src.loops.multipliers import numerical_rank
 
 
 def coupled_acceleration(loops: Loops, q: Array, v: Array, t=0.0,
                          baumgarte=(0.0, 0.0)) -> tuple[Array, Array, Array]:
     """(v_dot, K_c, rank) of Jerkovsky 1978 eqs 89-93 under the tree's forces; K_c are the multipliers
     of the rows of A, so A^t K_c is the generalized constraint force. The Baumgarte gains are
-    Python floats."""
-    tree = loops.tree
-    factor = jax.scipy.linalg.cho_factor(tree.mass_matrix(q))
-    a_free = jax.scipy.linalg.cho_solve(factor, -tree.bias(t, q, v))
-    A = loops.jacobian(q, t)
-    b = loops.acceleration_bias(q, v, t)
-    if tuple(baumgarte) != (0.0, 0.0):        # Python floats: no extra passes when unused
-        alpha, beta = baumgarte
-        b = b + 2.0 * alpha * loops.rate(q, v, t) + beta**2 * loops.phi(q, t)
-    nu_At = jax.scipy.linalg.cho_solve(factor, A.T)
-    K_c, rank = multipliers(A @ nu_At, -(A @ a_free + b))
-    return a_free + nu_At @ K_c, K_c, rank
+    Python floats. Differentiated through the factored KKT system (`mbjax._src.loops.kkt`)."""
+    v_dot, K_c = coupled_solution(loops, q, v, t, baumgarte)
+    return v_dot, K_c, _rank(loops, q, jnp.asarray(t, q.dtype))
+
+
+def coupled_solution(loops: Loops, q: Array, v: Array, t=0.0,
+                     baumgarte=(0.0, 0.0)) -> tuple[Array, Array]:
+    """(v_dot, K_c) of `coupled_acceleration`, without the rank."""
+    return implicit_kkt((loops, q, v, jnp.asarray(t, q.dtype)), _matrices,
+                        _Residual(tuple(baumgarte)))
+
+
+def _rank(loops: Loops, q: Array, t) -> Array:
+    """The numerical rank of A M^-1 A^t (redundant closures, singular configurations)."""
+    M, A = _matrices((loops, q, None, t))
+    return numerical_rank(A @ cho_solve(cholesky(M), A.T))
+
+
+def _matrices(theta) -> tuple[Array, Array]:
+    loops, q, _, t = theta
+    return loops.tree.mass_matrix(q), loops.jacobian(q, t)
+
+
+class _Residual(eqx.Module):
+    """The coupled equations as a residual of (v_dot, K_c) (`mbjax._src.loops.kkt`):
+    (M v_dot + bias - A^t K_c, A v_dot + b + 2 alpha (A v + B) + beta^2 Phi)."""
+
+    baumgarte: tuple = eqx.field(static=True)
+
+    def __call__(self, theta, v_dot: Array, K_c: Array) -> tuple[Array, Array]:
+        loops, q, v, t = theta
+        tree = loops.tree
+        rate, constraint_force = jax.vjp(lambda v_: loops.rate(q, v_, t), v)
+        # A v_dot + b, the second derivative of Phi along (q_dot, v_dot)
+        drift = jax.jvp(lambda q_, v_, t_: loops.rate(q_, v_, t_), (q, v, t),
+                        (tree.q_dot(q, v), v_dot, jnp.ones_like(t)))[1]
+        if self.baumgarte != (0.0, 0.0):         # Python floats: no extra passes when unused
+            alpha, beta = self.baumgarte
+            drift = drift + 2.0 * alpha * rate + beta**2 * loops.phi(q, t)
+        return tree.inverse(t, q, v, v_dot) - constraint_force(K_c)[0], drift
 
 
 def _gains(gains) -> tuple:
@@ -75,8 +107,8 @@ class Coupled(AbstractLoopMethod):
         require_symmetric("Coupled", tree)
 
     def acceleration(self, loops, t, q, u):
-        return coupled_acceleration(loops, q, u, t, self.baumgarte)[0]
+        return coupled_solution(loops, q, u, t, self.baumgarte)[0]
 
     def loads(self, loops, t, q, u):
         """The multipliers K_c (Jerkovsky 1978 eq 92): A^t K_c is the generalized constraint force."""
-        return coupled_acceleration(loops, q, u, t, self.baumgarte)[1]
+        return coupled_solution(loops, q, u, t, self.baumgarte)[1]

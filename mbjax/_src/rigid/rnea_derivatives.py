@@ -34,9 +34,13 @@ import numpy as np
 from jax import Array
 
 from mbjax._src.linalg import unrolled_dot
+from mbjax._src.linear_map import linear_map
 from mbjax._src.model import Model
-from mbjax._src.rigid.kinematics import columns, fixed_in_body, gravity_acceleration, joint_increments
+from mbjax._src.rigid import rnea
+from mbjax._src.rigid.kinematics import (columns, fixed_in_body, gravity_acceleration,
+                                         increments_matrix, joint_increments)
 from mbjax._src.rigid.rnea import rnea_passes
+from mbjax._src.rigid.tangents import instantiate, is_zero
 from mbjax._src.spatial import cross_force, cross_motion, skew
 from mbjax._src.tree import backward_pass, forward_pass, outward_sum
 from mbjax._src.tree.take import take
@@ -140,3 +144,54 @@ def rnea_partials(model: Model, q: Array, v: Array, a: Array) -> tuple[Array, Ar
     nv = model.nv
     return D[:, :nv], D[:, nv:] + jnp.diag(model.damping), M
 
+
+
+def _tangent(fixed: tuple, x: Array) -> Array:
+    """d RNEA along x = (dq, dv) at the fixed (model, q, v, a): `rnea_jvp`."""
+    model, q, v, a = fixed
+    dq, dv = jnp.split(x, [model.nq])
+    return rnea_jvp(model, q, v, a, dq, dv)
+
+
+def _tangents(fixed: tuple, xs: Array) -> Array:
+    """`_tangent` for a batch xs (B, nq + nv) at one state (`jax.jacfwd`): the partial
+    derivatives once (`rnea_partials`, Pinocchio's `computeRNEADerivatives`) and a product."""
+    model, q, v, a = fixed
+    if xs.shape[0] < 4:
+        return jax.vmap(lambda x: _tangent(fixed, x))(xs)
+    D_e, D_v, _ = rnea_partials(model, q, v, a)
+    D_q = D_e @ increments_matrix(model, q, v)
+    return xs[:, :model.nq] @ D_q.T + xs[:, model.nq:] @ D_v.T
+
+
+_rnea_tangent = linear_map("rnea_tangent", _tangent, _tangents)
+
+
+@jax.custom_jvp
+def inverse_dynamics(model: Model, q: Array, v: Array, a: Array) -> Array:
+    """The RNEA (`mbjax.inverse_dynamics` without external wrenches) whose derivative in (q, v)
+    is written out: `rnea_jvp` along one direction, `rnea_partials` formed once for a batch of
+    them (`jax.jacfwd`); in the model's parameters and in a, JAX's own. For a tree of the joints
+    `applies` accepts."""
+    return rnea.inverse_dynamics(model, q, v, a)
+
+
+def _inverse_dynamics_jvp(primals, tangents):
+    model, q, v, a = primals
+    dmodel, dq, dv, da = tangents
+    tau = rnea.inverse_dynamics(model, q, v, a)
+    dq, dv = (instantiate(t, x) for t, x in ((dq, q), (dv, v)))
+    dtau = _rnea_tangent((model, q, v, a), jnp.concatenate([dq, dv]))
+    others = [(i, t) for i, t in ((0, dmodel), (3, da)) if not is_zero(t)]
+    if others:
+        def moved(*xs):
+            full = list(primals)
+            for (i, _), x in zip(others, xs, strict=True):
+                full[i] = x
+            return rnea.inverse_dynamics(*full)
+        dtau = dtau + jax.jvp(moved, [primals[i] for i, _ in others],
+                              [instantiate(t, primals[i]) for i, t in others])[1]
+    return tau, dtau
+
+
+inverse_dynamics.defjvp(_inverse_dynamics_jvp, symbolic_zeros=True)

@@ -32,6 +32,7 @@ from mbjax._src.rigid.dynamics import forward_dynamics, mass_matrix
 from mbjax._src.rigid.energy import energy, floating, free_momenta, kinetic_energy
 from mbjax._src.rigid.kinematics import forward_kinematics
 from mbjax._src.rigid.momentum import momentum_rate, velocity_from_momentum
+from mbjax._src.rigid import rnea_derivatives
 from mbjax._src.rigid.rnea import inverse_dynamics
 
 
@@ -165,6 +166,16 @@ class TreeSystem(AbstractTreeSystem):
         """
         return forward_dynamics(self.model, q, u, self.applied(t, q, u), self.method,
                                 self.wrenches(t, q, u))
+
+    def inverse(self, t, q, v, v_dot):
+        """The RNEA at v_dot less the control (one O(n) pass): M v_dot + bias; shape (nv,).
+        Its derivative in (q, v) is written out where the joints allow it (`rnea_derivatives`)."""
+        f = self.wrenches(t, q, v)
+        if f is None and rnea_derivatives.applies(self.model):
+            tau = rnea_derivatives.inverse_dynamics(self.model, q, v, v_dot)
+        else:
+            tau = inverse_dynamics(self.model, q, v, v_dot, f)
+        return tau - self.applied(t, q, v)
 
     def bias(self, t, q, v):
         """The RNEA at zero acceleration (velocity terms, gravity, external wrenches) less the

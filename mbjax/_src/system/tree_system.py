@@ -214,6 +214,21 @@ class AbstractTreeSystem(AbstractDrivenSystem):
         raise TypeError(f"{type(self).__name__} has no equations of the form M(q) v_dot + bias = 0 "
                         "with a symmetric M (symmetric_dynamics is False)")
 
+    def inverse(self, t: Array, q: Array, v: Array, v_dot: Array) -> Array:
+        """M(q) v_dot + bias(t, q, v): the generalized force the accelerations v_dot leave
+        unbalanced, zero on the tree's own motion (trees with `symmetric_dynamics`).
+
+        Args:
+            t: time [s], a scalar.
+            q: configuration, shape (nq,).
+            v: generalized velocity, shape (nv,).
+            v_dot: accelerations, shape (nv,).
+
+        Returns:
+            The force, shape (nv,).
+        """
+        return self.mass_matrix(q) @ v_dot + self.bias(t, q, v)
+
     # -- applied forces -------------------------------------------------------------------------
 
     def wrenches(self, t: Array, q: Array, v: Array) -> Array | None:

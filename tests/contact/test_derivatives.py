@@ -1,0 +1,138 @@
+"""The derivatives of a stance's dynamics and of the impulse map (issue 57), taken through the
+factored KKT system (`mbjax._src.loops.kkt`), against forward mode through the plain dense solves
+and against central differences, on ANYmal and Solo12 from example-robot-data; a stance with
+every foot in the air is the free tree; and no program of a vmapped stance holds a LAPACK call
+(jaxlib 0.10.2's batched LAPACK calls deadlock its CPU runtime)."""
+
+import jax
+import jax.numpy as jnp
+import numpy as np
+import pytest
+
+import mbjax
+from mbjax._src.contact.stance import CROCODDYL_GAINS
+from mbjax.contact import PointContact, impulse, stance
+from mbjax.control import Constant
+from mbjax.rigid import TreeSystem
+from tests.conftest import example_robots
+
+ROBOTS = {"anymal": ("anymal_b_simple/anymal", ["LF_FOOT", "LH_FOOT", "RF_FOOT", "RH_FOOT"]),
+          "solo12": ("solo/solo12", ["FL_FOOT", "FR_FOOT", "HL_FOOT", "HR_FOOT"])}
+
+
+def _robot(name):
+    path, feet = ROBOTS[name]
+    model = mbjax.load_urdf(example_robots([path])[0], floating_base=True)
+    rng = np.random.default_rng(3)
+    q = model.normalize(jnp.clip(model.home() + jnp.asarray(rng.uniform(-0.2, 0.2, model.nq)),
+                                 model.lower, model.upper))
+    x = tuple(jnp.asarray(rng.normal(size=model.nv)) * s for s in (0.05, 1.0, 1.0))
+    return model, q, [PointContact(f) for f in feet], x
+
+
+def _stance(model, q0, contacts):
+    """(accelerations, multipliers) of the stance at (q0 (+) dq, v) under tau, and the same by
+    the plain route: dense solves that forward mode differentiates through."""
+    def new(dq, v, tau):
+        phase = stance(TreeSystem(model, Constant(tau)), q0, contacts)
+        q = model.integrate(q0, dq)
+        return jnp.concatenate([phase.acceleration(0.0, q, v), phase.multipliers(0.0, q, v)])
+
+    def plain(dq, v, tau):
+        loops = stance(TreeSystem(model, Constant(tau)), q0, contacts).loops
+        q, tree, (alpha, _) = model.integrate(q0, dq), loops.tree, CROCODDYL_GAINS
+        M, A = tree.mass_matrix(q), loops.jacobian(q)
+        b = loops.acceleration_bias(q, v) + 2 * alpha * loops.rate(q, v)
+        a_free, Y = jnp.linalg.solve(M, -tree.bias(0.0, q, v)), jnp.linalg.solve(M, A.T)
+        K = jnp.linalg.solve(A @ Y, -(A @ a_free + b))
+        return jnp.concatenate([a_free + Y @ K, K])
+
+    return new, plain
+
+
+def _rel(a, b):
+    return float(np.max(np.abs(np.asarray(a) - np.asarray(b))) / np.max(np.abs(np.asarray(b))))
+
+
+@pytest.mark.parametrize("robot", ["anymal", pytest.param("solo12", marks=pytest.mark.slow)])
+def test_stance_derivatives_agree_with_the_plain_route_and_differences(robot):
+    """d(v_dot, K_c)/d(dq, v, tau) by the factored KKT system equals forward mode through the
+    dense solves (1e-10) and central differences (1e-6); reverse mode equals it too."""
+    model, q0, contacts, x = _robot(robot)
+    new, plain = (jax.jit(f) for f in _stance(model, q0, contacts))
+    assert _rel(new(*x), plain(*x)) < 1e-12
+    J_new = jax.jit(jax.jacfwd(new, argnums=(0, 1, 2)))(*x)
+    J_plain = jax.jit(jax.jacfwd(plain, argnums=(0, 1, 2)))(*x)
+    for a, b in zip(J_new, J_plain, strict=True):
+        assert _rel(a, b) < 1e-10
+    h = 1e-6
+    for i, J in enumerate(J_new):
+        for j in range(0, model.nv, 5):
+            e = jnp.zeros(model.nv).at[j].set(h)
+            xp, xm = list(x), list(x)
+            xp[i], xm[i] = x[i] + e, x[i] - e
+            # against the whole Jacobian's scale: a column may be zero (a yaw of the base)
+            difference = (new(*xp) - new(*xm)) / (2 * h)
+            assert float(jnp.max(jnp.abs(J[:, j] - difference))) < 1e-6 * float(jnp.max(jnp.abs(J)))
+    w = jnp.asarray(np.random.default_rng(0).normal(size=J_new[0].shape[0]))
+    grads = jax.jit(jax.grad(lambda *a: new(*a) @ w, argnums=(0, 1, 2)))(*x)
+    for g, J in zip(grads, J_new, strict=True):
+        assert _rel(g, w @ J) < 1e-10
+
+
+def test_impulse_derivatives_agree_with_the_plain_route():
+    """d(v+, impulses)/d(q, v) of the impulse map equals forward mode through dense solves."""
+    model, q0, contacts, (dq, v, _) = _robot("anymal")
+
+    def new(dq, v):
+        v_plus, impulses = impulse(model, model.integrate(q0, dq), v, contacts)
+        return jnp.concatenate([v_plus, impulses.ravel()])
+
+    def plain(dq, v):
+        q = model.integrate(q0, dq)
+        closures = [c.closure(model, q) for c in contacts]
+        loops = stance(TreeSystem(model), q, contacts).loops
+        M, A = loops.tree.mass_matrix(q), loops.jacobian(q)
+        Y = jnp.linalg.solve(M, A.T)
+        Lambda = jnp.linalg.solve(A @ Y, -(A @ v))
+        forces = jnp.concatenate([jnp.zeros((len(closures), 3)), Lambda.reshape(-1, 3)], 1)
+        return jnp.concatenate([v + Y @ Lambda, forces.ravel()])
+
+    assert _rel(new(dq, v), plain(dq, v)) < 1e-12
+    for a, b in zip(jax.jacfwd(new, argnums=(0, 1))(dq, v),
+                    jax.jacfwd(plain, argnums=(0, 1))(dq, v), strict=True):
+        assert _rel(a, b) < 1e-10
+
+
+def test_a_stance_with_every_foot_in_the_air_is_the_free_tree():
+    """All contacts let go (a flight written as a stance over the feet): the accelerations are
+    the tree's own forward dynamics, the wrenches zero, the derivatives finite and equal."""
+    model, q, contacts, (_, v, tau) = _robot("anymal")
+    flying = [PointContact(c.frame, active=False) for c in contacts]
+    phase = stance(TreeSystem(model, Constant(tau)), q, flying)
+    free = TreeSystem(model, Constant(tau))
+    a = phase.acceleration(0.0, q, v)
+    assert _rel(a, free.acceleration(0.0, q, v)) < 1e-12
+    assert not np.any(np.asarray(phase.multipliers(0.0, q, v)))
+    J = jax.jacfwd(lambda v_: phase.acceleration(0.0, q, v_))(v)
+    assert np.all(np.isfinite(J))
+    assert _rel(J, jax.jacfwd(lambda v_: free.acceleration(0.0, q, v_))(v)) < 1e-10
+    v_plus, impulses = impulse(model, q, v, flying)
+    assert _rel(v_plus, v) < 1e-13 and not np.any(np.asarray(impulses))
+
+
+def test_a_vmapped_stance_holds_no_lapack_call_and_runs_repeatedly():
+    """`jax.vmap(jax.jacfwd(...))` of a four-foot stance's accelerations (the program that hung
+    on its second call with jaxlib 0.10.2's batched LAPACK calls) compiles to a program with no
+    LAPACK call and runs again and again."""
+    model, q0, contacts, _ = _robot("anymal")
+    new, _ = _stance(model, q0, contacts)
+    rng = np.random.default_rng(1)
+    xs = [jnp.asarray(rng.normal(size=(8, model.nv))) * s for s in (0.05, 1.0, 1.0)]
+    J = jax.jit(jax.vmap(jax.jacfwd(new, argnums=(0, 1, 2))))
+    assert 'custom_call_target="lapack' not in J.lower(*xs).compile().as_text()
+    first = J(*xs)
+    for _ in range(5):
+        again = J(*xs)
+    for a, b in zip(first, again, strict=True):
+        np.testing.assert_array_equal(a, b)
