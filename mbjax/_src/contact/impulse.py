@@ -31,8 +31,8 @@ def _residual(theta, v_plus: Array, Lambda: Array) -> tuple[Array, Array]:
     """The impulse map as a residual of (v+, Lambda) (`mbjax._src.loops.kkt`): (M (v+ - v) -
     A^t Lambda, A v+), the impulses that leave A v+ = 0."""
     loops, q, v = theta
-    rate, impulse_force = jax.vjp(lambda v_: loops.rate(q, v_), v_plus)
-    return loops.tree.mass_matrix(q) @ (v_plus - v) - impulse_force(Lambda)[0], rate
+    return (loops.tree.mass_matrix(q) @ (v_plus - v) - loops.force(q, Lambda),
+            loops.rate(q, v_plus))
 
 
 def impulse(model: Model, q: Array, v: Array, contacts: Sequence[AbstractContact]) -> tuple[Array, Array]:

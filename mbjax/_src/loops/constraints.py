@@ -93,13 +93,44 @@ class Loops(eqx.Module):
             R, p = self.tree.frames(q)
         else:                         # prescribed motions only: no kinematics to trace
             R = p = None
+        return self._phi(R, p, q, t)
+
+    def _phi(self, R, p, q, t) -> Array:
         return jnp.concatenate([c.residual(R, p, q, t) for c in self.closures])
+
+    def _rate(self, R, p, V, q, q_dot, t) -> Array:
+        """A v + B from the frames' poses and spatial velocities V (world origin): a cut joint
+        moves with its two frames (R_dot = omega x R, p_dot = v_O + omega x p), each closure on
+        its own bodies alone, the other closures with q along q_dot."""
+        one = jnp.ones_like(t)
+        rates = []
+        for c in self.closures:
+            if not isinstance(c, CutJoint):
+                rates.append(jax.jvp(lambda q_, t_, c=c: c.residual(None, None, q_, t_), (q, t),
+                                     (q_dot, one))[1])
+                continue
+            poses, motions = [], []
+            for body in (c.body_a, c.body_b):
+                if body == GROUND:
+                    poses += [None, None]
+                    motions += [None, None]
+                    continue
+                omega, v_origin = V[body, :3], V[body, 3:]
+                poses += [R[body], p[body]]
+                motions += [jnp.cross(omega[:, None], R[body], axis=0),
+                            v_origin + jnp.cross(omega, p[body])]
+            rates.append(jax.jvp(c.pose_residual, poses, motions)[1] * c.active)
+        return jnp.concatenate(rates)
 
     def rate(self, q: Array, v: Array, t=0.0) -> Array:
         """A v + B = dPhi/dt along the motion, shape (m,), for v of shape (nv,)."""
         self.checked(q, v)
-        return jax.jvp(self.phi, (q, jnp.asarray(t, q.dtype)),
-                       (self.tree.q_dot(q, v), jnp.ones((), q.dtype)))[1]
+        t = jnp.asarray(t, q.dtype)
+        motion = self.tree.body_motion(q, v)
+        if motion is None:
+            return jax.jvp(self.phi, (q, t), (self.tree.q_dot(q, v), jnp.ones((), q.dtype)))[1]
+        R, p, V, _ = motion
+        return self._rate(R, p, V, q, self.tree.q_dot(q, v), t)
 
     def jacobian(self, q: Array, t=0.0) -> Array:
         """The velocity constraint operator A, shape (m, nv): the rate is linear in v, A v + B.
@@ -110,5 +141,39 @@ class Loops(eqx.Module):
     def acceleration_bias(self, q: Array, v: Array, t=0.0) -> Array:
         """b = d/dt (A v + B) at fixed v, shape (m,), so that A v_dot + b is the second
         derivative of Phi."""
-        return jax.jvp(lambda q_, t_: self.rate(q_, v, t_), (q, jnp.asarray(t, q.dtype)),
-                       (self.tree.q_dot(q, v), jnp.ones((), q.dtype)))[1]
+        return self.drift(q, v, jnp.zeros_like(v), t)
+
+    def drift(self, q: Array, v: Array, v_dot: Array, t=0.0) -> Array:
+        """A v_dot + b, the second derivative of Phi along the motion (q, v, v_dot), shape (m,).
+        Where the tree writes its bodies' motion out (`body_motion`), a cut joint's is its
+        residual's second derivative along its frames' velocities and accelerations, with no
+        derivative of the tree's kinematics."""
+        t = jnp.asarray(t, q.dtype)
+        motion = self.tree.body_motion(q, v, v_dot)
+        q_dot = self.tree.q_dot(q, v)
+        if motion is None:
+            return jax.jvp(lambda q_, v_, t_: self.rate(q_, v_, t_), (q, v, t),
+                           (q_dot, v_dot, jnp.ones_like(t)))[1]
+        R, p, V, A = motion
+        omega, v_origin = V[:, :3], V[:, 3:]
+        R_dot = jnp.cross(omega[:, :, None], R, axis=1)
+        p_dot = v_origin + jnp.cross(omega, p)
+        q_ddot = jax.jvp(self.tree.q_dot, (q, v), (q_dot, v_dot))[1]
+        return jax.jvp(self._rate, (R, p, V, q, q_dot, t),
+                       (R_dot, p_dot, A, q_dot, q_ddot, jnp.ones_like(t)))[1]
+
+    def force(self, q: Array, K: Array, t=0.0) -> Array:
+        """A^t K, the generalized force of the multipliers K, shape (nv,). Where the tree writes
+        its bodies' motion out, the cut joints' loads are wrenches on their frames and the
+        tree's inward pass sums them (`body_forces`), with no reverse pass through the tree's
+        kinematics."""
+        t = jnp.asarray(t, q.dtype)
+        v = jnp.zeros(self.tree.nv, q.dtype)
+        motion = self.tree.body_motion(q, v)
+        if motion is None:
+            return jax.vjp(lambda v_: self.rate(q, v_, t), v)[1](K)[0]
+        R, p, V, _ = motion
+        q_dot, q_dot_transpose = jax.vjp(lambda v_: self.tree.q_dot(q, v_), v)
+        wrenches, generalized = jax.vjp(lambda V_, qd: self._rate(R, p, V_, q, qd, t), V,
+                                        q_dot)[1](K)
+        return self.tree.body_forces(q, wrenches) + q_dot_transpose(generalized)[0]

@@ -50,15 +50,11 @@ class _Residual(eqx.Module):
 
     def __call__(self, theta, v_dot: Array, K_c: Array) -> tuple[Array, Array]:
         loops, q, v, t = theta
-        tree = loops.tree
-        rate, constraint_force = jax.vjp(lambda v_: loops.rate(q, v_, t), v)
-        # A v_dot + b, the second derivative of Phi along (q_dot, v_dot)
-        drift = jax.jvp(lambda q_, v_, t_: loops.rate(q_, v_, t_), (q, v, t),
-                        (tree.q_dot(q, v), v_dot, jnp.ones_like(t)))[1]
+        drift = loops.drift(q, v, v_dot, t)
         if self.baumgarte != (0.0, 0.0):         # Python floats: no extra passes when unused
             alpha, beta = self.baumgarte
-            drift = drift + 2.0 * alpha * rate + beta**2 * loops.phi(q, t)
-        return tree.inverse(t, q, v, v_dot) - constraint_force(K_c)[0], drift
+            drift = drift + 2.0 * alpha * loops.rate(q, v, t) + beta**2 * loops.phi(q, t)
+        return loops.tree.inverse(t, q, v, v_dot) - loops.force(q, K_c, t), drift
 
 
 def _gains(gains) -> tuple:

@@ -150,13 +150,20 @@ class CutJoint(eqx.Module):
         return self._residual(R, p) * self.active
 
     def _residual(self, R: Array, p: Array) -> Array:
-        RA = R[self.body_a] @ self.rotation_a
-        pA = p[self.body_a] + R[self.body_a] @ self.origin_a
         if self.body_b == GROUND:
+            return self.pose_residual(R[self.body_a], p[self.body_a], None, None)
+        return self.pose_residual(R[self.body_a], p[self.body_a], R[self.body_b], p[self.body_b])
+
+    def pose_residual(self, R_a: Array, p_a: Array, R_b: Array | None, p_b: Array | None) -> Array:
+        """Phi of this joint, before `active`, from the world poses of body_a and body_b (None
+        for the ground), shape (size,)."""
+        RA = R_a @ self.rotation_a
+        pA = p_a + R_a @ self.origin_a
+        if R_b is None:
             RB, pB = self.rotation_b, self.origin_b
         else:
-            RB = R[self.body_b] @ self.rotation_b
-            pB = p[self.body_b] + R[self.body_b] @ self.origin_b
+            RB = R_b @ self.rotation_b
+            pB = p_b + R_b @ self.origin_b
         d = pA - pB
         x_A, y_A, z_A = RA.T
         x_B, y_B, z_B = RB.T

@@ -124,6 +124,37 @@ class AbstractTreeSystem(AbstractDrivenSystem):
                 (n_frames, 3).
         """
 
+    def body_motion(self, q: Array, v: Array, v_dot: Array | None = None):
+        """The frames' motion written out, for closures differentiated without nested autodiff
+        (`mbjax._src.loops.constraints`): None where the tree does not offer it (closures then go
+        through `frames`).
+
+        Args:
+            q: configuration, shape (nq,).
+            v: generalized velocity, shape (nv,).
+            v_dot: accelerations, shape (nv,), or None.
+
+        Returns:
+            (R, p, V, A) or None: the frames' poses as `frames`, their spatial velocities and
+                accelerations (angular; linear) in world components at the world origin, shape
+                (n_frames, 6) (A: None without v_dot; no gravity in it).
+        """
+        return None
+
+    def body_forces(self, q: Array, wrenches: Array) -> Array:
+        """The generalized force of wrenches on the frames, (torque about the world origin;
+        force) in world components, shape (n_frames, 6): J^T w summed over the frames, where
+        `body_motion` is offered.
+
+        Args:
+            q: configuration, shape (nq,).
+            wrenches: shape (n_frames, 6).
+
+        Returns:
+            The generalized force, shape (nv,).
+        """
+        raise TypeError(f"{type(self).__name__} offers no body_motion")
+
     @abc.abstractmethod
     def energy(self, q: Array, v: Array) -> Array:
         """Kinetic plus gravitational (plus strain) energy.
