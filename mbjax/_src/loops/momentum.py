@@ -4,6 +4,7 @@ the equations)."""
 import jax
 from jax import Array
 
+from mbjax._src.linalg import cho_solve, cholesky
 from mbjax._src.loops.constraints import Loops
 from mbjax._src.loops.method import AbstractLoopMethod, require_symmetric
 from mbjax._src.loops.multipliers import multipliers
@@ -13,13 +14,13 @@ def loop_momentum_rate(loops: Loops, q: Array, G: Array, t=0.0) -> tuple[Array, 
     """(G_dot, K_c, rank) of the momentum formulation, Jerkovsky 1978 eqs 95-98, for momenta G = mu v,
     under the tree's forces."""
     tree = loops.tree
-    factor = jax.scipy.linalg.cho_factor(tree.mass_matrix(q))
-    v = jax.scipy.linalg.cho_solve(factor, G)
+    factor = cholesky(tree.mass_matrix(q))
+    v = cho_solve(factor, G)
     mu_dot_v = jax.jvp(tree.mass_matrix, (q,), (tree.q_dot(q, v),))[1] @ v
     free = mu_dot_v - tree.bias(t, q, v)                                 # K^a - X, eq 99
     A = loops.jacobian(q, t)
-    nu_At = jax.scipy.linalg.cho_solve(factor, A.T)
-    nu_dot_G = -jax.scipy.linalg.cho_solve(factor, mu_dot_v)
+    nu_At = cho_solve(factor, A.T)
+    nu_dot_G = -cho_solve(factor, mu_dot_v)
     rhs = -(nu_At.T @ free + loops.acceleration_bias(q, v, t) + A @ nu_dot_G)   # eq 98
     K_c, rank = multipliers(A @ nu_At, rhs)
     return free + A.T @ K_c, K_c, rank
@@ -44,8 +45,8 @@ class Momentum(AbstractLoopMethod):
         require_symmetric("Momentum", tree)
 
     def velocity(self, loops, q, u):
-        factor = jax.scipy.linalg.cho_factor(loops.tree.mass_matrix(q))
-        return jax.scipy.linalg.cho_solve(factor, u)
+        factor = cholesky(loops.tree.mass_matrix(q))
+        return cho_solve(factor, u)
 
     def with_velocity(self, loops, q, u, v):
         return loops.tree.mass_matrix(q) @ v

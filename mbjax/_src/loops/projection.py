@@ -26,6 +26,7 @@ import jax.numpy as jnp
 import numpy as np
 from jax import Array
 
+from mbjax._src.linalg import cho_solve, cholesky
 from mbjax._src.loops.constraints import Loops
 from mbjax._src.loops.multipliers import multipliers, solver
 
@@ -120,8 +121,8 @@ def project_velocity(loops: Loops, q: Array, v: Array, t=0.0, mass=None) -> Arra
     if mass is None:
         y, _ = multipliers(A @ A.T, loops.rate(q, v, t))
         return v - A.T @ y
-    factor = jax.scipy.linalg.cho_factor(mass)
-    nu_At = jax.scipy.linalg.cho_solve(factor, A.T)
+    factor = cholesky(mass)
+    nu_At = cho_solve(factor, A.T)
     y, _ = multipliers(A @ nu_At, loops.rate(q, v, t))
     return v - nu_At @ y
 
