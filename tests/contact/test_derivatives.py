@@ -1,6 +1,7 @@
 """The derivatives of a stance's dynamics and of the impulse map (issue 57), taken through the
-factored KKT system (`mbjax._src.loops.kkt`), against forward mode through the plain dense solves
-and against central differences, on ANYmal and Solo12 from example-robot-data; a stance with
+factored KKT system (`mbjax._src.loops.kkt`), against Pinocchio's analytic derivatives, forward
+mode through the plain dense solves and central differences, on ANYmal and Solo12 from
+example-robot-data; a stance with
 every foot in the air is the free tree; and no program of a vmapped stance holds a LAPACK call
 (jaxlib 0.10.2's batched LAPACK calls deadlock its CPU runtime)."""
 
@@ -54,7 +55,8 @@ def _rel(a, b):
     return float(np.max(np.abs(np.asarray(a) - np.asarray(b))) / np.max(np.abs(np.asarray(b))))
 
 
-@pytest.mark.parametrize("robot", ["anymal", pytest.param("solo12", marks=pytest.mark.slow)])
+@pytest.mark.slow
+@pytest.mark.parametrize("robot", ["anymal", "solo12"])
 def test_stance_derivatives_agree_with_the_plain_route_and_differences(robot):
     """d(v_dot, K_c)/d(dq, v, tau) by the factored KKT system equals forward mode through the
     dense solves (1e-10) and central differences (1e-6); reverse mode equals it too."""
@@ -141,3 +143,65 @@ def test_a_vmapped_stance_holds_no_lapack_call_and_runs_repeatedly():
         again = J(*xs)
     for a, b in zip(first, again, strict=True):
         np.testing.assert_array_equal(a, b)
+
+
+@pytest.mark.parametrize("robot", ["anymal", pytest.param("solo12", marks=pytest.mark.slow)])
+def test_derivatives_equal_pinocchios_analytic_ones(robot):
+    """The stance's d(v_dot, forces)/d(q, v, tau) equal Pinocchio's
+    `computeConstraintDynamicsDerivatives`, and the impulse map's d(v+, impulses)/d(q, v) its
+    `computeImpulseDynamicsDerivatives` (whose ddq_dv is the jump's, d(v+ - v)/dv), on the same
+    point contacts with Crocoddyl's Kd = 50: Carpentier and Mansard's analytic derivatives,
+    computed independently in C++."""
+    pin = pytest.importorskip("pinocchio")
+    from mbjax.model import state_to_pinocchio
+
+    path, feet = ROBOTS[robot]
+    path = example_robots([path])[0]
+    model, q, contacts, (_, v, tau) = _robot(robot)
+    zero = jnp.zeros(model.nv)
+
+    @jax.jit
+    def derivatives(v, tau):
+        def dynamics(dq, v, tau):
+            phase = stance(TreeSystem(model, Constant(tau)), q, contacts)
+            q_ = model.integrate(q, dq)
+            return phase.acceleration(0.0, q_, v), phase.multipliers(0.0, q_, v)
+
+        def jump(dq, v):
+            v_plus, impulses = impulse(model, model.integrate(q, dq), v, contacts)
+            return v_plus, impulses[:, 3:].ravel()
+
+        return (jax.jacfwd(dynamics, argnums=(0, 1, 2))(zero, v, tau),
+                jax.jacfwd(jump, argnums=(0, 1))(zero, v))
+
+    ((a_q, a_v, a_tau), (f_q, f_v, f_tau)), ((j_q, j_v), (i_q, i_v)) = (
+        jax.tree.map(np.asarray, derivatives(v, tau)))
+    q_pin, v_pin = (np.asarray(x) for x in state_to_pinocchio(model, q, v))
+    P = np.asarray(jax.jacfwd(lambda v_: state_to_pinocchio(model, q, v_)[1])(v))  # a permutation
+    D = np.diag(np.asarray(model.damping))    # URDF damping: Pinocchio's torque is tau - D v
+    pm = pin.buildModelFromUrdf(str(path), pin.JointModelFreeFlyer())
+    pd = pm.createData()
+    models = []
+    for foot in feet:
+        frame = pm.frames[pm.getFrameId(foot)]
+        m = pin.RigidConstraintModel(pin.ContactType.CONTACT_3D, pm, frame.parentJoint,
+                                     frame.placement, pin.ReferenceFrame.LOCAL_WORLD_ALIGNED)
+        m.setBaumgarteCorrectorParameters(pin.BaumgarteCorrectorParameters(0.0, 2 * CROCODDYL_GAINS[0]))
+        models.append(m)
+    models = pin.StdVec_RigidConstraintModel(models)
+    datas = pin.StdVec_RigidConstraintData([m.createData() for m in models])
+    settings = pin.ProximalSettings(1e-14, 1e-14, 1)
+    pin.initConstraintDynamics(pm, pd, models, datas)
+    pin.constraintDynamics(pm, pd, q_pin, v_pin, P @ np.asarray(tau - model.damping * v), models,
+                           datas, settings)
+    pin.computeConstraintDynamicsDerivatives(pm, pd, models, datas, settings)
+    for ours, theirs in ((P @ a_q @ P.T, pd.ddq_dq), (P @ (a_v + a_tau @ D) @ P.T, pd.ddq_dv),
+                         (P @ a_tau @ P.T, pd.ddq_dtau), (f_q @ P.T, pd.dlambda_dq),
+                         ((f_v + f_tau @ D) @ P.T, pd.dlambda_dv), (f_tau @ P.T, pd.dlambda_dtau)):
+        assert _rel(ours, theirs) < 1e-9
+    pin.initConstraintDynamics(pm, pd, models, datas)
+    pin.impulseDynamics(pm, pd, q_pin, v_pin, models, datas, 0.0, settings)
+    pin.computeImpulseDynamicsDerivatives(pm, pd, models, datas, 0.0, settings)
+    for ours, theirs in ((P @ j_q @ P.T, pd.ddq_dq), (P @ j_v @ P.T - np.eye(model.nv), pd.ddq_dv),
+                         (i_q @ P.T, pd.dlambda_dq), (i_v @ P.T, pd.dlambda_dv)):
+        assert _rel(ours, theirs) < 1e-9
