@@ -96,6 +96,11 @@ def unrolled_dot(a: Array, b: Array) -> Array:
     return sum(a[..., :, i, None] * b[..., None, i, :] for i in range(a.shape[-1]))
 
 
+# `cholesky` and `cho_solve` run their loops unrolled up to this size: a loop of a few steps
+# costs more in launches (and in reverse mode, in saved carries) than its straight-line code
+UNROLL_LOOP = 8
+
+
 def cholesky(A: Array) -> Array:
     """The lower Cholesky factor L of symmetric positive-definite matrices, A = L L^T, by a loop
     over the columns (L[:, j] = (A[:, j] - L L[j]^T) / sqrt(.)), with no LAPACK call.
@@ -123,7 +128,7 @@ def cholesky(A: Array) -> Array:
         col = jnp.where(index == j, jnp.where(pivot > 0, root, 0.0), col)
         return jax.lax.dynamic_update_index_in_dim(jnp.swapaxes(L, -1, -2), col, j, -2).swapaxes(-1, -2)
 
-    return jax.lax.fori_loop(0, n, column, jnp.zeros_like(A))
+    return jax.lax.fori_loop(0, n, column, jnp.zeros_like(A), unroll=n <= UNROLL_LOOP)
 
 
 def cho_solve(L: Array, b: Array) -> Array:
@@ -155,5 +160,6 @@ def cho_solve(L: Array, b: Array) -> Array:
         value = (jnp.take(y, i, axis=-2) - (col * x).sum(-2)) * jnp.take(inverse, i, axis=-2)
         return jax.lax.dynamic_update_index_in_dim(x, value, i, -2)
 
-    y = jax.lax.fori_loop(0, n, forward, jnp.zeros_like(b))
-    return jax.lax.fori_loop(0, n, backward, jnp.zeros_like(b))
+    unroll = n <= UNROLL_LOOP
+    y = jax.lax.fori_loop(0, n, forward, jnp.zeros_like(b), unroll=unroll)
+    return jax.lax.fori_loop(0, n, backward, jnp.zeros_like(b), unroll=unroll)

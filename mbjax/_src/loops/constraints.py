@@ -34,7 +34,13 @@ class Loops(eqx.Module):
 
         with A = dPhi/dq . dq/dv (the velocity constraint operator, (m, nv)), B = dPhi/dt and b =
         d/dt (A v + B) at fixed v, the "A_dot u + B_dot" of Anderson 1993 eq 92. Derivatives follow
-        q along q_dot = tree.q_dot(q, v), so quaternion joints need no special case.
+        q along q_dot = tree.q_dot(q, v), so quaternion joints need no special case. Where the
+        tree writes its bodies' motion out (`body_motion`, a rigid tree), `drift` (A v_dot + b)
+        and `force` (A^t K), the terms the KKT system's derivatives differentiate
+        (`mbjax._src.loops.kkt`), take a cut joint's rates from its residual along its two
+        frames' velocities and accelerations, and A^t K from the tree's inward pass of the
+        wrenches on them (`body_forces`): no nested derivative of the tree's kinematics. (The
+        route through `phi` stays for the rest: reverse mode through a rollout runs it faster.)
     """
 
     tree: AbstractTreeSystem
@@ -115,22 +121,16 @@ class Loops(eqx.Module):
                     poses += [None, None]
                     motions += [None, None]
                     continue
-                omega, v_origin = V[body, :3], V[body, 3:]
                 poses += [R[body], p[body]]
-                motions += [jnp.cross(omega[:, None], R[body], axis=0),
-                            v_origin + jnp.cross(omega, p[body])]
+                motions += list(_pose_rates(R[body], p[body], V[body]))
             rates.append(jax.jvp(c.pose_residual, poses, motions)[1] * c.active)
         return jnp.concatenate(rates)
 
     def rate(self, q: Array, v: Array, t=0.0) -> Array:
         """A v + B = dPhi/dt along the motion, shape (m,), for v of shape (nv,)."""
         self.checked(q, v)
-        t = jnp.asarray(t, q.dtype)
-        motion = self.tree.body_motion(q, v)
-        if motion is None:
-            return jax.jvp(self.phi, (q, t), (self.tree.q_dot(q, v), jnp.ones((), q.dtype)))[1]
-        R, p, V, _ = motion
-        return self._rate(R, p, V, q, self.tree.q_dot(q, v), t)
+        return jax.jvp(self.phi, (q, jnp.asarray(t, q.dtype)),
+                       (self.tree.q_dot(q, v), jnp.ones((), q.dtype)))[1]
 
     def jacobian(self, q: Array, t=0.0) -> Array:
         """The velocity constraint operator A, shape (m, nv): the rate is linear in v, A v + B.
@@ -141,7 +141,8 @@ class Loops(eqx.Module):
     def acceleration_bias(self, q: Array, v: Array, t=0.0) -> Array:
         """b = d/dt (A v + B) at fixed v, shape (m,), so that A v_dot + b is the second
         derivative of Phi."""
-        return self.drift(q, v, jnp.zeros_like(v), t)
+        return jax.jvp(lambda q_, t_: self.rate(q_, v, t_), (q, jnp.asarray(t, q.dtype)),
+                       (self.tree.q_dot(q, v), jnp.ones((), q.dtype)))[1]
 
     def drift(self, q: Array, v: Array, v_dot: Array, t=0.0) -> Array:
         """A v_dot + b, the second derivative of Phi along the motion (q, v, v_dot), shape (m,).
@@ -155,9 +156,7 @@ class Loops(eqx.Module):
             return jax.jvp(lambda q_, v_, t_: self.rate(q_, v_, t_), (q, v, t),
                            (q_dot, v_dot, jnp.ones_like(t)))[1]
         R, p, V, A = motion
-        omega, v_origin = V[:, :3], V[:, 3:]
-        R_dot = jnp.cross(omega[:, :, None], R, axis=1)
-        p_dot = v_origin + jnp.cross(omega, p)
+        R_dot, p_dot = _pose_rates(R, p, V)
         q_ddot = jax.jvp(self.tree.q_dot, (q, v), (q_dot, v_dot))[1]
         return jax.jvp(self._rate, (R, p, V, q, q_dot, t),
                        (R_dot, p_dot, A, q_dot, q_ddot, jnp.ones_like(t)))[1]
@@ -177,3 +176,10 @@ class Loops(eqx.Module):
         wrenches, generalized = jax.vjp(lambda V_, qd: self._rate(R, p, V_, q, qd, t), V,
                                         q_dot)[1](K)
         return self.tree.body_forces(q, wrenches) + q_dot_transpose(generalized)[0]
+
+
+def _pose_rates(R: Array, p: Array, V: Array) -> tuple[Array, Array]:
+    """(R_dot, p_dot) = (omega x R, v_O + omega x p) of frames (..., 3, 3), (..., 3) moving with
+    spatial velocities V = (omega; v_O) at the world origin, shape (..., 6)."""
+    omega, v_origin = V[..., :3], V[..., 3:]
+    return jnp.cross(omega[..., :, None], R, axis=-2), v_origin + jnp.cross(omega, p)
