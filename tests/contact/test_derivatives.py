@@ -82,6 +82,7 @@ def test_stance_derivatives_agree_with_the_plain_route_and_differences(robot):
         assert _rel(g, w @ J) < 1e-10
 
 
+@pytest.mark.slow
 def test_impulse_derivatives_agree_with_the_plain_route():
     """d(v+, impulses)/d(q, v) of the impulse map equals forward mode through dense solves."""
     model, q0, contacts, (dq, v, _) = _robot("anymal")
