@@ -4,7 +4,6 @@ the equations)."""
 import math
 
 import equinox as eqx
-import jax
 import jax.numpy as jnp
 from jax import Array
 
