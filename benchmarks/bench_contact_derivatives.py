@@ -38,6 +38,7 @@ def run(robot: str, batch: int) -> dict:
     from mbjax.contact import PointContact, stance
     from mbjax.control import Constant
     from mbjax.rigid import TreeSystem
+    from mbjax_harness.peers import pinocchio_point_contacts
 
     name, feet = ROBOTS[robot]
     r = erd.load(name)
@@ -60,16 +61,7 @@ def run(robot: str, batch: int) -> dict:
 
     pm = r.model
     pd = pm.createData()
-    models = []
-    for foot in feet:
-        frame = pm.frames[pm.getFrameId(foot)]
-        m = pin.RigidConstraintModel(pin.ContactType.CONTACT_3D, pm, frame.parentJoint,
-                                     frame.placement, pin.ReferenceFrame.LOCAL_WORLD_ALIGNED)
-        m.setBaumgarteCorrectorParameters(pin.BaumgarteCorrectorParameters(0.0, 50.0))
-        models.append(m)
-    models = pin.StdVec_RigidConstraintModel(models)
-    datas = pin.StdVec_RigidConstraintData([m.createData() for m in models])
-    settings = pin.ProximalSettings(1e-12, 1e-12, 1)
+    models, datas, settings = pinocchio_point_contacts(pm, feet, 50.0)
     pin.initConstraintDynamics(pm, pd, models, datas)
     states = [(pin.integrate(pm, r.q0, 0.05 * rng.normal(size=pm.nv)), rng.normal(size=pm.nv),
                rng.normal(size=pm.nv)) for _ in range(batch)]

@@ -392,3 +392,21 @@ def random_state(model, seed):
     q = np.asarray(model.neutral()) + rng.normal(size=model.nq)
     q = np.asarray(model.normalize(jnp.asarray(q)))
     return q, rng.normal(size=model.nv), rng.normal(size=model.nv)
+
+
+def pinocchio_point_contacts(pin_model, feet, kd: float):
+    """Pinocchio's point contacts (`CONTACT_3D`, LOCAL_WORLD_ALIGNED) on the named frames, with
+    the Baumgarte gains (0, kd) of Crocoddyl's contact models, their data and solver settings,
+    initialised for `constraintDynamics` and `impulseDynamics`: (models, datas, settings)."""
+    import pinocchio as pin
+
+    models = []
+    for foot in feet:
+        frame = pin_model.frames[pin_model.getFrameId(foot)]
+        model = pin.RigidConstraintModel(pin.ContactType.CONTACT_3D, pin_model, frame.parentJoint,
+                                         frame.placement, pin.ReferenceFrame.LOCAL_WORLD_ALIGNED)
+        model.setBaumgarteCorrectorParameters(pin.BaumgarteCorrectorParameters(0.0, kd))
+        models.append(model)
+    models = pin.StdVec_RigidConstraintModel(models)
+    datas = pin.StdVec_RigidConstraintData([m.createData() for m in models])
+    return models, datas, pin.ProximalSettings(1e-14, 1e-14, 1)

@@ -15,6 +15,7 @@ from mbjax._src.contact.stance import CROCODDYL_GAINS
 from mbjax.contact import PointContact, impulse, stance
 from mbjax.control import Constant
 from mbjax.rigid import TreeSystem
+from mbjax_harness.peers import pinocchio_point_contacts
 from tests.conftest import example_robots
 
 ROBOTS = {"anymal": ("anymal_b_simple/anymal", ["LF_FOOT", "LH_FOOT", "RF_FOOT", "RH_FOOT"]),
@@ -182,16 +183,7 @@ def test_derivatives_equal_pinocchios_analytic_ones(robot):
     D = np.diag(np.asarray(model.damping))    # URDF damping: Pinocchio's torque is tau - D v
     pm = pin.buildModelFromUrdf(str(path), pin.JointModelFreeFlyer())
     pd = pm.createData()
-    models = []
-    for foot in feet:
-        frame = pm.frames[pm.getFrameId(foot)]
-        m = pin.RigidConstraintModel(pin.ContactType.CONTACT_3D, pm, frame.parentJoint,
-                                     frame.placement, pin.ReferenceFrame.LOCAL_WORLD_ALIGNED)
-        m.setBaumgarteCorrectorParameters(pin.BaumgarteCorrectorParameters(0.0, 2 * CROCODDYL_GAINS[0]))
-        models.append(m)
-    models = pin.StdVec_RigidConstraintModel(models)
-    datas = pin.StdVec_RigidConstraintData([m.createData() for m in models])
-    settings = pin.ProximalSettings(1e-14, 1e-14, 1)
+    models, datas, settings = pinocchio_point_contacts(pm, feet, 2 * CROCODDYL_GAINS[0])
     pin.initConstraintDynamics(pm, pd, models, datas)
     pin.constraintDynamics(pm, pd, q_pin, v_pin, P @ np.asarray(tau - model.damping * v), models,
                            datas, settings)
