@@ -14,10 +14,11 @@ from mbjax._src.contact.contact import SurfaceContact as SurfaceContact
 from mbjax._src.contact.impulse import impulse as impulse
 from mbjax._src.contact.stance import contact_wrenches as contact_wrenches
 from mbjax._src.contact.stance import stance as stance
+from mbjax._src.contact.stance import stance_contacts as stance_contacts
 from mbjax._src.contact.schedule import ContactSolution as ContactSolution
 from mbjax._src.contact.schedule import simulate_schedule as simulate_schedule
 
 __all__ = [
-    "AbstractContact", "PointContact", "SurfaceContact", "stance", "contact_wrenches", "impulse",
+    "AbstractContact", "PointContact", "SurfaceContact", "stance", "stance_contacts", "contact_wrenches", "impulse",
     "simulate_schedule", "ContactSolution",
 ]

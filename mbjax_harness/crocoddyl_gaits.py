@@ -96,9 +96,9 @@ class _Gait:
         """`createSwingFootModel`: the support feet held, the swing feet and CoM tracked."""
         contacts = self.contacts(support)
         phase = stance(self.tree, self.q0, contacts, method=self.method)
-        costs = [friction_cone_residual(phase, contacts, MU, weight=10.0)
+        costs = [friction_cone_residual(phase, MU, weight=10.0)
                  if self.kind is PointContact else
-                 wrench_cone_residual(phase, contacts, MU, *SOLE, weight=10.0),
+                 wrench_cone_residual(phase, MU, *SOLE, weight=10.0),
                  com_residual(self.model, np.zeros(3) if com is None else com,
                               weight=0.0 if com is None else 1e6),
                  *self.tracks(swing, 1e6), self.regularisation(self.state_weights),

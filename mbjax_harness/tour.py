@@ -578,8 +578,7 @@ def legged_gait_tour(out: Path, quick: bool) -> dict:
                                      us0), repeats=1)
     iterations = int(result.iterations)
     xs = jnp.concatenate([result.qs, result.vs], axis=1)
-    forces = np.asarray(knot_wrenches(problem, xs, result.us,
-                                      [PointContact(f) for f in FEET]))[..., 3:]
+    forces = np.asarray(knot_wrenches(problem, xs, result.us))[..., 3:]
     ts = np.asarray(problem.times())
     histories = {"mbjax iLQR": np.asarray(result.costs)[:iterations + 1]}
 

@@ -84,7 +84,7 @@ def test_contact_dynamics_agree_with_pinocchio(robot):
         v = v_plus
     phase = stance(TreeSystem(model, Constant(tau)), q, contacts)
     a = phase.acceleration(0.0, q, v)
-    wrenches = contact_wrenches(phase, contacts, 0.0, q, v)
+    wrenches = contact_wrenches(phase, 0.0, q, v)
 
     q_pin, v_pin = (np.asarray(x) for x in state_to_pinocchio(model, q, v))
     P = np.asarray(jax.jacfwd(lambda v_: state_to_pinocchio(model, q, v_)[1])(v))   # v_pin = P v
@@ -107,7 +107,7 @@ def test_contact_dynamics_agree_with_pinocchio(robot):
     a_pin, forces, v_plus_pin, impulses_pin = _pinocchio(
         path, feet[1:], kind, q_pin, v_pin, P @ np.asarray(tau - model.damping * v),
         (0.0, 2 * CROCODDYL_GAINS[0]), P @ np.asarray(v_before))
-    wrenches = contact_wrenches(phase, lifted, 0.0, q, v)
+    wrenches = contact_wrenches(phase, 0.0, q, v)
     v_up, impulses_up = impulse(model, q, v_before, lifted)
     assert _rel(P @ np.asarray(phase.acceleration(0.0, q, v)), a_pin) < 1e-9
     assert _rel(_world_pairs(wrenches[1:], kind.size), forces) < 1e-9
@@ -122,8 +122,8 @@ def test_contact_dynamics_agree_with_pinocchio(robot):
     a_dense = coupled.acceleration(0.0, q, on)
     np.testing.assert_allclose(recursive.acceleration(0.0, q, on), a_dense, rtol=1e-8,
                                atol=1e-8 * float(jnp.abs(a_dense).max()))
-    w_dense = contact_wrenches(coupled, contacts, 0.0, q, on)
-    np.testing.assert_allclose(contact_wrenches(recursive, contacts, 0.0, q, on), w_dense,
+    w_dense = contact_wrenches(coupled, 0.0, q, on)
+    np.testing.assert_allclose(contact_wrenches(recursive, 0.0, q, on), w_dense,
                                rtol=1e-8, atol=1e-8 * float(jnp.abs(w_dense).max()))
 
 
@@ -162,7 +162,7 @@ def test_anymal_stands_on_its_four_feet():
         moved = (mbjax.rigid.frame_pose(model, sol.qs[-1], foot.frame)[1]
                  - mbjax.rigid.frame_pose(model, q0, foot.frame)[1])
         assert float(jnp.abs(moved).max()) < 1e-8
-    wrenches = contact_wrenches(phase, feet, 1.0, sol.qs[-1], sol.us[-1])
+    wrenches = contact_wrenches(phase, 1.0, sol.qs[-1], sol.us[-1])
     weight = float(model.mass.sum()) * 9.81
     assert float(wrenches[:, 5].sum()) == pytest.approx(weight, rel=1e-6)
     assert np.all(np.asarray(wrenches[:, :3]) == 0.0)       # a point contact carries no torque

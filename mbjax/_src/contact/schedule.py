@@ -8,9 +8,8 @@ import jax.numpy as jnp
 import numpy as np
 from jax import Array
 
-from mbjax._src.contact.contact import wrenches
 from mbjax._src.contact.impulse import impulse
-from mbjax._src.contact.stance import _contacts, stance
+from mbjax._src.contact.stance import _contacts, contact_wrenches, stance
 from mbjax._src.integrate.base import AbstractIntegrator
 from mbjax._src.integrate.simulate import simulate
 from mbjax._src.system.status import Status, WithStatus
@@ -116,8 +115,8 @@ def simulate_schedule(tree: AbstractTreeSystem, integrator: AbstractIntegrator, 
         sol = simulate(system, integrator, q, v, dt=dt, t0=t, t1=t + duration)
         w = jnp.zeros((sol.ts.shape[0], len(frames), 6))
         if contacts:
-            forces = jax.vmap(lambda t_, q_, u_, s=system, c=contacts: wrenches(
-                c, s.closures[:len(c)], s.multipliers(t_, q_, u_)))(sol.ts, sol.qs, sol.us)
+            forces = jax.vmap(lambda t_, q_, u_, s=system: contact_wrenches(s, t_, q_, u_))(
+                sol.ts, sol.qs, sol.us)
             w = w.at[:, [frames.index(c.frame) for c in contacts]].set(forces)
         keep = slice(0, None) if k == 0 else slice(1, None)     # a phase's first state is the
         parts.append((sol.ts[keep], sol.qs[keep], sol.us[keep], w[keep],     # last one's end

@@ -31,15 +31,18 @@ def _contacts(contacts) -> tuple[AbstractContact, ...]:
 
 
 class Grip(eqx.Module):
-    """A stance's watch (`ClosedSystem`'s `watch`): `Status.PULLING` where a contact's normal
-    force is negative, `Status.SLIPPING` where its tangential force exceeds mu times the normal
-    one (the exact cone), each beyond round-off (1e-9 of the force)."""
+    """A stance's watch (`ClosedSystem`'s `watch`), which holds its contacts: with a friction
+    coefficient mu, `Status.PULLING` where a contact's normal force is negative,
+    `Status.SLIPPING` where its tangential force exceeds mu times the normal one (the exact
+    cone), each beyond round-off (1e-9 of the force); no flags without mu."""
 
     contacts: tuple
     rotations: Array               # each closure's ground frame orientation
-    mu: Array
+    mu: Array | None
 
     def __call__(self, multipliers: Array) -> Array:
+        if self.mu is None:
+            return jnp.zeros((), jnp.int32)
         w = wrenches(self.contacts, (), multipliers, self.rotations)
         normals = jnp.stack([c.normal for c in self.contacts])
         f = w[:, 3:]
@@ -56,8 +59,9 @@ def stance(tree: AbstractTreeSystem, q: Array, contacts: Sequence[AbstractContac
     """A contact phase: `tree` with each contact's frame held where it is in configuration q.
 
     Each contact becomes a cut joint with the ground (`AbstractContact.closure`), and the phase
-    is a `ClosedSystem` of the tree and those closures, in the order of `contacts`; its
-    multipliers are the ground's reactions (`contact_wrenches`).
+    is a `ClosedSystem` of the tree and those closures, in the order of `contacts`, which holds
+    the contacts (`stance_contacts`): its multipliers are the ground's reactions on them
+    (`contact_wrenches`), which the contact residuals of `mbjax.trajopt` read.
 
     Args:
         tree: the robot, a rigid tree system such as `TreeSystem(model, control)`.
@@ -86,9 +90,8 @@ def stance(tree: AbstractTreeSystem, q: Array, contacts: Sequence[AbstractContac
     contacts = _contacts(contacts)
     closures = tuple(c.closure(tree.model, jnp.asarray(q, float)) for c in contacts)
     method = Coupled(baumgarte=CROCODDYL_GAINS) if method is None else method
-    watch = None
-    if mu is not None:
-        watch = Grip(contacts, jnp.stack([j.rotation_b for j in closures]), friction(mu))
+    watch = Grip(contacts, jnp.stack([j.rotation_b for j in closures]),
+                 None if mu is None else friction(mu))
     return ClosedSystem(tree, closures, method, projection, watch=watch)
 
 
@@ -102,36 +105,53 @@ def friction(mu) -> Array:
     return mu
 
 
-def contact_wrenches(system: ClosedSystem, contacts: Sequence[AbstractContact], t, q: Array,
-                     u: Array) -> Array:
-    """The ground's wrench on each contact's frame, (torque; force) in world components at the
-    frame's origin: the contacts' multipliers (Pinocchio's `constraintDynamics` forces, in its
-    LOCAL_WORLD_ALIGNED frame).
+def contact_wrenches(phase: ClosedSystem, t, q: Array, u: Array) -> Array:
+    """The ground's wrench on each of a stance's contacts, (torque; force) in world components
+    at the frame's origin: the contacts' multipliers (Pinocchio's `constraintDynamics` forces,
+    in its LOCAL_WORLD_ALIGNED frame).
 
     Args:
-        system: the phase, as `stance` made it from the same contacts.
-        contacts: the contacts, in the order `stance` took them.
+        phase: the stance, as `stance` made it.
         t: time [s], a scalar.
         q: configuration, shape (nq,).
         u: the phase's velocity state (the joint velocities for `Coupled`).
 
     Returns:
-        The wrenches, shape (len(contacts), 6); a point contact's torque is zero.
+        The wrenches, shape (len(contacts), 6), in the order `stance` took the contacts; a point
+            contact's torque is zero.
 
     Raises:
-        ValueError: the system's first closures do not match the contacts' sizes.
+        ValueError: the phase is not a stance.
     """
-    contacts = stance_contacts(system, contacts, "system")
-    return wrenches(contacts, system.closures, system.multipliers(t, q, u))
+    return stance_wrenches(phase, phase.multipliers(t, q, u))
 
 
-def stance_contacts(system, contacts, name: str) -> tuple[AbstractContact, ...]:
-    """The contacts as a tuple, or a ValueError naming `name` where `system`'s first closures
-    are not theirs (a stance made from other contacts)."""
-    contacts = _contacts(contacts)
-    closures = getattr(system, "closures", ())
-    if len(closures) < len(contacts) or any(
-            c.kind != j.kind for c, j in zip(contacts, closures, strict=False)):
-        raise ValueError(f"{name} must be the stance of these contacts (stance(tree, q, "
-                         "contacts))")
-    return contacts
+def stance_wrenches(phase: ClosedSystem, multipliers: Array) -> Array:
+    """The ground's wrench on each of a stance's contacts from the phase's multipliers, as
+    `contact_wrenches` gives them, shape (len(contacts), 6)."""
+    contacts = stance_contacts(phase)
+    return wrenches(contacts, phase.closures, multipliers)
+
+
+def is_stance(system) -> bool:
+    """Whether a system is a stance, as `stance` makes it."""
+    return isinstance(system, ClosedSystem) and isinstance(getattr(system, "watch", None), Grip)
+
+
+def stance_contacts(phase, name: str = "phase") -> tuple[AbstractContact, ...]:
+    """The contacts a stance holds, in order.
+
+    Args:
+        phase: a stance, as `stance` made it.
+        name: the argument's name, for the error.
+
+    Returns:
+        The contacts, a tuple.
+
+    Raises:
+        ValueError: naming `name`, where phase is not a stance (`stance(tree, q, contacts)`).
+    """
+    if not is_stance(phase):
+        raise ValueError(f"{name} must be a stance (mbjax.contact.stance(tree, q, contacts)), got "
+                         f"{type(phase).__name__}")
+    return phase.watch.contacts

@@ -20,8 +20,8 @@ class AbstractIntegrator(eqx.Module):
     name: ClassVar[str]
 
     @abc.abstractmethod
-    def step(self, system: AbstractSystem, t: Array, q: Array, u: Array,
-             dt: Array) -> tuple[Array, Array, Array]:
+    def step(self, system: AbstractSystem, t: Array, q: Array, u: Array, dt: Array,
+             a0: Array | None = None) -> tuple[Array, Array, Array]:
         """Advance the system one step.
 
         Args:
@@ -30,6 +30,9 @@ class AbstractIntegrator(eqx.Module):
             q: configuration at t, shape (nq,).
             u: velocity coordinates at t, shape (nv,).
             dt: the step [s], a scalar.
+            a0: the acceleration `system.acceleration(t, q, u)` where the caller has it already
+                (a knot whose costs read the forces of the same solve), shape (nv,); None to
+                evaluate it. Integrators whose first stage is not at (t, q, u) ignore it.
 
         Returns:
             q1: configuration at t + dt, projected (`system.project`), shape (nq,).

@@ -18,7 +18,7 @@ class ExplicitEuler(AbstractIntegrator):
     order = 1
     name = "explicit_euler"
 
-    def step(self, system, t, q, u, dt):
+    def step(self, system, t, q, u, dt, a0=None):
         q1 = system.project(system.retract(q, dt * system.tangent(q, u)))
-        u1 = u + dt * system.acceleration(t, q, u)
+        u1 = u + dt * (system.acceleration(t, q, u) if a0 is None else a0)
         return q1, u1, jnp.array(True)

@@ -50,7 +50,7 @@ class ImplicitMidpoint(AbstractIntegrator):
     order = 2
     name = "implicit_midpoint"
 
-    def step(self, system, t, q, u, dt):
+    def step(self, system, t, q, u, dt, a0=None):
         n = q.shape[0]
         y0 = jnp.concatenate([q, u])
         tm = t + dt / 2

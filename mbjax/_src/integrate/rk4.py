@@ -28,7 +28,7 @@ class RK4(AbstractIntegrator):
     order = 4
     name = "rk4"
 
-    def step(self, system, t, q, u, dt):
+    def step(self, system, t, q, u, dt, a0=None):
         a, c = jnp.asarray(A, q.dtype), jnp.asarray(C, q.dtype)
 
         def stage(ks, i):
@@ -40,7 +40,11 @@ class RK4(AbstractIntegrator):
                     ku.at[i].set(system.acceleration(s, yq, yu))), None
 
         zeros = (jnp.zeros((4,) + q.shape, q.dtype), jnp.zeros((4,) + u.shape, u.dtype))
-        (kq, ku), _ = jax.lax.scan(stage, zeros, jnp.arange(4))
+        if a0 is None:
+            (kq, ku), _ = jax.lax.scan(stage, zeros, jnp.arange(4))
+        else:                                   # the first stage's acceleration is known
+            first = (zeros[0].at[0].set(system.kinematics(q, u)), zeros[1].at[0].set(a0))
+            (kq, ku), _ = jax.lax.scan(stage, first, jnp.arange(1, 4))
         b = jnp.asarray(B, q.dtype)
         q1 = q + dt * jnp.tensordot(b, kq, axes=1)
         u1 = u + dt * jnp.tensordot(b, ku, axes=1)

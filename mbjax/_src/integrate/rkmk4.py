@@ -24,13 +24,13 @@ class RKMK4(AbstractIntegrator):
     order = 4
     name = "rkmk4"
 
-    def step(self, system, t, q, u, dt):
+    def step(self, system, t, q, u, dt, a0=None):
         def f(s, xi, u_):
             return (system.local_rate(q, xi, u_),
                     system.acceleration(s, system.retract(q, xi), u_))
 
         xi0 = jnp.zeros_like(u)
-        k1x, k1u = f(t, xi0, u)
+        k1x, k1u = ((system.local_rate(q, xi0, u), a0) if a0 is not None else f(t, xi0, u))
         k2x, k2u = f(t + dt / 2, dt / 2 * k1x, u + dt / 2 * k1u)
         k3x, k3u = f(t + dt / 2, dt / 2 * k2x, u + dt / 2 * k2u)
         k4x, k4u = f(t + dt, dt * k3x, u + dt * k3u)

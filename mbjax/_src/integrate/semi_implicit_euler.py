@@ -17,7 +17,7 @@ class SemiImplicitEuler(AbstractIntegrator):
     order = 1
     name = "semi_implicit_euler"
 
-    def step(self, system, t, q, u, dt):
-        u1 = u + dt * system.acceleration(t, q, u)
+    def step(self, system, t, q, u, dt, a0=None):
+        u1 = u + dt * (system.acceleration(t, q, u) if a0 is None else a0)
         q1 = system.project(system.retract(q, dt * system.tangent(q, u1)))
         return q1, u1, jnp.array(True)

@@ -107,3 +107,6 @@ class Coupled(AbstractLoopMethod):
     def loads(self, loops, t, q, u):
         """The multipliers K_c (Jerkovsky 1978 eq 92): A^t K_c is the generalized constraint force."""
         return coupled_solution(loops, q, u, t, self.baumgarte)[1]
+
+    def solve(self, loops, t, q, u):
+        return coupled_solution(loops, q, u, t, self.baumgarte)

@@ -64,6 +64,11 @@ class AbstractLoopMethod(eqx.Module):
         1978 eq 93). `loads` by default (arguments as `acceleration`)."""
         return self.loads(loops, t, q, u)
 
+    def solve(self, loops, t: Array, q: Array, u: Array) -> tuple[Array, Array]:
+        """(`acceleration`, `multipliers`) at (t, q, u): a method that finds both in one solve
+        (`Coupled`) returns them from it; the two calls by default."""
+        return self.acceleration(loops, t, q, u), self.multipliers(loops, t, q, u)
+
 
 def require_symmetric(method: str, tree) -> None:
     """The dense routes need M(q) v_dot + bias = 0 with a symmetric M."""

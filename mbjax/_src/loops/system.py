@@ -200,6 +200,20 @@ class ClosedSystem(AbstractSystem):
         """
         return self.method.multipliers(self.loops, t, q, u)
 
+    def solve(self, t, q: Array, u: Array) -> tuple[Array, Array]:
+        """The acceleration and the multipliers at a state from one solve where the method
+        finds both at once (`Coupled`).
+
+        Args:
+            t: time [s], a scalar.
+            q: configuration, shape (nq,).
+            u: the method's velocity state.
+
+        Returns:
+            (`acceleration`, `multipliers`) at (t, q, u).
+        """
+        return self.method.solve(self.loops, t, q, u)
+
     # -- AbstractSystem ---------------------------------------------------------------------------
 
     def kinematics(self, q, u):

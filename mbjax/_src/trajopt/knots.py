@@ -13,11 +13,13 @@ from jax import Array
 
 from mbjax._src.contact.contact import AbstractContact
 from mbjax._src.contact.impulse import impulse_map
+from mbjax._src.contact.stance import contact_wrenches, is_stance, stance_wrenches
 from mbjax._src.control import Constant
 from mbjax._src.model.model import Model
 from mbjax._src.rigid.frames import frame_placement
 from mbjax._src.system.system import AbstractSystem
 from mbjax._src.trajopt.costs import as_cost
+from mbjax._src.trajopt.residuals import given_forces, knot_forces, reads_forces
 
 
 class AbstractKnot(eqx.Module):
@@ -33,8 +35,32 @@ class AbstractKnot(eqx.Module):
     rate: ClassVar[bool]
 
     @abc.abstractmethod
+    def advance(self, integrator, t, q: Array, v: Array, u: Array,
+                dt) -> tuple[Array, Array, Array | None]:
+        """(q, v) at the next knot from (q, v) at time t under the control u, and the forces
+        that the step solved which the knot's costs read (None where they read none)."""
+
     def transition(self, integrator, t, q: Array, v: Array, u: Array, dt) -> tuple[Array, Array]:
         """(q, v) at the next knot from (q, v) at time t under the control u."""
+        return self.advance(integrator, t, q, v, u, dt)[:2]
+
+    def cost(self, t, q: Array, v: Array, u: Array, forces: Array | None = None) -> Array:
+        """The running cost at (q, v, u), time t: a scalar or residuals.
+
+        Args:
+            t: the knot's time [s].
+            q: configuration, shape (nq,).
+            v: velocity, shape (nv,).
+            u: control, shape (nu,).
+            forces: the forces from `advance` at the same (t, q, v, u), or None to solve them
+                where the costs read them.
+        """
+        return self.running(q, v, u)
+
+    def wrenches(self, t, q: Array, v: Array, u: Array) -> Array | None:
+        """The ground's wrench on each contact of the knot's stance at (t, q, v, u), as
+        `mbjax.contact.contact_wrenches` gives them; None where the knot holds no stance."""
+        return None
 
     def duration(self, dt: float) -> float:
         """The time from this knot to the next."""
@@ -44,6 +70,10 @@ class AbstractKnot(eqx.Module):
 class Knot(AbstractKnot):
     """A step of a system under a control held over it: a knot of a contact phase (its
     `mbjax.contact.stance`), of a flight, or of any system.
+
+    The contact residuals (`friction_cone_residual`, ...) made from the knot's own stance (that
+    very object) read the forces that the knot's step solves: the stance is solved once per
+    knot, for the step and its costs alike (Crocoddyl's shared contact data).
 
     Args:
         system: the system stepped (its control is the problem's unknown u_k).
@@ -59,12 +89,32 @@ class Knot(AbstractKnot):
         if not isinstance(system, AbstractSystem):
             raise TypeError(f"system must be an mbjax system (TreeSystem, stance(...), ...), got "
                             f"{type(system).__name__}")
-        self.system, self.running = system, as_cost(running, "running(q, v, u)")
+        self.system = system
+        self.running = knot_forces(as_cost(running, "running(q, v, u)"), system)
 
-    def transition(self, integrator, t, q, v, u, dt):
-        system = self.system.with_control(Constant(u)).hold(t, q, v)
-        q1, v1, _ = integrator.step(system, t, q, v, dt)
-        return system.constrain(t + dt, q1, v1)
+    def _held(self, t, q, v, u) -> AbstractSystem:
+        return self.system.with_control(Constant(u)).hold(t, q, v)
+
+    def advance(self, integrator, t, q, v, u, dt):
+        system = self._held(t, q, v, u)
+        a0 = forces = None
+        if reads_forces(self.running):          # one solve for the step and the costs
+            a0, multipliers = system.solve(t, q, v)
+            forces = stance_wrenches(system, multipliers)
+        q1, v1, _ = integrator.step(system, t, q, v, dt, a0=a0)
+        return (*system.constrain(t + dt, q1, v1), forces)
+
+    def cost(self, t, q, v, u, forces=None):
+        if not reads_forces(self.running):
+            return self.running(q, v, u)
+        if forces is None:
+            forces = self.wrenches(t, q, v, u)
+        return given_forces(self.running, forces)(q, v, u)
+
+    def wrenches(self, t, q, v, u):
+        if not is_stance(self.system):
+            return None
+        return contact_wrenches(self._held(t, q, v, u), t, q, v)
 
 
 class Impulse(AbstractKnot):
@@ -94,8 +144,8 @@ class Impulse(AbstractKnot):
                                 f"{c!r}")
             frame_placement(model, c.frame)          # a KeyError names a frame the model lacks
 
-    def transition(self, integrator, t, q, v, u, dt):
-        return q, impulse_map(self.model, q, v, self.contacts)[0]
+    def advance(self, integrator, t, q, v, u, dt):
+        return q, impulse_map(self.model, q, v, self.contacts)[0], None
 
 
 class Schedule(eqx.Module):

@@ -304,13 +304,16 @@ class Problem(eqx.Module):
         problem the step and the residuals are differentiated in one forward-mode pass over
         (dx, u), rather than one pass for the step and one per argument for the costs."""
         zero_q, zero_v = jnp.zeros(self.ndq, x.dtype), jnp.zeros(self.nv, x.dtype)
-        running = self._about(x, knot.running)
+        running = self._about(x, lambda q, v, u, forces=None: knot.cost(t, q, v, u, forces))
         if self.knots is None or not _is_residual(running, zero_q, zero_v, u):
-            return self._jacobians(knot, x, u, t, x_next), self._expansion(knot, x, u)
+            return self._jacobians(knot, x, u, t, x_next), self._expansion(knot, x, u, t)
 
-        def both(dx, u):
-            gap = self.difference(x_next, self._transition(knot, self.integrate(x, dx), u, t))
-            out = (gap, running(dx[:self.ndq], dx[self.ndq:], u))
+        def both(dx, u):          # the costs read the forces the step solved (`Knot.advance`)
+            q, v = self.split(self.integrate(x, dx))
+            q1, v1, forces = knot.advance(self.integrator, t, q, v, u,
+                                          jnp.asarray(self.dt, x.dtype))
+            gap = self.difference(x_next, jnp.concatenate([q1, v1]))
+            out = (gap, running(dx[:self.ndq], dx[self.ndq:], u, forces))
             return out, out
 
         ((A, B), (Jx, Ju)), (e, r) = jax.jacfwd(both, argnums=(0, 1), has_aux=True)(
@@ -338,9 +341,9 @@ class Problem(eqx.Module):
         """A knot's running cost weight: dt for a rate, 1 for an impulse's cost."""
         return jnp.asarray(self.dt if knot.rate else 1.0, dtype)
 
-    def _stage_cost(self, knot, x: Array, u: Array) -> Array:
+    def _stage_cost(self, knot, x: Array, u: Array, t) -> Array:
         """running(q, v, u) dt (1/2 |r|^2 dt for residuals r); an impulse's not times dt."""
-        return _value(knot.running(*self.split(x), u)) * self._weight(knot, x.dtype)
+        return _value(knot.cost(t, *self.split(x), u)) * self._weight(knot, x.dtype)
 
     def final_cost(self, x: Array) -> Array:
         return _value(self.terminal(*self.split(x)))
@@ -350,10 +353,12 @@ class Problem(eqx.Module):
         q, v = self.split(x)
         return lambda dq, dv, *rest: fn(self.system.retract(q, dq), v + dv, *rest)
 
-    def _expansion(self, knot, x: Array, u: Array):
-        """(l_x, l_u, l_xx, l_ux, l_uu) of a knot's stage cost at (x, u) in the tangent space."""
+    def _expansion(self, knot, x: Array, u: Array, t):
+        """(l_x, l_u, l_xx, l_ux, l_uu) of a knot's stage cost at (x, u), time t, in the
+        tangent space."""
         zero_q, zero_v = jnp.zeros(self.ndq, x.dtype), jnp.zeros(self.nv, x.dtype)
-        running, dt = self._about(x, knot.running), self._weight(knot, x.dtype)
+        running = self._about(x, lambda q, v, u: knot.cost(t, q, v, u))
+        dt = self._weight(knot, x.dtype)
         if _is_residual(running, zero_q, zero_v, u):
             (Jq, Jv, Ju), r = _jacobian_and_value(running, zero_q, zero_v, u)
             Jx = jnp.concatenate([Jq, Jv], axis=1)
@@ -400,7 +405,8 @@ class Problem(eqx.Module):
 
     def cost(self, xs: Array, us: Array) -> Array:
         """The objective of a trajectory (xs from `rollout`)."""
-        return jnp.sum(self._map(self._stage_cost, xs[:-1], us)) + self.final_cost(xs[-1])
+        return (jnp.sum(self._map(self._stage_cost, xs[:-1], us, self.times(xs.dtype)))
+                + self.final_cost(xs[-1]))
 
     def objective(self, us: Array) -> Array:
         """The objective as a function of the controls alone (single shooting).

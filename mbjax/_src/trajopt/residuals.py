@@ -7,9 +7,14 @@ by sqrt(w), so that the cost is w 1/2 |r|^2: Crocoddyl's `CostModelResidual` wit
 quadratic (`ActivationModelQuad`) or weighted quadratic (`ActivationModelWeightedQuad`)
 activation. Being modules, their targets and weights are leaves: a problem with another target
 reuses the compiled solve. A tuple of them is their sum (`Problem`'s running and terminal).
+
+The contact residuals read a stance's forces: in a `Knot` of the stance they were made from,
+the forces that the knot's step solved (Crocoddyl's shared contact data), so a knot solves its
+stance once; called on their own, they solve it.
 """
 
 import equinox as eqx
+import jax
 import jax.numpy as jnp
 import numpy as np
 from jax import Array
@@ -170,18 +175,45 @@ def com_residual(model, target, weight=1.0) -> eqx.Module:
 
 
 class _Forces(eqx.Module):
-    """The ground's force on each of a stance's contacts at (q, v, u), world components."""
+    """The ground's wrench on each of a stance's contacts at (q, v, u), world components:
+    solved from `phase`, or, in a knot of that phase (phase None), the wrenches its step solved
+    (`given`, bound by `Knot.cost`)."""
 
-    phase: eqx.Module
-    contacts: tuple
+    phase: eqx.Module | None
+    given: Array | None = None
 
     def __call__(self, q: Array, v: Array, u: Array) -> Array:
+        if self.given is not None:
+            return self.given
+        if self.phase is None:
+            raise ValueError("this contact residual reads the forces of its knot's step: "
+                             "evaluate it through its Knot (Knot.cost)")
         system = self.phase.with_control(Constant(u)).hold(0.0, q, v)
-        return contact_wrenches(system, self.contacts, 0.0, q, v)
+        return contact_wrenches(system, 0.0, q, v)
 
 
-def _phase_contacts(phase, contacts) -> tuple:
-    return stance_contacts(phase, contacts, "phase")
+def _is_forces(x) -> bool:
+    return isinstance(x, _Forces)
+
+
+def knot_forces(cost, phase):
+    """`cost` with each contact residual made from `phase` (that very object) reading the
+    forces that a knot of `phase` computes in its step (Crocoddyl's shared contact data)."""
+    return jax.tree.map(lambda f: _Forces(None) if _is_forces(f) and f.phase is phase else f,
+                        cost, is_leaf=_is_forces)
+
+
+def reads_forces(cost) -> bool:
+    """Whether a cost holds contact residuals that read their knot's forces (`knot_forces`)."""
+    return any(_is_forces(f) and f.phase is None and f.given is None
+               for f in jax.tree.leaves(cost, is_leaf=_is_forces))
+
+
+def given_forces(cost, wrenches: Array):
+    """`cost` with the contact residuals that read their knot's forces given `wrenches`, shape
+    (number of contacts, 6)."""
+    return jax.tree.map(lambda f: _Forces(None, wrenches) if _is_forces(f) and f.phase is None
+                        else f, cost, is_leaf=_is_forces)
 
 
 class _Cone(eqx.Module):
@@ -196,7 +228,7 @@ class _Cone(eqx.Module):
                                             jnp.minimum(r[:, -1:], 0.0)], axis=1).ravel()
 
 
-def friction_cone_residual(phase, contacts, mu=0.7, facets: int = 4, weight=1.0) -> eqx.Module:
+def friction_cone_residual(phase, mu=0.7, facets: int = 4, weight=1.0) -> eqx.Module:
     """Each point contact's force outside its linearised friction cone, with a bounded
     activation: zero inside (Crocoddyl's `ResidualModelContactFrictionCone` with
     `ActivationModelQuadraticBarrier`, its gait examples' cost).
@@ -208,8 +240,8 @@ def friction_cone_residual(phase, contacts, mu=0.7, facets: int = 4, weight=1.0)
     or pulling.
 
     Args:
-        phase: the stance, as `mbjax.contact.stance` made it from the same contacts.
-        contacts: its contacts (point contacts; a surface contact's force is coned alike).
+        phase: the stance, as `mbjax.contact.stance` made it: its contacts are coned (point
+            contacts; a surface contact's force alike).
         mu: the friction coefficient, positive.
         facets: the cone's facets (static).
         weight (float | Array): w.
@@ -218,14 +250,14 @@ def friction_cone_residual(phase, contacts, mu=0.7, facets: int = 4, weight=1.0)
         The residual function r(q, v, u), shape (len(contacts) (facets + 1),).
 
     Raises:
-        ValueError: mu is not positive, facets < 3, or the phase is not the contacts' stance.
+        ValueError: mu is not positive, facets < 3, or the phase is not a stance.
     """
     mu = friction(mu)
     if int(facets) < 3:
         raise ValueError(f"facets must be at least 3, got {facets!r}")
-    contacts = _phase_contacts(phase, contacts)
+    contacts = stance_contacts(phase)
     A = jnp.stack([cone_rows(c.normal, mu, int(facets)) for c in contacts])
-    return _Cone(_Forces(phase, contacts), A, _root(weight))
+    return _Cone(_Forces(phase), A, _root(weight))
 
 
 def ground_frame(normal: Array) -> Array:
@@ -255,14 +287,13 @@ class _Force(eqx.Module):
         return self.root * (self.forces(q, v, u) - self.reference).ravel()
 
 
-def contact_force_residual(phase, contacts, reference=None, weight=1.0) -> eqx.Module:
+def contact_force_residual(phase, reference=None, weight=1.0) -> eqx.Module:
     """The contacts' wrenches against a reference (Crocoddyl's `ResidualModelContactForce`):
     r = sqrt(w) (w_c - w_ref), each contact's (torque; force) in world components at its frame
     (`mbjax.contact.contact_wrenches`).
 
     Args:
-        phase: the stance, as `mbjax.contact.stance` made it from the same contacts.
-        contacts: its contacts.
+        phase: the stance, as `mbjax.contact.stance` made it.
         reference (Array | None): the reference wrenches, shape (len(contacts), 6); zeros by
             default.
         weight (float | Array): w, a scalar or one per residual.
@@ -271,14 +302,14 @@ def contact_force_residual(phase, contacts, reference=None, weight=1.0) -> eqx.M
         The residual function r(q, v, u), shape (6 len(contacts),).
 
     Raises:
-        ValueError: the phase is not the contacts' stance, or a reference of the wrong shape.
+        ValueError: the phase is not a stance, or a reference of the wrong shape.
     """
-    contacts = _phase_contacts(phase, contacts)
+    contacts = stance_contacts(phase)
     shape = (len(contacts), 6)
     reference = jnp.zeros(shape) if reference is None else jnp.asarray(reference, dtype=float)
     if reference.shape != shape:
         raise ValueError(f"reference must have shape {shape}, got {reference.shape}")
-    return _Force(_Forces(phase, contacts), reference, _root(weight))
+    return _Force(_Forces(phase), reference, _root(weight))
 
 
 class _Barrier(eqx.Module):
@@ -344,7 +375,7 @@ def wrench_cone_rows(mu, length, width, inner: bool = True) -> np.ndarray:
     return np.concatenate([rows[:, 3:], rows[:, :3]], axis=1)
 
 
-def wrench_cone_residual(phase, contacts, mu=0.7, length=0.1, width=0.05, weight=1.0,
+def wrench_cone_residual(phase, mu=0.7, length=0.1, width=0.05, weight=1.0,
                          inner: bool = True) -> eqx.Module:
     """Each surface contact's wrench outside the contact wrench cone of its rectangular sole,
     with a bounded activation (Crocoddyl's `ResidualModelContactWrenchCone` with
@@ -353,9 +384,9 @@ def wrench_cone_residual(phase, contacts, mu=0.7, length=0.1, width=0.05, weight
     friction can carry (Caron, Pham and Nakamura 2015).
 
     Args:
-        phase: the stance, as `mbjax.contact.stance` made it from the same contacts.
-        contacts: its surface contacts; each sole's rectangle is centred at its frame, its
-            length along the ground's first tangent and its width along the second
+        phase: the stance, as `mbjax.contact.stance` made it from surface contacts; each
+            sole's rectangle is centred at its frame, its length along the ground's first
+            tangent and its width along the second
             (`ground_frame`: the world's x and y on a ground of normal z, as Crocoddyl's
             `WrenchCone` with its surface rotation), the wrench taken in those axes.
         mu: the friction coefficient, positive.
@@ -369,14 +400,13 @@ def wrench_cone_residual(phase, contacts, mu=0.7, length=0.1, width=0.05, weight
         The residual function r(q, v, u), shape (17 len(contacts),).
 
     Raises:
-        ValueError: mu, length or width is not positive, or the phase is not the contacts'
-            stance.
+        ValueError: mu, length or width is not positive, or the phase is not a stance.
     """
     for name, x in (("mu", mu), ("length", length), ("width", width)):
         if not (np.ndim(x) == 0 and float(x) > 0 and np.isfinite(float(x))):
             raise ValueError(f"{name} must be positive, got {x!r}")
-    contacts = _phase_contacts(phase, contacts)
+    contacts = stance_contacts(phase)
     A = jnp.asarray(np.stack([wrench_cone_rows(float(mu), float(length), float(width), inner)]
                              * len(contacts)))
     rotations = jnp.stack([ground_frame(c.normal) for c in contacts])
-    return _WrenchCone(_Forces(phase, contacts), A, rotations, _root(weight))
+    return _WrenchCone(_Forces(phase), A, rotations, _root(weight))
