@@ -20,6 +20,8 @@ tracking, friction cones with its quadratic barrier, the state bounds' barrier; 
 knot's costs are not weighted by dt, as Crocoddyl's impulse models' are not.
 """
 
+from functools import partial
+
 import equinox as eqx
 import jax.numpy as jnp
 import numpy as np
@@ -58,7 +60,8 @@ class _Gait:
     Args:
         model, q0: the robot and its standing configuration (the state costs' reference).
         kind: `PointContact` (a quadruped's feet: friction cones, translations tracked) or
-            `SurfaceContact` (a biped's soles: wrench cones, placements tracked).
+            `SurfaceContact` (a biped's soles: wrench cones, placements tracked; spatial, as
+            Crocoddyl's `ContactModel6D`).
         feet: the feet's frames and their positions at q0, a dict.
         weights: the state weights of a step's knot and of an impulse's, mbjax's tangent order.
         bounds: (lower, upper) of the state barrier, or None.
@@ -238,7 +241,8 @@ def talos_step(step_length=0.6, step_height=0.1, dt=3e-2, step_knots=15,
     nv = model.nv
     weights = (_weights([0.0] * 3 + [500.0] * 3, 0.01, [10.0] * nv, nv),
                _weights([1.0] * 6, 0.1, [10.0] * nv, nv))
-    gait = _Gait(model, q0, SurfaceContact, feet, weights, None, 30.0, 1e8)
+    sole = partial(SurfaceContact, spatial=True)        # ContactModel6D's spatial acceleration
+    gait = _Gait(model, q0, sole, feet, weights, None, 30.0, 1e8)
     right, left = SOLES
     support = [gait.knot(SOLES) for _ in range(support_knots)]
     knots = support + gait.footsteps(com, feet, 0.5 * step_length, step_height, step_knots,

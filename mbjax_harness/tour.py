@@ -561,7 +561,6 @@ def legged_gait_tour(out: Path, quick: bool) -> dict:
     same problem solved by Crocoddyl's FDDP from the same guess where Crocoddyl is installed."""
     from mbjax._src.trajopt import ILQR, solve
     from mbjax._src.trajopt.ilqr import CROCODDYL_SCHEDULE
-    from mbjax.contact import PointContact
     from mbjax.trajopt import knot_wrenches
     from mbjax_harness.crocoddyl_gaits import FEET, MU, anymal_trot
     from mbjax_harness.plot.animate import gait_animation

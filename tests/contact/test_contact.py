@@ -27,9 +27,10 @@ def _path(name: str):
     return example_robots([name])[0]
 
 
-def _pinocchio(path, feet, kind, q_pin, v_pin, tau_pin, gains, v_before):
+def _pinocchio(path, feet, kind, q_pin, v_pin, tau_pin, gains, v_before, anchors=None):
     """Pinocchio's constrained accelerations and contact forces (LOCAL_WORLD_ALIGNED, (f; tau)
-    per contact) at (q, v), and its impulse map's velocity and impulses from v_before."""
+    per contact) at (q, v), and its impulse map's velocity and impulses from v_before; each
+    contact anchored at its frame's placement, or at `anchors` (SE3s)."""
     pm = pin.buildModelFromUrdf(str(path), pin.JointModelFreeFlyer())
     pd = pm.createData()
     contact_type = pin.ContactType.CONTACT_3D if kind is PointContact else pin.ContactType.CONTACT_6D
@@ -39,6 +40,8 @@ def _pinocchio(path, feet, kind, q_pin, v_pin, tau_pin, gains, v_before):
         model = pin.RigidConstraintModel(contact_type, pm, frame.parentJoint, frame.placement,
                                          pin.ReferenceFrame.LOCAL_WORLD_ALIGNED)
         model.setBaumgarteCorrectorParameters(pin.BaumgarteCorrectorParameters(*gains))
+        if anchors is not None:
+            model.joint2_placement = anchors[len(models)]
         models.append(model)
     models = pin.StdVec_RigidConstraintModel(models)
     datas = pin.StdVec_RigidConstraintData([m.createData() for m in models])
@@ -199,3 +202,57 @@ def test_a_schedule_flags_a_foot_that_pulls():
     first = int(np.flatnonzero(np.asarray(sol.phases) == 2)[0])
     J = frame_jacobian(model, sol.qs[first], lifted.frame)
     assert float(jnp.abs(J[3:] @ sol.vs[first]).max()) < 1e-2
+
+
+def test_a_moving_sole_holds_pinocchios_spatial_acceleration():
+    """Talos on its two soles with `SurfaceContact(spatial=True)`, at a velocity that moves
+    both soles, with Pinocchio's Baumgarte gains (Kp, Kd) = (100, 50): the accelerations and
+    the soles' wrenches equal Pinocchio's `constraintDynamics` with `CONTACT_6D` (which holds
+    the spatial acceleration) to 1e-9, while the classical weld differs by omega x v. Off the
+    anchors, where the position term acts, the wrenches of both conventions stay exact (the
+    soles' frame Jacobians' transpose of them is the constraint force A^t K), and the spatial
+    convention's motion agrees with Pinocchio's to first order in the anchor's offset (its
+    position error is the same SE(3) logarithm; its rate Jlog6 v where Pinocchio's is v)."""
+    name, feet, _ = TALOS
+    path = _path(name)
+    model = mbjax.load_urdf(path, floating_base=True)
+    rng = np.random.default_rng(3)
+    q = model.normalize(jnp.clip(model.home() + jnp.asarray(rng.uniform(-0.2, 0.2, model.nq)),
+                                 model.lower, model.upper))
+    v, tau = jnp.asarray(rng.normal(size=model.nv)), jnp.asarray(rng.normal(size=model.nv))
+    gains = (100.0, 50.0)                                # Pinocchio's (Kp, Kd)
+    method = Coupled(baumgarte=(gains[1] / 2, np.sqrt(gains[0])))
+    tree = TreeSystem(model, Constant(tau))
+    q_pin, v_pin = (np.asarray(x) for x in state_to_pinocchio(model, q, v))
+    P = np.asarray(jax.jacfwd(lambda v_: state_to_pinocchio(model, q, v_)[1])(v))
+    pm = pin.buildModelFromUrdf(str(path), pin.JointModelFreeFlyer())
+    pd = pm.createData()
+
+    def pinocchio(q_anchor):
+        pin.framesForwardKinematics(pm, pd, np.asarray(state_to_pinocchio(model, q_anchor, v)[0]))
+        anchors = [pd.oMf[pm.getFrameId(f)].copy() for f in feet]
+        return _pinocchio(path, feet, SurfaceContact, q_pin, v_pin,
+                          P @ np.asarray(tau - model.damping * v), gains, v_pin, anchors)[:2]
+
+    def phases(q_anchor):
+        return [stance(tree, q_anchor, [SurfaceContact(f, spatial=spatial) for f in feet],
+                       method=method) for spatial in (True, False)]
+
+    a_pin, forces = pinocchio(q)
+    spatial, weld = phases(q)
+    assert _rel(P @ np.asarray(spatial.acceleration(0.0, q, v)), a_pin) < 1e-9
+    assert _rel(_world_pairs(contact_wrenches(spatial, 0.0, q, v), 6), forces) < 1e-9
+    assert _rel(P @ np.asarray(weld.acceleration(0.0, q, v)), a_pin) > 1e-3
+
+    errors = []
+    for offset in (1e-2, 1e-3):
+        q_anchor = model.integrate(q, jnp.asarray(rng.normal(size=model.nv)) * offset)
+        a_pin, _ = pinocchio(q_anchor)
+        for phase in phases(q_anchor):
+            w = np.asarray(contact_wrenches(phase, 0.0, q, v))
+            generalized = np.asarray(phase.loops.force(q, phase.multipliers(0.0, q, v)))
+            from_wrenches = sum(np.asarray(frame_jacobian(model, q, f)).T @ w[i]
+                                for i, f in enumerate(feet))
+            assert _rel(from_wrenches, generalized) < 1e-10
+        errors.append(_rel(P @ np.asarray(phases(q_anchor)[0].acceleration(0.0, q, v)), a_pin))
+    assert errors[1] < errors[0] / 5         # first order in the offset

@@ -120,7 +120,6 @@ def test_short_walk_is_crocoddyls_problem():
     # the quasi-static guess holds the robot at rest at x0: on every stance knot the ground
     # carries its weight (the momentum balance, which no part of the stance computes), and a
     # foot in the air, or an impulse's knot, carries nothing
-    feet = ["LF_FOOT", "RF_FOOT", "LH_FOOT", "RH_FOOT"]
     wrenches = np.asarray(knot_wrenches(problem, jnp.broadcast_to(problem.x0, (22, problem.nx)),
                                         example.us0))
     model = problem.knots.knot(0, 0).system.tree.model
@@ -167,14 +166,13 @@ def test_short_talos_step_is_crocoddyls_problem():
     """Talos's legs (upper body locked in both libraries) stepping with each foot, soles held
     as surface contacts with wrench-cone costs: the quasi-static guess is Crocoddyl's, and under
     perturbed controls each step and impulse of Crocoddyl from mbjax's state lands on mbjax's
-    next state and the costs agree (1e-6: a weld's rotation rows and Crocoddyl's 6-D contact
-    hold the sole's classical and spatial accelerations, which differ by omega x v, second order
-    in the sole's tiny velocity)."""
+    next state and the costs agree to 1e-10 (the soles are `SurfaceContact(spatial=True)`,
+    which hold the spatial acceleration as Crocoddyl's `ContactModel6D` does)."""
     example_robots(["talos_data/talos_reduced"])
     from mbjax_harness.crocoddyl_gaits import talos_step
 
     example = talos_step(step_knots=4, support_knots=1)
-    _agrees_with_crocoddyl(example, scale=0.3, seed=0, guess=1e-9, tolerance=1e-6)
+    _agrees_with_crocoddyl(example, scale=0.3, seed=0, guess=1e-9, tolerance=1e-10)
 
 
 @crocoddyl_only

@@ -47,7 +47,8 @@ class AbstractContact(eqx.Module):
 
     Attributes:
         size: the number of constraints (3 for a point, 6 for a surface).
-        kind: the kind of its cut joint ("spherical" for a point, "weld" for a surface).
+        kind: the kind of its cut joint ("spherical" for a point; "weld" or "weld_log6" for a
+            surface).
     """
 
     frame: str = eqx.field(static=True)
@@ -81,19 +82,6 @@ class AbstractContact(eqx.Module):
         return CutJoint(self.kind, int(body), GROUND, origin_a=p_f, origin_b=p, rotation_a=R_f,
                         rotation_b=R, active=self.active)
 
-    def wrench(self, multipliers: Array, rotation: Array) -> Array:
-        """The ground's wrench on the frame from this contact's multipliers, in world
-        components at the frame's origin, (torque; force).
-
-        Args:
-            multipliers: the contact's multipliers, shape (size,).
-            rotation: the orientation of the closure's ground frame, shape (3, 3).
-
-        Returns:
-            The wrench, shape (6,).
-        """
-        return jnp.concatenate([jnp.zeros(3, multipliers.dtype), multipliers[:3]])
-
 
 class PointContact(AbstractContact):
     """A point of the robot held on the ground: 3 constraints (Crocoddyl's `ContactModel3D`,
@@ -120,32 +108,76 @@ class SurfaceContact(AbstractContact):
     (Crocoddyl's `ContactModel6D`, Pinocchio's `CONTACT_6D`): a foot's sole. The ground pushes
     on it with a force and a torque.
 
+    Which acceleration of the sole is held is a convention, the same on the ground (a sole at
+    rest) but not for a moving one, nor for the Baumgarte terms' drift:
+
+    - spatial=False (the default), a weld: the residual is the frame's position and
+      orientation error (`mbjax.loops.CutJoint`'s "weld"), whose second derivative is the
+      frame's classical acceleration (its origin's acceleration and its angular acceleration).
+    - spatial=True: the residual is the SE(3) logarithm of the frame's placement relative to
+      its anchor (Pinocchio's `log6`, the "weld_log6" cut joint), whose rate on the ground is
+      the frame's twist in its own axes and whose second derivative there is its spatial
+      acceleration: Pinocchio's `CONTACT_6D` and Crocoddyl's `ContactModel6D`, which hold
+      that, and whose position term (Kp) is that logarithm. Rebuild a Crocoddyl or Pinocchio
+      problem with it; the two differ by omega x v on a moving sole.
+
     Args:
         frame (str): the frame held, e.g. "left_sole_link".
         normal (ArrayLike): the ground's normal, world components, shape (3,); z by default.
         active (ArrayLike): True (the default) for a sole on the ground, False for one in the
             air (see `AbstractContact`).
+        spatial (bool): hold the sole's spatial acceleration, as Pinocchio and Crocoddyl do
+            (see above); static.
 
     Raises:
         ValueError: the normal is not a finite nonzero 3-vector, or active is not a boolean.
     """
 
+    spatial: bool = eqx.field(static=True)
     size: ClassVar[int] = 6
-    kind: ClassVar[str] = "weld"
 
-    def wrench(self, multipliers, rotation):
-        # the weld's rotation rows are vee(R_B^T R_A - R_A^T R_B) / 2, whose rate is the
-        # relative angular velocity in the ground frame B's components: their multipliers are
-        # a torque in B's components
-        return jnp.concatenate([rotation @ multipliers[3:6], multipliers[:3]])
+    def __init__(self, frame: str, normal=(0.0, 0.0, 1.0), active=True, *,
+                 spatial: bool = False):
+        super().__init__(frame, normal, active)
+        self.spatial = bool(spatial)
+
+    @property
+    def kind(self) -> str:
+        return "weld_log6" if self.spatial else "weld"
 
 
-def wrenches(contacts, closures, multipliers: Array, rotations=None) -> Array:
-    """Each contact's wrench (`AbstractContact.wrench`) from the stacked multipliers of its
-    closure, in order: shape (len(contacts), 6). The closures' ground-frame orientations are
-    read from `closures`, or given as `rotations` (len(contacts), 3, 3)."""
-    starts = np.cumsum([0] + [c.size for c in contacts])
-    if rotations is None:
-        rotations = [j.rotation_b for j in closures]
-    return jnp.stack([c.wrench(multipliers[s:s + c.size], R)
-                      for c, R, s in zip(contacts, rotations, starts, strict=False)])
+def frame_wrench(joint: CutJoint, R: Array, p: Array, multipliers: Array) -> Array:
+    """The wrench that a ground closure's multipliers put on its frame A, (torque about the
+    frame's origin; force) in world components: the transpose of the closure's rate along the
+    frame's twist (Jerkovsky 1978 eq 93), exact at any pose, so that the frame Jacobian's
+    transpose of the wrench is the closure's generalized force A^t K.
+
+    Args:
+        joint: the cut joint, to the ground.
+        R: the orientation of its body_a, shape (3, 3).
+        p: the origin of its body_a [m], shape (3,).
+        multipliers: the joint's multipliers, shape (size,).
+
+    Returns:
+        The wrench, shape (6,).
+    """
+    def rate(omega, v):           # the frame's angular velocity and its origin's velocity
+        R_dot = jnp.cross(omega, R.T).T
+        # the body origin's velocity, with the residual's own term, so that a point's torque
+        # cancels exactly
+        p_dot = v - R_dot @ joint.origin_a
+        return jax.jvp(lambda R_, p_: joint.pose_residual(R_, p_, None, None), (R, p),
+                       (R_dot, p_dot))[1]
+
+    zero = jnp.zeros(3, multipliers.dtype)
+    torque, force = jax.vjp(rate, zero, zero)[1](multipliers)
+    return jnp.concatenate([torque, force])
+
+
+def wrenches(closures, multipliers: Array, R: Array, p: Array) -> Array:
+    """Each ground closure's wrench on its frame (`frame_wrench`) from the stacked multipliers,
+    in order, shape (len(closures), 6), the tree's frames at (R, p) ((n_frames, 3, 3),
+    (n_frames, 3))."""
+    starts = np.cumsum([0] + [j.size for j in closures])
+    return jnp.stack([frame_wrench(j, R[j.body_a], p[j.body_a], multipliers[s:s + j.size])
+                      for j, s in zip(closures, starts, strict=False)])

@@ -19,7 +19,7 @@ def impulse_map(model: Model, q: Array, v: Array, contacts: tuple) -> tuple[Arra
     closures = tuple(c.closure(model, q) for c in contacts)
     loops = Loops(TreeSystem(model), closures)
     v_plus, Lambda = implicit_kkt((loops, q, v), _matrices, _residual)
-    return v_plus, wrenches(contacts, closures, Lambda)
+    return v_plus, wrenches(closures, Lambda, *loops.tree.frames(q))
 
 
 def _matrices(theta) -> tuple[Array, Array]:

@@ -37,13 +37,13 @@ class Grip(eqx.Module):
     cone), each beyond round-off (1e-9 of the force); no flags without mu."""
 
     contacts: tuple
-    rotations: Array               # each closure's ground frame orientation
+    closures: tuple                # each contact's cut joint with the ground
     mu: Array | None
 
-    def __call__(self, multipliers: Array) -> Array:
+    def __call__(self, tree, q: Array, multipliers: Array) -> Array:
         if self.mu is None:
             return jnp.zeros((), jnp.int32)
-        w = wrenches(self.contacts, (), multipliers, self.rotations)
+        w = wrenches(self.closures, multipliers, *tree.frames(q))
         normals = jnp.stack([c.normal for c in self.contacts])
         f = w[:, 3:]
         fn = jnp.sum(f * normals, axis=1)
@@ -90,8 +90,7 @@ def stance(tree: AbstractTreeSystem, q: Array, contacts: Sequence[AbstractContac
     contacts = _contacts(contacts)
     closures = tuple(c.closure(tree.model, jnp.asarray(q, float)) for c in contacts)
     method = Coupled(baumgarte=CROCODDYL_GAINS) if method is None else method
-    watch = Grip(contacts, jnp.stack([j.rotation_b for j in closures]),
-                 None if mu is None else friction(mu))
+    watch = Grip(contacts, closures, None if mu is None else friction(mu))
     return ClosedSystem(tree, closures, method, projection, watch=watch)
 
 
@@ -123,14 +122,14 @@ def contact_wrenches(phase: ClosedSystem, t, q: Array, u: Array) -> Array:
     Raises:
         ValueError: the phase is not a stance.
     """
-    return stance_wrenches(phase, phase.multipliers(t, q, u))
+    return stance_wrenches(phase, q, phase.multipliers(t, q, u))
 
 
-def stance_wrenches(phase: ClosedSystem, multipliers: Array) -> Array:
-    """The ground's wrench on each of a stance's contacts from the phase's multipliers, as
-    `contact_wrenches` gives them, shape (len(contacts), 6)."""
-    contacts = stance_contacts(phase)
-    return wrenches(contacts, phase.closures, multipliers)
+def stance_wrenches(phase: ClosedSystem, q: Array, multipliers: Array) -> Array:
+    """The ground's wrench on each of a stance's contacts at configuration q from the phase's
+    multipliers, as `contact_wrenches` gives them, shape (len(contacts), 6)."""
+    n = len(stance_contacts(phase))
+    return wrenches(phase.closures[:n], multipliers, *phase.tree.frames(q))
 
 
 def is_stance(system) -> bool:

@@ -100,7 +100,7 @@ class Knot(AbstractKnot):
         a0 = forces = None
         if reads_forces(self.running):          # one solve for the step and the costs
             a0, multipliers = system.solve(t, q, v)
-            forces = stance_wrenches(system, multipliers)
+            forces = stance_wrenches(system, q, multipliers)
         q1, v1, _ = integrator.step(system, t, q, v, dt, a0=a0)
         return (*system.constrain(t + dt, q1, v1), forces)
 
