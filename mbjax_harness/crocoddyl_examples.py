@@ -46,6 +46,9 @@ class Example:
     final_error: Callable | None = None     # mbjax q -> the task's remaining error [m]
     # Crocoddyl's problem -> (mbjax controls (N, nu) -> Crocoddyl's list, an impulse's empty)
     controls: Callable | None = None
+    # the first guess's states, (N + 1, nx), where the example starts infeasible (Crocoddyl's
+    # xs); None for the rollout of us0
+    states0: np.ndarray | None = None
 
 
 def _robot(name: str):

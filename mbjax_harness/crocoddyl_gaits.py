@@ -233,6 +233,46 @@ def anymal_trot(step_length=0.25, step_height=0.15, dt=1e-2, step_knots=25,
                    support_knots)
 
 
+def anymal_jump(jump_height=0.15, jump_length=(0.0, 0.3, 0.0), dt=1e-2, ground_knots=10,
+                flying_knots=20) -> Example:
+    """Crocoddyl's jump (`createJumpingProblem`, its example's parameters): the four feet on
+    the ground, a flight of 2 `flying_knots` (written as stances with every foot in the air,
+    the CoM driven up and along for the first half), the four feet landing `jump_length`
+    further, and `ground_knots` on the ground there, the last one the terminal model. Its
+    `states0` is the example's infeasible start, x0 at every knot."""
+    robot = _robot("anymal")
+    model, q_pin0, q0, v0, feet, com = _start(robot, "standing", FEET)
+    nv, nj = model.nv, model.nv - 6
+    weights = (_weights([0.0] * 3 + [500.0] * 3, 0.01, [10.0] * 6 + [1.0] * nj, nv),
+               _weights([1.0] * 6, 10.0, [10.0] * nv, nv))
+    lower = np.r_[[-np.inf] * 6, [-9.42] * nj, [-np.inf] * 6, [-15.0] * nj]
+    gait = _Gait(model, q0, PointContact, feet, weights, (lower, -lower), 50.0, 1e7)
+    length = np.asarray(jump_length, float)
+    ground = {f: p * np.array([1.0, 1.0, 0.0]) for f, p in feet.items()}    # soles at z = 0
+    rise = np.r_[length[:2] / 2, length[2] / 2 + jump_height]
+    landed = com + np.r_[length[:2], length[2] - feet[FEET[1]][2]]          # Crocoddyl's df
+    knots = ([gait.knot(FEET) for _ in range(ground_knots)]
+             + [gait.knot([], com + rise * (k + 1) / flying_knots) for k in range(flying_knots)]
+             + [gait.knot([]) for _ in range(flying_knots)]
+             + [gait.impulse(FEET, [(f, ground[f] + length) for f in FEET])]
+             + [gait.knot(FEET, landed) for _ in range(ground_knots - 1)])
+    # the last landed model is the terminal one: its state and CoM costs
+    terminal = (com_residual(model, landed, weight=1e6), gait.regularisation(gait.state_weights),
+                *gait.bounds)
+    problem = Problem(knots, q0, v0, dt=dt, terminal=terminal, integrator=SemiImplicitEuler())
+
+    def crocoddyl():
+        from crocoddyl.utils.quadruped import SimpleQuadrupedalGaitProblem
+
+        x0 = np.concatenate([q_pin0, np.zeros(robot.model.nv)])
+        return SimpleQuadrupedalGaitProblem(robot.model, *FEET).createJumpingProblem(
+            x0, jump_height, list(jump_length), dt, ground_knots, flying_knots)
+
+    states0 = np.tile(np.asarray(problem.x0), (problem.horizon + 1, 1))
+    return Example(problem, np.asarray(quasi_static(problem)), crocoddyl, "SolverFDDP",
+                   _converter(model), controls=_controls, states0=states0)
+
+
 def talos_step(step_length=0.6, step_height=0.1, dt=3e-2, step_knots=15,
                support_knots=4) -> Example:
     robot = _robot("talos")
@@ -266,4 +306,4 @@ def talos_step(step_length=0.6, step_height=0.1, dt=3e-2, step_knots=15,
                    _converter(model), controls=_controls)
 
 
-GAITS = {"anymal-walk": anymal_walk, "talos-step": talos_step}
+GAITS = {"anymal-walk": anymal_walk, "talos-step": talos_step, "anymal-jump": anymal_jump}

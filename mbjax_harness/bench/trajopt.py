@@ -140,20 +140,24 @@ def _to_tolerance(costs, best: float) -> int | None:
 
 class CrocoddylSolver:
     """One Crocoddyl problem's solver (FDDP, or BoxDDP for bounded controls), from a fixed first
-    guess and its rollout, its problem set to `threads` threads (None: Crocoddyl's default, a
-    thread per core)."""
+    guess and its rollout (or the states xs0, an infeasible start), its problem set to
+    `threads` threads (None: Crocoddyl's default, a thread per core)."""
 
-    def __init__(self, problem, us0, solver: str = "SolverFDDP", threads: int | None = 1):
+    def __init__(self, problem, us0, solver: str = "SolverFDDP", threads: int | None = 1,
+                 xs0=None):
         import crocoddyl
 
         if threads is not None:
             problem.nthreads = threads
         self.problem, self.us0 = problem, [np.asarray(u, float) for u in us0]
+        self.xs0 = None if xs0 is None else [np.asarray(x, float) for x in xs0]
         self.solver = getattr(crocoddyl, solver)(problem)
 
+    def _states(self) -> list:
+        return self.problem.rollout(self.us0) if self.xs0 is None else self.xs0
+
     def solve(self, iterations: int) -> bool:
-        xs0 = self.problem.rollout(self.us0)
-        return self.solver.solve(xs0, self.us0, iterations, True)
+        return self.solver.solve(self._states(), self.us0, iterations, self.xs0 is None)
 
     def history(self) -> list[float]:
         """The cost before and after each iteration of a full solve."""
@@ -165,8 +169,7 @@ class CrocoddylSolver:
             def __call__(self, solver):
                 costs.append(solver.cost)
 
-        xs0 = self.problem.rollout(self.us0)
-        first = self.problem.calc(xs0, self.us0)
+        first = self.problem.calc(self._states(), self.us0)
         self.solver.setCallbacks([Record()])
         self.solve(ITERATIONS)
         self.solver.setCallbacks([])
@@ -211,9 +214,10 @@ def single(name: str, repeats: int, common: dict) -> list[dict]:
     each engine's solution priced by the other."""
     example = PROBLEMS[name]()
     problem, us0 = example.problem, jnp.asarray(example.us0)
+    states0 = None if example.states0 is None else jnp.asarray(example.states0)
     final_error = example.final_error or (lambda q: None)
     ilqr = ILQR(iterations=ITERATIONS, **CROCODDYL_SCHEDULE)
-    result, timing = measure(solve, problem, ilqr, us0, repeats=repeats)
+    result, timing = measure(solve, problem, ilqr, us0, states0, repeats=repeats)
     iterations = int(result.iterations)
     costs = np.asarray(result.costs)[:iterations + 1]
     mbjax = {**common, "kind": "single", "problem": name, "engine": "mbjax", "solver": "ILQR",
@@ -229,7 +233,8 @@ def single(name: str, repeats: int, common: dict) -> list[dict]:
     else:
         croc_problem = example.crocoddyl()
         to_croc, from_croc = _controls(example, croc_problem)
-        croc = CrocoddylSolver(croc_problem, to_croc(example.us0), example.solver)
+        croc = CrocoddylSolver(croc_problem, to_croc(example.us0), example.solver,
+                               xs0=None if states0 is None else example.to_crocoddyl(states0))
         checks = agreement(example, croc_problem)
         history = croc.history()
         converged = croc.solve(ITERATIONS)
@@ -257,7 +262,7 @@ def single(name: str, repeats: int, common: dict) -> list[dict]:
     runs = {}
     if k is not None:
         stopped = ILQR(iterations=max(k, 1), **CROCODDYL_SCHEDULE)
-        runs["mbjax"] = lambda: jax.block_until_ready(solve(problem, stopped, us0).us)
+        runs["mbjax"] = lambda: jax.block_until_ready(solve(problem, stopped, us0, states0).us)
     if why is None and records[-1]["iterations_to_tolerance"] is not None:
         runs["crocoddyl"] = partial(croc.solve, max(records[-1]["iterations_to_tolerance"], 1))
     seconds = in_turns(runs, GAIT_TIMED_RUNS if name in GAITS else TIMED_RUNS)

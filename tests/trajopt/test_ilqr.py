@@ -12,7 +12,7 @@ from scipy.optimize import minimize
 from mbjax.model import Model
 from mbjax.rigid import TreeSystem
 from mbjax.scenes import arm as scene
-from mbjax.trajopt import ILQR, MultipleShooting, Problem, solve
+from mbjax.trajopt import ILQR, MultipleShooting, Problem, Shooting, solve
 
 # a 2 kg slider without gravity: x = (q, v), q_ddot = u / m; RK4 with u held over the step is
 # exact for it, x_{k+1} = F x_k + G u_k
@@ -67,6 +67,31 @@ def test_a_linear_quadratic_problem_lands_on_the_lqr_optimum():
     costs = np.asarray(result.costs)
     assert np.all(np.isnan(costs[int(result.iterations) + 1:]))
     assert np.all(np.diff(costs[:int(result.iterations) + 1]) <= 0)
+
+
+def test_an_infeasible_start_closes_its_gaps_on_the_lqr_optimum():
+    """FDDP's infeasible start (`solve(..., states0=...)`, Mastalli et al. 2020): from states
+    far from any rollout, the first iteration's full step closes every gap (a linear-quadratic
+    problem's model, the gaps' terms included, is exact: its trajectory is then the rollout of
+    its controls), and the iteration ends on the LQR optimum, converged only once feasible.
+    The cost history starts at the infeasible guess's own cost."""
+    problem = _slider_problem()
+    H, g, c = _slider_qp()
+    u = np.linalg.solve(H, -g)
+    states = jnp.asarray(np.random.default_rng(0).normal(size=(N + 1, 2)))
+    first = solve(problem, ILQR(iterations=1), states0=states)
+    assert first.messages() == ["not converged"]
+    np.testing.assert_allclose(problem.rollout(first.us),
+                               jnp.concatenate([first.qs, first.vs], axis=1), rtol=0, atol=1e-12)
+    result = solve(problem, ILQR(), states0=states)
+    assert result.messages() == ["success"] and int(result.iterations) <= 4
+    np.testing.assert_allclose(np.asarray(result.us[:, 0]), u, rtol=0, atol=1e-9)
+    assert abs(float(result.cost) - (0.5 * u @ H @ u + g @ u + c)) < 1e-10
+    xs = jnp.concatenate([result.qs, result.vs], axis=1)
+    np.testing.assert_allclose(problem.rollout(result.us), xs, rtol=0, atol=1e-12)
+    guess = states.at[0].set(problem.x0)
+    assert float(result.costs[0]) == pytest.approx(
+        float(problem.cost(guess, jnp.zeros((N, 1)))), rel=1e-14)
 
 
 def test_control_bounds_give_the_box_constrained_optimum():
@@ -131,8 +156,10 @@ def test_bad_problems_are_refused_with_the_argument_named():
         solve(problem, ILQR(), jnp.zeros((4, 1)))
     with pytest.raises(TypeError, match="solver"):
         solve(problem, ILQR)
-    with pytest.raises(ValueError, match="states0: ILQR starts from the rollout"):
-        solve(problem, ILQR(), states0=jnp.zeros((6, 2)))
+    with pytest.raises(ValueError, match="states0: Shooting starts from the rollout"):
+        solve(problem, Shooting(), states0=jnp.zeros((6, 2)))
+    with pytest.raises(ValueError, match=r"states0 must be \(horizon \+ 1, nq \+ nv\)"):
+        solve(problem, ILQR(), states0=jnp.zeros((5, 2)))
     with pytest.raises(ValueError, match=r"states0 must be \(horizon \+ 1, nq \+ nv\)"):
         solve(problem, MultipleShooting(), states0=jnp.zeros((5, 2)))
 

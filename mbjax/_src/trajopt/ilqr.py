@@ -12,6 +12,9 @@ from mbjax._src.trajopt.problem import Problem
 from mbjax._src.trajopt.result import AbstractIterativeSolver, Result, cost_floor, history
 
 MU_MIN, MU_MAX, MU_FACTOR = 1e-9, 1e10, 10.0
+# an infeasible start (Mastalli et al. 2020, FDDP): the gaps below which a trajectory is a
+# rollout, and the fraction of a predicted cost increase a gap-closing step may cost
+GAP_TOLERANCE, INCREASE_ACCEPTANCE = 1e-9, 2.0
 CROCODDYL_SCHEDULE = {"steps": tuple(0.5**k for k in range(10)), "acceptance": 0.1,
                       "shrink_above": 0.5, "grow_below": 0.01, "regularization": 1e-9}
 # the control blocks' Cholesky written out up to this size (`linalg.spd_solve`), so that the
@@ -52,7 +55,8 @@ def riccati_step(problem: Problem, stage: tuple, u: Array, Vx: Array, Vxx: Array
     the stage's expansion (A, B, l_x, l_u, l_xx, l_ux, l_uu) about the control u: the control
     step k within the bounds, the feedback K on the free controls, this stage's value
     (Vx, Vxx), and Q_u, Q_uu. The unconstrained step and feedback come from one factorization
-    of Q_uu; the box's projected Newton steps run only where that step leaves the bounds."""
+    of Q_uu; the box's projected Newton steps run only where that step leaves the bounds. Vx
+    is the next value's gradient at the step's end, with a gap's term already added (FDDP)."""
     A, B, lx, lu, lxx, lux, luu = stage
     eye = jnp.eye(problem.nu, dtype=u.dtype)
     At, Bt = A.T, B.T
@@ -143,6 +147,18 @@ class ILQR(AbstractIterativeSolver):
         everywhere (Crocoddyl's on the semi-implicit Euler benchmark problems, the defaults on the
         acrobot with RK4 steps); see benchmarks/README.md.
 
+    Infeasible start:
+        From a state trajectory (`solve`'s states0, Crocoddyl's xs; each knot's state held where
+        the guess puts it, so the steps leave gaps e_k = difference(x_{k+1}, step(x_k, u_k))),
+        the iteration is Crocoddyl's FDDP (Mastalli et al. 2020, "Crocoddyl: an efficient and
+        versatile framework for multi-contact optimal control", Algorithm 1): the backward
+        pass takes each value's gradient at the step's end, V_x + V_xx e_k; the forward pass
+        closes a fraction alpha of every gap, x_{k+1} = step(x_k, u_k) (+) (alpha - 1) e_k (a full
+        step is a rollout); the predicted change counts the gaps, and a step that closes gaps
+        may raise the cost by up to twice a predicted increase. It is converged only once
+        the gaps are closed (below 1e-9); without states0 the gaps are zero and it is the
+        iteration above.
+
     Stopping:
         The iterations are one `lax.while_loop`, so `solve` compiles once. It stops with success
         when an accepted step lowers the cost by less than `tolerance` relative to it (or the model
@@ -163,10 +179,11 @@ class ILQR(AbstractIterativeSolver):
     grow_below: float = 0.0
     qp_iterations: int = eqx.field(static=True, default=8)
 
-    def init(self, problem: Problem, us: Array) -> dict:
-        """The iteration's state before the first iteration, from the first guess us: its
-        rollout and cost, mu, and room for the expansion and the costs' history."""
-        xs = problem.rollout(us)
+    def init(self, problem: Problem, us: Array, states: Array | None = None) -> dict:
+        """The iteration's state before the first iteration, from the first guess us and a
+        state trajectory (an infeasible start; None for us's rollout): its cost, mu, and room
+        for the expansion and the costs' history."""
+        xs = problem.initial_states(states, us)
         cost = problem.cost(xs, us)
         N, nx, nu = problem.horizon, problem.ndx, problem.nu
         return dict(xs=xs, us=us, cost=cost, mu=jnp.asarray(self.regularization, cost.dtype),
@@ -189,18 +206,29 @@ class ILQR(AbstractIterativeSolver):
         # expansion is traced once, inside the loop, not also before it
         expansion = jax.lax.cond(s["stale"], lambda: self._linearize(problem, s["xs"], s["us"]),
                                  lambda: s["expansion"])
-        k, K, decrease, ok = self._backward(problem, expansion, s["us"], s["mu"])
+        k, K, (dg, dq), Vxx, ok = self._backward(problem, expansion, s["us"], s["mu"])
+        gaps = expansion[0][2]
+        gap = jnp.max(jnp.abs(gaps))
+
+        def predicted(xs, alpha):
+            """The model's cost decrease for a step alpha that lands on xs (FDDP's, with the
+            gaps' term dv, zero on a rollout)."""
+            dx = jax.vmap(problem.difference)(xs[1:], s["xs"][1:])
+            dv = -jnp.sum(gaps * jnp.einsum("kij,kj->ki", Vxx, dx))
+            return alpha * (dg + dv + 0.5 * alpha * (dq - 2.0 * dv))
 
         def acceptable(trial):
-            _, _, cost, i, _ = trial
+            xs, _, cost, i, _ = trial
             alpha = alphas[jnp.maximum(i - 1, 0)]
-            predicted = -(alpha * decrease[0] + alpha**2 * decrease[1])
-            decreased = s["cost"] - cost > self.acceptance * predicted
+            expected = predicted(xs, alpha)
+            change = s["cost"] - cost
+            decreased = jnp.where(expected >= 0, change > self.acceptance * expected,
+                                  change > INCREASE_ACCEPTANCE * expected)
             return (i > 0) & jnp.isfinite(cost) & decreased
 
         def next_step(trial):                          # the longest acceptable step first
             i, blocked = trial[3], trial[4]
-            xs, us, cost = self._forward(problem, s["xs"], s["us"], k, K, alphas[i])
+            xs, us, cost = self._forward(problem, s["xs"], s["us"], k, K, gaps, alphas[i])
             return xs, us, cost, i + 1, blocked | ~jnp.isfinite(cost)
 
         first = (s["xs"], s["us"], s["cost"], jnp.array(0), jnp.array(False))
@@ -215,10 +243,13 @@ class ILQR(AbstractIterativeSolver):
         # not finite (the step was cut short by the non-finite region, not by the optimum)
         # (relative to the cost, above round-off: `cost_floor`, an exact optimum's 0)
         floor = cost_floor(cost.dtype)
-        converged = ((ok & (s["mu"] <= self.regularization)
-                      & (-decrease[0] <= self.tolerance * jnp.abs(s["cost"]) + floor))
-                     | (accept & ~blocked & (change <= self.tolerance * jnp.abs(cost) + floor)))
         taken = alphas[jnp.maximum(tried - 1, 0)]
+        # converged only from a trajectory without gaps (a step from one with gaps compares
+        # costs of different kinds, and may raise the cost)
+        converged = (gap <= GAP_TOLERANCE) & (
+            (ok & (s["mu"] <= self.regularization)
+             & (dg <= self.tolerance * jnp.abs(s["cost"]) + floor))
+            | (accept & ~blocked & (change <= self.tolerance * jnp.abs(cost) + floor)))
         mu = jnp.where(accept & (taken > self.shrink_above),
                        jnp.maximum(s["mu"] / MU_FACTOR, MU_MIN),
                        jnp.where(accept & (taken > self.grow_below), s["mu"],
@@ -244,37 +275,44 @@ class ILQR(AbstractIterativeSolver):
 
     @staticmethod
     def _linearize(problem: Problem, xs: Array, us: Array) -> tuple:
-        """The dynamics' and costs' expansion about (xs, us): (A, B, l_x, l_u, l_xx, l_ux, l_uu)
-        per step and the terminal (V_x, V_xx)."""
-        (A, B, _), costs = problem.linearize(xs, us)
-        return (A, B, *costs), problem.final_expansion(xs[-1])
+        """The dynamics' and costs' expansion about (xs, us): (A, B, e, l_x, l_u, l_xx, l_ux,
+        l_uu) per step (e the gaps) and the terminal (V_x, V_xx)."""
+        dynamics, costs = problem.linearize(xs, us)
+        return (*dynamics, *costs), problem.final_expansion(xs[-1])
 
     def _backward(self, problem: Problem, expansion: tuple, us: Array, mu: Array):
-        """(k, K, (sum k^T Q_u, sum 1/2 k^T Q_uu k), ok): the Riccati pass over an `expansion`
-        about the trajectory of us."""
+        """(k, K, (dg, dq), V_xx, ok): the Riccati pass over an `expansion` about the trajectory
+        of us, with the predicted decrease's terms dg = -sum k^T Q_u and dq = -sum k^T Q_uu k
+        and, for gaps e, -sum V_x^T e and sum e^T V_xx e (FDDP), and the value's Hessian at each
+        step's end (for the gaps' term of a trial step)."""
         stages, (Vx, Vxx) = expansion
 
         def back(carry, inputs):
             Vx, Vxx = carry
-            A, B, lx, lu, lxx, lux, luu, u = inputs
-            k, K, Vx, Vxx, Qu, Quu = riccati_step(problem, (A, B, lx, lu, lxx, lux, luu), u,
-                                                  Vx, Vxx, mu, self.qp_iterations)
-            return (Vx, Vxx), (k, K, k @ Qu, 0.5 * k @ Quu @ k)
+            A, B, e, lx, lu, lxx, lux, luu, u = inputs
+            Vx = Vx + small_dot(Vxx, e)          # the value at the step's end, across its gap
+            gap_terms = (-Vx @ e, e @ small_dot(Vxx, e))
+            k, K, Vx_k, Vxx_k, Qu, Quu = riccati_step(problem, (A, B, lx, lu, lxx, lux, luu), u,
+                                                      Vx, Vxx, mu, self.qp_iterations)
+            return (Vx_k, Vxx_k), (k, K, -k @ Qu + gap_terms[0], -k @ Quu @ k + gap_terms[1],
+                                   Vxx)
 
-        _, (k, K, d1, d2) = jax.lax.scan(back, (Vx, Vxx), (*stages, us), reverse=True)
+        _, (k, K, dg, dq, Vxx_next) = jax.lax.scan(back, (Vx, Vxx), (*stages, us), reverse=True)
         ok = jnp.all(jnp.isfinite(k)) & jnp.all(jnp.isfinite(K))
-        return k, K, (jnp.sum(d1), jnp.sum(d2)), ok
+        return k, K, (jnp.sum(dg), jnp.sum(dq)), Vxx_next, ok
 
     @staticmethod
-    def _forward(problem: Problem, xs: Array, us: Array, k: Array, K: Array, alpha: Array):
-        """(xs, us, cost) of the closed-loop rollout with step length alpha."""
+    def _forward(problem: Problem, xs: Array, us: Array, k: Array, K: Array, gaps: Array,
+                 alpha: Array):
+        """(xs, us, cost) of the closed-loop rollout with step length alpha, which closes that
+        fraction of each gap (FDDP's forward pass; a rollout where alpha = 1 or no gaps)."""
         def f(x, inputs):
-            x_ref, u_ref, k_, K_, i = inputs
+            x_ref, u_ref, k_, K_, e, i = inputs
             u = jnp.clip(u_ref + alpha * k_ + K_ @ problem.difference(x_ref, x), problem.lower,
                          problem.upper)
-            return problem.step(x, u, i), (x, u)
+            return problem.integrate(problem.step(x, u, i), (alpha - 1.0) * e), (x, u)
 
-        x_end, (x_seq, u_seq) = jax.lax.scan(f, xs[0], (xs[:-1], us, k, K,
+        x_end, (x_seq, u_seq) = jax.lax.scan(f, xs[0], (xs[:-1], us, k, K, gaps,
                                                         jnp.arange(problem.horizon)))
         x_new = jnp.concatenate([x_seq, x_end[None]])
         return x_new, u_seq, problem.cost(x_new, u_seq)

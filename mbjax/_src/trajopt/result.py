@@ -108,8 +108,10 @@ class AbstractIterativeSolver(AbstractSolver):
     steps through a working set (`mbjax._src.trajopt.batch`), so converged members leave."""
 
     @abc.abstractmethod
-    def init(self, problem: Problem, us: Array):
-        """The iteration's state (a pytree of arrays) before the first iteration."""
+    def init(self, problem: Problem, us: Array, states: Array | None = None):
+        """The iteration's state (a pytree of arrays) before the first iteration, from the
+        controls us and a state trajectory (None for us's rollout; a solver that cannot start
+        from one raises a ValueError naming states0, `no_states`)."""
 
     @abc.abstractmethod
     def running(self, state) -> Array:
@@ -125,9 +127,8 @@ class AbstractIterativeSolver(AbstractSolver):
 
     def solve(self, problem: Problem, us: Array, states: Array | None = None) -> Result:
         """Optimise the controls of `problem` from `us` (see `AbstractSolver.solve`)."""
-        no_states(states, type(self).__name__)
         state = jax.lax.while_loop(self.running, partial(self.step, problem),
-                                   self.init(problem, us))
+                                   self.init(problem, us, states))
         return self.result(problem, state)
 
 
@@ -140,7 +141,7 @@ def no_states(states, solver: str) -> None:
     """Refuse a state trajectory as first guess for a solver that starts from a rollout."""
     if states is not None:
         raise ValueError(f"states0: {solver} starts from the rollout of us0 and takes no state "
-                         "trajectory; MultipleShooting takes one (an infeasible start)")
+                         "trajectory; ILQR and MultipleShooting take one (an infeasible start)")
 
 
 def rollout_result(problem: Problem, us: Array, costs: Array, iterations: Array,

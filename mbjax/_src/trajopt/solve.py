@@ -30,9 +30,9 @@ def solve(problem: Problem, solver: AbstractSolver = ILQR(), us0: Array | None =
         solver: the method, an `AbstractSolver` instance (`ILQR()`, `MultipleShooting()`,
             `Shooting()`).
         us0: the first guess, shape (horizon, nu), clipped to the bounds; None for zeros.
-        states0: a state trajectory as first guess, shape (horizon + 1, nq + nv), for
-            `MultipleShooting` (an infeasible start: the knots need not follow the dynamics);
-            None for the rollout of us0.
+        states0: a state trajectory as first guess, shape (horizon + 1, nq + nv), for `ILQR`
+            (FDDP's infeasible start) and `MultipleShooting`: the knots need not follow the
+            dynamics; None for the rollout of us0.
         throw: raise an error naming the failure (not converged, non-finite) instead of
             returning the result with its status.
         width: a batch's working set per device (static); None for 1 on a CPU, where a
@@ -45,7 +45,7 @@ def solve(problem: Problem, solver: AbstractSolver = ILQR(), us0: Array | None =
     Raises:
         TypeError: problem is not a `Problem` or solver not a solver instance.
         ValueError: us0 or states0 has the wrong shape, states0 was given to a solver that
-            starts from a rollout (`ILQR`, `Shooting`), or width is not a positive int.
+            starts from a rollout (`Shooting`), or width is not a positive int.
         equinox.EquinoxRuntimeError: with throw=True, the solve failed.
 
     Compilation:
