@@ -5,8 +5,10 @@ time shows (`mbjax bench trajopt` times the whole solve as one program).
 
     python benchmarks/bench_gait_iterations.py [STEP_KNOTS] [SUPPORT_KNOTS]
 
-Prints each iteration's wall time and cost, FDDP's time, iterations and cost, and the cost of
-mbjax's controls rolled out in Crocoddyl's own problem.
+Prints each iteration's wall time and cost, FDDP's time, iterations and cost, the cost of
+mbjax's controls rolled out in Crocoddyl's own problem, and the linearization per knot at the
+solution: mbjax's `Problem.linearize` (the knots' dynamics and costs, jitted) against
+Crocoddyl's `calc` + `calcDiff` of the same problem, both divided by the number of knots.
 """
 
 import sys
@@ -39,6 +41,7 @@ def main(step_knots: int = 25, support_knots: int = 2) -> None:
     import crocoddyl
 
     croc = example.crocoddyl()
+    croc.nthreads = 1                                  # single-threaded, as mbjax's CPU runs
     to_croc = example.controls(croc)
     fddp = crocoddyl.SolverFDDP(croc)
     us0 = to_croc(example.us0)
@@ -49,6 +52,23 @@ def main(step_knots: int = 25, support_knots: int = 2) -> None:
     us = to_croc(state["us"])
     print(f"mbjax's controls rolled out in Crocoddyl's problem: cost "
           f"{croc.calc(croc.rollout(us), us):.12g}")
+
+    linearize = jax.jit(problem.linearize)
+    xs = state["xs"]
+    jax.block_until_ready(linearize(xs, state["us"]))
+    xs_croc = croc.rollout(us)
+    per_knot = {}
+    for name, run in (("mbjax", lambda: jax.block_until_ready(linearize(xs, state["us"]))),
+                      ("crocoddyl", lambda: (croc.calc(xs_croc, us), croc.calcDiff(xs_croc, us)))):
+        times = []
+        for _ in range(50):
+            start = time.perf_counter()
+            run()
+            times.append(time.perf_counter() - start)
+        per_knot[name] = sorted(times)[len(times) // 2] / problem.horizon
+    print(f"linearization per knot: mbjax {per_knot['mbjax'] * 1e6:.0f} us, Crocoddyl calc + "
+          f"calcDiff {per_knot['crocoddyl'] * 1e6:.0f} us "
+          f"({per_knot['mbjax'] / per_knot['crocoddyl']:.1f}x)")
 
 
 if __name__ == "__main__":

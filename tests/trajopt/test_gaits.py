@@ -177,6 +177,36 @@ def test_short_talos_step_is_crocoddyls_problem():
 
 @crocoddyl_only
 @pytest.mark.slow
+def test_the_jump_from_an_infeasible_start_reaches_fddps_optimum():
+    """Crocoddyl's ANYmal jump (`createJumpingProblem`: 40 flying knots written as stances with
+    every foot in the air, a landing impulse) built in both libraries: the quasi-static guess is
+    Crocoddyl's, each of Crocoddyl's steps from mbjax's states lands on mbjax's next state and
+    the costs agree; from the example's infeasible start (x0 held at every knot), ILQR (FDDP's
+    gaps) ends at FDDP's optimum from the same start within 1e-8 (relative), converged, its
+    trajectory the rollout of its controls."""
+    example_robots(["anymal_b_simple/anymal"])
+    from mbjax._src.trajopt.ilqr import CROCODDYL_SCHEDULE
+    from mbjax_harness.bench.trajopt import CrocoddylSolver
+    from mbjax_harness.crocoddyl_gaits import anymal_jump
+
+    example = anymal_jump()
+    problem, states0 = example.problem, jnp.asarray(example.states0)
+    assert problem.horizon == 60 and len(problem.knots.templates) == 2
+    _agrees_with_crocoddyl(example, scale=3.0, seed=2, guess=1e-10, tolerance=1e-9)
+    result = solve(problem, ILQR(iterations=100, **CROCODDYL_SCHEDULE),
+                   jnp.asarray(example.us0), states0)
+    croc = example.crocoddyl()
+    fddp = CrocoddylSolver(croc, example.controls(croc)(example.us0),
+                           xs0=example.to_crocoddyl(states0))
+    assert fddp.solve(100)
+    assert result.messages() == ["success"]
+    assert abs(float(result.cost) - fddp.solver.cost) < 1e-8 * fddp.solver.cost
+    np.testing.assert_allclose(problem.rollout(result.us),
+                               jnp.concatenate([result.qs, result.vs], axis=1), atol=1e-12)
+
+
+@crocoddyl_only
+@pytest.mark.slow
 def test_the_trots_optimal_cost_is_differentiable_in_the_trunks_mass():
     """Co-design through contact: on Crocoddyl's trot, `optimal_cost`'s gradient with respect to
     the trunk's mass and inertia scale (the envelope theorem, one reverse pass through every
