@@ -18,8 +18,7 @@ import equinox as eqx
 import jax
 import jax.numpy as jnp
 
-from mbjax._src.trajopt.ilqr import CROCODDYL_SCHEDULE
-from mbjax.trajopt import ILQR
+from mbjax.trajopt import CROCODDYL_SCHEDULE, ILQR
 from mbjax_harness.crocoddyl_gaits import anymal_walk
 
 

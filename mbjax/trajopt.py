@@ -9,6 +9,7 @@ from mbjax._src.trajopt.solve import solve as solve
 from mbjax._src.trajopt.result import AbstractSolver as AbstractSolver
 from mbjax._src.trajopt.result import Result as Result
 from mbjax._src.trajopt.ilqr import ILQR as ILQR
+from mbjax._src.trajopt.ilqr import CROCODDYL_SCHEDULE as CROCODDYL_SCHEDULE
 from mbjax._src.trajopt.multiple_shooting import MultipleShooting as MultipleShooting
 from mbjax._src.trajopt.shooting import Shooting as Shooting
 from mbjax._src.trajopt.codesign import optimal_cost as optimal_cost
@@ -27,7 +28,8 @@ from mbjax._src.trajopt.quasi_static import quasi_static as quasi_static
 from mbjax._src.trajopt.wrenches import knot_wrenches as knot_wrenches
 
 __all__ = [
-    "Problem", "solve", "AbstractSolver", "Result", "ILQR", "MultipleShooting", "Shooting",
+    "Problem", "solve", "AbstractSolver", "Result", "ILQR", "CROCODDYL_SCHEDULE",
+    "MultipleShooting", "Shooting",
     "optimal_cost", "sweep", "state_residual", "frame_residual", "control_residual",
     "com_residual", "friction_cone_residual", "contact_force_residual", "barrier_residual",
     "wrench_cone_residual",

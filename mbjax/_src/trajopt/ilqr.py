@@ -15,6 +15,7 @@ MU_MIN, MU_MAX, MU_FACTOR = 1e-9, 1e10, 10.0
 # an infeasible start (Mastalli et al. 2020, FDDP): the gaps below which a trajectory is a
 # rollout, and the fraction of a predicted cost increase a gap-closing step may cost
 GAP_TOLERANCE, INCREASE_ACCEPTANCE = 1e-9, 2.0
+# Crocoddyl's FDDP schedule, `ILQR(**CROCODDYL_SCHEDULE)` (see `ILQR`'s Schedules)
 CROCODDYL_SCHEDULE = {"steps": tuple(0.5**k for k in range(10)), "acceptance": 0.1,
                       "shrink_above": 0.5, "grow_below": 0.01, "regularization": 1e-9}
 # the control blocks' Cholesky written out up to this size (`linalg.spd_solve`), so that the
