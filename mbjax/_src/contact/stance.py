@@ -37,13 +37,12 @@ class Grip(eqx.Module):
     cone), each beyond round-off (1e-9 of the force); no flags without mu."""
 
     contacts: tuple
-    closures: tuple                # each contact's cut joint with the ground
     mu: Array | None
 
-    def __call__(self, tree, q: Array, multipliers: Array) -> Array:
+    def __call__(self, loops, q: Array, multipliers: Array) -> Array:
         if self.mu is None:
             return jnp.zeros((), jnp.int32)
-        w = wrenches(self.closures, multipliers, *tree.frames(q))
+        w = wrenches(loops.closures[:len(self.contacts)], multipliers, *loops.tree.frames(q))
         normals = jnp.stack([c.normal for c in self.contacts])
         f = w[:, 3:]
         fn = jnp.sum(f * normals, axis=1)
@@ -90,7 +89,7 @@ def stance(tree: AbstractTreeSystem, q: Array, contacts: Sequence[AbstractContac
     contacts = _contacts(contacts)
     closures = tuple(c.closure(tree.model, jnp.asarray(q, float)) for c in contacts)
     method = Coupled(baumgarte=CROCODDYL_GAINS) if method is None else method
-    watch = Grip(contacts, closures, None if mu is None else friction(mu))
+    watch = Grip(contacts, None if mu is None else friction(mu))
     return ClosedSystem(tree, closures, method, projection, watch=watch)
 
 

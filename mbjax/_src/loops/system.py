@@ -74,9 +74,10 @@ class ClosedSystem(AbstractSystem):
         external (Callable | None): the tree's external wrenches, if not given to the tree.
         external_point (Array | None): where the external forces act, if not given to the tree.
         iterations: chord iterations of each projection; static.
-        watch (Callable | None): a check of the loads: watch(tree, q, multipliers) -> `Status`
-            flags (int32), OR-ed into `check` (`mbjax.contact.stance` watches its contacts for
-            a pulling or slipping foot).
+        watch (Callable | None): a check of the loads: watch(loops, q, multipliers) ->
+            `Status` flags (int32), with `loops` the tree and its closures (`Loops`), OR-ed
+            into `check` (`mbjax.contact.stance` watches its contacts for a pulling or
+            slipping foot).
 
     Raises:
         TypeError: `tree` is not a tree system, `method` is a class or not a loop method, the
@@ -126,7 +127,7 @@ class ClosedSystem(AbstractSystem):
         self.tolerance = float(tolerance)
         self.iterations = int(iterations)
         if watch is not None and not callable(watch):
-            raise TypeError(f"watch must be a callable of (tree, q, multipliers), got {watch!r}")
+            raise TypeError(f"watch must be a callable of (loops, q, multipliers), got {watch!r}")
         self.watch = watch
 
     @property
@@ -282,7 +283,7 @@ class ClosedSystem(AbstractSystem):
         A = self.loops.jacobian(q, t)
         redundant = numerical_rank(A @ A.T) < self.loops.held()
         watched = (0 if self.watch is None
-                   else self.watch(self.tree, q, self.multipliers(t, q, u)).astype(jnp.int32))
+                   else self.watch(self.loops, q, self.multipliers(t, q, u)).astype(jnp.int32))
         return (jnp.where(violated, int(Status.CONSTRAINT_VIOLATED), 0)
                 | jnp.where(redundant, int(Status.REDUNDANT), 0) | watched
                 | self.tree.check(t, q, self.velocity(q, u))).astype(jnp.int32)
