@@ -43,6 +43,19 @@ def test_convergence_order(name):
     assert abs(order - cls.order) < 0.1, (name, order, errors)
 
 
+@pytest.mark.parametrize("name", INTEGRATORS)
+def test_a_known_first_acceleration_changes_no_step(name):
+    """A step given the acceleration at its start (`a0`, as a knot that solved its stance for
+    its costs passes it) is the step that evaluates it: bitwise for the integrators whose first
+    stage is there, and an integrator that has none ignores it."""
+    t, dt = jnp.asarray(0.3), jnp.asarray(0.05)
+    integrator = INTEGRATORS[name]()
+    plain = integrator.step(OSC, t, Q0, U0, dt)
+    given = integrator.step(OSC, t, Q0, U0, dt, a0=OSC.acceleration(t, Q0, U0))
+    for a, b in zip(plain, given, strict=True):
+        np.testing.assert_array_equal(np.asarray(a), np.asarray(b))
+
+
 def test_explicit_euler_gains_energy_and_midpoint_conserves_it():
     energy = lambda q, u: 0.5 * u @ u + 0.5 * OSC.k * q @ q  # noqa: E731
     E0 = energy(Q0, U0)
