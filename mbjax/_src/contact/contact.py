@@ -47,8 +47,8 @@ class AbstractContact(eqx.Module):
 
     Attributes:
         size: the number of constraints (3 for a point, 6 for a surface).
-        kind: the kind of its cut joint ("spherical" for a point; "weld" or "weld_log6" for a
-            surface).
+        kind: the kind of its cut joint ("spherical" for a point; "weld" or "spatial_weld" for
+            a surface).
     """
 
     frame: str = eqx.field(static=True)
@@ -114,12 +114,13 @@ class SurfaceContact(AbstractContact):
     - spatial=False (the default), a weld: the residual is the frame's position and
       orientation error (`mbjax.loops.CutJoint`'s "weld"), whose second derivative is the
       frame's classical acceleration (its origin's acceleration and its angular acceleration).
-    - spatial=True: the residual is the SE(3) logarithm of the frame's placement relative to
-      its anchor (Pinocchio's `log6`, the "weld_log6" cut joint), whose rate on the ground is
-      the frame's twist in its own axes and whose second derivative there is its spatial
-      acceleration: Pinocchio's `CONTACT_6D` and Crocoddyl's `ContactModel6D`, which hold
-      that, and whose position term (Kp) is that logarithm. Rebuild a Crocoddyl or Pinocchio
-      problem with it; the two differ by omega x v on a moving sole.
+    - spatial=True: the position rows are the offset in the mean of the frame's and the
+      anchor's axes, (R_A + R_B)^T (p_A - p_B) / 2 (`mbjax.loops.CutJoint`'s "spatial_weld"),
+      whose rate on the ground is the frame's twist in its own axes and whose second
+      derivative there is its spatial acceleration: what Pinocchio's `CONTACT_6D` and
+      Crocoddyl's `ContactModel6D` hold. Rebuild a Crocoddyl or Pinocchio problem with it; the
+      two conventions differ by omega x v on a moving sole. (Off the anchor, where a Baumgarte
+      position term acts, it agrees with their SE(3) logarithm to first order in the offset.)
 
     Args:
         frame (str): the frame held, e.g. "left_sole_link".
@@ -143,7 +144,7 @@ class SurfaceContact(AbstractContact):
 
     @property
     def kind(self) -> str:
-        return "weld_log6" if self.spatial else "weld"
+        return "spatial_weld" if self.spatial else "weld"
 
 
 def frame_wrench(joint: CutJoint, R: Array, p: Array, multipliers: Array) -> Array:

@@ -27,11 +27,10 @@ import numpy as np
 from jax import Array
 
 from mbjax._src.lie.inputs import check_point, check_rotation
-from mbjax._src.lie.rotation_vector import gamma_inv, log
 
 GROUND = -1             # the ground as a body index (`CutJoint`'s body_b)
-SIZES = {"spherical": 3, "revolute": 5, "universal": 4, "weld": 6, "weld_log6": 6, "prismatic": 5,
-         "point_on_line": 2, "point_on_plane": 1}
+SIZES = {"spherical": 3, "revolute": 5, "universal": 4, "weld": 6, "spatial_weld": 6,
+         "prismatic": 5, "point_on_line": 2, "point_on_plane": 1}
 
 
 def _vee_antisym(R: Array) -> Array:
@@ -59,7 +58,7 @@ class CutJoint(eqx.Module):
     z axis. For a flexible tree, `body_a` and `body_b` may also be marker frames (n, n + 1, ...).
 
     Args:
-        kind: "spherical", "revolute", "universal", "weld", "weld_log6", "prismatic",
+        kind: "spherical", "revolute", "universal", "weld", "spatial_weld", "prismatic",
             "point_on_line" or "point_on_plane"; static.
         body_a: the body (frame index) of frame A, >= 0; static.
         body_b: the body of frame B, or `GROUND` (-1); static.
@@ -89,9 +88,9 @@ class CutJoint(eqx.Module):
             revolute       p_A - p_B, z_A . x_B, z_A . y_B                                5
             universal      p_A - p_B, x_A . y_B          (cross axes x_A and y_B)         4
             weld           p_A - p_B, vee(R_B^T R_A - R_A^T R_B) / 2                      6
-            weld_log6      log6(M_B^-1 M_A): (Gamma(r)^-1 R_B^T (p_A - p_B), r),           6
-                           r = log(R_B^T R_A) (Pinocchio's SE(3) logarithm; its second
-                           derivative at the weld is A's spatial acceleration in A's axes)
+            spatial_weld   (R_A + R_B)^T (p_A - p_B) / 2, vee(R_B^T R_A - R_A^T R_B) / 2    6
+                           (on the weld its rate is A's twist in A's axes and its second
+                           derivative A's spatial acceleration, omega x v from the weld's)
             prismatic      (p_A - p_B) . x_B, (p_A - p_B) . y_B, vee(...) / 2  (along z_B) 5
             point_on_line  (p_A - p_B) . x_B, (p_A - p_B) . y_B  (p_A on the line z_B)   2
             point_on_plane (p_A - p_B) . z_B                     (p_A on the plane z_B)  1
@@ -182,9 +181,8 @@ class CutJoint(eqx.Module):
             return jnp.concatenate([d, (x_A @ y_B)[None]])
         if self.kind == "weld":
             return jnp.concatenate([d, orientation])
-        if self.kind == "weld_log6":
-            r = log(RB.T @ RA, check=False)
-            return jnp.concatenate([gamma_inv(r) @ (RB.T @ d), r])
+        if self.kind == "spatial_weld":
+            return jnp.concatenate([0.5 * (RA + RB).T @ d, orientation])
         across = jnp.stack([d @ x_B, d @ y_B])
         if self.kind == "prismatic":
             return jnp.concatenate([across, orientation])
