@@ -15,9 +15,11 @@ MU_MIN, MU_MAX, MU_FACTOR = 1e-9, 1e10, 10.0
 # an infeasible start (Mastalli et al. 2020, FDDP): the gaps below which a trajectory is a
 # rollout, and the fraction of a predicted cost increase a gap-closing step may cost
 GAP_TOLERANCE, INCREASE_ACCEPTANCE = 1e-9, 2.0
-# Crocoddyl's FDDP schedule, `ILQR(**CROCODDYL_SCHEDULE)` (see `ILQR`'s Schedules)
 CROCODDYL_SCHEDULE = {"steps": tuple(0.5**k for k in range(10)), "acceptance": 0.1,
                       "shrink_above": 0.5, "grow_below": 0.01, "regularization": 1e-9}
+"""Crocoddyl's FDDP schedule, for `ILQR(**CROCODDYL_SCHEDULE)`: steps halving from 1 to 2^-9,
+a tenth of the predicted decrease to accept, the regularization starting at 1e-9, shrunk after
+steps above 1/2 and grown after steps of 1/100 or shorter (`ILQR`'s Schedules)."""
 # the control blocks' Cholesky written out up to this size (`linalg.spd_solve`), so that the
 # backward pass compiles as one kernel (a LAPACK call would keep it kernel by kernel)
 UNROLL = 16
