@@ -175,10 +175,10 @@ def _weights(base, joints, velocity, nv):
     return w[np.r_[3:6, 0:3, 6:2 * nv]]
 
 
-def _anymal(schedule, builder: str, step_length, step_height, dt, step_knots,
-            support_knots) -> Example:
-    """ANYmal's gait of `schedule(gait, com, feet, support, lengths)` (the knots after the
-    first double support), with `SimpleQuadrupedalGaitProblem`'s `builder` as Crocoddyl's."""
+def _anymal_start():
+    """ANYmal standing as `SimpleQuadrupedalGaitProblem` starts it, and its `_Gait` (the
+    builder's state weights, joint and velocity bounds, Baumgarte Kd and impulse tracking):
+    (robot, model, q_pin0, q0, v0, feet, com, gait)."""
     robot = _robot("anymal")
     model, q_pin0, q0, v0, feet, com = _start(robot, "standing", FEET)
     nv, nj = model.nv, model.nv - 6
@@ -186,6 +186,14 @@ def _anymal(schedule, builder: str, step_length, step_height, dt, step_knots,
                _weights([1.0] * 6, 10.0, [10.0] * nv, nv))
     lower = np.r_[[-np.inf] * 6, [-9.42] * nj, [-np.inf] * 6, [-15.0] * nj]
     gait = _Gait(model, q0, PointContact, feet, weights, (lower, -lower), 50.0, 1e7)
+    return robot, model, q_pin0, q0, v0, feet, com, gait
+
+
+def _anymal(schedule, builder: str, step_length, step_height, dt, step_knots,
+            support_knots) -> Example:
+    """ANYmal's gait of `schedule(gait, com, feet, support, lengths)` (the knots after the
+    first double support), with `SimpleQuadrupedalGaitProblem`'s `builder` as Crocoddyl's."""
+    robot, model, q_pin0, q0, v0, feet, com, gait = _anymal_start()
     support = [gait.knot(FEET) for _ in range(support_knots)]
 
     def steps(length, legs, swing):
@@ -240,13 +248,7 @@ def anymal_jump(jump_height=0.15, jump_length=(0.0, 0.3, 0.0), dt=1e-2, ground_k
     the CoM driven up and along for the first half), the four feet landing `jump_length`
     further, and `ground_knots` on the ground there, the last one the terminal model. Its
     `states0` is the example's infeasible start, x0 at every knot."""
-    robot = _robot("anymal")
-    model, q_pin0, q0, v0, feet, com = _start(robot, "standing", FEET)
-    nv, nj = model.nv, model.nv - 6
-    weights = (_weights([0.0] * 3 + [500.0] * 3, 0.01, [10.0] * 6 + [1.0] * nj, nv),
-               _weights([1.0] * 6, 10.0, [10.0] * nv, nv))
-    lower = np.r_[[-np.inf] * 6, [-9.42] * nj, [-np.inf] * 6, [-15.0] * nj]
-    gait = _Gait(model, q0, PointContact, feet, weights, (lower, -lower), 50.0, 1e7)
+    robot, model, q_pin0, q0, v0, feet, com, gait = _anymal_start()
     length = np.asarray(jump_length, float)
     ground = {f: p * np.array([1.0, 1.0, 0.0]) for f, p in feet.items()}    # soles at z = 0
     rise = np.r_[length[:2] / 2, length[2] / 2 + jump_height]
