@@ -60,6 +60,14 @@ def _world_pairs(wrenches, size):
     return (w[:, 3:] if size == 3 else np.concatenate([w[:, 3:], w[:, :3]], 1)).ravel()
 
 
+def _random_state(model, rng):
+    """(q, v, tau): a configuration within the joints' limits near home, a velocity and a
+    torque, random."""
+    q = model.normalize(jnp.clip(model.home() + jnp.asarray(rng.uniform(-0.2, 0.2, model.nq)),
+                                 model.lower, model.upper))
+    return q, jnp.asarray(rng.normal(size=model.nv)), jnp.asarray(rng.normal(size=model.nv))
+
+
 def _rel(a, b):
     return float(np.max(np.abs(np.asarray(a) - np.asarray(b))) / max(1.0, np.max(np.abs(b))))
 
@@ -74,9 +82,7 @@ def test_contact_dynamics_agree_with_pinocchio(robot):
     path = _path(name)
     model = mbjax.load_urdf(path, floating_base=True)
     rng = np.random.default_rng(0)
-    q = model.normalize(jnp.clip(model.home() + jnp.asarray(rng.uniform(-0.2, 0.2, model.nq)),
-                                 model.lower, model.upper))
-    v, tau = jnp.asarray(rng.normal(size=model.nv)), jnp.asarray(rng.normal(size=model.nv))
+    q, v, tau = _random_state(model, rng)
     contacts = [kind(foot) for foot in feet]
     v_before = v
     v_plus, impulses = impulse(model, q, v_before, contacts)
@@ -217,9 +223,7 @@ def test_a_moving_sole_holds_pinocchios_spatial_acceleration():
     path = _path(name)
     model = mbjax.load_urdf(path, floating_base=True)
     rng = np.random.default_rng(3)
-    q = model.normalize(jnp.clip(model.home() + jnp.asarray(rng.uniform(-0.2, 0.2, model.nq)),
-                                 model.lower, model.upper))
-    v, tau = jnp.asarray(rng.normal(size=model.nv)), jnp.asarray(rng.normal(size=model.nv))
+    q, v, tau = _random_state(model, rng)
     gains = (100.0, 50.0)                                # Pinocchio's (Kp, Kd)
     method = Coupled(baumgarte=(gains[1] / 2, np.sqrt(gains[0])))
     tree = TreeSystem(model, Constant(tau))
