@@ -35,8 +35,16 @@ def linear_map(name: str, apply: Callable, batched: Callable) -> Callable:
         return jax.core.ShapedArray(out.shape, out.dtype)
 
     def jvp(primals, tangents, *, treedef):
-        return jax.jvp(partial(impl, treedef=treedef), primals,
-                       [ad.instantiate_zeros(t) for t in tangents])
+        *fixed, x = primals
+        out = primitive.bind(*primals, treedef=treedef)
+        # linear in x: its tangent is the map itself (a batch of them, the batched rule)
+        tangent = (jnp.zeros(out.shape, out.dtype) if type(tangents[-1]) is ad.Zero
+                   else primitive.bind(*fixed, tangents[-1], treedef=treedef))
+        if any(type(t) is not ad.Zero for t in tangents[:-1]):
+            moved = jax.jvp(lambda *f: impl(*f, x, treedef=treedef), tuple(fixed),
+                            tuple(ad.instantiate_zeros(t) for t in tangents[:-1]))[1]
+            tangent = tangent + moved
+        return out, tangent
 
     def transpose(cotangent, *args, treedef):
         *fixed, x = args                                    # x is the undefined (linear) one

@@ -10,9 +10,10 @@ import numpy as np
 from jax import Array
 
 from mbjax._src.lie.inputs import check_point
-from mbjax._src.model.closures import GROUND, CutJoint, active_flag
+from mbjax._src.model.closures import GROUND, CutJoint, active_flag, cut_joint_groups
 from mbjax._src.model.model import Model
 from mbjax._src.rigid.frames import frame_placement, frame_pose
+from mbjax._src.tree.take import take
 
 
 def _normal(normal) -> Array:
@@ -180,5 +181,15 @@ def wrenches(closures, multipliers: Array, R: Array, p: Array) -> Array:
     in order, shape (len(closures), 6), the tree's frames at (R, p) ((n_frames, 3, 3),
     (n_frames, 3))."""
     starts = np.cumsum([0] + [j.size for j in closures])
-    return jnp.stack([frame_wrench(j, R[j.body_a], p[j.body_a], multipliers[s:s + j.size])
-                      for j, s in zip(closures, starts, strict=False)])
+    pieces, order = [], []
+    for idx, template, stacked in cut_joint_groups(closures):   # joints alike: one vmap
+        bodies = np.array([closures[i].body_a for i in idx])
+        rows = np.concatenate([np.arange(starts[i], starts[i + 1]) for i in idx])
+        pieces.append(jax.vmap(lambda arrays, R_, p_, K: frame_wrench(
+            eqx.combine(arrays, template), R_, p_, K))(
+                stacked, take(R, bodies), take(p, bodies),
+                take(multipliers, rows).reshape(len(idx), -1)))
+        order += idx
+    out = jnp.concatenate(pieces)
+    inverse = np.argsort(order)
+    return out if np.array_equal(inverse, np.arange(len(order))) else take(out, inverse)

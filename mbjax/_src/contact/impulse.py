@@ -2,6 +2,7 @@
 
 from collections.abc import Sequence
 
+import equinox as eqx
 import jax
 import jax.numpy as jnp
 from jax import Array
@@ -11,6 +12,8 @@ from mbjax._src.contact.stance import _contacts
 from mbjax._src.loops.constraints import Loops
 from mbjax._src.loops.kkt import implicit_kkt
 from mbjax._src.model.model import Model
+from mbjax._src.rigid import rnea_derivatives
+from mbjax._src.rigid.rnea import inverse_dynamics
 from mbjax._src.rigid.system import TreeSystem
 
 
@@ -29,10 +32,20 @@ def _matrices(theta) -> tuple[Array, Array]:
 
 def _residual(theta, v_plus: Array, Lambda: Array) -> tuple[Array, Array]:
     """The impulse map as a residual of (v+, Lambda) (`mbjax._src.loops.kkt`): (M (v+ - v) -
-    A^t Lambda, A v+), the impulses that leave A v+ = 0."""
+    A^t Lambda, A v+), the impulses that leave A v+ = 0. M (v+ - v) is the RNEA at rest
+    without gravity, whose derivative in q is written out (`rnea_derivatives`, Pinocchio's
+    `computeImpulseDynamicsDerivatives` likewise) rather than the mass matrix's."""
     loops, q, v = theta
-    return (loops.tree.mass_matrix(q) @ (v_plus - v) - loops.force(q, Lambda),
+    return (_momentum(loops.tree.model, q, v_plus - v) - loops.force(q, Lambda),
             loops.rate(q, v_plus))
+
+
+def _momentum(model: Model, q: Array, jump: Array) -> Array:
+    """M(q) jump, as the RNEA at zero velocity with no gravity."""
+    still = eqx.tree_at(lambda m: m.gravity, model, jnp.zeros_like(model.gravity))
+    rnea = (rnea_derivatives.inverse_dynamics if rnea_derivatives.applies(model)
+            else inverse_dynamics)
+    return rnea(still, q, jnp.zeros_like(jump), jump)
 
 
 def impulse(model: Model, q: Array, v: Array, contacts: Sequence[AbstractContact]) -> tuple[Array, Array]:

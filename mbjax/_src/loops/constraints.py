@@ -7,7 +7,7 @@ import jax.numpy as jnp
 from jax import Array
 
 from mbjax._src.system.tree_system import AbstractTreeSystem
-from mbjax._src.model.closures import GROUND, Coupling, CutJoint, Prescribed
+from mbjax._src.model.closures import GROUND, Coupling, CutJoint, Prescribed, cut_joint_rows
 
 
 class Loops(eqx.Module):
@@ -102,41 +102,52 @@ class Loops(eqx.Module):
         return self._phi(R, p, q, t)
 
     def _phi(self, R, p, q, t) -> Array:
-        return jnp.concatenate([c.residual(R, p, q, t) for c in self.closures])
+        def cut(joint, a, b):
+            return joint.pose_residual(*a, *(b or (None, None))) * joint.active
+        return cut_joint_rows(self.closures, cut, lambda c: c.residual(R, p, q, t), (R, p))
 
     def _rate(self, R, p, V, q, q_dot, t) -> Array:
         """A v + B from the frames' poses and spatial velocities V (world origin): a cut joint
         moves with its two frames (R_dot = omega x R, p_dot = v_O + omega x p), each closure on
         its own bodies alone, the other closures with q along q_dot."""
-        one = jnp.ones_like(t)
-        rates = []
-        for c in self.closures:
-            if not isinstance(c, CutJoint):
-                rates.append(jax.jvp(lambda q_, t_, c=c: c.residual(None, None, q_, t_), (q, t),
-                                     (q_dot, one))[1])
-                continue
+        def cut(joint, a, b):
             poses, motions = [], []
-            for body in (c.body_a, c.body_b):
-                if body == GROUND:
+            for frame in (a, b):
+                if frame is None:
                     poses += [None, None]
                     motions += [None, None]
                     continue
-                poses += [R[body], p[body]]
-                motions += list(_pose_rates(R[body], p[body], V[body]))
-            rates.append(jax.jvp(c.pose_residual, poses, motions)[1] * c.active)
-        return jnp.concatenate(rates)
+                R_, p_, V_ = frame
+                poses += [R_, p_]
+                motions += list(_pose_rates(R_, p_, V_))
+            return jax.jvp(joint.pose_residual, poses, motions)[1] * joint.active
+
+        def other(c):
+            return jax.jvp(lambda q_, t_: c.residual(None, None, q_, t_), (q, t),
+                           (q_dot, jnp.ones_like(t)))[1]
+        return cut_joint_rows(self.closures, cut, other, (R, p, V))
 
     def rate(self, q: Array, v: Array, t=0.0) -> Array:
-        """A v + B = dPhi/dt along the motion, shape (m,), for v of shape (nv,)."""
+        """A v + B = dPhi/dt along the motion, shape (m,), for v of shape (nv,). Where the tree
+        writes its bodies' motion out, a cut joint's rate is its residual's along its frames'
+        velocities (`body_motion`), whose derivatives are written out too."""
         self.checked(q, v)
-        return jax.jvp(self.phi, (q, jnp.asarray(t, q.dtype)),
-                       (self.tree.q_dot(q, v), jnp.ones((), q.dtype)))[1]
+        t = jnp.asarray(t, q.dtype)
+        motion = self.tree.body_motion(q, v)
+        if motion is None:
+            return jax.jvp(self.phi, (q, t), (self.tree.q_dot(q, v), jnp.ones((), q.dtype)))[1]
+        R, p, V, _ = motion
+        return self._rate(R, p, V, q, self.tree.q_dot(q, v), t)
 
     def jacobian(self, q: Array, t=0.0) -> Array:
         """The velocity constraint operator A, shape (m, nv): the rate is linear in v, A v + B.
-        Reverse mode, one pass per constraint row, so O(m n) rather than O(n^2) for long
-        chains."""
-        return jax.jacrev(lambda v: self.rate(q, v, t))(jnp.zeros(self.tree.nv, q.dtype))
+        Where the tree writes its bodies' motion out, forward mode over v through the bodies'
+        written-out velocity tangents (`body_motion`); otherwise reverse mode through the rate,
+        one pass per constraint row, so O(m n) rather than O(n^2) for long chains."""
+        zero = jnp.zeros(self.tree.nv, q.dtype)
+        if self.tree.body_motion(q, zero) is None:
+            return jax.jacrev(lambda v: self.rate(q, v, t))(zero)
+        return jax.jacfwd(lambda v: self.rate(q, v, t))(zero)
 
     def acceleration_bias(self, q: Array, v: Array, t=0.0) -> Array:
         """b = d/dt (A v + B) at fixed v, shape (m,), so that A v_dot + b is the second
@@ -161,17 +172,22 @@ class Loops(eqx.Module):
         return jax.jvp(self._rate, (R, p, V, q, q_dot, t),
                        (R_dot, p_dot, A, q_dot, q_ddot, jnp.ones_like(t)))[1]
 
-    def force(self, q: Array, K: Array, t=0.0) -> Array:
+    def force(self, q: Array, K: Array | None, t=0.0) -> Array:
         """A^t K, the generalized force of the multipliers K, shape (nv,). Where the tree writes
         its bodies' motion out, the cut joints' loads are wrenches on their frames and the
         tree's inward pass sums them (`body_forces`), with no reverse pass through the tree's
-        kinematics."""
+        kinematics. K None for no loads (zero)."""
+        if K is None:
+            return jnp.zeros(self.tree.nv, q.dtype)
         t = jnp.asarray(t, q.dtype)
         v = jnp.zeros(self.tree.nv, q.dtype)
-        motion = self.tree.body_motion(q, v)
-        if motion is None:
+        if self.tree.body_motion(q, v) is None:
             return jax.vjp(lambda v_: self.rate(q, v_, t), v)[1](K)[0]
-        R, p, V, _ = motion
+        R, p = self.tree.frames(q)                   # the loads act at rest: V = 0
+        V = jnp.zeros((R.shape[0], 6), q.dtype)
+        if all(isinstance(c, CutJoint) for c in self.closures):     # no term in q_dot
+            wrenches = jax.vjp(lambda V_: self._rate(R, p, V_, q, None, t), V)[1](K)[0]
+            return self.tree.body_forces(q, wrenches)
         q_dot, q_dot_transpose = jax.vjp(lambda v_: self.tree.q_dot(q, v_), v)
         wrenches, generalized = jax.vjp(lambda V_, qd: self._rate(R, p, V_, q, qd, t), V,
                                         q_dot)[1](K)

@@ -49,8 +49,7 @@ def _factored(theta, matrices: Callable, residual: Callable):
         K = loads(rG - A @ x)
         return x + Y @ K, K
 
-    zero_x, zero_K = jnp.zeros(M.shape[0], M.dtype), jnp.zeros(A.shape[0], M.dtype)
-    F0, G0 = residual(theta, zero_x, zero_K)
+    F0, G0 = residual(theta, jnp.zeros(M.shape[0], M.dtype), None)
     return solve(-F0, -G0), solve
 
 
@@ -62,7 +61,8 @@ def implicit_kkt(theta, matrices: Callable, residual: Callable) -> tuple[Array, 
         theta: a pytree of everything the system depends on; its inexact arrays are
             differentiated.
         matrices: theta -> (M (n, n), A (m, n)), M symmetric positive definite.
-        residual: (theta, x, K) -> (M x - A^T K + f, A x + g), affine in (x, K).
+        residual: (theta, x, K) -> (M x - A^T K + f, A x + g), affine in (x, K); K None for
+            zero loads (no A^T K to form).
 
     Returns:
         (x, K), shapes (n,) and (m,).

@@ -27,6 +27,7 @@ import numpy as np
 from jax import Array
 
 from mbjax._src.lie.inputs import check_point, check_rotation
+from mbjax._src.tree.take import take
 
 GROUND = -1             # the ground as a body index (`CutJoint`'s body_b)
 SIZES = {"spherical": 3, "revolute": 5, "universal": 4, "weld": 6, "spatial_weld": 6,
@@ -187,6 +188,59 @@ class CutJoint(eqx.Module):
         if self.kind == "prismatic":
             return jnp.concatenate([across, orientation])
         return across                                   # point_on_line
+
+
+def cut_joint_rows(closures, cut: Callable, other: Callable, frames) -> Array:
+    """Every closure's rows, in order: cut(joint, frame_a, frame_b) for the cut joints, other(c)
+    for the rest. Cut joints alike but for their arrays and bodies (a stance's feet) are one
+    `vmap`, not one program piece each.
+
+    Args:
+        closures: the closures, in order.
+        cut: (joint, frame_a, frame_b) -> the joint's rows (size,); frame_a the pytree `frames`
+            at body_a's row, frame_b at body_b's, or None for the ground.
+        other: (closure) -> its rows (size,).
+        frames: a pytree of per-frame arrays, each with a first axis of the tree's frames.
+
+    Returns:
+        The rows, shape (sum of the closures' sizes,).
+    """
+    start = np.cumsum([0] + [c.size for c in closures])
+    pieces, order = [], []
+    for idx, template, stacked in cut_joint_groups(closures):
+        joints = [closures[i] for i in idx]
+        frame_a = jax.tree.map(lambda x: take(x, np.array([j.body_a for j in joints])), frames)
+        frame_b = (None if template.body_b == GROUND else
+                   jax.tree.map(lambda x: take(x, np.array([j.body_b for j in joints])), frames))
+        rows = jax.vmap(lambda arrays, fa, fb: cut(eqx.combine(arrays, template), fa, fb))(
+            stacked, frame_a, frame_b)
+        pieces.append(rows.reshape(-1))
+        order += [np.arange(start[i], start[i + 1]) for i in idx]
+    for i, c in enumerate(closures):
+        if not isinstance(c, CutJoint):
+            pieces.append(other(c))
+            order.append(np.arange(start[i], start[i + 1]))
+    rows = jnp.concatenate(pieces)
+    inverse = np.argsort(np.concatenate(order))
+    return rows if np.array_equal(inverse, np.arange(len(inverse))) else take(rows, inverse)
+
+
+def cut_joint_groups(closures) -> list:
+    """The cut joints as groups alike but for their arrays and bodies: (their places in
+    closures, a template (the first's static part), their arrays stacked)."""
+    groups = {}
+    for i, c in enumerate(closures):
+        if isinstance(c, CutJoint):
+            arrays, static = eqx.partition(c, eqx.is_array)
+            key = (c.kind, c.body_b == GROUND,
+                   tuple((a.shape, a.dtype) for a in jax.tree.leaves(arrays)))
+            groups.setdefault(key, (static, []))[1].append((i, arrays))
+    # the joints' arrays differ in their static part (their bodies): stack leaf by leaf
+    return [([i for i, _ in members], static,
+             jax.tree.unflatten(jax.tree.structure(members[0][1]),
+                                [jnp.stack(a) for a in zip(*[jax.tree.leaves(a)
+                                                              for _, a in members])]))
+            for static, members in groups.values()]
 
 
 class Prescribed(eqx.Module):

@@ -20,6 +20,7 @@ import numpy as np
 from jax import Array
 
 from mbjax._src.linalg import unrolled_dot
+from mbjax._src.linear_map import linear_map
 from mbjax._src.lie import vee
 from mbjax._src.model import Model
 from mbjax._src.model.joints import joint_calc
@@ -107,13 +108,27 @@ def fixed_in_body(model: Model) -> bool:
 def joint_increments(model: Model, q: Array, v: Array, dq: Array) -> Array:
     """Each joint's increments (n, width) along its columns for the coordinate tangent dq: dq
     itself for revolute and prismatic joints; otherwise S_local^T (vee(R^T dR); R^T dp) of the
-    joint's local pose (R, p), a quaternion's normalization included."""
+    joint's local pose (R, p), a quaternion's normalization included. Linear in dq: a batch of
+    directions at one state (`jax.jacfwd`) is one product with `increments_matrix`."""
     if model.euclidean:
         return model.body_v(dq)
+    return _increments((model, q, v), dq)
+
+
+def _increments_along(fixed: tuple, dq: Array) -> Array:
+    model, q, v = fixed
     (R, _, S_local, _), (dR, dp, _, _) = jax.jvp(lambda q: model.joints(q, v), (q,), (dq,))
     Rt = jnp.swapaxes(R, -1, -2)
     twist = jnp.concatenate([jax.vmap(vee)(Rt @ dR), jnp.einsum("kij,kj->ki", Rt, dp)], -1)
     return jnp.einsum("kic,ki->kc", S_local, twist)
+
+
+def _increments_batch(fixed: tuple, dqs: Array) -> Array:
+    model, q, v = fixed
+    return jax.vmap(model.body_v)(dqs @ increments_matrix(model, q, v).T)
+
+
+_increments = linear_map("joint_increments", _increments_along, _increments_batch)
 
 
 def increments_matrix(model: Model, q: Array, v: Array) -> Array:

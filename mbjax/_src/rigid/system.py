@@ -24,14 +24,14 @@ from mbjax._src.system.system import AbstractSystem
 from mbjax._src.system.tree_system import AbstractTreeSystem
 from mbjax._src.system.status import Status
 from mbjax._src.model import Model
-from mbjax._src.tree import backward_pass, forward_pass
 from mbjax._src.model.limits import exceeded, excess_names, first_exceeded
 from mbjax._src.rigid.aba import aba_responses
+from mbjax._src.rigid.motion import body_forces, body_motion
 from mbjax._src.rigid.batched import batch_aba
 from mbjax._src.rigid.dense import dense_responses
 from mbjax._src.rigid.dynamics import forward_dynamics, mass_matrix
 from mbjax._src.rigid.energy import energy, floating, free_momenta, kinetic_energy
-from mbjax._src.rigid.kinematics import body_kinematics, forward_kinematics
+from mbjax._src.rigid.kinematics import forward_kinematics
 from mbjax._src.rigid.momentum import momentum_rate, velocity_from_momentum
 from mbjax._src.rigid import rnea_derivatives
 from mbjax._src.rigid.rnea import inverse_dynamics
@@ -96,20 +96,15 @@ class TreeSystem(AbstractTreeSystem):
 
     def body_motion(self, q, v, v_dot=None):
         """The bodies' poses, spatial velocities and (without gravity) accelerations at the world
-        origin, from the outward pass (`mbjax._src.rigid.kinematics`)."""
-        kin = body_kinematics(self.model, q, v)
+        origin (`mbjax._src.rigid.motion`: derivatives written out)."""
         if v_dot is None:
-            return kin.R, kin.p, kin.V, None
-        joint = jnp.einsum("kij,kj->ki", kin.S, self.model.body_v(v_dot)) + kin.c
-        A = forward_pass(self.model.topology, lambda a_parent, da: a_parent + da,
-                         jnp.zeros(6, q.dtype), joint)
-        return kin.R, kin.p, kin.V, A
+            R, p, V, _ = body_motion(self.model, q, v, jnp.zeros_like(v))
+            return R, p, V, None
+        return body_motion(self.model, q, v, v_dot)
 
     def body_forces(self, q, wrenches):
-        """S^T of the wrenches summed over each joint's outward set (the RNEA's inward pass)."""
-        kin = body_kinematics(self.model, q, jnp.zeros(self.model.nv, q.dtype))
-        total, _ = backward_pass(self.model.topology, lambda f_k, _: (f_k, f_k), wrenches)
-        return self.model.flat_v(jnp.einsum("kij,ki->kj", kin.S, total))
+        """S^T of the wrenches summed over each joint's outward set (`mbjax._src.rigid.motion`)."""
+        return body_forces(self.model, q, wrenches)
 
     def quaternions(self):
         """The spherical and free joints' quaternions in q (`Model.quaternions`)."""
