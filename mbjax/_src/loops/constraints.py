@@ -35,12 +35,14 @@ class Loops(eqx.Module):
         with A = dPhi/dq . dq/dv (the velocity constraint operator, (m, nv)), B = dPhi/dt and b =
         d/dt (A v + B) at fixed v, the "A_dot u + B_dot" of Anderson 1993 eq 92. Derivatives follow
         q along q_dot = tree.q_dot(q, v), so quaternion joints need no special case. Where the
-        tree writes its bodies' motion out (`body_motion`, a rigid tree), `drift` (A v_dot + b)
+        tree writes its bodies' motion out (`body_motion`, a rigid tree, whose derivatives are
+        written out too: `mbjax._src.rigid.motion`), `rate`, `jacobian`, `drift` (A v_dot + b)
         and `force` (A^t K), the terms the KKT system's derivatives differentiate
         (`mbjax._src.loops.kkt`), take a cut joint's rates from its residual along its two
         frames' velocities and accelerations, and A^t K from the tree's inward pass of the
-        wrenches on them (`body_forces`): no nested derivative of the tree's kinematics. (The
-        route through `phi` stays for the rest: reverse mode through a rollout runs it faster.)
+        wrenches on them (`body_forces`): no nested derivative of the tree's kinematics. Cut
+        joints alike but for their arrays and bodies (a stance's feet) are one `vmap`
+        (`cut_joint_rows`).
     """
 
     tree: AbstractTreeSystem
@@ -144,6 +146,7 @@ class Loops(eqx.Module):
         Where the tree writes its bodies' motion out, forward mode over v through the bodies'
         written-out velocity tangents (`body_motion`); otherwise reverse mode through the rate,
         one pass per constraint row, so O(m n) rather than O(n^2) for long chains."""
+        self.checked(q)
         zero = jnp.zeros(self.tree.nv, q.dtype)
         if self.tree.body_motion(q, zero) is None:
             return jax.jacrev(lambda v: self.rate(q, v, t))(zero)
