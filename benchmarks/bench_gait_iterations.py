@@ -52,7 +52,11 @@ def main(step_knots: int = 25, support_knots: int = 2) -> None:
     print(f"mbjax's controls rolled out in Crocoddyl's problem: cost "
           f"{croc.calc(croc.rollout(us), us):.12g}")
 
-    linearize = jax.jit(problem.linearize)
+    linearize_program = eqx.filter_jit(lambda p, xs, us: p.linearize(xs, us))
+
+    def linearize(xs, us):
+        return linearize_program(problem, xs, us)
+
     xs = state["xs"]
     jax.block_until_ready(linearize(xs, state["us"]))
     xs_croc = croc.rollout(us)
