@@ -309,13 +309,20 @@ class ILQR(AbstractIterativeSolver):
                  alpha: Array):
         """(xs, us, cost) of the closed-loop rollout with step length alpha, which closes that
         fraction of each gap (FDDP's forward pass; a rollout where alpha = 1 or no gaps)."""
+        # a multi-phase problem's knots price their step's forces as they step (one stance
+        # solve a knot, not two); a one-system problem's costs stay vectorized over the knots
+        fused = problem.knots is not None
+
         def f(x, inputs):
             x_ref, u_ref, k_, K_, e, i = inputs
             u = jnp.clip(u_ref + alpha * k_ + K_ @ problem.difference(x_ref, x), problem.lower,
                          problem.upper)
-            return problem.integrate(problem.step(x, u, i), (alpha - 1.0) * e), (x, u)
+            x1, cost = problem.step_cost(x, u, i) if fused else (problem.step(x, u, i), None)
+            return problem.integrate(x1, (alpha - 1.0) * e), (x, u, cost)
 
-        x_end, (x_seq, u_seq) = jax.lax.scan(f, xs[0], (xs[:-1], us, k, K, gaps,
-                                                        jnp.arange(problem.horizon)))
+        x_end, (x_seq, u_seq, costs) = jax.lax.scan(f, xs[0], (xs[:-1], us, k, K, gaps,
+                                                               jnp.arange(problem.horizon)))
         x_new = jnp.concatenate([x_seq, x_end[None]])
-        return x_new, u_seq, problem.cost(x_new, u_seq)
+        if not fused:
+            return x_new, u_seq, problem.cost(x_new, u_seq)
+        return x_new, u_seq, jnp.sum(costs) + problem.final_cost(x_end)

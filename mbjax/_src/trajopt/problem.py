@@ -218,6 +218,31 @@ class Problem(eqx.Module):
         t = jnp.asarray(self.knots.times, x.dtype)[k]
         return self.knots.switch(k, self._transition, x, u, t)
 
+    def step_cost(self, x: Array, u: Array, k) -> tuple[Array, Array]:
+        """(x_{k+1}, knot k's running cost at (x_k, u)) from one solve of the knot's dynamics:
+        a stance's contact costs read the forces its step solved (`Knot.advance`), rather than
+        solving them again as `cost` does.
+
+        Args:
+            x: the state x_k, shape (nx,).
+            u: the control, shape (nu,).
+            k: the knot's index (may be traced).
+
+        Returns:
+            (x_{k+1}, the stage cost), shapes (nx,) and ().
+        """
+        if self.knots is None:
+            knot, t = self._knot(), jnp.asarray(k, x.dtype) * self.dt
+            return self._transition(knot, x, u, t), self._stage_cost(knot, x, u, t)
+        t = jnp.asarray(self.knots.times, x.dtype)[k]
+        return self.knots.switch(k, self._step_cost, x, u, t)
+
+    def _step_cost(self, knot, x: Array, u: Array, t) -> tuple[Array, Array]:
+        q, v = self.split(x)
+        q1, v1, forces = knot.advance(self.integrator, t, q, v, u, jnp.asarray(self.dt, x.dtype))
+        cost = _value(knot.cost(t, q, v, u, forces)) * self._weight(knot, x.dtype)
+        return jnp.concatenate([q1, v1]), cost
+
     def _knot(self) -> Knot:
         """The knot every step of a one-phase problem is."""
         return Knot(self.system, self.running)
