@@ -29,16 +29,15 @@ import functools
 
 import jax
 import jax.numpy as jnp
-import numpy as np
 from jax import Array
 
 from mbjax._src.model import Model
+from mbjax._src.rigid.rnea_derivatives import _parent
 from mbjax._src.rigid.kinematics import (body_kinematics, columns, fixed_in_body,
                                          forward_kinematics, joint_increments, to_ground)
 from mbjax._src.rigid.tangents import instantiate, is_zero
 from mbjax._src.spatial import cross_force, cross_motion
 from mbjax._src.tree import outward_sum, path_sum
-from mbjax._src.tree.take import take
 
 
 def body_motion(model: Model, q: Array, v: Array, v_dot: Array) -> tuple[Array, Array, Array, Array]:
@@ -67,12 +66,6 @@ def _motion(model: Model, q: Array, v: Array, a: Array):
     return kin.R, kin.p, kin.V, A
 
 
-def _parent(model: Model, x: Array) -> Array:
-    """Each body's parent's row of x (n, 6), zero for a base body."""
-    parents = np.asarray(model.topology.parents)
-    return take(jnp.concatenate([x, jnp.zeros_like(x[:1])]), np.where(parents < 0, model.n, parents))
-
-
 @functools.partial(_motion.defjvp, symbolic_zeros=True)
 def _motion_jvp(primals, tangents):
     model, q, v, a = primals
@@ -80,7 +73,8 @@ def _motion_jvp(primals, tangents):
     kin = body_kinematics(model, q, v)
     S, V = kin.S, kin.V
     A = path_sum(model.topology, columns(S, model.body_v(a)) + kin.c)
-    U, B = _parent(model, V), _parent(model, A)
+    ground = jnp.zeros(6, V.dtype)
+    U, B = _parent(model, V, ground), _parent(model, A, ground)
     zero = jnp.zeros_like(V)
     s = columns(S, joint_increments(model, q, v, dq)) if not is_zero(dq) else zero
     sU = cross_motion(s, U)
