@@ -232,8 +232,7 @@ class Problem(eqx.Module):
             (x_{k+1}, the stage cost), shapes (nx,) and ().
         """
         if self.knots is None:
-            knot, t = self._knot(), jnp.asarray(k, x.dtype) * self.dt
-            return self._transition(knot, x, u, t), self._stage_cost(knot, x, u, t)
+            return self._step_cost(self._knot(), x, u, jnp.asarray(k, x.dtype) * self.dt)
         t = jnp.asarray(self.knots.times, x.dtype)[k]
         return self.knots.switch(k, self._step_cost, x, u, t)
 
