@@ -1,8 +1,10 @@
 """Models of rigid-body trees: `Model` (its `Topology`: Jerkovsky 1978's path and reference
-matrices), builders, the URDF and MJCF loaders, the plausibility warning and the peers' state
+matrices), its collision geometry (`Geoms`), builders, the URDF and MJCF loaders, the plausibility warning and the peers' state
 layouts."""
 
 from mbjax._src.model.model import Model as Model
+from mbjax._src.model.geoms import Geoms as Geoms
+from mbjax._src.model.geoms import ground_plane as ground_plane
 from mbjax._src.tree.topology import Topology as Topology
 from mbjax._src.model.checks import ModelWarning as ModelWarning
 from mbjax._src.model.builders import chain as chain
@@ -17,7 +19,7 @@ from mbjax._src.model.states import state_to_mujoco as state_to_mujoco
 from mbjax._src.model.states import state_to_pinocchio as state_to_pinocchio
 
 __all__ = [
-    "Model", "Topology", "ModelWarning", "chain", "random_tree", "load_urdf", "to_urdf",
+    "Model", "Geoms", "ground_plane", "Topology", "ModelWarning", "chain", "random_tree", "load_urdf", "to_urdf",
     "load_mjcf", "from_mujoco", "state_from_mujoco", "state_from_pinocchio", "state_to_mujoco",
     "state_to_pinocchio"
 ]

@@ -35,7 +35,8 @@ LAYERS = (
 RANK = {name: rank for rank, names in enumerate(LAYERS) for name in names}
 NAMESPACES = ("lie", "model", "control", "integrate", "rigid", "flex", "loops", "tfe", "wrist",
               "trajopt", "scenes", "data", "contact")
-MAX_PUBLIC_NAMES = 170       # 150, the contact namespace (legged robots), multi-phase problems
+MAX_PUBLIC_NAMES = 175       # 150, the contact namespace (legged robots), multi-phase problems,
+#                              contacts that find themselves (geoms, their system and model)
                              # and contact costs (issue 45)
 
 

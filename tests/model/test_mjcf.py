@@ -440,7 +440,7 @@ def test_ignored_features_are_named_in_one_warning():
         model = mbjax.model.from_mujoco(mjmodel)
     assert len(caught) == 1 and issubclass(caught[0].category, ModelWarning)
     message = str(caught[0].message)
-    for what in ("contacts (2 geom pairs", "actuator forces (1", "tendons (1)", "joint springs (1)",
+    for what in ("contacts in TreeSystem(model) (2 geom pairs", "actuator forces (1", "tendons (1)", "joint springs (1)",
                  "joint, tendon, flex and distance equality constraints (1)",
                  "connect and weld equality constraints in TreeSystem(model) (1; they are "
                  "model.closures"):

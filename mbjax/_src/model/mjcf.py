@@ -8,6 +8,7 @@ import numpy as np
 
 from mbjax._src.model.checks import ModelWarning, combine
 from mbjax._src.model.closures import CutJoint
+from mbjax._src.model.geoms import Geoms
 from mbjax._src.model.joints import JOINT_TYPES
 from mbjax._src.model.model import Model
 
@@ -45,7 +46,7 @@ def object_name(mjmodel, kind: str, i: int) -> str:
     """The name of MuJoCo object i of `kind` ("body", "joint", "site"), or kind + index."""
     mujoco = _mujoco()
     obj = {"body": mujoco.mjtObj.mjOBJ_BODY, "joint": mujoco.mjtObj.mjOBJ_JOINT,
-           "site": mujoco.mjtObj.mjOBJ_SITE}[kind]
+           "site": mujoco.mjtObj.mjOBJ_SITE, "geom": mujoco.mjtObj.mjOBJ_GEOM}[kind]
     return mujoco.mj_id2name(mjmodel, obj, i) or f"{kind}{i}"
 
 
@@ -82,8 +83,14 @@ def _nonzero(m, field: str) -> int:
 def _contact_pairs(m, filter_parent: bool) -> int:
     """Geom pairs that MuJoCo's broadphase may pass on (contype/conaffinity match, different
     rigid bodies, not both static, not parent and child), plus explicit <pair>s."""
+    return len(_pair_list(m, filter_parent)) + int(m.npair)
+
+
+def _pair_list(m, filter_parent: bool) -> list[tuple[int, int]]:
+    """The geom pairs of `_contact_pairs` without the explicit <pair>s, less the <exclude>d
+    body pairs."""
     if m.ngeom < 2:
-        return int(m.npair)
+        return []
     ct, ca = m.geom_contype, m.geom_conaffinity
     weld = m.body_weldid[m.geom_bodyid]
     parent = m.body_weldid[m.body_parentid[weld]]
@@ -93,7 +100,59 @@ def _contact_pairs(m, filter_parent: bool) -> int:
     if filter_parent:
         related = (weld[:, None] == parent[None, :]) | (parent[:, None] == weld[None, :])
         can &= ~(related & (weld[:, None] != 0) & (weld[None, :] != 0))
-    return int(np.triu(can, 1).sum()) + int(m.npair)
+    for signature in np.asarray(getattr(m, "exclude_signature", np.zeros(0)), dtype=np.int64):
+        b1, b2 = int(signature) >> 16, int(signature) & 0xFFFF
+        body = m.geom_bodyid
+        can &= ~(((body[:, None] == b1) & (body[None, :] == b2))
+                 | ((body[:, None] == b2) & (body[None, :] == b1)))
+    return [(int(i), int(j)) for i, j in zip(*np.nonzero(np.triu(can, 1)), strict=True)]
+
+
+# mjtGeom: the kinds mbjax detects
+_GEOM_KINDS = {0: "plane", 2: "sphere", 3: "capsule", 6: "box"}
+
+
+def _geoms(m, mujoco, where) -> tuple[Geoms | None, list[str]]:
+    """The model's geoms that mbjax detects contacts of (planes, spheres, capsules, boxes), on
+    the mbjax bodies that carry them, with the pairs MuJoCo's broadphase would pass on; and
+    what is left out."""
+    if not m.ngeom:
+        return None, []
+    filter_parent = not int(m.opt.disableflags) & int(mujoco.mjtDisableBit.mjDSBL_FILTERPARENT)
+    kept = [g for g in range(m.ngeom) if int(m.geom_type[g]) in _GEOM_KINDS]
+    index = {g: k for k, g in enumerate(kept)}
+    rotation, position, bodies = [], [], []
+    geom_quat = quat_matrix(m.geom_quat)
+    for g in kept:
+        k, R, p = where[int(m.geom_bodyid[g])]
+        bodies.append(k)
+        rotation.append(R @ geom_quat[g])
+        position.append(p + R @ m.geom_pos[g])
+    pairs = [(index[i], index[j]) for i, j in _pair_list(m, filter_parent)
+             if i in index and j in index]
+    left = []
+    skipped = sorted({mujoco.mjtGeom(int(m.geom_type[g])).name[6:].lower()
+                      for g in range(m.ngeom) if g not in index
+                      and (m.geom_contype[g] or m.geom_conaffinity[g])})
+    if skipped:
+        left.append(f"contacts of {', '.join(skipped)} geoms (mbjax detects planes, spheres, "
+                    f"capsules and boxes)")
+    if m.npair:
+        left.append(f"explicit contact pairs ({m.npair})")
+    if not kept:
+        return None, left
+    names = [object_name(m, "geom", g) for g in kept]
+    geoms = Geoms([_GEOM_KINDS[int(m.geom_type[g])] for g in kept], bodies,
+                  np.asarray(m.geom_size)[kept], position=np.stack(position),
+                  rotation=np.stack(rotation), friction=np.asarray(m.geom_friction)[kept],
+                  solref=np.asarray(m.geom_solref)[kept], solimp=np.asarray(m.geom_solimp)[kept],
+                  solmix=np.asarray(m.geom_solmix)[kept], margin=np.asarray(m.geom_margin)[kept],
+                  gap=np.asarray(m.geom_gap)[kept],
+                  condim=[1 if int(m.geom_condim[g]) == 1 else 3 for g in kept],
+                  names=names, pairs=pairs)
+    if any(int(m.geom_condim[g]) not in (1, 3) for g in kept):
+        left.append("torsional and rolling friction (condim 4 and 6 geoms are condim 3)")
+    return geoms, left
 
 
 def _ignored(m, mujoco) -> list[str]:
@@ -106,7 +165,8 @@ def _ignored(m, mujoco) -> list[str]:
     pairs = (_contact_pairs(m, not off(bits.mjDSBL_FILTERPARENT))
              if constraints and not off(bits.mjDSBL_CONTACT) else 0)
     if pairs:
-        out.append(f"contacts ({pairs} geom pairs can collide)")
+        out.append(f"contacts in TreeSystem(model) ({pairs} geom pairs can collide; "
+                   "mbjax.contact.ContactSystem(TreeSystem(model)) detects them)")
     if m.nu:
         out.append(f"actuator forces ({m.nu} actuators; apply them as tau)")
     if m.ntendon:
@@ -232,7 +292,8 @@ def from_mujoco(mjmodel, *, strict: bool = False) -> Model:
     if int(m.opt.disableflags) & int(mujoco.mjtDisableBit.mjDSBL_GRAVITY):
         gravity = np.zeros(3)
     cuts, connect_weld = _cut_joints(m, mujoco, where)
-    ignored = _ignored(m, mujoco)
+    geoms, left_out = _geoms(m, mujoco, where)
+    ignored = _ignored(m, mujoco) + left_out
     if connect_weld:
         ignored.append(f"connect and weld equality constraints in TreeSystem(model) "
                        f"({connect_weld}; they are model.closures, which "
@@ -256,7 +317,7 @@ def from_mujoco(mjmodel, *, strict: bool = False) -> Model:
         frame_parents=[f[1] for f in frames],
         frame_rotation=np.reshape([f[2] for f in frames], (-1, 3, 3)),
         frame_translation=np.reshape([f[3] for f in frames], (-1, 3)), closures=cuts,
-        strict=strict)
+        geoms=geoms, strict=strict)
     return model
 
 

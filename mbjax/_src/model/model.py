@@ -17,6 +17,7 @@ import jax.numpy as jnp
 import numpy as np
 from jax import Array
 
+from mbjax._src.model.geoms import Geoms
 from mbjax._src.model.joints import (
     JOINT_TYPES,
     NEUTRAL,
@@ -116,6 +117,9 @@ class Model(eqx.Module):
             joints as `mbjax.loops.Coupling`s, an MJCF's connect and weld equalities as
             `mbjax.loops.CutJoint`s); `TreeSystem(model)` leaves them out and
             `ClosedSystem(TreeSystem(model), model.closures)` enforces them.
+        geoms (mbjax.model.Geoms | None): the collision geometry (`load_mjcf` keeps an MJCF's
+            geoms), which `mbjax.contact.ContactSystem` detects contacts between; None for
+            none.
         strict (bool): turn the mass-data warnings into errors.
 
     Raises:
@@ -151,14 +155,19 @@ class Model(eqx.Module):
     frame_rotation: Array
     frame_translation: Array
     closures: tuple
+    geoms: object
 
     def __init__(self, parents, joint_types, *, mass, inertia, com=None, axis=None, axis2=None,
                  placement_rotation=None, placement_translation=None,
                  gravity=(0.0, 0.0, -9.81), names=None, joint_names=None, lower=None,
                  upper=None, velocity_limit=None, effort_limit=None, damping=None,
                  armature=None, friction=None, frame_names=(), frame_parents=(),
-                 frame_rotation=None, frame_translation=None, closures=(), strict: bool = False):
+                 frame_rotation=None, frame_translation=None, closures=(), geoms=None,
+                 strict: bool = False):
         self.closures = tuple(closures)
+        if geoms is not None and not isinstance(geoms, Geoms):
+            raise TypeError(f"geoms must be mbjax.model.Geoms or None, got {type(geoms).__name__}")
+        self.geoms = geoms
         self.topology = parents if isinstance(parents, Topology) else Topology(parents)
         n = self.topology.n
         joint_types = (joint_types,) * n if isinstance(joint_types, str) else tuple(joint_types)

@@ -1,0 +1,325 @@
+"""`ContactSystem`: a rigid tree whose geoms find their own contacts each step, and whose limited
+joints stay in their ranges, under a contact model solved each step."""
+
+import equinox as eqx
+import jax
+import jax.numpy as jnp
+import numpy as np
+from jax import Array
+
+from mbjax._src.contact.collision import COUNT, PAIRS
+from mbjax._src.model.geoms import SOLIMP, SOLREF, Geoms, pair_parameters
+from mbjax._src.contact.soft import AbstractContactModel, SoftConstraints
+from mbjax._src.linalg import cho_solve, cholesky
+from mbjax._src.model.joints import JOINT_TYPES
+from mbjax._src.model.model import Model
+from mbjax._src.rigid.kinematics import body_kinematics
+from mbjax._src.system.tree_system import AbstractTreeSystem
+from mbjax._src.system.system import AbstractSystem
+
+
+class Contacts(eqx.Module):
+    """The candidate contacts at a state, a fixed number of them (one not touching has a
+    positive distance past its margin: it is data, as a contact let go is).
+
+    Attributes:
+        distance: signed distance between the surfaces (negative: penetration) [m], (c,).
+        position: the contact point, midway between the surfaces, world [m], (c, 3).
+        frame: rows (normal from the first geom to the second, tangent, tangent), (c, 3, 3).
+        geoms: each contact's pair of geom indices, c pairs.
+        margin: distance below which the contact pushes (its pair's margin; MuJoCo 4 leaves
+            the gap out of it), (c,).
+    """
+
+    distance: Array
+    position: Array
+    frame: Array
+    margin: Array
+    geoms: tuple = eqx.field(static=True)
+
+    @property
+    def touching(self) -> Array:
+        """Whether each contact pushes: its distance is below its margin."""
+        return self.distance < self.margin
+
+
+def _groups(geoms: Geoms) -> list:
+    """The detected pairs grouped by their kinds: [(kinds, (P, 2) pair indices)]."""
+    groups = {}
+    for i, j in geoms.pairs:
+        kinds = (geoms.kinds[i], geoms.kinds[j])
+        if kinds not in PAIRS:
+            raise ValueError(f"geoms: contacts between a {kinds[0]} and a {kinds[1]} "
+                             f"({geoms.names[i]!r}, {geoms.names[j]!r}) are not detected; "
+                             f"detected kinds: {sorted(PAIRS)}")
+        groups.setdefault(kinds, []).append((i, j))
+    return [(kinds, np.asarray(p, dtype=int)) for kinds, p in groups.items()]
+
+
+def _world(geoms: Geoms, R: Array, p: Array, index: np.ndarray):
+    """World rotations and origins of the geoms `index`, from the bodies' poses."""
+    body = np.asarray(geoms.bodies)[index]
+    on_ground = body < 0
+    Rb = jnp.where(on_ground[:, None, None], jnp.eye(3, dtype=R.dtype), R[np.maximum(body, 0)])
+    pb = jnp.where(on_ground[:, None], 0.0, p[np.maximum(body, 0)])
+    return (Rb @ geoms.rotation[index], pb + jnp.einsum("gij,gj->gi", Rb, geoms.position[index]))
+
+
+def detect(geoms: Geoms, R: Array, p: Array) -> Contacts:
+    """The candidate contacts of every pair of `geoms` at the bodies' poses
+    (`mbjax.rigid.forward_kinematics`): each pair kind's collision function `vmap`ped over its
+    pairs.
+
+    Args:
+        geoms: the geometry, with its pairs.
+        R, p: the bodies' world rotations (n, 3, 3) and origins (n, 3).
+
+    Returns:
+        `Contacts`, the pairs' candidates one after another.
+    """
+    out = []
+    for kinds, pairs in _groups(geoms):
+        poses = [(*_world(geoms, R, p, pairs[:, s]), geoms.size[pairs[:, s]]) for s in (0, 1)]
+        dist, pos, frame = jax.vmap(PAIRS[kinds])(*poses)
+        margin = pair_parameters(geoms, pairs[:, 0], pairs[:, 1])[3]
+        k = COUNT[kinds]
+        out.append((dist.reshape(-1), pos.reshape(-1, 3), frame.reshape(-1, 3, 3),
+                    jnp.repeat(margin, k), np.repeat(pairs, k, axis=0)))
+    if not out:
+        z = jnp.zeros((0,), R.dtype)
+        return Contacts(z, z.reshape(0, 3), z.reshape(0, 3, 3), z, ())
+    dist, pos, frame, margin, index = (jnp.concatenate(x) if i < 4 else np.concatenate(x)
+                                       for i, x in enumerate(zip(*out, strict=True)))
+    return Contacts(dist, pos, frame, margin, tuple(map(tuple, index.tolist())))
+
+
+def _invweights(model, q: Array) -> tuple[Array, Array]:
+    """MuJoCo's `body_invweight0` (translational) and `dof_invweight0` at q: the mean diagonal
+    of J M^-1 J^T for each body's centre of mass (its rotational mean where the translational
+    one vanishes), and of each joint's block of M^-1."""
+    from mbjax._src.rigid.dynamics import mass_matrix
+
+    kin = body_kinematics(model, q, jnp.zeros(model.nv, q.dtype))
+    Minv = jnp.linalg.inv(mass_matrix(model, q))
+    S = model.flat_v(jnp.swapaxes(kin.S, -1, -2))                          # (nv, 6)
+    path = jnp.asarray(model.topology.path_matrix()[:, model.dof_body()], float)   # (n, nv)
+    com = kin.p + jnp.einsum("kij,kj->ki", kin.R, model.com)
+    w = S[None, :, :3] * path[:, :, None]                                   # (n, nv, 3)
+    v = (S[None, :, 3:] + jnp.cross(S[None, :, :3], com[:, None, :])) * path[:, :, None]
+    tran = jnp.einsum("kci,cd,kdi->k", v, Minv, v) / 3
+    rot = jnp.einsum("kci,cd,kdi->k", w, Minv, w) / 3
+    body = jnp.where(tran > 1e-15, tran, rot)
+    diagonal = jnp.diagonal(Minv)
+    dof = []
+    for k, kind in enumerate(model.joint_types):
+        start = int(np.searchsorted(model.dof_body(), k))
+        width = int(np.sum(model.dof_body() == k))
+        block = diagonal[start:start + width]
+        if kind == "free":                     # (omega; v): the translational and rotational means
+            block = jnp.concatenate([jnp.full(3, block[:3].mean()), jnp.full(3, block[3:].mean())])
+        elif width > 1:
+            block = jnp.full(width, block.mean())
+        dof.append(block)
+    return body, jnp.concatenate(dof)
+
+
+def _world_rate(model, v: Array) -> Array:
+    """What each free joint's velocity rate gains in world components: the rows' accelerations
+    are MuJoCo's, J a_MuJoCo = J (a + this), with a free joint's linear velocity in world
+    components, whose rate differs from that of mbjax's body components by omega x v."""
+    out = jnp.zeros_like(v)
+    for k, kind in enumerate(model.joint_types):
+        if kind == "free":
+            i = int(np.searchsorted(model.dof_body(), k))
+            out = out.at[i + 3:i + 6].set(jnp.cross(v[i:i + 3], v[i + 3:i + 6]))
+    return out
+
+
+class ContactSystem(AbstractSystem):
+    """A rigid tree on its geoms: contacts found each step between the pairs of geoms that may
+    touch (`mbjax.contact.detect`), and limited joints held in their ranges, all solved by one
+    contact model (`SoftConstraints`, MuJoCo's, by default). `mbjax.simulate` runs it like any
+    other system (MuJoCo's own integrator is `mbjax.integrate.SemiImplicitEuler`).
+
+    Args:
+        tree: the `TreeSystem` (its model, control and external wrenches).
+        geoms: the geometry, or None for the model's own (`tree.model.geoms`, from
+            `load_mjcf`); join a ground with `geoms.join(mbjax.model.ground_plane())`.
+        method: the contact model, a strategy object (`SoftConstraints()` by default).
+        timestep: the simulation's step [s], for MuJoCo's safety bound on the time constants
+            (at least two steps); 0.002 s (MuJoCo's default) by default.
+        limits: hold the joints whose bounds are finite (`model.lower`, `model.upper`: MJCF's
+            and URDF's limited joints) in their ranges, as MuJoCo does; True by default.
+        limit_solref, limit_solimp: the limits' parameters (MuJoCo's defaults).
+        q_reference: the configuration at which each body's and joint's inverse inertia scale
+            is taken (MuJoCo's qpos0); the model's `home()` by default.
+
+    Raises:
+        TypeError: a tree that is not a `TreeSystem`, or a method that is not a contact model.
+        ValueError: no geoms and no limits, or a pair of geom kinds that is not detected.
+    """
+
+    tree: AbstractTreeSystem
+    geoms: Geoms
+    method: AbstractContactModel
+    invweight: Array
+    dof_invweight: Array
+    limit_solref: Array
+    limit_solimp: Array
+    timestep: float = eqx.field(static=True)
+    limited: tuple = eqx.field(static=True)      # the velocity coordinate of each limited joint
+
+    def __init__(self, tree: AbstractTreeSystem, geoms: Geoms | None = None, *,
+                 method: AbstractContactModel = SoftConstraints(), timestep: float = 0.002,
+                 limits: bool = True, limit_solref=SOLREF, limit_solimp=SOLIMP,
+                 q_reference=None):
+        if not (isinstance(tree, AbstractTreeSystem) and isinstance(tree.model, Model)):
+            raise TypeError(f"tree must be a mbjax.rigid.TreeSystem, got {type(tree).__name__}")
+        if not isinstance(method, AbstractContactModel):
+            raise TypeError(f"method must be a contact model such as SoftConstraints(), got "
+                            f"{method!r}")
+        model = tree.model
+        geoms = getattr(model, "geoms", None) if geoms is None else geoms
+        if geoms is None:
+            geoms = Geoms((), (), np.zeros((0, 3)))
+        if not isinstance(geoms, Geoms):
+            raise TypeError(f"geoms must be mbjax.contact.Geoms, got {type(geoms).__name__}")
+        _groups(geoms)                                  # a ValueError for an undetected pair
+        if any(b >= model.n for b in geoms.bodies):
+            raise ValueError(f"geoms: a body index beyond the model's {model.n} bodies")
+        self.tree, self.geoms, self.method = tree, geoms, method
+        if not (float(timestep) > 0):
+            raise ValueError(f"timestep must be positive, got {timestep!r}")
+        self.timestep = float(timestep)
+        limited, iq = [], 0
+        lower, upper = np.asarray(model.lower), np.asarray(model.upper)
+        for k, kind in enumerate(model.joint_types):
+            if limits and kind in ("revolute", "prismatic") and (np.isfinite(lower[iq])
+                                                                  or np.isfinite(upper[iq])):
+                limited.append((iq, int(np.searchsorted(model.dof_body(), k))))
+            iq += JOINT_TYPES[kind][0]
+        self.limited = tuple(limited)
+        self.limit_solref = jnp.asarray(limit_solref, dtype=float)
+        self.limit_solimp = jnp.asarray(limit_solimp, dtype=float)
+        q_reference = model.home() if q_reference is None else jnp.asarray(q_reference, float)
+        self.invweight, self.dof_invweight = _invweights(model, q_reference)
+
+    @property
+    def model(self):
+        """The tree's model."""
+        return self.tree.model
+
+    def contacts(self, q: Array) -> Contacts:
+        """The candidate contacts at configuration q (`detect`)."""
+        kin = body_kinematics(self.model, q, jnp.zeros(self.model.nv, q.dtype))
+        return detect(self.geoms, kin.R, kin.p)
+
+    def _rows(self, q: Array, v: Array):
+        """The constraint rows at (q, v): (J, position, invweight, solref, solimp, frictional)
+        of every contact's pyramid edges (or normal, condim 1) and every joint limit, and the
+        contacts."""
+        model, geoms = self.model, self.geoms
+        kin = body_kinematics(model, q, v)
+        found = detect(geoms, kin.R, kin.p)
+        S = model.flat_v(jnp.swapaxes(kin.S, -1, -2))                       # (nv, 6)
+        path = model.topology.path_matrix()[:, model.dof_body()].astype(float)   # (n, nv)
+        parts = []
+        if found.geoms:
+            i, j = np.asarray(found.geoms).T
+            body = np.asarray(geoms.bodies)
+
+            def point_jacobian(b: np.ndarray, x: Array) -> Array:     # (c, 3, nv)
+                mask = jnp.asarray(np.where(b[:, None] >= 0, path[np.maximum(b, 0)], 0.0))
+                lin = S[None, :, 3:] + jnp.cross(S[None, :, :3], x[:, None, :])
+                return jnp.swapaxes(lin * mask[:, :, None], -1, -2)
+
+            J = found.frame @ (point_jacobian(body[j], found.position)
+                               - point_jacobian(body[i], found.position))  # (c, 3, nv)
+            friction, solref, solimp, _, _ = pair_parameters(geoms, i, j)
+            condim = np.maximum(np.asarray(geoms.condim)[i], np.asarray(geoms.condim)[j])
+            weight = self.invweight[np.maximum(body[i], 0)] * (body[i] >= 0) + \
+                self.invweight[np.maximum(body[j], 0)] * (body[j] >= 0)
+            position = found.distance - found.margin
+            for dim in (1, 3):
+                on = np.flatnonzero(condim == dim)
+                if not on.size:
+                    continue
+                if dim == 1:
+                    rows, scale = J[on, :1], weight[on][:, None]
+                else:           # a pair of pyramid edges per tangent: J_n +- mu J_t
+                    mu = friction[on, 0]               # sliding friction, the same both ways
+                    signs = jnp.stack([mu, -mu, mu, -mu], 1)
+                    rows = J[on, :1] + jnp.repeat(J[on, 1:], 2, axis=1) * signs[:, :, None]
+                    scale = (weight[on] * (1 + mu**2) * 2 * mu**2)[:, None]
+                edges = rows.shape[1]
+                parts.append((rows.reshape(-1, model.nv), jnp.repeat(position[on], edges),
+                              jnp.broadcast_to(scale, (on.size, edges)).reshape(-1),
+                              jnp.repeat(solref[on], edges, axis=0),
+                              jnp.repeat(solimp[on], edges, axis=0),
+                              jnp.full(on.size * edges, dim > 1)))
+        if self.limited:
+            iq, iv = (np.asarray(x) for x in zip(*self.limited, strict=True))
+            below, above = q[iq] - model.lower[iq], model.upper[iq] - q[iq]
+            near = jnp.where(below < above, 1.0, -1.0)
+            J = jnp.zeros((iq.size, model.nv), q.dtype).at[np.arange(iq.size), iv].set(near)
+            parts.append((J, jnp.minimum(below, above), self.dof_invweight[iv],
+                          jnp.broadcast_to(self.limit_solref, (iq.size, 2)),
+                          jnp.broadcast_to(self.limit_solimp, (iq.size, 5)),
+                          jnp.zeros(iq.size, bool)))
+        if not parts:
+            z = jnp.zeros((0,), q.dtype)
+            return (z.reshape(0, model.nv), z, z, z.reshape(0, 2), z.reshape(0, 5),
+                    z.astype(bool)), found
+        return tuple(jnp.concatenate(x) for x in zip(*parts, strict=True)), found
+
+    def solve(self, t, q: Array, v: Array) -> tuple[Array, Array, Contacts]:
+        """(v_dot, each row's force, the contacts) at (t, q, v)."""
+        model = self.model
+        M = self.tree.mass_matrix(q)
+        free = cho_solve(cholesky(M), -self.tree.bias(t, q, v))
+        (J, position, invweight, solref, solimp, frictional), found = self._rows(q, v)
+        D, aref = self.method.rows(J, position, J @ v, invweight, solref, solimp, frictional,
+                                   self.timestep)
+        aref = aref - J @ _world_rate(model, v)
+        a, forces = self.method.solve(M, free, J, D, aref)
+        return a, forces, found
+
+    # -- AbstractSystem ---------------------------------------------------------------------------
+
+    def kinematics(self, q, u):
+        return self.tree.kinematics(q, u)
+
+    def acceleration(self, t, q, u):
+        return self.solve(t, q, u)[0]
+
+    def retract(self, q0, xi):
+        return self.tree.retract(q0, xi)
+
+    def local_rate(self, q0, xi, u):
+        return self.tree.local_rate(q0, xi, u)
+
+    def tangent(self, q, u):
+        return self.tree.tangent(q, u)
+
+    def difference(self, q0, q1):
+        return self.tree.difference(q0, q1)
+
+    def project(self, q):
+        return self.tree.project(q)
+
+    def hold(self, t, q, u):
+        tree = self.tree.hold(t, q, u)
+        return self if tree is self.tree else eqx.tree_at(lambda s: s.tree, self, tree)
+
+    def quaternions(self):
+        return self.tree.quaternions()
+
+    def state_sizes(self):
+        return self.tree.state_sizes()
+
+    @property
+    def n_controls(self) -> int:
+        return self.tree.n_controls
+
+    def with_control(self, control) -> "ContactSystem":
+        return eqx.tree_at(lambda s: s.tree, self, self.tree.with_control(control))

@@ -1,0 +1,168 @@
+"""Contacts that find themselves (`mbjax.contact.ContactSystem`): geoms read from MJCF, detected
+each step and solved by MuJoCo's soft constraints, against MuJoCo itself on the same files
+(a sphere, a box dropped and slid, gymnasium's Ant), joint limits, gradients against central
+differences, and bad geometry named."""
+
+import os
+import warnings
+
+import jax
+import jax.numpy as jnp
+import numpy as np
+import pytest
+
+import mbjax
+from mbjax.contact import ContactSystem, SoftConstraints
+from mbjax.integrate import RK4, SemiImplicitEuler
+from mbjax.model import Geoms, ground_plane, state_from_mujoco
+from mbjax.rigid import TreeSystem
+
+mujoco = pytest.importorskip("mujoco")
+
+FLOOR = '<geom type="plane" size="5 5 .1"/>'
+
+
+def _load(xml):
+    m = mujoco.MjModel.from_xml_string(xml) if xml.lstrip().startswith("<") else \
+        mujoco.MjModel.from_xml_path(xml)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        model = mbjax.model.from_mujoco(m)
+    return m, model
+
+
+def _mujoco_run(m, steps, qvel=None):
+    d = mujoco.MjData(m)
+    if qvel is not None:
+        d.qvel[:] = qvel
+    out = []
+    for _ in range(steps):
+        mujoco.mj_step(m, d)
+        out.append(d.qpos.copy())
+    return np.asarray(out)
+
+
+@pytest.mark.parametrize("body, qvel, atol, rest", [
+    ('<geom type="sphere" size="0.1" mass="1"/>', None, 1e-9, 0.1),
+    ('<geom type="box" size="0.1 0.2 0.05" mass="1"/>', None, 1e-9, 0.05),
+    ('<geom type="box" size="0.1 0.2 0.05" mass="1"/>', [1.0, 0.3, 0, 0, 0, 0], 1e-4, 0.05),
+], ids=["sphere-drop", "box-drop", "box-slide"])
+def test_dropped_and_slid_bodies_follow_mujoco(body, qvel, atol, rest):
+    """MuJoCo's Euler step is semi-implicit Euler; the same soft constraints give the same
+    motion (the slide's remaining difference is the two integrators' free-joint coordinates:
+    mbjax's body-frame velocity, MuJoCo's world-frame one)."""
+    xml = (f'<mujoco><worldbody>{FLOOR}<body pos="0 0 0.3"><freejoint/>{body}</body>'
+           '</worldbody></mujoco>')
+    m, model = _load(xml)
+    reference = _mujoco_run(m, 400, qvel)
+    system = ContactSystem(TreeSystem(model), timestep=m.opt.timestep)
+    v0 = np.zeros(6) if qvel is None else state_from_mujoco(model, m.qpos0, np.asarray(qvel))[1]
+    sol = mbjax.simulate(system, SemiImplicitEuler(), jnp.asarray(m.qpos0), jnp.asarray(v0),
+                         dt=m.opt.timestep, t1=0.8)
+    assert int(sol.status) == 0
+    np.testing.assert_allclose(np.asarray(sol.qs[1:, :3]), reference[:, :3], atol=atol)
+    assert abs(float(sol.qs[-1, 2]) - rest) < 2e-3            # resting on the floor
+
+
+def test_ant_accelerations_and_fall_follow_mujoco():
+    """gymnasium's Ant (capsule legs, a sphere torso, limited hips and ankles, margins): the
+    accelerations at MuJoCo's own states, contacts and limits pushing, agree to round-off, and
+    the torso's height through a 1 s fall and settle (RK4, as the file asks) within 1 cm."""
+    gymnasium = pytest.importorskip("gymnasium")
+    path = os.path.join(os.path.dirname(gymnasium.__file__), "envs/mujoco/assets/ant.xml")
+    m, model = _load(path)
+    system = ContactSystem(TreeSystem(model), timestep=m.opt.timestep,
+                           q_reference=jnp.asarray(m.qpos0))
+    acceleration = jax.jit(lambda q, v: system.acceleration(0.0, q, v))
+    d = mujoco.MjData(m)
+    pushing = 0
+    for step in range(100):
+        mujoco.mj_step(m, d)
+        if step % 5 == 4:
+            mujoco.mj_forward(m, d)
+            q, v = state_from_mujoco(model, d.qpos, d.qvel)
+            a = np.asarray(acceleration(q, v))
+            np.testing.assert_allclose(a[6:], d.qacc[6:], atol=1e-9 * (1 + np.abs(d.qacc).max()))
+            pushing += d.nefc > 0
+    assert pushing >= 5
+    reference = _mujoco_run(m, 100)
+    sol = mbjax.simulate(system, RK4(), jnp.asarray(m.qpos0), jnp.zeros(m.nv),
+                         dt=m.opt.timestep, t1=1.0)
+    assert int(sol.status) == 0
+    np.testing.assert_allclose(np.asarray(sol.qs[1:, 2]), reference[:, 2], atol=1e-2)
+
+
+def test_joint_limit_holds_as_mujoco():
+    """A hinge pendulum falling onto its limit: the limit's soft constraint stops it as
+    MuJoCo's does."""
+    xml = ('<mujoco><worldbody><body><joint type="hinge" axis="0 1 0" range="-30 30"/>'
+           '<geom type="capsule" fromto="0 0 0 0.5 0 0" size="0.05" mass="1" contype="0" '
+           'conaffinity="0"/></body></worldbody></mujoco>')
+    m, model = _load(xml)
+    reference = _mujoco_run(m, 500)
+    system = ContactSystem(TreeSystem(model), timestep=m.opt.timestep)
+    sol = mbjax.simulate(system, SemiImplicitEuler(), jnp.asarray(m.qpos0), jnp.zeros(1),
+                         dt=m.opt.timestep, t1=1.0)
+    np.testing.assert_allclose(np.asarray(sol.qs[1:, 0]), reference[:, 0], atol=1e-9)
+    assert abs(float(sol.qs[-1, 0]) - np.radians(30)) < 0.01       # held at its bound
+    free = mbjax.simulate(ContactSystem(TreeSystem(model), limits=False), SemiImplicitEuler(),
+                          jnp.asarray(m.qpos0), jnp.zeros(1), dt=m.opt.timestep, t1=1.0)
+    assert np.asarray(free.qs).max() > 1.0                          # without limits it swings
+
+
+def test_derivatives_through_landing_and_sliding_match_central_differences():
+    """A box dropped from 0.3 m with a forward speed lands and slides: the derivatives of where
+    it stops in the drop height, the speed and the friction coefficient (the implicit function
+    theorem at each step's solution) agree with central differences; finite at first touch."""
+    _, model = _load(f'<mujoco><worldbody>{FLOOR}<body pos="0 0 0.3"><freejoint/>'
+                     '<geom type="box" size="0.1 0.2 0.05" mass="1"/></body></worldbody></mujoco>')
+    base = ContactSystem(TreeSystem(model))
+    q0 = model.neutral()
+
+    def stop(h, speed, mu):
+        system = eqx_set(base, mu)
+        sol = mbjax.simulate(system, SemiImplicitEuler(), q0.at[2].set(h),
+                             jnp.zeros(6).at[3].set(speed), dt=0.002, t1=0.6)
+        return jnp.stack([sol.qs[-1, 0], sol.qs[-1, 2]])
+
+    x = (0.3, 1.0, 0.3)
+    J = np.stack(jax.jit(jax.jacfwd(stop, argnums=(0, 1, 2)))(*x), 1)
+    f = jax.jit(stop)
+    h = 1e-5
+    for k in range(3):
+        up, down = list(x), list(x)
+        up[k] += h
+        down[k] -= h
+        np.testing.assert_allclose(J[:, k], (f(*up) - f(*down)) / (2 * h), rtol=1e-6, atol=1e-8)
+    touching = jax.grad(lambda h: stop(h, 0.0, 0.3)[1])(0.05)        # resting at first touch
+    assert np.isfinite(touching)
+
+
+def eqx_set(system, mu):
+    import equinox as eqx
+
+    friction = jnp.asarray(system.geoms.friction).at[:, 0].set(mu)
+    return eqx.tree_at(lambda s: s.geoms.friction, system, friction)
+
+
+def test_bad_geometry_is_named():
+    with pytest.raises(ValueError, match="size"):
+        Geoms(("sphere",), (0,), [[-0.1, 0, 0]])
+    with pytest.raises(ValueError, match="friction"):
+        Geoms(("sphere",), (0,), [[0.1, 0, 0]], friction=[[-1.0, 0, 0]])
+    with pytest.raises(ValueError, match="solref"):
+        Geoms(("sphere",), (0,), [[0.1, 0, 0]], solref=[[0.02, -1.0]])
+    with pytest.raises(ValueError, match="kinds"):
+        Geoms(("torus",), (0,), [[0.1, 0, 0]])
+    with pytest.raises(ValueError, match="condim"):
+        Geoms(("sphere",), (0,), [[0.1, 0, 0]], condim=[4])
+    with pytest.raises(ValueError, match="solimp"):
+        Geoms(("sphere",), (0,), [[0.1, 0, 0]], solimp=[[0.9, 1.5, 0.001, 0.5, 2]])
+    model = mbjax.model.random_tree(2, seed=0)
+    boxes = Geoms(("box", "box"), (0, 1), [[0.1] * 3] * 2)
+    with pytest.raises(ValueError, match="box and a box"):
+        ContactSystem(TreeSystem(model), boxes)
+    with pytest.raises(ValueError, match="iterations"):
+        SoftConstraints(iterations=0)
+    floor = ground_plane()
+    assert floor.kinds == ("plane",) and floor.bodies == (-1,)
