@@ -4,12 +4,13 @@ Each suite is run(out: Path, quick: bool) -> list of records, written as out/SUI
 out/SUITE.png. Peers (MuJoCo, Pinocchio, exudyn, Crocoddyl) are measured in the same process when installed.
 """
 
-from mbjax_harness.bench import (accuracy, compile_time, flexible, integrators, loops, rigid, speed, tfe, throughput,
-                         trajopt, wrist)
+from mbjax_harness.bench import (accuracy, compile_time, contact, flexible, integrators, loops, rigid, speed,
+                         tfe, throughput, trajopt, wrist)
 
 SUITES = {
     accuracy.NAME: accuracy.run,
     compile_time.NAME: compile_time.run,
+    contact.NAME: contact.run,
     flexible.NAME: flexible.run,
     integrators.NAME: integrators.run,
     loops.NAME: loops.run,

@@ -112,7 +112,7 @@ def test_joint_limit_holds_as_mujoco():
 
 def test_derivatives_through_landing_and_sliding_match_central_differences():
     """A box dropped from 0.3 m with a forward speed lands and slides: the derivatives of where
-    it stops in the drop height, the speed and the friction coefficient (the implicit function
+    it ends in the drop height, the speed and the friction coefficient (the implicit function
     theorem at each step's solution) agree with central differences; finite at first touch."""
     _, model = _load(f'<mujoco><worldbody>{FLOOR}<body pos="0 0 0.3"><freejoint/>'
                      '<geom type="box" size="0.1 0.2 0.05" mass="1"/></body></worldbody></mujoco>')
@@ -122,11 +122,12 @@ def test_derivatives_through_landing_and_sliding_match_central_differences():
     def stop(h, speed, mu):
         system = eqx_set(base, mu)
         sol = mbjax.simulate(system, SemiImplicitEuler(), q0.at[2].set(h),
-                             jnp.zeros(6).at[3].set(speed), dt=0.002, t1=0.6)
+                             jnp.zeros(6).at[3].set(speed), dt=0.002, t1=0.6, saveat=[0.6])
         return jnp.stack([sol.qs[-1, 0], sol.qs[-1, 2]])
 
     x = (0.3, 1.0, 0.3)
-    J = np.stack(jax.jit(jax.jacfwd(stop, argnums=(0, 1, 2)))(*x), 1)
+    jacobian = jax.jit(jax.jacfwd(stop, argnums=(0, 1, 2)))
+    J = np.stack(jacobian(*x), 1)
     f = jax.jit(stop)
     h = 1e-5
     for k in range(3):
@@ -134,8 +135,8 @@ def test_derivatives_through_landing_and_sliding_match_central_differences():
         up[k] += h
         down[k] -= h
         np.testing.assert_allclose(J[:, k], (f(*up) - f(*down)) / (2 * h), rtol=1e-6, atol=1e-8)
-    touching = jax.grad(lambda h: stop(h, 0.0, 0.3)[1])(0.05)        # resting at first touch
-    assert np.isfinite(touching)
+    touching = np.stack(jacobian(0.05, 0.0, 0.3), 1)       # resting at first touch, at rest
+    assert np.all(np.isfinite(touching))
 
 
 def eqx_set(system, mu):
@@ -143,6 +144,25 @@ def eqx_set(system, mu):
 
     friction = jnp.asarray(system.geoms.friction).at[:, 0].set(mu)
     return eqx.tree_at(lambda s: s.geoms.friction, system, friction)
+
+
+def test_penetration_and_an_unconverged_solve_are_named_failures():
+    """A box landing sinks past a tight `penetration` bound, and one Newton iteration does not
+    solve its four corners' contacts (the default run succeeds: the other tests)."""
+    from mbjax import Status
+
+    _, model = _load(f'<mujoco><worldbody>{FLOOR}<body pos="0 0 0.3"><freejoint/>'
+                     '<geom type="box" size="0.1 0.2 0.05" mass="1"/></body></worldbody></mujoco>')
+    q0 = model.neutral().at[2].set(0.3)
+
+    def status(**options):
+        sol = mbjax.simulate(ContactSystem(TreeSystem(model), **options), SemiImplicitEuler(),
+                             q0, jnp.zeros(6), dt=0.002, t1=0.3)
+        return int(sol.status), sol
+
+    flags, sol = status(penetration=1e-4, method=SoftConstraints(iterations=1))
+    assert flags & Status.PENETRATING and flags & Status.NOT_CONVERGED and not sol.ok
+    assert "penetrating" in sol.messages()[0] and "not converged" in sol.messages()[0]
 
 
 def test_bad_geometry_is_named():
@@ -164,5 +184,38 @@ def test_bad_geometry_is_named():
         ContactSystem(TreeSystem(model), boxes)
     with pytest.raises(ValueError, match="iterations"):
         SoftConstraints(iterations=0)
+    with pytest.raises(ValueError, match="penetration"):
+        ContactSystem(TreeSystem(model), penetration=0.0)
     floor = ground_plane()
     assert floor.kinds == ("plane",) and floor.bodies == (-1,)
+
+
+def test_geoms_are_kept_from_mjcf_and_swept_as_data():
+    """`from_mujoco` keeps the Ant's geoms on the bodies that carry them, with MuJoCo's
+    candidate pairs; the geometry is array data, so a vmapped sweep of the friction slides a
+    box as far as separate runs do, less the rougher the floor."""
+    import equinox as eqx
+
+    gymnasium = pytest.importorskip("gymnasium")
+    path = os.path.join(os.path.dirname(gymnasium.__file__), "envs/mujoco/assets/ant.xml")
+    m, model = _load(path)
+    geoms = model.geoms
+    assert geoms.kinds.count("capsule") == 12 and geoms.kinds[0] == "plane"
+    assert geoms.bodies[0] == -1 and len(geoms.pairs) == 13       # the floor with each geom
+    np.testing.assert_allclose(np.asarray(geoms.size)[:, :2], m.geom_size[:, :2])
+
+    _, box = _load(f'<mujoco><worldbody>{FLOOR}<body pos="0 0 0.049"><freejoint/>'
+                   '<geom type="box" size="0.1 0.2 0.05" mass="1"/></body></worldbody></mujoco>')
+    base = ContactSystem(TreeSystem(box))
+
+    def slide(mu):
+        friction = jnp.asarray(base.geoms.friction).at[:, 0].set(mu)
+        system = eqx.tree_at(lambda s: s.geoms.friction, base, friction)
+        sol = mbjax.simulate(system, SemiImplicitEuler(), box.neutral().at[2].set(0.049),
+                             jnp.zeros(6).at[3].set(1.0), dt=0.002, t1=0.3, saveat=[0.3])
+        return sol.qs[-1, 0]
+
+    mus = jnp.asarray([0.2, 0.5, 1.0])
+    swept = np.asarray(jax.jit(jax.vmap(slide))(mus))
+    assert np.all(np.diff(swept) < 0)
+    np.testing.assert_allclose(swept[1], float(slide(0.5)), rtol=1e-9)

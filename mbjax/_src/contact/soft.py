@@ -58,6 +58,12 @@ class AbstractContactModel(eqx.Module):
             reference: aref, (m,).
         """
 
+    def converged(self, mass: Array, free: Array, jacobian: Array, weight: Array,
+                  reference: Array) -> Array:
+        """Whether `solve` met its tolerance at these arguments (a boolean scalar); True for a
+        model solved in closed form (the default)."""
+        return jnp.array(True)
+
 
 def impedance(solimp: Array, position: Array) -> Array:
     """MuJoCo's impedance d(r) in [dmin, dmax]: a sigmoid of |r| / width with midpoint `mid`
@@ -150,6 +156,10 @@ class SoftConstraints(AbstractContactModel):
         return _soft_solve(mass, free, jacobian, weight, reference, self.iterations,
                            self.tolerance)
 
+    def converged(self, mass, free, jacobian, weight, reference):
+        return jax.lax.stop_gradient(_newton(mass, free, jacobian, weight, reference,
+                                             self.iterations, self.tolerance, True)[1])
+
 
 def _gradient(a, mass, free, jacobian, weight, reference, pushing):
     """The cost's gradient at a with the pushing rows held: M (a - a0) + J^T D (J a - aref)."""
@@ -196,8 +206,9 @@ def _cost(a, mass, free, jacobian, weight, reference):
     return 0.5 * (a - free) @ mass @ (a - free) + 0.5 * jnp.sum(weight * jnp.minimum(x, 0.0) ** 2)
 
 
-def _newton(mass, free, jacobian, weight, reference, iterations, tolerance):
-    """The minimizer, by Newton's method with exact line searches from a0."""
+def _newton(mass, free, jacobian, weight, reference, iterations, tolerance, report=False):
+    """The minimizer, by Newton's method with exact line searches from a0; with report, also
+    whether it met the tolerance within the iterations."""
     scale = jnp.maximum(free @ mass @ free, 1.0)
 
     def body(state):
@@ -211,7 +222,8 @@ def _newton(mass, free, jacobian, weight, reference, iterations, tolerance):
 
     a0 = free
     state = (a0, _cost(a0, mass, free, jacobian, weight, reference), jnp.array(False), 0)
-    return jax.lax.while_loop(lambda s: ~s[2] & (s[3] < iterations), body, state)[0]
+    a, _, done, _ = jax.lax.while_loop(lambda s: ~s[2] & (s[3] < iterations), body, state)
+    return (a, done) if report else a
 
 
 @functools.partial(jax.custom_jvp, nondiff_argnums=(5, 6))

@@ -15,6 +15,7 @@ from mbjax._src.model.joints import JOINT_TYPES
 from mbjax._src.model.model import Model
 from mbjax._src.rigid.kinematics import body_kinematics
 from mbjax._src.system.tree_system import AbstractTreeSystem
+from mbjax._src.system.status import Status
 from mbjax._src.system.system import AbstractSystem
 
 
@@ -153,6 +154,14 @@ class ContactSystem(AbstractSystem):
         limit_solref, limit_solimp: the limits' parameters (MuJoCo's defaults).
         q_reference: the configuration at which each body's and joint's inverse inertia scale
             is taken (MuJoCo's qpos0); the model's `home()` by default.
+        penetration: the deepest a contact may sink past its margin before `check` fails the
+            run (`Status.PENETRATING`) [m]; 0.05 by default.
+
+    Statuses:
+        `simulate`'s saved states are checked: a contact deeper than `penetration` fails the
+        run with `Status.PENETRATING`, a contact solve that missed its tolerance within its
+        iterations with `Status.NOT_CONVERGED`; the tree's own notes follow (a joint past its
+        position limit is not noted where the limits are held).
 
     Raises:
         TypeError: a tree that is not a `TreeSystem`, or a method that is not a contact model.
@@ -167,12 +176,13 @@ class ContactSystem(AbstractSystem):
     limit_solref: Array
     limit_solimp: Array
     timestep: float = eqx.field(static=True)
+    penetration: float = eqx.field(static=True)
     limited: tuple = eqx.field(static=True)      # the velocity coordinate of each limited joint
 
     def __init__(self, tree: AbstractTreeSystem, geoms: Geoms | None = None, *,
                  method: AbstractContactModel = SoftConstraints(), timestep: float = 0.002,
                  limits: bool = True, limit_solref=SOLREF, limit_solimp=SOLIMP,
-                 q_reference=None):
+                 q_reference=None, penetration: float = 0.05):
         if not (isinstance(tree, AbstractTreeSystem) and isinstance(tree.model, Model)):
             raise TypeError(f"tree must be a mbjax.rigid.TreeSystem, got {type(tree).__name__}")
         if not isinstance(method, AbstractContactModel):
@@ -191,6 +201,9 @@ class ContactSystem(AbstractSystem):
         if not (float(timestep) > 0):
             raise ValueError(f"timestep must be positive, got {timestep!r}")
         self.timestep = float(timestep)
+        if not (float(penetration) > 0):
+            raise ValueError(f"penetration must be positive, got {penetration!r}")
+        self.penetration = float(penetration)
         limited, iq = [], 0
         lower, upper = np.asarray(model.lower), np.asarray(model.upper)
         for k, kind in enumerate(model.joint_types):
@@ -272,17 +285,44 @@ class ContactSystem(AbstractSystem):
                     z.astype(bool)), found
         return tuple(jnp.concatenate(x) for x in zip(*parts, strict=True)), found
 
-    def solve(self, t, q: Array, v: Array) -> tuple[Array, Array, Contacts]:
-        """(v_dot, each row's force, the contacts) at (t, q, v)."""
-        model = self.model
+    def _problem(self, t, q: Array, v: Array):
+        """(M, a0, J, D, aref) of the contact model's problem at (t, q, v), and the contacts."""
         M = self.tree.mass_matrix(q)
         free = cho_solve(cholesky(M), -self.tree.bias(t, q, v))
         (J, position, invweight, solref, solimp, frictional), found = self._rows(q, v)
         D, aref = self.method.rows(J, position, J @ v, invweight, solref, solimp, frictional,
                                    self.timestep)
-        aref = aref - J @ _world_rate(model, v)
-        a, forces = self.method.solve(M, free, J, D, aref)
+        return (M, free, J, D, aref - J @ _world_rate(self.model, v)), found
+
+    def solve(self, t, q: Array, v: Array) -> tuple[Array, Array, Contacts]:
+        """The contact model's solution at a state.
+
+        Args:
+            t: time [s], a scalar.
+            q: configuration, shape (nq,).
+            v: velocity, shape (nv,).
+
+        Returns:
+            (v_dot, each constraint row's force (the contacts' pyramid edges, then the joint
+            limits), the candidate contacts).
+        """
+        problem, found = self._problem(t, q, v)
+        a, forces = self.method.solve(*problem)
         return a, forces, found
+
+    def check(self, t, q, u):
+        """`Status.PENETRATING` where a contact sinks deeper than `penetration`,
+        `Status.NOT_CONVERGED` where the contact solve missed its tolerance, and the tree's
+        flags (an int32 scalar)."""
+        problem, found = self._problem(t, q, u)
+        flags = jnp.where(self.method.converged(*problem), 0, int(Status.NOT_CONVERGED))
+        if found.geoms:
+            deep = jnp.any(found.distance - found.margin < -self.penetration)
+            flags = flags | jnp.where(deep, int(Status.PENETRATING), 0)
+        tree = self.tree.check(t, q, u)
+        if self.limited:          # the limits are held (softly, as MuJoCo's), not just noted
+            tree = tree & ~int(Status.LIMIT_EXCEEDED)
+        return (flags | tree).astype(jnp.int32)
 
     # -- AbstractSystem ---------------------------------------------------------------------------
 

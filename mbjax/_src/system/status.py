@@ -36,6 +36,9 @@ class Status(enum.IntFlag):
         PULLING: a contact held on the ground pulls on it (a negative normal force): the foot
             would have lifted off (`mbjax.contact.stance` with a friction coefficient).
         SLIPPING: a contact's force leaves its friction cone: the foot would have slipped.
+        PENETRATING: a contact found by `mbjax.contact.ContactSystem` sinks deeper than the
+            system's `penetration` bound: the steps or the contact's softness let a body
+            pass through another.
     """
 
     SUCCESS = 0
@@ -49,6 +52,7 @@ class Status(enum.IntFlag):
     SINGULAR = 128
     PULLING = 256
     SLIPPING = 512
+    PENETRATING = 1024
 
     @classmethod
     def failures(cls) -> int:
@@ -58,7 +62,7 @@ class Status(enum.IntFlag):
             The failure flags OR-ed into one int mask.
         """
         return (cls.NONFINITE | cls.NOT_CONVERGED | cls.SOLVER_FAILED | cls.CONSTRAINT_VIOLATED
-                | cls.INACCURATE | cls.SINGULAR | cls.PULLING | cls.SLIPPING)
+                | cls.INACCURATE | cls.SINGULAR | cls.PULLING | cls.SLIPPING | cls.PENETRATING)
 
 
 # the flags in order: `flagged_at` keeps the time each was first raised
