@@ -75,7 +75,7 @@ def agreement(name: str, common: dict) -> dict:
         heights.append(d.qpos[root])
     sol, timing = measure(partial(mbjax.simulate, system(m, model), integrator(m),
                                   jnp.asarray(m.qpos0), jnp.zeros(m.nv), dt=m.opt.timestep,
-                                  t1=DURATION), repeats=3)
+                                  t1=steps * m.opt.timestep), repeats=3)
     ours = np.asarray(sol.qs[1:, root])
     return {**common, "kind": "agreement", "model": name, "dt": float(m.opt.timestep),
             "integrator": type(integrator(m)).__name__, "steps": steps,
@@ -96,9 +96,10 @@ def throughput(batch: int, common: dict) -> list[dict]:
     contact = system(m, model)
     q0 = jnp.asarray(m.qpos0)
     v0s = jnp.stack([state_from_mujoco(model, m.qpos0, p)[1] for p in pushes])
+    t1 = steps * m.opt.timestep
     run = jax.jit(jax.vmap(lambda v: mbjax.simulate(contact, integrator(m), q0, v,
-                                                    dt=m.opt.timestep, t1=DURATION,
-                                                    saveat=[DURATION]).qs[-1]))
+                                                    dt=m.opt.timestep, t1=t1,
+                                                    saveat=[t1]).qs[-1]))
     final, timing = measure(run, v0s, repeats=3)
     records = [{**common, "kind": "throughput", "engine": "mbjax", "model": "ant",
                 "robots": batch, "steps": steps, "compile_s": timing.compile_s,
