@@ -65,10 +65,9 @@ class Geoms(eqx.Module):
             None to leave out parent and child.
 
     Raises:
-        ValueError: naming the field: an unknown kind, a negative size, a sphere, capsule or
-            box of zero size, negative friction, a solref mixing signs or with a nonpositive
-            time constant, a solimp outside MuJoCo's range, a condim other than 1 or 3, a pair
-            out of range.
+        ValueError: naming the field: an unknown kind, a negative size, a sphere or capsule
+            of zero radius, negative friction, margin or solmix, a solref mixing signs, a
+            solimp outside MuJoCo's range, a condim other than 1 or 3, a pair out of range.
     """
 
     kinds: tuple = eqx.field(static=True)
@@ -137,11 +136,10 @@ class Geoms(eqx.Module):
                 raise ValueError(f"{name} {what}, got {np.asarray(value).tolist()}")
         if _concrete(self.size):
             size = np.asarray(self.size)
-            for k, kind in enumerate(self.kinds):
-                used = {"sphere": 1, "capsule": 2, "box": 3}.get(kind, 0)
-                if used and not np.all(size[k, :used] > 0):
-                    raise ValueError(f"size of {kind} geom {self.names[k]!r} must be positive, got "
-                                     f"{size[k, :used].tolist()}")
+            for k, kind in enumerate(self.kinds):     # a radius (a segment, a box may be flat)
+                if kind in ("sphere", "capsule") and not size[k, 0] > 0:
+                    raise ValueError(f"size of {kind} geom {self.names[k]!r}: its radius must be "
+                                     f"positive, got {size[k, 0]}")
 
     @property
     def n(self) -> int:
