@@ -49,13 +49,16 @@ def _mujoco_run(m, steps, qvel=None):
 ], ids=["sphere-drop", "box-drop", "box-slide"])
 def test_dropped_and_slid_bodies_follow_mujoco(body, qvel, atol, rest):
     """MuJoCo's Euler step is semi-implicit Euler; the same soft constraints give the same
-    motion (the slide's remaining difference is the two integrators' free-joint coordinates:
+    motion, from the file's geoms or from the same ones written in code (the slide's remaining difference is the two integrators' free-joint coordinates:
     mbjax's body-frame velocity, MuJoCo's world-frame one)."""
     xml = (f'<mujoco><worldbody>{FLOOR}<body pos="0 0 0.3"><freejoint/>{body}</body>'
            '</worldbody></mujoco>')
     m, model = _load(xml)
     reference = _mujoco_run(m, 400, qvel)
-    system = ContactSystem(TreeSystem(model), timestep=m.opt.timestep)
+    geoms = None
+    if "sphere" in body:              # the same geometry written in code: a ball and a floor
+        geoms = Geoms(("sphere",), (0,), [[0.1, 0.0, 0.0]]).join(ground_plane())
+    system = ContactSystem(TreeSystem(model), geoms, timestep=m.opt.timestep)
     v0 = np.zeros(6) if qvel is None else state_from_mujoco(model, m.qpos0, np.asarray(qvel))[1]
     sol = mbjax.simulate(system, SemiImplicitEuler(), jnp.asarray(m.qpos0), jnp.asarray(v0),
                          dt=m.opt.timestep, t1=0.8)

@@ -147,9 +147,17 @@ class Geoms(eqx.Module):
         return len(self.kinds)
 
     def join(self, other: "Geoms", pairs=None) -> "Geoms":
-        """These geoms and `other`'s, with `pairs` (indices into the joined list) or each one's
-        pairs plus every pair of one geom of each that the default rule allows (different
-        bodies, not both the ground)."""
+        """These geoms and `other`'s (a floor: `model.geoms.join(ground_plane())`).
+
+        Args:
+            other: the geoms to add, after these.
+            pairs: the pairs that may touch, indices into the joined list; None for each
+                one's pairs and every pair of one geom of each on different bodies, not both
+                the ground.
+
+        Returns:
+            The joined `Geoms`.
+        """
         n = self.n
         if pairs is None:
             across = [(i, n + j) for i in range(n) for j in range(other.n)
@@ -157,11 +165,13 @@ class Geoms(eqx.Module):
                       and not (self.bodies[i] == GROUND and other.bodies[j] == GROUND)]
             pairs = [*self.pairs, *((n + i, n + j) for i, j in other.pairs), *across]
         return Geoms(self.kinds + other.kinds, self.bodies + other.bodies,
-                     jnp.concatenate([self.size, other.size]) if not _concrete(self.size)
-                     else np.concatenate([self.size, other.size]),
-                     **{f: _cat(getattr(self, f), getattr(other, f))
-                        for f in ("position", "rotation", "friction", "solref", "solimp",
-                                  "solmix", "margin", "gap")},
+                     _cat(self.size, other.size),
+                     position=_cat(self.position, other.position),
+                     rotation=_cat(self.rotation, other.rotation),
+                     friction=_cat(self.friction, other.friction),
+                     solref=_cat(self.solref, other.solref), solimp=_cat(self.solimp, other.solimp),
+                     solmix=_cat(self.solmix, other.solmix), margin=_cat(self.margin, other.margin),
+                     gap=_cat(self.gap, other.gap),
                      condim=self.condim + other.condim, names=self.names + other.names,
                      pairs=pairs)
 
