@@ -74,8 +74,7 @@ def test_ant_accelerations_and_fall_follow_mujoco():
     gymnasium = pytest.importorskip("gymnasium")
     path = os.path.join(os.path.dirname(gymnasium.__file__), "envs/mujoco/assets/ant.xml")
     m, model = _load(path)
-    system = ContactSystem(TreeSystem(model), timestep=m.opt.timestep,
-                           q_reference=jnp.asarray(m.qpos0))
+    system = ContactSystem(TreeSystem(model), timestep=m.opt.timestep)   # neutral(): qpos0
     acceleration = jax.jit(lambda q, v: system.acceleration(0.0, q, v))
     d = mujoco.MjData(m)
     pushing = 0

@@ -153,7 +153,8 @@ class ContactSystem(AbstractSystem):
             and URDF's limited joints) in their ranges, as MuJoCo does; True by default.
         limit_solref, limit_solimp: the limits' parameters (MuJoCo's defaults).
         q_reference: the configuration at which each body's and joint's inverse inertia scale
-            is taken (MuJoCo's qpos0); the model's `home()` by default.
+            is taken (MuJoCo's qpos0); the model's `neutral()` by default, which is MuJoCo's
+            qpos0 for an MJCF file whose hinges and slides have no `ref`.
         penetration: the deepest a contact may sink past its margin before `check` fails the
             run (`Status.PENETRATING`) [m]; 0.05 by default.
 
@@ -214,7 +215,8 @@ class ContactSystem(AbstractSystem):
         self.limited = tuple(limited)
         self.limit_solref = jnp.asarray(limit_solref, dtype=float)
         self.limit_solimp = jnp.asarray(limit_solimp, dtype=float)
-        q_reference = model.home() if q_reference is None else jnp.asarray(q_reference, float)
+        q_reference = (model.neutral() if q_reference is None
+                       else jnp.asarray(q_reference, float))
         self.invweight, self.dof_invweight = _invweights(model, q_reference)
 
     @property
