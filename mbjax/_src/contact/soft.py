@@ -23,6 +23,8 @@ from mbjax._src.linalg import cho_solve, cholesky
 
 # MuJoCo's bounds on the impedance and its smallest value
 MIN_IMPEDANCE, MAX_IMPEDANCE, MIN_VALUE = 1e-4, 0.9999, 1e-15
+# the line search stops where the cost's slope is below this fraction of its slope at the start
+LINE_TOLERANCE = 1e-3
 
 
 class AbstractContactModel(eqx.Module):
@@ -172,9 +174,11 @@ def _hessian(mass, jacobian, weight, pushing):
 
 
 def _line_search(a, d, mass, free, jacobian, weight, reference):
-    """The exact minimizer along d of the convex piecewise-quadratic cost: the root of its
-    derivative, a nondecreasing piecewise-linear function of the step, by Newton's method
-    on the current piece kept inside a bracket (MuJoCo's Newton line search)."""
+    """The minimizer along d of the convex piecewise-quadratic cost: the root of its
+    derivative, a nondecreasing piecewise-linear function of the step, by Newton's method on
+    the current piece kept inside a bracket, until the derivative falls below LINE_TOLERANCE
+    of its value at the start (MuJoCo's Newton line search and its `ls_tolerance`); the Newton
+    iterations around it converge whatever the tolerance."""
     Md = mass @ d
     dMd, gM = d @ Md, (a - free) @ Md
     x0, jd = jacobian @ a - reference, jacobian @ d
@@ -184,6 +188,8 @@ def _line_search(a, d, mass, free, jacobian, weight, reference):
         on = weight * (x < 0)
         return gM + alpha * dMd + jnp.sum(on * x * jd), dMd + jnp.sum(on * jd * jd)
 
+    enough = LINE_TOLERANCE * jnp.abs(slope(0.0)[0])          # of the slope at the start
+
     def body(state):
         alpha, lo, hi, _, i = state
         g, h = slope(alpha)
@@ -191,8 +197,9 @@ def _line_search(a, d, mass, free, jacobian, weight, reference):
         step = alpha - g / jnp.maximum(h, MIN_VALUE)
         inside = (step > lo) & (step < hi)
         middle = jnp.where(jnp.isfinite(hi), 0.5 * (lo + hi), 2 * jnp.maximum(alpha, 1.0))
-        new = jnp.where(inside, step, middle)
-        done = (g == 0) | (jnp.abs(new - alpha) <= 1e-14 * jnp.maximum(1.0, jnp.abs(alpha)))
+        small = jnp.abs(g) <= enough
+        new = jnp.where(small, alpha, jnp.where(inside, step, middle))
+        done = small | (jnp.abs(new - alpha) <= 1e-14 * jnp.maximum(1.0, jnp.abs(alpha)))
         return new, lo, hi, done, i + 1
 
     state = (jnp.ones_like(dMd), jnp.zeros_like(dMd), jnp.full_like(dMd, jnp.inf),
