@@ -13,6 +13,7 @@ from mbjax._src.contact.soft import AbstractContactModel, SoftConstraints
 from mbjax._src.linalg import cho_solve, cholesky
 from mbjax._src.model.joints import JOINT_TYPES
 from mbjax._src.model.model import Model
+from mbjax._src.rigid.dynamics import mass_matrix
 from mbjax._src.rigid.kinematics import body_kinematics
 from mbjax._src.system.tree_system import AbstractTreeSystem
 from mbjax._src.system.status import Status
@@ -98,10 +99,8 @@ def _invweights(model, q: Array) -> tuple[Array, Array]:
     """MuJoCo's `body_invweight0` (translational) and `dof_invweight0` at q: the mean diagonal
     of J M^-1 J^T for each body's centre of mass (its rotational mean where the translational
     one vanishes), and of each joint's block of M^-1."""
-    from mbjax._src.rigid.dynamics import mass_matrix
-
     kin = body_kinematics(model, q, jnp.zeros(model.nv, q.dtype))
-    Minv = jnp.linalg.inv(mass_matrix(model, q))
+    Minv = cho_solve(cholesky(mass_matrix(model, q)), jnp.eye(model.nv, dtype=q.dtype))
     S = model.flat_v(jnp.swapaxes(kin.S, -1, -2))                          # (nv, 6)
     path = jnp.asarray(model.topology.path_matrix()[:, model.dof_body()], float)   # (n, nv)
     com = kin.p + jnp.einsum("kij,kj->ki", kin.R, model.com)
@@ -128,12 +127,13 @@ def _world_rate(model, v: Array) -> Array:
     """What each free joint's velocity rate gains in world components: the rows' accelerations
     are MuJoCo's, J a_MuJoCo = J (a + this), with a free joint's linear velocity in world
     components, whose rate differs from that of mbjax's body components by omega x v."""
-    out = jnp.zeros_like(v)
+    pieces, done = [], 0
     for k, kind in enumerate(model.joint_types):
-        if kind == "free":
+        if kind == "free":                          # (omega; v): omega x v on the v rows
             i = int(np.searchsorted(model.dof_body(), k))
-            out = out.at[i + 3:i + 6].set(jnp.cross(v[i:i + 3], v[i + 3:i + 6]))
-    return out
+            pieces += [jnp.zeros(i + 3 - done, v.dtype), jnp.cross(v[i:i + 3], v[i + 3:i + 6])]
+            done = i + 6
+    return jnp.concatenate([*pieces, jnp.zeros(model.nv - done, v.dtype)])
 
 
 class ContactSystem(AbstractSystem):
@@ -276,7 +276,7 @@ class ContactSystem(AbstractSystem):
             iq, iv = (np.asarray(x) for x in zip(*self.limited, strict=True))
             below, above = q[iq] - model.lower[iq], model.upper[iq] - q[iq]
             near = jnp.where(below < above, 1.0, -1.0)
-            J = jnp.zeros((iq.size, model.nv), q.dtype).at[np.arange(iq.size), iv].set(near)
+            J = near[:, None] * np.eye(model.nv)[iv]                 # no scatter in a step
             parts.append((J, jnp.minimum(below, above), self.dof_invweight[iv],
                           jnp.broadcast_to(self.limit_solref, (iq.size, 2)),
                           jnp.broadcast_to(self.limit_solimp, (iq.size, 5)),
