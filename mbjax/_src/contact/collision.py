@@ -26,13 +26,16 @@ def _normalize(x: Array) -> tuple[Array, Array]:
     return x / jnp.sqrt(safe), norm[..., 0]
 
 
+def _default_tangent(n: Array) -> Array:
+    """y, or z where n is within 60 degrees of y (MuJoCo's `mju_makeFrame`)."""
+    return jnp.where(jnp.abs(n[1]) < 0.5, jnp.array([0.0, 1.0, 0.0]), jnp.array([0.0, 0.0, 1.0]))
+
+
 def frame_from_normal(n: Array, tangent: Array | None = None) -> Array:
     """The contact frame (3, 3), rows (normal, tangent, normal x tangent): the tangent is
-    `tangent` made orthogonal to n, or y (z where n is within 60 degrees of y) as MuJoCo's
-    `mju_makeFrame`."""
+    `tangent` made orthogonal to n, or `_default_tangent`'s."""
     if tangent is None:
-        tangent = jnp.where(jnp.abs(n[1]) < 0.5, jnp.array([0.0, 1.0, 0.0]),
-                            jnp.array([0.0, 0.0, 1.0]))
+        tangent = _default_tangent(n)
     t, _ = _normalize(tangent - n * jnp.dot(n, tangent))
     return jnp.stack([n, t, jnp.cross(n, t)])
 
@@ -53,9 +56,7 @@ def plane_capsule(plane, capsule):
     (R1, p1, _), (R2, p2, s2) = plane, capsule
     n, axis = R1[:, 2], R2[:, 2]
     along = axis - n * jnp.dot(n, axis)            # the capsule's axis in the plane
-    fallback = jnp.where(jnp.abs(n[1]) < 0.5, jnp.array([0.0, 1.0, 0.0]),
-                         jnp.array([0.0, 0.0, 1.0]))
-    tangent = jnp.where(jnp.dot(along, along) < 1e-20, fallback, along)
+    tangent = jnp.where(jnp.dot(along, along) < 1e-20, _default_tangent(n), along)
     frame = frame_from_normal(n, tangent)
     ends = p2 + jnp.stack([axis, -axis]) * s2[1]
     dist, pos = (jnp.stack(x) for x in zip(*(_plane_point(n, p1, e, s2[0]) for e in ends)))

@@ -14,6 +14,7 @@ from mbjax._src.linalg import cho_solve, cholesky
 from mbjax._src.model.joints import JOINT_TYPES
 from mbjax._src.model.model import Model
 from mbjax._src.rigid.dynamics import mass_matrix
+from mbjax._src.rigid.frames import on_bodies, point_columns
 from mbjax._src.rigid.kinematics import body_kinematics
 from mbjax._src.system.tree_system import AbstractTreeSystem
 from mbjax._src.system.status import Status
@@ -39,11 +40,6 @@ class Contacts(eqx.Module):
     margin: Array
     geoms: tuple = eqx.field(static=True)
 
-    @property
-    def touching(self) -> Array:
-        """Whether each contact pushes: its distance is below its margin."""
-        return self.distance < self.margin
-
 
 def _groups(geoms: Geoms) -> list:
     """The detected pairs grouped by their kinds: [(kinds, (P, 2) pair indices)]."""
@@ -56,15 +52,6 @@ def _groups(geoms: Geoms) -> list:
                              f"detected kinds: {sorted(PAIRS)}")
         groups.setdefault(kinds, []).append((i, j))
     return [(kinds, np.asarray(p, dtype=int)) for kinds, p in groups.items()]
-
-
-def _world(geoms: Geoms, R: Array, p: Array, index: np.ndarray):
-    """World rotations and origins of the geoms `index`, from the bodies' poses."""
-    body = np.asarray(geoms.bodies)[index]
-    on_ground = body < 0
-    Rb = jnp.where(on_ground[:, None, None], jnp.eye(3, dtype=R.dtype), R[np.maximum(body, 0)])
-    pb = jnp.where(on_ground[:, None], 0.0, p[np.maximum(body, 0)])
-    return (Rb @ geoms.rotation[index], pb + jnp.einsum("gij,gj->gi", Rb, geoms.position[index]))
 
 
 def detect(geoms: Geoms, R: Array, p: Array) -> Contacts:
@@ -81,9 +68,10 @@ def detect(geoms: Geoms, R: Array, p: Array) -> Contacts:
     """
     out = []
     for kinds, pairs in _groups(geoms):
-        poses = [(*_world(geoms, R, p, pairs[:, s]), geoms.size[pairs[:, s]]) for s in (0, 1)]
+        poses = [(*on_bodies(R, p, np.asarray(geoms.bodies)[g], geoms.rotation[g],
+                             geoms.position[g]), geoms.size[g]) for g in pairs.T]
         dist, pos, frame = jax.vmap(PAIRS[kinds])(*poses)
-        margin = pair_parameters(geoms, pairs[:, 0], pairs[:, 1])[3]
+        margin = pair_parameters(geoms, *pairs.T)[3]
         k = COUNT[kinds]
         out.append((dist.reshape(-1), pos.reshape(-1, 3), frame.reshape(-1, 3, 3),
                     jnp.repeat(margin, k), np.repeat(pairs, k, axis=0)))
@@ -101,11 +89,10 @@ def _invweights(model, q: Array) -> tuple[Array, Array]:
     one vanishes), and of each joint's block of M^-1."""
     kin = body_kinematics(model, q, jnp.zeros(model.nv, q.dtype))
     Minv = cho_solve(cholesky(mass_matrix(model, q)), jnp.eye(model.nv, dtype=q.dtype))
-    S = model.flat_v(jnp.swapaxes(kin.S, -1, -2))                          # (nv, 6)
     path = jnp.asarray(model.topology.path_matrix()[:, model.dof_body()], float)   # (n, nv)
     com = kin.p + jnp.einsum("kij,kj->ki", kin.R, model.com)
-    w = S[None, :, :3] * path[:, :, None]                                   # (n, nv, 3)
-    v = (S[None, :, 3:] + jnp.cross(S[None, :, :3], com[:, None, :])) * path[:, :, None]
+    columns = point_columns(model, kin.S, com) * path[:, :, None]         # (n, nv, 6)
+    w, v = columns[..., :3], columns[..., 3:]
     tran = jnp.einsum("kci,cd,kdi->k", v, Minv, v) / 3
     rot = jnp.einsum("kci,cd,kdi->k", w, Minv, w) / 3
     body = jnp.where(tran > 1e-15, tran, rot)
@@ -138,7 +125,7 @@ def _world_rate(model, v: Array) -> Array:
 
 class ContactSystem(AbstractSystem):
     """A rigid tree on its geoms: contacts found each step between the pairs of geoms that may
-    touch (`mbjax.contact.detect`), and limited joints held in their ranges, all solved by one
+    touch (`ContactSystem.contacts`), and limited joints held in their ranges, all solved by one
     contact model (`SoftConstraints`, MuJoCo's, by default). `mbjax.simulate` runs it like any
     other system (MuJoCo's own integrator is `mbjax.integrate.SemiImplicitEuler`).
 
@@ -165,8 +152,10 @@ class ContactSystem(AbstractSystem):
         position limit is not noted where the limits are held).
 
     Raises:
-        TypeError: a tree that is not a `TreeSystem`, or a method that is not a contact model.
-        ValueError: no geoms and no limits, or a pair of geom kinds that is not detected.
+        TypeError: a tree that is not a `TreeSystem`, geoms that are not `Geoms`, or a method
+            that is not a contact model.
+        ValueError: a pair of geom kinds that is not detected, a geom on a body the model
+            lacks, a nonpositive timestep or penetration.
     """
 
     tree: AbstractTreeSystem
@@ -190,11 +179,11 @@ class ContactSystem(AbstractSystem):
             raise TypeError(f"method must be a contact model such as SoftConstraints(), got "
                             f"{method!r}")
         model = tree.model
-        geoms = getattr(model, "geoms", None) if geoms is None else geoms
+        geoms = model.geoms if geoms is None else geoms
         if geoms is None:
             geoms = Geoms((), (), np.zeros((0, 3)))
         if not isinstance(geoms, Geoms):
-            raise TypeError(f"geoms must be mbjax.contact.Geoms, got {type(geoms).__name__}")
+            raise TypeError(f"geoms must be mbjax.model.Geoms, got {type(geoms).__name__}")
         _groups(geoms)                                  # a ValueError for an undetected pair
         if any(b >= model.n for b in geoms.bodies):
             raise ValueError(f"geoms: a body index beyond the model's {model.n} bodies")
@@ -236,21 +225,19 @@ class ContactSystem(AbstractSystem):
         model, geoms = self.model, self.geoms
         kin = body_kinematics(model, q, v)
         found = detect(geoms, kin.R, kin.p)
-        S = model.flat_v(jnp.swapaxes(kin.S, -1, -2))                       # (nv, 6)
         path = model.topology.path_matrix()[:, model.dof_body()].astype(float)   # (n, nv)
         parts = []
         if found.geoms:
             i, j = np.asarray(found.geoms).T
             body = np.asarray(geoms.bodies)
+            linear = point_columns(model, kin.S, found.position)[..., 3:]     # (c, nv, 3)
 
-            def point_jacobian(b: np.ndarray, x: Array) -> Array:     # (c, 3, nv)
-                mask = jnp.asarray(np.where(b[:, None] >= 0, path[np.maximum(b, 0)], 0.0))
-                lin = S[None, :, 3:] + jnp.cross(S[None, :, :3], x[:, None, :])
-                return jnp.swapaxes(lin * mask[:, :, None], -1, -2)
+            def support(b: np.ndarray) -> np.ndarray:        # the columns on b's path, (c, nv)
+                return np.where(b[:, None] >= 0, path[np.maximum(b, 0)], 0.0)
 
-            J = found.frame @ (point_jacobian(body[j], found.position)
-                               - point_jacobian(body[i], found.position))  # (c, 3, nv)
-            friction, solref, solimp, _, _ = pair_parameters(geoms, i, j)
+            relative = linear * (support(body[j]) - support(body[i]))[..., None]
+            J = found.frame @ jnp.swapaxes(relative, -1, -2)                  # (c, 3, nv)
+            friction, solref, solimp, _ = pair_parameters(geoms, i, j)
             condim = np.maximum(np.asarray(geoms.condim)[i], np.asarray(geoms.condim)[j])
             weight = self.invweight[np.maximum(body[i], 0)] * (body[i] >= 0) + \
                 self.invweight[np.maximum(body[j], 0)] * (body[j] >= 0)

@@ -244,16 +244,16 @@ def ground_plane(normal=(0.0, 0.0, 1.0), height: float = 0.0, **parameters) -> G
 
 def pair_parameters(geoms: Geoms, i: np.ndarray, j: np.ndarray):
     """Pairs' contact parameters from their two geoms', as MuJoCo 4 combines them: the larger
-    friction (each component), the sum of the margins and of the gaps, and solref and solimp
-    averaged with weights solmix (the smaller components where the solrefs are direct,
-    negative values).
+    friction (each component), the sum of the margins (MuJoCo 4 leaves the gaps out of the
+    margin a contact pushes within), and solref and solimp averaged with weights solmix (the
+    smaller components where the solrefs are direct, negative values).
 
     Args:
         geoms: the geometry.
         i, j: the pairs' first and second geoms, NumPy int arrays (P,).
 
     Returns:
-        (friction (P, 3), solref (P, 2), solimp (P, 5), margin (P,), gap (P,)).
+        (friction (P, 3), solref (P, 2), solimp (P, 5), margin (P,)).
     """
     s1, s2 = geoms.solmix[i], geoms.solmix[j]
     total = s1 + s2
@@ -263,6 +263,4 @@ def pair_parameters(geoms: Geoms, i: np.ndarray, j: np.ndarray):
                        jnp.minimum(r1, r2))
     solimp = mix * geoms.solimp[i] + (1 - mix) * geoms.solimp[j]
     friction = jnp.maximum(geoms.friction[i], geoms.friction[j])
-    margin = geoms.margin[i] + geoms.margin[j]
-    gap = geoms.gap[i] + geoms.gap[j]
-    return friction, solref, solimp, margin, gap
+    return friction, solref, solimp, geoms.margin[i] + geoms.margin[j]

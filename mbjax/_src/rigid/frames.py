@@ -102,12 +102,29 @@ def _frame_jacobian(model: Model, q: Array, body: Array, p_f: Array) -> Array:
     kin = body_kinematics(model, q, jnp.zeros(model.nv, q.dtype))
     k = jnp.maximum(body, 0)
     x = kin.p[k] + kin.R[k] @ p_f                        # the frame origin, world
-    S = model.flat_v(jnp.swapaxes(kin.S, -1, -2))          # (nv, 6) at the ground origin
-    w, v0 = S[:, :3], S[:, 3:]
     path = jnp.asarray(model.topology.path_matrix()[:, model.dof_body()], bool)   # (n, nv)
     support = path[k] & (body >= 0)
-    columns = jnp.concatenate([w, v0 + jnp.cross(w, x)], -1)
-    return jnp.where(support[:, None], columns, 0.0).T
+    return jnp.where(support[:, None], point_columns(model, kin.S, x), 0.0).T
+
+
+def point_columns(model: Model, S: Array, x: Array) -> Array:
+    """Each joint column's (angular; linear) velocity of the world points x (..., 3) moving with
+    it, (..., nv, 6): (w, v_O + w x x) of the columns S (n, 6, width) at the ground origin.
+    A point's Jacobian keeps the columns on its body's path (Jerkovsky 1978 eq 1)."""
+    S = model.flat_v(jnp.swapaxes(S, -1, -2))                  # (nv, 6)
+    w, v0 = S[:, :3], S[:, 3:]
+    return jnp.concatenate([jnp.broadcast_to(w, (*x.shape[:-1], *w.shape)),
+                            v0 + jnp.cross(w, x[..., None, :])], -1)
+
+
+def on_bodies(R: Array, p: Array, bodies, rotation: Array, translation: Array):
+    """World poses of frames fixed to `bodies` (a NumPy int array, -1 for the ground) at
+    `rotation` (m, 3, 3) and `translation` (m, 3) in them, from the bodies' poses R, p."""
+    bodies = np.asarray(bodies, dtype=int)
+    on_ground = jnp.asarray(bodies < 0)[:, None]
+    R_b = jnp.where(on_ground[..., None], jnp.eye(3, dtype=R.dtype), R[np.maximum(bodies, 0)])
+    p_b = jnp.where(on_ground, 0.0, p[np.maximum(bodies, 0)])
+    return R_b @ rotation, p_b + jnp.einsum("mij,mj->mi", R_b, translation)
 
 
 @jax.jit
@@ -115,8 +132,4 @@ def frame_poses(model: Model, q: Array) -> tuple[Array, Array]:
     """World orientations (m, 3, 3) and origins (m, 3) of all the named frames
     (`Model.frame_names`) at once."""
     R, p = forward_kinematics(model, q)
-    parents = np.asarray(model.frame_parents, dtype=int)
-    on_ground = jnp.asarray(parents < 0)[:, None]
-    R_b = jnp.where(on_ground[..., None], jnp.eye(3, dtype=q.dtype), R[np.maximum(parents, 0)])
-    p_b = jnp.where(on_ground, 0.0, p[np.maximum(parents, 0)])
-    return R_b @ model.frame_rotation, p_b + jnp.einsum("mij,mj->mi", R_b, model.frame_translation)
+    return on_bodies(R, p, model.frame_parents, model.frame_rotation, model.frame_translation)
