@@ -15,13 +15,13 @@ random qvel and qfrc_applied) `compare` sets both engines side by side:
                     xpos/xmat and site_xpos/site_xmat: max abs difference.
 
 MuJoCo computes what mbjax models and nothing else: `comparable` disables contacts, constraints
-(limits, dry friction, equality), actuator forces and springs by flag (mjDSBL_CONTACT,
-mjDSBL_CONSTRAINT, mjDSBL_ACTUATION, mjDSBL_SPRING) and zeroes, in a copy of the model, what
-mbjax does not model but mjDSBL_DAMPER would not remove alone or would remove with the joint
-damping mbjax does model: tendon damping and armature, polynomial damping, gravity compensation,
-fluid forces (opt.density, viscosity) and free joints' translational armature; sleeping is
-disabled. Joint damping, armature (actuators' included), gravity and the rigid-body dynamics
-stay on. A row's note is what the model's `from_mujoco` warning listed as ignored.
+(limits, dry friction, equality) and actuator forces by flag (mjDSBL_CONTACT,
+mjDSBL_CONSTRAINT, mjDSBL_ACTUATION) and zeroes, in a copy of the model, what mbjax does not
+model but mjDSBL_DAMPER or mjDSBL_SPRING would not remove alone or would remove with the joint
+damping and springs mbjax does model: tendon damping, armature and springs, polynomial damping
+and springs, ball and free joints' springs, gravity compensation, fluid forces (opt.density,
+viscosity) and free joints' translational armature; sleeping is disabled. Joint damping, hinge
+and slide springs, armature (actuators' included), gravity and the rigid-body dynamics stay on. A row's note is what the model's `from_mujoco` warning listed as ignored.
 
 `mbjax reproduce model-corpus` (`mbjax_harness.reproduce.model_corpus`) writes the rows with the URDF
 corpus's.
@@ -89,13 +89,16 @@ def comparable(mjmodel):
     m = copy.deepcopy(mjmodel)
     bits = mujoco.mjtDisableBit
     m.opt.disableflags |= int(bits.mjDSBL_CONTACT | bits.mjDSBL_CONSTRAINT
-                              | bits.mjDSBL_ACTUATION | bits.mjDSBL_SPRING)
+                              | bits.mjDSBL_ACTUATION)
     m.opt.enableflags &= ~int(mujoco.mjtEnableBit.mjENBL_SLEEP)
     m.opt.density = m.opt.viscosity = 0.0
     for j in np.flatnonzero(m.jnt_type == int(mujoco.mjtJoint.mjJNT_FREE)):
         m.dof_armature[m.jnt_dofadr[j]:m.jnt_dofadr[j] + 3] = 0.0    # translational armature
+    scalar = np.isin(m.jnt_type, (int(mujoco.mjtJoint.mjJNT_HINGE), int(mujoco.mjtJoint.mjJNT_SLIDE)))
+    m.jnt_stiffness[~scalar] = 0.0                        # ball and free joints' springs
     for field in ("tendon_damping", "tendon_armature", "tendon_dampingpoly", "dof_dampingpoly",
-                  "actuator_dampingpoly", "body_gravcomp"):
+                  "actuator_dampingpoly", "body_gravcomp", "tendon_stiffness",
+                  "tendon_stiffnesspoly", "jnt_stiffnesspoly"):
         if getattr(m, field, None) is not None:
             getattr(m, field)[:] = 0.0
     return m

@@ -3,7 +3,7 @@ several joints per body, ball and free joints, inertias, joint data, connect and
 the ignored-features warning, and the corpus of MJCF models shipped by the installed packages.
 
 Every dynamic comparison runs `mbjax_harness.reproduce.mjcf_corpus.compare`: MuJoCo with contacts,
-constraints, actuators and springs disabled (joint damping and armature kept) at a random state
+constraints and actuators disabled (joint damping, hinge and slide springs and armature kept) at a random state
 (qpos, qvel, qfrc_applied), mbjax's `forward_dynamics` mapped to MuJoCo's qacc by `jax.jvp` of
 `state_to_mujoco`, relative difference below 1e-8; poses are `mbjax.rigid.frame_pose` of every body
 and site against xpos/xmat and site_xpos/site_xmat.
@@ -440,7 +440,7 @@ def test_ignored_features_are_named_in_one_warning():
         model = mbjax.model.from_mujoco(mjmodel)
     assert len(caught) == 1 and issubclass(caught[0].category, ModelWarning)
     message = str(caught[0].message)
-    for what in ("contacts in TreeSystem(model) (2 geom pairs", "actuator forces (1", "tendons (1)", "joint springs (1)",
+    for what in ("contacts in TreeSystem(model) (2 geom pairs", "actuator forces (1", "tendons (1)",
                  "joint, tendon, flex and distance equality constraints (1)",
                  "connect and weld equality constraints in TreeSystem(model) (1; they are "
                  "model.closures"):
@@ -448,6 +448,44 @@ def test_ignored_features_are_named_in_one_warning():
     assert model.nv == 2
     assert len(model.closures) == 1 and model.closures[0].kind == "spherical"
     _check(mjmodel, model)       # with what mbjax ignores switched off in MuJoCo
+
+
+SPRINGS = f"""
+<mujoco><compiler angle="radian"/>{NO_CONTACT}<worldbody>
+ <body name="a" pos="0 0 1"><joint name="h" axis="0 1 0" stiffness="30" springref="0.4" ref="0.2"
+   damping="0.3"/><geom type="capsule" size="0.05" fromto="0 0 0 0.3 0 0"/>
+  <body name="b" pos="0.3 0 0"><joint name="s" type="slide" axis="1 0 0" stiffness="50"
+    springref="-0.1"/><geom type="sphere" size="0.1"/>
+   <body name="c" pos="0.2 0 0"><joint name="ball" type="ball" stiffness="5"/>
+    <geom type="box" size="0.1 0.05 0.02"/></body>
+  </body>
+ </body>
+</worldbody></mujoco>"""
+
+
+def test_hinge_and_slide_springs_are_modelled_as_mujoco():
+    """Hinge and slide springs (stiffness, springref, with a joint ref) give MuJoCo's qacc; a
+    ball joint's spring is named as left out, and the tree's energy counts the springs'."""
+    mjmodel = mujoco.MjModel.from_xml_string(SPRINGS)
+    with pytest.warns(ModelWarning, match=r"springs on ball and free joints \(1\)"):
+        model = mbjax.model.from_mujoco(mjmodel)
+    np.testing.assert_array_equal(model.stiffness, [30, 50, 0, 0, 0])
+    np.testing.assert_array_equal(model.spring_reference[:2], [0.4, -0.1])
+    _check(mjmodel, model)
+    # the energy with the springs is conserved along an undamped, unforced motion
+    undamped = eqx.tree_at(lambda m: m.damping, model, jnp.zeros(model.nv))
+    q = jnp.concatenate([jnp.array([0.7, 0.1]), jnp.array([0.9, 0.1, 0.3, 0.3])])
+    q = q.at[2:].set(q[2:] / jnp.linalg.norm(q[2:]))
+    system = TreeSystem(undamped)
+    sol = mbjax.simulate(system, mbjax.integrate.RK4(), q, jnp.array([0.0, 0.5, 1.0, 0.0, -1.0]),
+                         dt=1e-3, t1=0.5, saveat=jnp.array([0.0, 0.5]))
+    energy = jax.jit(TreeSystem.energy)
+    start, end = (energy(system, sol.qs[i], sol.us[i]) for i in (0, -1))
+    assert abs(end - start) < 1e-8 * abs(start), (start, end)
+    spring = 0.5 * (30 * (0.7 - 0.4) ** 2 + 50 * (0.1 + 0.1) ** 2)
+    no_spring = eqx.tree_at(lambda m: m.stiffness, undamped, jnp.zeros(model.nv))
+    assert abs(energy(system, q, jnp.zeros(5)) - energy(TreeSystem(no_spring), q, jnp.zeros(5))
+               - spring) < 1e-12
 
 
 def test_strict():

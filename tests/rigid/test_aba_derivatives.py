@@ -42,8 +42,11 @@ def _jacobians(model, q, v, tau):
 @pytest.mark.filterwarnings("ignore::mbjax.model.ModelWarning")
 def test_rnea_partials_equal_the_rneas_derivative():
     """Every column of the composite-body matrices against `jax.jacfwd` through the RNEA itself,
-    and their mass matrix against the operator form's: a chain, an arm, a floating quadruped."""
-    models = [chain(7)] + [mbjax.load_urdf(p, floating_base="solo" in str(p))
+    and their mass matrix against the operator form's: a chain with joint springs, an arm, a
+    floating quadruped."""
+    sprung = eqx.tree_at(lambda m: (m.stiffness, m.spring_reference), chain(7),
+                         (jnp.linspace(1.0, 7.0, 7), jnp.full(7, 0.3)))     # joint springs
+    models = [sprung] + [mbjax.load_urdf(p, floating_base="solo" in str(p))
                            for p in example_robots(("panda/panda", "solo/solo12"))]
     for model in models:
         partials = jax.jit(rnea_derivatives.rnea_partials)

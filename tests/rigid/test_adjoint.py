@@ -19,12 +19,15 @@ from mbjax._src.rigid.rnea_derivatives import applies, rnea_jvp
 
 def _with_joint_data(model):
     rng = np.random.default_rng(7)
-    return eqx.tree_at(lambda m: (m.damping, m.armature), model,
+    sprung = model.spring_index() >= 0          # springs on revolute, prismatic, universal joints
+    return eqx.tree_at(lambda m: (m.damping, m.armature, m.stiffness, m.spring_reference), model,
                        (jnp.asarray(rng.uniform(0.0, 0.5, model.nv)),
-                        jnp.asarray(rng.uniform(0.0, 0.1, model.nv))))
+                        jnp.asarray(rng.uniform(0.0, 0.1, model.nv)),
+                        jnp.asarray(rng.uniform(0.0, 3.0, model.nv) * sprung),
+                        jnp.asarray(rng.uniform(-1.0, 1.0, model.nq))))
 
 
-# every joint type, a branching tree, joint damping and armature
+# every joint type, a branching tree, joint damping, springs and armature
 MODEL = _with_joint_data(
     random_tree(5, seed=4, joint_types=("free", "spherical", "universal", "revolute", "prismatic")))
 # the joints whose RNEA derivatives in (q, v) are written out (`rnea_derivatives`): revolute and

@@ -20,6 +20,9 @@ MODELS = {
     "regular chain": lambda: chain(7),
     "random chain": lambda: chain(9, seed=3),
     "tree with sliders": lambda: random_tree(12, seed=4, joint_types=("revolute", "prismatic")),
+    "damped, sprung chain": lambda: eqx.tree_at(
+        lambda m: (m.damping, m.stiffness, m.spring_reference), chain(5, seed=2),
+        (jnp.full(5, 0.2), jnp.linspace(1.0, 5.0, 5), jnp.full(5, -0.4))),
 }
 
 

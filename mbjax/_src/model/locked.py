@@ -9,7 +9,7 @@ frames of the parent at that pose, its own frames move to the parent with compos
 and its children hang from the parent with composed placements. Chains of locked joints collapse
 into the nearest kept ancestor (or the ground). The kept bodies keep their relative order, which
 is parent-before-child and Pinocchio's numbering of the reduced model, and their joints keep their
-types, axes, names, limits, damping, armature and friction (the kept coordinates' entries).
+types, axes, names, limits, damping, springs, armature and friction (the kept coordinates' entries).
 
 Closures follow the bodies and coordinates: a `CutJoint`'s frames move with their bodies into the
 kept ones; a `Coupling` or `Prescribed` motion is renumbered to the kept coordinates, and a
@@ -141,7 +141,8 @@ def lock_joints(model: Model, joint_names, q) -> Model:
         names=[model.names[k] for k in kept], joint_names=[model.joint_names[k] for k in kept],
         lower=per("lower", q_kept), upper=per("upper", q_kept),
         velocity_limit=per("velocity_limit", v_kept), effort_limit=per("effort_limit", v_kept),
-        damping=per("damping", v_kept), armature=per("armature", v_kept),
+        damping=per("damping", v_kept), stiffness=per("stiffness", v_kept),
+        spring_reference=per("spring_reference", q_kept), armature=per("armature", v_kept),
         friction=per("friction", v_kept),
         frame_names=[f[0] for f in frames], frame_parents=[f[1] for f in frames],
         frame_rotation=np.reshape([f[2] for f in frames], (-1, 3, 3)),

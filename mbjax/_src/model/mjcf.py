@@ -171,9 +171,13 @@ def _ignored(m, mujoco) -> list[str]:
         out.append(f"actuator forces ({m.nu} actuators; apply them as tau)")
     if m.ntendon:
         out.append(f"tendons ({m.ntendon})")
-    if not off(bits.mjDSBL_SPRING) and (springs := _nonzero(m, "jnt_stiffness")
-                                        + _nonzero(m, "jnt_stiffnesspoly")):
-        out.append(f"joint springs ({springs})")
+    if not off(bits.mjDSBL_SPRING):
+        scalar = np.isin(m.jnt_type, (int(mujoco.mjtJoint.mjJNT_HINGE),
+                                      int(mujoco.mjtJoint.mjJNT_SLIDE)))
+        if springs := int(np.sum((np.asarray(m.jnt_stiffness) != 0) & ~scalar)):
+            out.append(f"springs on ball and free joints ({springs})")
+        if poly := _nonzero(m, "jnt_stiffnesspoly"):
+            out.append(f"polynomial joint springs ({poly})")
     if not off(bits.mjDSBL_DAMPER) and (poly := _nonzero(m, "dof_dampingpoly")
                                         + _nonzero(m, "actuator_dampingpoly")):
         out.append(f"polynomial damping ({poly})")
@@ -266,9 +270,11 @@ def from_mujoco(mjmodel, *, strict: bool = False) -> Model:
 
     nq = m.nq
     lower, upper = np.full(nq, -np.inf), np.full(nq, np.inf)
-    per_dof = {key: np.zeros(m.nv) for key in ("damping", "armature", "friction")}
+    per_dof = {key: np.zeros(m.nv) for key in ("damping", "stiffness", "armature", "friction")}
+    spring_reference = np.zeros(nq)
     effort = np.full(m.nv, np.inf)
     damper = not (int(m.opt.disableflags) & int(mujoco.mjtDisableBit.mjDSBL_DAMPER))
+    spring = not (int(m.opt.disableflags) & int(mujoco.mjtDisableBit.mjDSBL_SPRING))
     iq = iv = free_armature = 0
     for body in bodies:
         j, kind = body["joint"], body["kind"]
@@ -276,6 +282,9 @@ def from_mujoco(mjmodel, *, strict: bool = False) -> Model:
         nq_j, nv_j = JOINT_TYPES[kind]
         if kind in ("revolute", "prismatic") and m.jnt_limited[j]:
             lower[iq], upper[iq] = m.jnt_range[j]
+        if kind in ("revolute", "prismatic") and spring:     # qfrc_spring, MuJoCo's passive.c
+            per_dof["stiffness"][iv] = m.jnt_stiffness[j]
+            spring_reference[iq] = m.qpos_spring[iq]
         dofs = iv + np.asarray(_FREE_DOFS if kind == "free" else range(nv_j))
         per_dof["damping"][iv:iv + nv_j] = (m.dof_damping[dofs] + act_damping[j]) * damper
         per_dof["armature"][iv:iv + nv_j] = m.dof_armature[dofs] + act_armature[j]
@@ -313,7 +322,7 @@ def from_mujoco(mjmodel, *, strict: bool = False) -> Model:
         placement_translation=np.stack([body["p"] for body in bodies]), gravity=gravity,
         names=[body["name"] for body in bodies],
         joint_names=[body["joint_name"] for body in bodies], lower=lower, upper=upper,
-        effort_limit=effort, **per_dof, frame_names=[f[0] for f in frames],
+        effort_limit=effort, **per_dof, spring_reference=spring_reference, frame_names=[f[0] for f in frames],
         frame_parents=[f[1] for f in frames],
         frame_rotation=np.reshape([f[2] for f in frames], (-1, 3, 3)),
         frame_translation=np.reshape([f[3] for f in frames], (-1, 3)), closures=cuts,
@@ -408,6 +417,8 @@ def load_mjcf(source: str | os.PathLike, *, strict: bool = False) -> Model:
         - Joint data: jnt_range of limited hinges and slides as lower/upper, dof_armature plus the
           armature of actuators on the joint (gear^2-scaled, MuJoCo >= 4) as armature, dof_damping
           plus such actuators' damping as damping (zero where the model disables dampers),
+          jnt_stiffness and qpos_spring of hinges and slides as stiffness and spring_reference
+          (zero where the model disables springs),
           dof_frictionloss as friction, jnt_actfrcrange of force-limited joints as effort_limit;
           opt.gravity (zero where disabled). Limits and friction are data, not forces. A free
           joint's translational armature is left out: MuJoCo adds it to the world-frame linear
@@ -418,10 +429,12 @@ def load_mjcf(source: str | os.PathLike, *, strict: bool = False) -> Model:
           the model's `closures`.
 
     Not modelled:
-        What mbjax does not model (contacts, actuator forces, tendons, springs, polynomial damping,
-        gravity compensation, fluid forces, flexes, plugins, ball joint limits, other equality
-        constraints, free joints' translational armature) is named in one `ModelWarning`, also with
-        `strict=True`, which makes only implausible inertias errors.
+        What mbjax does not model (actuator forces, tendons, ball and free joints' springs,
+        polynomial springs and damping, gravity compensation, fluid forces, flexes, plugins,
+        ball joint limits, other equality constraints, free joints' translational armature),
+        and what `TreeSystem(model)` leaves to `mbjax.contact.ContactSystem` (contacts), is
+        named in one `ModelWarning`, also with `strict=True`, which makes only implausible
+        inertias errors.
     """
     mujoco = _mujoco()
     text = str(source)

@@ -103,6 +103,11 @@ class Model(eqx.Module):
         effort_limit (ArrayLike): bounds on |tau|, shape (nv,) [N m or N]; inf by default.
         damping (ArrayLike): viscous joint damping, a force -damping * v in the dynamics, shape
             (nv,).
+        stiffness (ArrayLike): joint springs, a force -stiffness * (q - spring_reference) in the
+            dynamics (MuJoCo's joint stiffness), shape (nv,); zero on spherical and free joints'
+            coordinates (a spring there is not modelled).
+        spring_reference (ArrayLike): the springs' rest positions (MuJoCo's springref), shape
+            (nq,); zeros by default (read on the revolute, prismatic and universal joints only).
         armature (ArrayLike): rotor inertia reflected to the joint, added to the mass matrix
             diagonal (Featherstone's ABA adds it to D; MuJoCo's and Pinocchio's armature), shape
             (nv,).
@@ -125,8 +130,8 @@ class Model(eqx.Module):
     Raises:
         ValueError: an invalid parents array, unknown joint type, wrong number of names, an
             array of the wrong shape, a non-finite value, a placement that is not a rotation,
-            a zero or parallel joint axis, limits out of order, negative damping, armature or
-            friction, an invalid mass or inertia (see `ModelWarning`; with strict=True also the
+            a zero or parallel joint axis, limits out of order, negative damping, stiffness,
+            armature or friction, a spring on a spherical or free joint, an invalid mass or inertia (see `ModelWarning`; with strict=True also the
             implausible ones), or a frame whose parent is not a body.
         TypeError: an array argument that is not real numbers.
     """
@@ -148,6 +153,8 @@ class Model(eqx.Module):
     velocity_limit: Array
     effort_limit: Array
     damping: Array
+    stiffness: Array
+    spring_reference: Array
     armature: Array
     friction: Array
     frame_names: tuple[str, ...] = eqx.field(static=True)
@@ -161,9 +168,9 @@ class Model(eqx.Module):
                  placement_rotation=None, placement_translation=None,
                  gravity=(0.0, 0.0, -9.81), names=None, joint_names=None, lower=None,
                  upper=None, velocity_limit=None, effort_limit=None, damping=None,
-                 armature=None, friction=None, frame_names=(), frame_parents=(),
-                 frame_rotation=None, frame_translation=None, closures=(), geoms=None,
-                 strict: bool = False):
+                 stiffness=None, spring_reference=None, armature=None, friction=None,
+                 frame_names=(), frame_parents=(), frame_rotation=None, frame_translation=None,
+                 closures=(), geoms=None, strict: bool = False):
         self.closures = tuple(closures)
         if geoms is not None and not isinstance(geoms, Geoms):
             raise TypeError(f"geoms must be mbjax.model.Geoms or None, got {type(geoms).__name__}")
@@ -226,6 +233,8 @@ class Model(eqx.Module):
         self.velocity_limit = field(velocity_limit, np.full(nv, inf), (nv,), "velocity_limit")
         self.effort_limit = field(effort_limit, np.full(nv, inf), (nv,), "effort_limit")
         self.damping = field(damping, np.zeros(nv), (nv,), "damping")
+        self.stiffness = field(stiffness, np.zeros(nv), (nv,), "stiffness")
+        self.spring_reference = field(spring_reference, np.zeros(nq), (nq,), "spring_reference")
         self.armature = field(armature, np.zeros(nv), (nv,), "armature")
         self.friction = field(friction, np.zeros(nv), (nv,), "friction")
         self.frame_names, self.frame_parents = tuple(frame_names), tuple(int(k) for k in frame_parents)
@@ -315,7 +324,8 @@ class Model(eqx.Module):
             raise ValueError(f"lower must not exceed upper; joint {joint(bad[0], layout['q_start'])}"
                              f" (coordinate {bad[0]}): lower {lower[bad[0]]}, upper "
                              f"{upper[bad[0]]}")
-        for what in ("velocity_limit", "effort_limit", "damping", "armature", "friction"):
+        for what in ("velocity_limit", "effort_limit", "damping", "stiffness", "armature",
+                     "friction"):
             value = np.asarray(getattr(self, what))
             infinite_allowed = what.endswith("limit")           # an infinite limit: none
             bad = np.flatnonzero(np.isnan(value) | (value < 0)
@@ -325,6 +335,13 @@ class Model(eqx.Module):
                                  f"{'' if infinite_allowed else ' and finite'}; joint "
                                  f"{joint(bad[0], layout['v_start'])} (coordinate {bad[0]}) has "
                                  f"{value[bad[0]]}")
+
+        index, sprung = self.spring_index(), np.asarray(self.stiffness) != 0
+        bad = np.flatnonzero(sprung & (index < 0))
+        if bad.size:
+            raise ValueError(f"stiffness must be zero on spherical and free joints (their springs "
+                             f"are not modelled); joint {joint(bad[0], layout['v_start'])} "
+                             f"(coordinate {bad[0]}) has {np.asarray(self.stiffness)[bad[0]]}")
 
     # -- sizes and layout -----------------------------------------------------------------------
 
@@ -424,6 +441,45 @@ class Model(eqx.Module):
             Body indices, a NumPy int array of shape (nv,).
         """
         return np.repeat(np.arange(self.n), [JOINT_TYPES[k].nv for k in self.joint_types])
+
+    def spring_index(self) -> np.ndarray:
+        """Where each velocity coordinate's spring reads its position: the position coordinate
+        of a revolute, prismatic or universal joint's (whose q and v coordinates are the same),
+        -1 on spherical and free joints (no spring).
+
+        Returns:
+            Indices into q, a NumPy int array of shape (nv,).
+        """
+        layout, index = _layout(self.joint_types), []
+        for kind, iq in zip(self.joint_types, layout["q_start"]):
+            nq, nv = JOINT_TYPES[kind]
+            index += list(range(iq, iq + nq)) if nq == nv else [-1] * nv
+        return np.asarray(index, dtype=int)
+
+    def passive_force(self, q: Array, v: Array) -> Array:
+        """The joints' passive forces, -damping * v - stiffness * (q - spring_reference).
+
+        Args:
+            q: configuration, shape (nq,).
+            v: velocity, shape (nv,).
+
+        Returns:
+            Generalized forces, shape (nv,).
+        """
+        return -self.damping * v - self.stiffness * self.spring_stretch(q)
+
+    def spring_stretch(self, q: Array) -> Array:
+        """q - spring_reference at each velocity coordinate's position coordinate
+        (`spring_index`; a spherical or free joint's entries, which have no stiffness, read
+        coordinate 0).
+
+        Args:
+            q: configuration, shape (nq,).
+
+        Returns:
+            The springs' stretches, shape (nv,).
+        """
+        return (q - self.spring_reference)[np.maximum(self.spring_index(), 0)]
 
     # -- joints ---------------------------------------------------------------------------------
 

@@ -173,7 +173,7 @@ def _recursion(model: Model, q: Array, v: Array, tau: Array, loads: Array,
     zeros = jnp.zeros((model.n, 6, m), q.dtype)
     F1 = jnp.concatenate([bias[..., None], zeros], -1)
     c = jnp.concatenate([kin.c[..., None], zeros], -1)
-    t = jnp.concatenate([model.body_v(tau - model.damping * v)[..., None],
+    t = jnp.concatenate([model.body_v(tau + model.passive_force(q, v))[..., None],
                          jax.vmap(model.body_v, out_axes=-1)(loads)], -1)
 
     # A floating base is eliminated on its own (`_wide_root`): in the tree passes its joint has

@@ -257,7 +257,8 @@ def _chunk(model: Model, revolute: np.ndarray, q: Array, v: Array, tau: Array, s
     dtype, (n, batch) = q.dtype, q.shape
     model = jax.tree.map(lambda x: x.astype(dtype) if jnp.issubdtype(x.dtype, jnp.floating) else x,
                          model)
-    tau = tau - model.damping[:, None] * v                  # joint damping, a force -d v
+    tau = (tau - model.damping[:, None] * v                 # joint damping and springs
+           - model.stiffness[:, None] * (q - model.spring_reference[:, None]))
     R, p, s = _joint_transforms(model, revolute, q, sin, cos)
     sv = (_scale(s[0], v), _scale(s[1], v))
     inertia = model.spatial_inertia()

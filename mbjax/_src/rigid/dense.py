@@ -25,10 +25,10 @@ from mbjax._src.rigid.operator import OperatorTerms, generalized_mass, operator_
 
 def _bias(terms: OperatorTerms, v: Array) -> Array:
     """Y_hat_f - alpha_f^T K: everything in eq 74 that is not mass times acceleration or tau
-    (joint damping included)."""
+    (the joints' passive forces included)."""
     remainder = jnp.einsum("kan,n->ka", terms.alpha_dot, v)
     force = jnp.einsum("kab,kb->ka", terms.mu, remainder) + terms.Y - terms.K
-    return jnp.einsum("kan,ka->n", terms.alpha, force) - terms.damping
+    return jnp.einsum("kan,ka->n", terms.alpha, force) - terms.passive
 
 
 def dense_forward_dynamics(model: Model, q: Array, v: Array, tau: Array,

@@ -51,8 +51,10 @@ def potential_energy(model: Model, q: Array) -> Array:
 
 @jax.jit
 def energy(model: Model, q: Array, v: Array) -> Array:
-    """Kinetic plus gravitational energy, T + V, a scalar [J]."""
-    return kinetic_energy(model, q, v) + potential_energy(model, q)
+    """Kinetic plus gravitational energy plus the joint springs' energy,
+    T + V + sum 1/2 stiffness (q - spring_reference)^2, a scalar [J]."""
+    return (kinetic_energy(model, q, v) + potential_energy(model, q)
+            + 0.5 * jnp.sum(model.stiffness * model.spring_stretch(q)**2))
 
 
 @jax.jit

@@ -36,11 +36,12 @@ def velocity_from_momentum(model: Model, q: Array, p: Array) -> Array:
 
 def momentum_rate(model: Model, q: Array, v: Array, tau: Array, f_ext: Array | None = None) -> Array:
     """G_hat_f_dot = tau + alpha_f^T K + alpha_f_dot^T mu sigma (eq 72); external wrenches f_ext
-    (n, 6) (world frame, torque about the body origins) join the applied forces K, and joint
-    damping -damping * v joins tau (armature is constant, so it adds nothing to the rate)."""
+    (n, 6) (world frame, torque about the body origins) join the applied forces K, and the joints'
+    passive forces (`Model.passive_force`) join tau (armature is constant, so it adds nothing
+    to the rate)."""
     terms = with_external(operator_terms(model, q, v), f_ext)
     G = jnp.einsum("kab,kb->ka", terms.mu, terms.sigma)
-    return (tau + terms.damping + jnp.einsum("kan,ka->n", terms.alpha, terms.K)
+    return (tau + terms.passive + jnp.einsum("kan,ka->n", terms.alpha, terms.K)
             + jnp.einsum("kan,ka->n", terms.alpha_dot, G))
 
 

@@ -46,7 +46,7 @@ class OperatorTerms(NamedTuple):
     c: Array           # (n, 3) centres of mass c_k, world frame
     h: Array           # (n, 3) hinge points h_k (body-frame origins), world frame
     armature: Array    # (nv,) rotor inertias on the joint coordinates (model.armature)
-    damping: Array     # (nv,) joint forces -damping * v (model.damping times v, negated)
+    passive: Array     # (nv,) the joints' passive forces (`Model.passive_force`)
 
 
 def _shift(r: Array) -> Array:
@@ -185,7 +185,7 @@ def operator_terms(model: Model, q: Array, v: Array) -> OperatorTerms:
                          jnp.zeros_like(omega)], -1)
     K = jnp.concatenate([jnp.zeros_like(c), model.mass[:, None] * model.gravity], -1)
     return OperatorTerms(A, alpha, alpha_dot, sigma, mu, Y, K, Sw, c, h, model.armature,
-                         -model.damping * v)
+                         model.passive_force(q, v))
 
 
 def with_external(terms: OperatorTerms, f_ext: Array | None) -> OperatorTerms:

@@ -47,7 +47,7 @@ def joint_wrenches(model: Model, q: Array, v: Array, a: Array, f_ext: Array | No
 def inverse_dynamics(model: Model, q: Array, v: Array, a: Array, f_ext: Array | None = None) -> Array:
     """Joint forces tau (nv,) that give accelerations a at state (q, v) under gravity and the
     external wrenches f_ext (n, 6) (world frame, (torque about body k's origin; force)), with
-    the joints' armature and damping."""
+    the joints' armature, damping and springs."""
     f_bar, kin, _ = rnea_passes(model, q, v, a, f_ext)
     return (model.flat_v(jnp.einsum("kij,ki->kj", kin.S, f_bar))
-            + model.armature * a + model.damping * v)
+            + model.armature * a - model.passive_force(q, v))

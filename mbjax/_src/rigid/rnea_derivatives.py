@@ -19,7 +19,7 @@ its columns (dq itself for a revolute or prismatic joint), U_j = V and B_j = A o
     (P2, P3) = the outward sums of (g2, g3)                         (one outward pass)
     o_k = s_k x* F_k
     L_k = I_k P2_k - P3_k x* h_k - I_k (P3_k x V_k) - V_k x* I_k P3_k + o_k
-    dtau_k = S_k^T (the sum of L over k's outward set - o_k) + damping_k dv_k   (one inward pass)
+    dtau_k = S_k^T (the sum of L over k's outward set - o_k) + damping_k dv_k + stiffness_k dq_k   (one inward pass)
 
 The formulas are linear in the columns of S, so each joint enters through its two twists s and
 w. It is linear in (dq, dv), so reverse mode transposes it into the same two passes run the
@@ -51,7 +51,7 @@ def applies(model: Model) -> bool:
 
 
 def rnea_jvp(model: Model, q: Array, v: Array, a: Array, dq: Array, dv: Array) -> Array:
-    """d tau = d/de RNEA(model, q + e dq, v + e dv, a) at e = 0 (armature and damping included),
+    """d tau = d/de RNEA(model, q + e dq, v + e dv, a) at e = 0 (armature, damping and springs included),
     for a tree of the joints `applies` accepts. dq is a tangent of the coordinates q (a
     quaternion's included, as the RNEA reads it, normalized)."""
     F, kin, A = rnea_passes(model, q, v, a, None)
@@ -71,7 +71,8 @@ def rnea_jvp(model: Model, q: Array, v: Array, a: Array, dq: Array, dv: Array) -
     L = (_times(I, P2) - cross_force(P3, h) - _times(I, cross_motion(P3, V))
          - cross_force(V, _times(I, P3)) + own)
     dtau = jnp.einsum("kic,ki->kc", S, _inward_sum(model, L) - own)
-    return model.flat_v(dtau) + model.damping * dv
+    spring = model.stiffness * dq[np.maximum(model.spring_index(), 0)]
+    return model.flat_v(dtau) + model.damping * dv + spring
 
 
 def _times(I: Array, x: Array) -> Array:       # noqa: E741
@@ -97,7 +98,7 @@ def _parent(model: Model, x: Array, ground: Array) -> Array:
 def rnea_partials(model: Model, q: Array, v: Array, a: Array) -> tuple[Array, Array, Array]:
     """(d tau / d e, d tau / d v, d tau / d a = M), each (nv, nv): the RNEA's partial derivatives
     at (q, v, a) in the joints' increments e (the tangent space: `joint_increments`), in v and in
-    a, for a tree of the joints `applies` accepts (damping and armature included).
+    a, for a tree of the joints `applies` accepts (damping, springs and armature included).
 
     `rnea_jvp` for every direction at once, with no pass per direction: a direction along a
     column of joint j has its twists at body j alone, so its outward sums P are (g2_j, g3_j) on
@@ -142,7 +143,7 @@ def rnea_partials(model: Model, q: Array, v: Array, a: Array) -> tuple[Array, Ar
     inner = rows_I @ s.T
     M = path * inner + outward * inner.T + jnp.diag(model.armature)
     nv = model.nv
-    return D[:, :nv], D[:, nv:] + jnp.diag(model.damping), M
+    return D[:, :nv] + jnp.diag(model.stiffness), D[:, nv:] + jnp.diag(model.damping), M
 
 
 
