@@ -53,13 +53,18 @@ def load(name: str):
     return m, model, ignored
 
 
-def system(m, model) -> ContactSystem:
-    return ContactSystem(TreeSystem(model), timestep=m.opt.timestep,
-                         q_reference=jnp.asarray(m.qpos0))
+def mujoco_step(m, model) -> tuple[ContactSystem, object]:
+    """(system, integrator) that step as MuJoCo steps the file m: its RK4, or its Euler as
+    semi-implicit Euler with the joints' damping taken implicitly (unless the file disables
+    `eulerdamp`), at its timestep, with its qpos0 as the inverse inertias' reference."""
+    import mujoco
 
-
-def integrator(m):
-    return RK4() if int(m.opt.integrator) == 1 else SemiImplicitEuler()
+    rk4 = int(m.opt.integrator) == int(mujoco.mjtIntegrator.mjINT_RK4)
+    eulerdamp = not int(m.opt.disableflags) & int(mujoco.mjtDisableBit.mjDSBL_EULERDAMP)
+    system = ContactSystem(TreeSystem(model), timestep=m.opt.timestep,
+                           q_reference=jnp.asarray(m.qpos0),
+                           implicit_damping=not rk4 and eulerdamp)
+    return system, RK4() if rk4 else SemiImplicitEuler()
 
 
 def agreement(name: str, common: dict) -> dict:
@@ -73,12 +78,12 @@ def agreement(name: str, common: dict) -> dict:
     for _ in range(steps):
         mujoco.mj_step(m, d)
         heights.append(d.qpos[root])
-    sol, timing = measure(partial(mbjax.simulate, system(m, model), integrator(m),
-                                  jnp.asarray(m.qpos0), jnp.zeros(m.nv), dt=m.opt.timestep,
+    system, integrator = mujoco_step(m, model)
+    sol, timing = measure(partial(mbjax.simulate, system, integrator, jnp.asarray(m.qpos0), jnp.zeros(m.nv), dt=m.opt.timestep,
                                   t1=steps * m.opt.timestep), repeats=3)
     ours = np.asarray(sol.qs[1:, root])
     return {**common, "kind": "agreement", "model": name, "dt": float(m.opt.timestep),
-            "integrator": type(integrator(m)).__name__, "steps": steps,
+            "integrator": type(integrator).__name__, "steps": steps,
             "height_error_max_m": float(np.abs(ours - np.asarray(heights)).max()),
             "height_final_mbjax_m": float(ours[-1]), "height_final_mujoco_m": float(heights[-1]),
             "compile_s": timing.compile_s, "run_s": timing.run_s,
@@ -93,11 +98,11 @@ def throughput(batch: int, common: dict) -> list[dict]:
     steps = int(round(DURATION / m.opt.timestep))
     rng = np.random.default_rng(0)
     pushes = rng.normal(scale=0.5, size=(batch, m.nv))
-    contact = system(m, model)
+    contact, integrator = mujoco_step(m, model)
     q0 = jnp.asarray(m.qpos0)
     v0s = jnp.stack([state_from_mujoco(model, m.qpos0, p)[1] for p in pushes])
     t1 = steps * m.opt.timestep
-    run = jax.jit(jax.vmap(lambda v: mbjax.simulate(contact, integrator(m), q0, v,
+    run = jax.jit(jax.vmap(lambda v: mbjax.simulate(contact, integrator, q0, v,
                                                     dt=m.opt.timestep, t1=t1,
                                                     saveat=[t1]).qs[-1]))
     final, timing = measure(run, v0s, repeats=3)

@@ -23,8 +23,8 @@ from PIL import Image
 from mbjax.wrist import WristSystem
 from mbjax_harness.progress import step
 
-__all__ = ["animate", "frames_along", "gait_animation", "stick_animation", "wrist_animation",
-           "write_gif"]
+__all__ = ["animate", "frames_along", "gait_animation", "geom_animation", "stick_animation",
+           "wrist_animation", "write_gif"]
 
 AXIS_COLORS = ("#d62728", "#2ca02c", "#1f77b4")     # x, y, z
 
@@ -179,6 +179,63 @@ def gait_animation(path: Path, tree, ts, qs, feet: Sequence[str], forces, mu: fl
         return [*sticks, *arrows, *(line for cone in cones for line in cone), label]
 
     return write_gif(path, fig, draw, len(keep), fps=15)
+
+
+def geom_animation(path: Path, ts, panels: Sequence[tuple[str, np.ndarray, np.ndarray]], *,
+                   title: str = "", frames: int = 60, fps: int = 15, columns: int = 2) -> Path:
+    """Write a GIF of robots drawn by their collision geometry, one 3-D panel each, on a floor.
+
+    Args:
+        path: the GIF's path.
+        ts: the save times, (T,).
+        panels: (title, segments, radii) per panel: each capsule's axis as a segment from end
+            to end, a sphere's (or box's) centre twice, in world coordinates, (T, g, 2, 3) [m];
+            the geoms' radii, (g,) [m] (a line's width follows its radius).
+        title: the figure's title, followed by the time.
+        frames: at most this many of the saved states, evenly spaced.
+        fps: frames per second.
+        columns: panels per row.
+
+    Returns:
+        The path.
+    """
+    step(f"animation {Path(path).name}")
+    ts = np.asarray(ts)
+    keep = np.unique(np.linspace(0, len(ts) - 1, min(frames, len(ts))).round().astype(int))
+    rows = -(-len(panels) // columns)
+    fig = Figure(figsize=(3.4 * columns, 3.2 * rows + 0.4), layout="constrained")
+    lines = []
+    for index, (name, segments, radii) in enumerate(panels):
+        segments = np.asarray(segments)
+        centre = segments[:, :, :, :2].reshape(-1, 2).mean(0)
+        half = max(float(np.ptp(segments[..., :2].reshape(-1, 2), axis=0).max()) / 2, 0.5)
+        top = max(float(segments[..., 2].max()), 0.5)
+        ax = fig.add_subplot(rows, columns, index + 1, projection="3d")
+        ax.set(xlim=(centre[0] - half, centre[0] + half), ylim=(centre[1] - half, centre[1] + half),
+               zlim=(0.0, top), title=name)
+        ax.set_box_aspect((2 * half, 2 * half, top))
+        ax.view_init(18, -60)
+        for axis in (ax.xaxis, ax.yaxis, ax.zaxis):
+            axis.set_major_locator(MaxNLocator(3))
+        floor = np.array([[-1, -1], [1, -1], [1, 1], [-1, 1], [-1, -1]]) * half + centre
+        ax.plot(floor[:, 0], floor[:, 1], 0.0, color="0.6", lw=1)
+        widths = 2 + 60 * np.asarray(radii, float)
+        lines.append([(ax.plot([], [], [], "-", color="#1f77b4", lw=w, solid_capstyle="round",
+                                marker="o", ms=w)[0], segments) for w in widths])
+    label = fig.suptitle("")
+
+    def draw(i):
+        k = keep[i]
+        moving = []
+        for panel in lines:
+            for g, (line, segments) in enumerate(panel):
+                seg = segments[k, g]
+                line.set_data_3d(seg[:, 0], seg[:, 1], seg[:, 2])
+                moving.append(line)
+        label.set_text(f"{title}  t = {ts[k]:.2f} s".strip())
+        return [*moving, label]
+
+    return write_gif(path, fig, draw, len(keep), fps)
 
 
 def write_gif(path: Path, fig: Figure, draw, frames: int, fps: int, dpi: int = 72) -> Path:

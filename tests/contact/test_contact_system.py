@@ -95,17 +95,22 @@ def test_ant_accelerations_and_fall_follow_mujoco():
 
 
 def test_joint_limit_holds_as_mujoco():
-    """A hinge pendulum falling onto its limit: the limit's soft constraint stops it as
-    MuJoCo's does."""
-    xml = ('<mujoco><worldbody><body><joint type="hinge" axis="0 1 0" range="-30 30"/>'
+    """A damped hinge pendulum falling onto its limit: the limit's soft constraint stops it as
+    MuJoCo's does, MuJoCo's Euler step (damping taken implicitly) to round-off."""
+    xml = ('<mujoco><worldbody><body><joint type="hinge" axis="0 1 0" range="-30 30" '
+           'damping="0.2"/>'
            '<geom type="capsule" fromto="0 0 0 0.5 0 0" size="0.05" mass="1" contype="0" '
            'conaffinity="0"/></body></worldbody></mujoco>')
     m, model = _load(xml)
     reference = _mujoco_run(m, 500)
-    system = ContactSystem(TreeSystem(model), timestep=m.opt.timestep)
+    system = ContactSystem(TreeSystem(model), timestep=m.opt.timestep, implicit_damping=True)
     sol = mbjax.simulate(system, SemiImplicitEuler(), jnp.asarray(m.qpos0), jnp.zeros(1),
                          dt=m.opt.timestep, t1=1.0)
     np.testing.assert_allclose(np.asarray(sol.qs[1:, 0]), reference[:, 0], atol=1e-9)
+    explicit = mbjax.simulate(ContactSystem(TreeSystem(model), timestep=m.opt.timestep),
+                              SemiImplicitEuler(),
+                              jnp.asarray(m.qpos0), jnp.zeros(1), dt=m.opt.timestep, t1=1.0)
+    assert np.abs(np.asarray(explicit.qs[1:, 0]) - reference[:, 0]).max() > 1e-6
     assert abs(float(sol.qs[-1, 0]) - np.radians(30)) < 0.01       # held at its bound
     free = mbjax.simulate(ContactSystem(TreeSystem(model), limits=False), SemiImplicitEuler(),
                           jnp.asarray(m.qpos0), jnp.zeros(1), dt=m.opt.timestep, t1=1.0)

@@ -128,6 +128,7 @@ TOUR_GROUPS = {
     "time-elements": ("time-elements", "flexible-bodies", "controls"),
     "carpal-wrist": ("carpal-wrist", "models", "trajectory-optimisation"),
     "legged-gait": ("legged-gait",),
+    "contacts": ("contacts",),
 }
 
 
@@ -140,7 +141,7 @@ def test_tour_groups_cover_every_scene():
     assert sorted(s for group in TOUR_GROUPS.values() for s in group) == sorted(TOUR)
     assert set(TOUR) == {"torque-free-body", "heavy-top", "rigid-chain", "time-elements",
                          "closed-loops", "flexible-bodies", "carpal-wrist", "controls", "models",
-                         "trajectory-optimisation", "floating-base", "legged-gait"}
+                         "trajectory-optimisation", "floating-base", "legged-gait", "contacts"}
 
 
 def test_tour_rejects_an_unknown_scene(capsys):
@@ -165,6 +166,18 @@ def test_the_gait_scene_says_what_to_install_without_the_robot(tmp_path, monkeyp
     assert (tmp_path / scene["figure"]).stat().st_size > 5_000 and "runs" not in scene
     assert scene["peers"]["example_robot_data"]["status"].startswith("unavailable")
     assert "pip install example-robot-data" in look_at("legged-gait", scene)
+
+
+def test_the_contact_scene_says_what_to_install_without_mujoco(tmp_path, monkeypatch):
+    """Without MuJoCo (a test extra; it reads the MJCF files) the contacts scene writes a
+    figure that says so, and the summary names it as a skipped peer."""
+    from mbjax_harness.tour import contacts_tour, look_at
+
+    monkeypatch.setitem(sys.modules, "mujoco", None)
+    scene = contacts_tour(tmp_path, quick=True)
+    assert (tmp_path / scene["figure"]).stat().st_size > 5_000 and "runs" not in scene
+    assert scene["peers"]["mujoco"]["status"].startswith("unavailable")
+    assert "pip install mujoco" in look_at("contacts", scene)
 
 
 def test_tour_in_workers(tmp_path):
@@ -298,8 +311,18 @@ def _check_legged_gait(scenes):
         assert record["status"] != "compared"
 
 
+def _check_contacts(scenes):
+    # the Ant and the HalfCheetah dropped on the floor land and settle as MuJoCo's runs of the
+    # same files do, to round-off (the same soft constraints, the same integrators)
+    scene = scenes["contacts"]
+    assert scene["peers"]["mujoco"]["status"] == "compared"
+    for run in scene["runs"].values():
+        assert run["status"] == "success" and run["height_error_max_m"] < 1e-9
+
+
 TOUR_CHECKS = {"rigid": _check_rigid, "time-elements": _check_time_elements,
-               "carpal-wrist": _check_carpal_wrist, "legged-gait": _check_legged_gait}
+               "carpal-wrist": _check_carpal_wrist, "legged-gait": _check_legged_gait,
+               "contacts": _check_contacts}
 
 
 @pytest.mark.slow     # a benchmark script: the library is tested in tests/wrist

@@ -144,6 +144,11 @@ class ContactSystem(AbstractSystem):
             qpos0 for an MJCF file whose hinges and slides have no `ref`.
         penetration: the deepest a contact may sink past its margin before `check` fails the
             run (`Status.PENETRATING`) [m]; 0.05 by default.
+        implicit_damping: take the joint damping implicitly over one step, as MuJoCo's Euler
+            integrator does: the accelerations returned are (M + timestep B)^-1 M a, B the
+            damping, so that `SemiImplicitEuler` at `timestep` steps as MuJoCo's Euler does
+            (MuJoCo's default integrator, unless the file disables `eulerdamp`); False by
+            default.
 
     Statuses:
         `simulate`'s saved states are checked: a contact deeper than `penetration` fails the
@@ -167,12 +172,13 @@ class ContactSystem(AbstractSystem):
     limit_solimp: Array
     timestep: float = eqx.field(static=True)
     penetration: float = eqx.field(static=True)
+    implicit_damping: bool = eqx.field(static=True)
     limited: tuple = eqx.field(static=True)      # the velocity coordinate of each limited joint
 
     def __init__(self, tree: AbstractTreeSystem, geoms: Geoms | None = None, *,
                  method: AbstractContactModel = SoftConstraints(), timestep: float = 0.002,
                  limits: bool = True, limit_solref=SOLREF, limit_solimp=SOLIMP,
-                 q_reference=None, penetration: float = 0.05):
+                 q_reference=None, penetration: float = 0.05, implicit_damping: bool = False):
         if not (isinstance(tree, AbstractTreeSystem) and isinstance(tree.model, Model)):
             raise TypeError(f"tree must be a mbjax.rigid.TreeSystem, got {type(tree).__name__}")
         if not isinstance(method, AbstractContactModel):
@@ -194,6 +200,7 @@ class ContactSystem(AbstractSystem):
         if not (float(penetration) > 0):
             raise ValueError(f"penetration must be positive, got {penetration!r}")
         self.penetration = float(penetration)
+        self.implicit_damping = bool(implicit_damping)
         limited, iq = [], 0
         lower, upper = np.asarray(model.lower), np.asarray(model.upper)
         for k, kind in enumerate(model.joint_types):
@@ -292,11 +299,14 @@ class ContactSystem(AbstractSystem):
             v: velocity, shape (nv,).
 
         Returns:
-            (v_dot, each constraint row's force (the contacts' pyramid edges, then the joint
+            (v_dot (with `implicit_damping`, the step's), each constraint row's force (the contacts' pyramid edges, then the joint
             limits), the candidate contacts).
         """
         problem, found = self._problem(t, q, v)
         a, forces = self.method.solve(*problem)
+        if self.implicit_damping:              # MuJoCo's mj_Euler: (M + h B) a_step = M a
+            M = problem[0]
+            a = cho_solve(cholesky(M + self.timestep * jnp.diag(self.model.damping)), M @ a)
         return a, forces, found
 
     def check(self, t, q, u):
