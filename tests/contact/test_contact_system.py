@@ -186,9 +186,11 @@ def test_bad_geometry_is_named():
     with pytest.raises(ValueError, match="solimp"):
         Geoms(("sphere",), (0,), [[0.1, 0, 0]], solimp=[[0.9, 1.5, 0.001, 0.5, 2]])
     model = mbjax.model.random_tree(2, seed=0)
-    boxes = Geoms(("box", "box"), (0, 1), [[0.1] * 3] * 2)
-    with pytest.raises(ValueError, match="box and a box"):
-        ContactSystem(TreeSystem(model), boxes)
+    undetected = Geoms(("sphere", "cylinder"), (0, 1), [[0.1] * 3] * 2)
+    with pytest.raises(ValueError, match="sphere and a cylinder"):
+        ContactSystem(TreeSystem(model), undetected)
+    with pytest.raises(ValueError, match="ellipsoid geom 'egg': its semi-axes"):
+        Geoms(("ellipsoid",), (0,), [[0.1, 0.0, 0.2]], names=["egg"])
     with pytest.raises(ValueError, match="iterations"):
         SoftConstraints(iterations=0)
     with pytest.raises(ValueError, match="penetration"):

@@ -9,7 +9,13 @@ from jax import Array
 
 # the primitives detected (`mbjax._src.contact.collision`), in MuJoCo's order: a pair is
 # ordered so that its first geom's kind comes first here
-KINDS = ("plane", "sphere", "capsule", "box")
+KINDS = ("plane", "sphere", "capsule", "ellipsoid", "cylinder", "box")
+# the pairs of kinds whose contacts `mbjax.contact.ContactSystem` detects (its collision
+# functions, `mbjax._src.contact.collision.PAIRS`)
+DETECTED = frozenset({("plane", "sphere"), ("plane", "capsule"), ("plane", "ellipsoid"),
+                      ("plane", "cylinder"), ("plane", "box"), ("sphere", "sphere"),
+                      ("sphere", "capsule"), ("sphere", "box"), ("capsule", "capsule"),
+                      ("capsule", "box"), ("box", "box")})
 GROUND = -1
 # MuJoCo's defaults
 FRICTION = (1.0, 0.005, 0.0001)
@@ -21,9 +27,9 @@ def _rows(value, default, n: int, width: int | None, name: str):
     """value (or default) broadcast to (n,) or (n, width), float; a ValueError naming it."""
     value = default if value is None else value
     shape = (n,) if width is None else (n, width)
-    xp = jnp if isinstance(value, jax.core.Tracer) else np
+    xp = jnp if isinstance(value, jax.core.Tracer) else np      # shaped in NumPy, as Model's
     try:
-        return xp.broadcast_to(xp.asarray(value, dtype=float), shape)
+        return jnp.asarray(xp.broadcast_to(xp.asarray(value, dtype=float), shape))
     except ValueError as error:
         raise ValueError(f"{name} must broadcast to shape {shape}, got shape "
                          f"{np.shape(value)}") from error
@@ -39,14 +45,15 @@ class Geoms(eqx.Module):
     pairs of geoms that may touch.
 
     Sizes follow MJCF: a plane (its half extents; an infinite plane for zeros, its normal the
-    geom's z axis), a sphere (radius), a capsule (radius, half length of its segment along z), a
-    box (half extents). Contact parameters are MuJoCo's (`friction` sliding, torsional, rolling;
+    geom's z axis), a sphere (radius), a capsule (radius, half length of its segment along z), an
+    ellipsoid (semi-axes), a cylinder (radius, half length along z), a box (half extents). Contact parameters are MuJoCo's (`friction` sliding, torsional, rolling;
     `solref` (timeconst, dampratio) or (-stiffness, -damping); `solimp` (dmin, dmax, width, mid,
     power); `margin` and `gap`; `solmix` the weight of a geom's solref and solimp in a pair);
     two geoms' parameters combine as MuJoCo combines them (`pair_parameters`).
 
     Args:
-        kinds: each geom's kind, one of "plane", "sphere", "capsule", "box".
+        kinds: each geom's kind, one of "plane", "sphere", "capsule", "ellipsoid", "cylinder",
+            "box".
         bodies: each geom's body (-1 for the ground).
         size: (n, 3) sizes (unused entries ignored).
         position: (n, 3) each geom's origin in its body's frame; zeros by default.
@@ -65,8 +72,8 @@ class Geoms(eqx.Module):
             None to leave out parent and child.
 
     Raises:
-        ValueError: naming the field: an unknown kind, a negative size, a sphere or capsule
-            of zero radius, negative friction, margin or solmix, a solref mixing signs, a
+        ValueError: naming the field: an unknown kind, a negative size, a sphere, capsule or
+            cylinder of zero radius, an ellipsoid with a zero semi-axis, negative friction, margin or solmix, a solref mixing signs, a
             solimp outside MuJoCo's range, a condim other than 1 or 3, a pair out of range.
     """
 
@@ -103,10 +110,10 @@ class Geoms(eqx.Module):
         self.size = _rows(size, None, n, 3, "size")
         self.position = _rows(position, 0.0, n, 3, "position")
         if rotation is None:
-            self.rotation = np.broadcast_to(np.eye(3), (n, 3, 3)).copy()
+            self.rotation = jnp.asarray(np.broadcast_to(np.eye(3), (n, 3, 3)))
         else:
             xp = np if _concrete(rotation) else jnp
-            self.rotation = xp.asarray(rotation, dtype=float).reshape(n, 3, 3)
+            self.rotation = jnp.asarray(xp.asarray(rotation, dtype=float).reshape(n, 3, 3))
         self.friction = _rows(friction, FRICTION, n, 3, "friction")
         self.solref = _rows(solref, SOLREF, n, 2, "solref")
         self.solimp = _rows(solimp, SOLIMP, n, 5, "solimp")
@@ -137,9 +144,12 @@ class Geoms(eqx.Module):
         if _concrete(self.size):
             size = np.asarray(self.size)
             for k, kind in enumerate(self.kinds):     # a radius (a segment, a box may be flat)
-                if kind in ("sphere", "capsule") and not size[k, 0] > 0:
+                if kind in ("sphere", "capsule", "cylinder") and not size[k, 0] > 0:
                     raise ValueError(f"size of {kind} geom {self.names[k]!r}: its radius must be "
                                      f"positive, got {size[k, 0]}")
+                if kind == "ellipsoid" and not np.all(size[k] > 0):
+                    raise ValueError(f"size of ellipsoid geom {self.names[k]!r}: its semi-axes "
+                                     f"must be positive, got {size[k].tolist()}")
 
     @property
     def n(self) -> int:

@@ -8,7 +8,8 @@ import numpy as np
 
 from mbjax._src.model.checks import ModelWarning, combine
 from mbjax._src.model.closures import CutJoint
-from mbjax._src.model.geoms import Geoms
+from mbjax._src.model.geoms import DETECTED, Geoms
+from mbjax._src.model.geoms import KINDS as GEOM_KINDS
 from mbjax._src.model.joints import JOINT_TYPES
 from mbjax._src.model.model import Model
 
@@ -109,11 +110,12 @@ def _pair_list(m, filter_parent: bool) -> list[tuple[int, int]]:
 
 
 # mjtGeom: the kinds mbjax detects
-_GEOM_KINDS = {0: "plane", 2: "sphere", 3: "capsule", 6: "box"}
+_GEOM_KINDS = {0: "plane", 2: "sphere", 3: "capsule", 4: "ellipsoid", 5: "cylinder", 6: "box"}
 
 
 def _geoms(m, mujoco, where) -> tuple[Geoms | None, list[str]]:
-    """The model's geoms that mbjax detects contacts of (planes, spheres, capsules, boxes), on
+    """The model's geoms that mbjax detects contacts of (planes, spheres, capsules,
+    ellipsoids, cylinders, boxes), on
     the mbjax bodies that carry them, with the pairs MuJoCo's broadphase would pass on; and
     what is left out."""
     if not m.ngeom:
@@ -128,15 +130,23 @@ def _geoms(m, mujoco, where) -> tuple[Geoms | None, list[str]]:
         bodies.append(k)
         rotation.append(R @ geom_quat[g])
         position.append(p + R @ m.geom_pos[g])
-    pairs = [(index[i], index[j]) for i, j in _pair_list(m, filter_parent)
-             if i in index and j in index]
-    left = []
+    kind = {g: _GEOM_KINDS[int(m.geom_type[g])] for g in kept}
+    pairs, undetected = [], {}
+    for i, j in _pair_list(m, filter_parent):
+        if i in index and j in index:
+            kinds = tuple(sorted((kind[i], kind[j]), key=GEOM_KINDS.index))
+            if kinds in DETECTED:
+                pairs.append((index[i], index[j]))
+            else:
+                undetected[kinds] = undetected.get(kinds, 0) + 1
+    left = [f"contacts between {a} and {b} geoms ({count} pairs; not detected)"
+            for (a, b), count in sorted(undetected.items())]
     skipped = sorted({mujoco.mjtGeom(int(m.geom_type[g])).name[6:].lower()
                       for g in range(m.ngeom) if g not in index
                       and (m.geom_contype[g] or m.geom_conaffinity[g])})
     if skipped:
         left.append(f"contacts of {', '.join(skipped)} geoms (mbjax detects planes, spheres, "
-                    f"capsules and boxes)")
+                    f"capsules, ellipsoids, cylinders and boxes)")
     if m.npair:
         left.append(f"explicit contact pairs ({m.npair})")
     if not kept:
