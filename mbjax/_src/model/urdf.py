@@ -1,16 +1,18 @@
 """`load_urdf`: a `Model` from a URDF file or string (its docstring gives the mapping)."""
 
 import os
+import warnings
 import xml.etree.ElementTree as ET
 from pathlib import Path
 
 import equinox as eqx
 import numpy as np
 
-from mbjax._src.model.checks import combine, warn
+from mbjax._src.model.checks import ModelWarning, combine, warn
 from mbjax._src.model.closures import Coupling
 from mbjax._src.model.joints import JOINT_TYPES
 from mbjax._src.model.model import Model
+from mbjax._src.model.urdf_geoms import collision_geoms
 
 _KINDS = {"revolute": "revolute", "continuous": "revolute", "prismatic": "prismatic",
           "floating": "free", "fixed": None}
@@ -115,7 +117,8 @@ def _armature(armature, nv: int) -> np.ndarray:
 
 def load_urdf(source: str | bytes | os.PathLike, *, floating_base: bool = False,
               gravity=(0.0, 0.0, -9.81), sibling_order: str = "name", armature=0.0,
-              min_mass: float = 0.0, min_inertia: float = 0.0, strict: bool = False) -> Model:
+              min_mass: float = 0.0, min_inertia: float = 0.0, package_dirs=(),
+              strict: bool = False) -> Model:
     """A `Model` from a URDF file or XML string.
 
     Links with an `<inertial>` become bodies, numbered depth-first from the root as Pinocchio
@@ -135,6 +138,9 @@ def load_urdf(source: str | bytes | os.PathLike, *, floating_base: bool = False,
             massless leaves on moving joints.
         min_inertia: lower bound on every body's principal moments [kg m^2] (MuJoCo's
             boundinertia).
+        package_dirs (Sequence[str | os.PathLike]): folders where `package://NAME/...` collision
+            meshes are looked for (`NAME/...` or `...` under each); the folder named NAME above
+            the URDF file is looked in too.
         strict: turn the warnings on implausible data into errors (not the note on mimic
             joints).
 
@@ -175,10 +181,20 @@ def load_urdf(source: str | bytes | os.PathLike, *, floating_base: bool = False,
         for it). `<mimic>` joints load as independent joints, as Pinocchio and MuJoCo load them,
         with a warning; their couplings are the model's `closures` (`mbjax.loops.Coupling`s), which
         `mbjax.loops.ClosedSystem(TreeSystem(model), model.closures)` enforces.
+
+    Collision geometry:
+        Each link's `<collision>` spheres, boxes and cylinders become the model's `geoms`
+        (`mbjax.model.Geoms`, on the body the link is merged into; MuJoCo's default contact
+        parameters), and a mesh (STL, OBJ or COLLADA) the box bounding its vertices, with a
+        `ModelWarning` that says so; `mbjax.contact.ContactSystem` detects their contacts with
+        what they are joined with (`model.geoms.join(mbjax.model.ground_plane())`: the robot on
+        a floor). No two of the robot's own geoms form a pair (a URDF does not say which may
+        touch, and the boxes of neighbouring links' meshes overlap); give the pairs for
+        self-collisions with `Geoms(..., pairs=...)`.
     """
     if sibling_order not in ("name", "document"):
         raise ValueError(f"sibling_order must be 'name' or 'document', got {sibling_order!r}")
-    text = source.decode() if isinstance(source, bytes) else str(source)
+    text, path = source.decode() if isinstance(source, bytes) else str(source), None
     if isinstance(source, os.PathLike) or not text.lstrip().startswith("<"):
         path = Path(source)
         if not path.is_file():
@@ -230,6 +246,7 @@ def load_urdf(source: str | bytes | os.PathLike, *, floating_base: bool = False,
 
     bodies = []    # dicts: parent index, kind, joint/link names, placement, axis, inertial, data
     frames = []    # (name, body, R, p): links merged through fixed joints, and those joints
+    where = {}     # each link's (body, R, p) in the frame of the body it is part of
 
     def visit(link: str, body: int, R_acc: np.ndarray, p_acc: np.ndarray) -> None:
         """Walk the joints below `link`, which sits at (R_acc, p_acc) in body `body`'s frame."""
@@ -246,6 +263,7 @@ def load_urdf(source: str | bytes | os.PathLike, *, floating_base: bool = False,
                     target["inertial"] = combine([target["inertial"],
                                                   (m, R_place @ c + p_place, R_place @ J @ R_place.T)])
                 frames.extend([(child, body, R_place, p_place), (name, body, R_place, p_place)])
+                where[child] = (body, R_place, p_place)
                 visit(child, body, R_place, p_place)
                 continue
             what = f"joint {name!r}"
@@ -270,6 +288,7 @@ def load_urdf(source: str | bytes | os.PathLike, *, floating_base: bool = False,
                 velocity=abs(_attribute(limit, "velocity", what, np.inf)) or np.inf,
                 damping=_attribute(dynamics, "damping", what, 0.0),
                 friction=_attribute(dynamics, "friction", what, 0.0)))
+            where[child] = (len(bodies) - 1, np.eye(3), np.zeros(3))
             visit(child, len(bodies) - 1, np.eye(3), np.zeros(3))
 
     root = roots[0]
@@ -278,9 +297,11 @@ def load_urdf(source: str | bytes | os.PathLike, *, floating_base: bool = False,
                            p=np.zeros(3), axis=np.array([1.0, 0.0, 0.0]), inertial=links[root],
                            mimic=None, lower=-np.inf, upper=np.inf, effort=np.inf,
                            velocity=np.inf, damping=0.0, friction=0.0))
+        where[root] = (0, np.eye(3), np.zeros(3))
         visit(root, 0, np.eye(3), np.zeros(3))
     else:
         frames.append((root, -1, np.eye(3), np.zeros(3)))
+        where[root] = (-1, np.eye(3), np.zeros(3))
         visit(root, -1, np.eye(3), np.zeros(3))
     if not bodies:
         raise ValueError("URDF: no movable joint; the model would have no degrees of freedom "
@@ -306,7 +327,12 @@ def load_urdf(source: str | bytes | os.PathLike, *, floating_base: bool = False,
         frame_names=[f[0] for f in frames], frame_parents=[f[1] for f in frames],
         frame_rotation=np.reshape([f[2] for f in frames], (-1, 3, 3)),
         frame_translation=np.reshape([f[3] for f in frames], (-1, 3)), strict=strict)
-    return eqx.tree_at(lambda m: m.closures, model, tuple(_mimics(model, bodies)))
+    base = None if path is None else path.resolve().parent
+    geoms, notes = collision_geoms(robot, where, base, tuple(package_dirs), _floats, _origin)
+    if notes:
+        warnings.warn("load_urdf: " + "; ".join(notes), ModelWarning, stacklevel=2)
+    return eqx.tree_at(lambda m: (m.closures, m.geoms), model,
+                       (tuple(_mimics(model, bodies)), geoms), is_leaf=lambda x: x is None)
 
 
 def _mimics(model: Model, bodies: list) -> list:
