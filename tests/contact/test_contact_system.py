@@ -6,6 +6,7 @@ differences, and bad geometry named."""
 import os
 import warnings
 
+import equinox as eqx
 import jax
 import jax.numpy as jnp
 import numpy as np
@@ -147,8 +148,6 @@ def test_derivatives_through_landing_and_sliding_match_central_differences():
 
 
 def eqx_set(system, mu):
-    import equinox as eqx
-
     friction = jnp.asarray(system.geoms.friction).at[:, 0].set(mu)
     return eqx.tree_at(lambda s: s.geoms.friction, system, friction)
 
@@ -170,6 +169,20 @@ def test_penetration_and_an_unconverged_solve_are_named_failures():
     flags, sol = status(penetration=1e-4, method=SoftConstraints(iterations=1))
     assert flags & Status.PENETRATING and flags & Status.NOT_CONVERGED and not sol.ok
     assert "penetrating" in sol.messages()[0] and "not converged" in sol.messages()[0]
+    # a contact stiffer than two steps can follow: a time constant of 1 ms without MuJoCo's
+    # safety bound, or a direct stiffness of 1e6 (1 / sqrt(k) = 1 ms), at 2 ms steps
+    assert int(status()[0]) == 0
+    fast = eqx.tree_at(lambda m: m.geoms.solref, model,
+                       jnp.broadcast_to(jnp.array([0.001, 1.0]), model.geoms.solref.shape))
+    stiff = eqx.tree_at(lambda m: m.geoms.solref, model,
+                        jnp.broadcast_to(jnp.array([-1e6, -3e3]), model.geoms.solref.shape))
+    for changed, method in ((fast, SoftConstraints(refsafe=False)), (stiff, SoftConstraints())):
+        sol = mbjax.simulate(ContactSystem(TreeSystem(changed), method=method), SemiImplicitEuler(),
+                             q0, jnp.zeros(6), dt=0.002, t1=0.3)
+        assert int(sol.status) & Status.UNRESOLVED and "unresolved" in sol.messages()[0]
+    sol = mbjax.simulate(ContactSystem(TreeSystem(fast)), SemiImplicitEuler(), q0, jnp.zeros(6),
+                         dt=0.002, t1=0.3)                       # refsafe keeps two steps
+    assert not int(sol.status) & Status.UNRESOLVED
 
 
 def test_bad_geometry_is_named():

@@ -66,6 +66,16 @@ class AbstractContactModel(eqx.Module):
         model solved in closed form (the default)."""
         return jnp.array(True)
 
+    def resolved(self, solref: Array, timestep: float) -> Array:
+        """Whether each row's transient spans at least two steps, (m,) booleans; True for a
+        model without one (the default).
+
+        Args:
+            solref: each row's parameters, (m, 2).
+            timestep: the simulation's step [s].
+        """
+        return jnp.ones(solref.shape[:-1], bool)
+
 
 def impedance(solimp: Array, position: Array) -> Array:
     """MuJoCo's impedance d(r) in [dmin, dmax]: a sigmoid of |r| / width with midpoint `mid`
@@ -161,6 +171,22 @@ class SoftConstraints(AbstractContactModel):
     def converged(self, mass, free, jacobian, weight, reference):
         return jax.lax.stop_gradient(_newton(mass, free, jacobian, weight, reference,
                                              self.iterations, self.tolerance, True)[1])
+
+    def resolved(self, solref, timestep):
+        """A row's time constant is solref's timeconst (at least two steps with refsafe), or,
+        for a direct (-stiffness, -damping) solref, the shorter of 1 / sqrt(stiffness) and
+        2 / damping (the timeconst that MuJoCo's formulas would turn into that stiffness and
+        damping); the bound is MuJoCo's refsafe: two steps."""
+        direct = solref[..., 0] <= 0
+        stiffness = jnp.where(direct, -solref[..., 0], 1.0)
+        damping = jnp.where(solref[..., 1] < 0, -solref[..., 1], 0.0)
+        scale = jnp.minimum(jnp.where(stiffness > 0, 1 / jnp.sqrt(stiffness), jnp.inf),
+                            jnp.where(damping > 0, 2 / jnp.where(damping > 0, damping, 1.0),
+                                      jnp.inf))
+        timeconst = jnp.where(direct, scale, solref[..., 0])
+        if self.refsafe:
+            timeconst = jnp.where(direct, timeconst, jnp.maximum(timeconst, 2 * timestep))
+        return timeconst >= 2 * timestep * (1 - 1e-9)
 
 
 def _gradient(a, mass, free, jacobian, weight, reference, pushing):

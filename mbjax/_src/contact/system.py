@@ -153,8 +153,10 @@ class ContactSystem(AbstractSystem):
     Statuses:
         `simulate`'s saved states are checked: a contact deeper than `penetration` fails the
         run with `Status.PENETRATING`, a contact solve that missed its tolerance within its
-        iterations with `Status.NOT_CONVERGED`; the tree's own notes follow (a joint past its
-        position limit is not noted where the limits are held).
+        iterations with `Status.NOT_CONVERGED`, a pushing contact or limit whose time constant
+        is shorter than two steps (which the steps cannot follow) with `Status.UNRESOLVED`;
+        the tree's own notes follow (a joint past its position limit is not noted where the
+        limits are held).
 
     Raises:
         TypeError: a tree that is not a `TreeSystem`, geoms that are not `Geoms`, or a method
@@ -282,13 +284,14 @@ class ContactSystem(AbstractSystem):
         return tuple(jnp.concatenate(x) for x in zip(*parts, strict=True)), found
 
     def _problem(self, t, q: Array, v: Array):
-        """(M, a0, J, D, aref) of the contact model's problem at (t, q, v), and the contacts."""
+        """(M, a0, J, D, aref) of the contact model's problem at (t, q, v), the contacts, and
+        the rows' (position, solref)."""
         M = self.tree.mass_matrix(q)
         free = cho_solve(cholesky(M), -self.tree.bias(t, q, v))
         (J, position, invweight, solref, solimp, frictional), found = self._rows(q, v)
         D, aref = self.method.rows(J, position, J @ v, invweight, solref, solimp, frictional,
                                    self.timestep)
-        return (M, free, J, D, aref - J @ _world_rate(self.model, v)), found
+        return (M, free, J, D, aref - J @ _world_rate(self.model, v)), found, (position, solref)
 
     def solve(self, t, q: Array, v: Array) -> tuple[Array, Array, Contacts]:
         """The contact model's solution at a state.
@@ -302,7 +305,7 @@ class ContactSystem(AbstractSystem):
             (v_dot (with `implicit_damping`, the step's), each constraint row's force (the contacts' pyramid edges, then the joint
             limits), the candidate contacts).
         """
-        problem, found = self._problem(t, q, v)
+        problem, found, _ = self._problem(t, q, v)
         a, forces = self.method.solve(*problem)
         if self.implicit_damping:              # MuJoCo's mj_Euler: (M + h B) a_step = M a
             M = problem[0]
@@ -311,10 +314,13 @@ class ContactSystem(AbstractSystem):
 
     def check(self, t, q, u):
         """`Status.PENETRATING` where a contact sinks deeper than `penetration`,
-        `Status.NOT_CONVERGED` where the contact solve missed its tolerance, and the tree's
-        flags (an int32 scalar)."""
-        problem, found = self._problem(t, q, u)
+        `Status.NOT_CONVERGED` where the contact solve missed its tolerance,
+        `Status.UNRESOLVED` where a pushing row's time constant is shorter than two steps, and
+        the tree's flags (an int32 scalar)."""
+        problem, found, (position, solref) = self._problem(t, q, u)
         flags = jnp.where(self.method.converged(*problem), 0, int(Status.NOT_CONVERGED))
+        fast = (position < 0) & ~self.method.resolved(solref, self.timestep)
+        flags = flags | jnp.where(jnp.any(fast), int(Status.UNRESOLVED), 0)
         if found.geoms:
             deep = jnp.any(found.distance - found.margin < -self.penetration)
             flags = flags | jnp.where(deep, int(Status.PENETRATING), 0)

@@ -39,6 +39,11 @@ class Status(enum.IntFlag):
         PENETRATING: a contact found by `mbjax.contact.ContactSystem` sinks deeper than the
             system's `penetration` bound: the steps or the contact's softness let a body
             pass through another.
+        UNRESOLVED: a pushing contact's or joint limit's time constant is shorter than two
+            of the system's steps (a `solref` below MuJoCo's safety bound, with
+            `SoftConstraints(refsafe=False)` or a direct stiffness and damping): the steps
+            cannot follow its transient, and the contact's motion is the integrator's, not the
+            model's.
     """
 
     SUCCESS = 0
@@ -53,6 +58,7 @@ class Status(enum.IntFlag):
     PULLING = 256
     SLIPPING = 512
     PENETRATING = 1024
+    UNRESOLVED = 2048
 
     @classmethod
     def failures(cls) -> int:
@@ -62,7 +68,8 @@ class Status(enum.IntFlag):
             The failure flags OR-ed into one int mask.
         """
         return (cls.NONFINITE | cls.NOT_CONVERGED | cls.SOLVER_FAILED | cls.CONSTRAINT_VIOLATED
-                | cls.INACCURATE | cls.SINGULAR | cls.PULLING | cls.SLIPPING | cls.PENETRATING)
+                | cls.INACCURATE | cls.SINGULAR | cls.PULLING | cls.SLIPPING | cls.PENETRATING
+                | cls.UNRESOLVED)
 
 
 # the flags in order: `flagged_at` keeps the time each was first raised
