@@ -4,9 +4,14 @@
   `mbjax.contact.ContactSystem` (the file's integrator: RK4, or Euler as semi-implicit Euler)
   and by MuJoCo; the largest difference of the root's height over the run (its z, or the
   planar models' rootz), and what mbjax leaves out of the file (`from_mujoco`'s warning).
+- Primitives: a sphere, a box and a capsule dropped, slid and rolled on a plane, and a box
+  dropped on a box, for 1 s by both engines (MuJoCo's Euler step, semi-implicit Euler here):
+  the rest heights' and the slide distances' differences.
 - Throughput: B vmapped 1 s Ant rollouts from pushed starts (random initial velocities), per
   step, against `mujoco.rollout` of the same starts on the same cores (its thread pool, one
   thread per core); MJX where it installs.
+- Memory: the compiled rollout's temporary bytes at 1e3 and 1e5 steps (XLA's memory analysis),
+  and the process's peak resident memory before and after a 1e5-step Ant rollout.
 
 Compile and run times are separate (median after warm-up). JSON lines + PNG.
 """
@@ -90,6 +95,81 @@ def agreement(name: str, common: dict) -> dict:
             "status": sol.messages()[0], "mbjax_ignores": ignored}
 
 
+PRIMITIVES = {   # name: (the body's geom, its initial qvel)
+    "sphere-drop": ('<geom type="sphere" size="0.1" mass="1"/>', None),
+    "box-drop": ('<geom type="box" size="0.1 0.2 0.05" mass="1"/>', None),
+    "capsule-drop": ('<geom type="capsule" size="0.05 0.2" euler="0 80 0" mass="1"/>', None),
+    "box-slide": ('<geom type="box" size="0.1 0.2 0.05" mass="1"/>', [1.0, 0.3, 0, 0, 0, 0]),
+    "sphere-roll": ('<geom type="sphere" size="0.1" mass="1"/>', [1.0, 0.0, 0, 0, 0, 0]),
+    "box-on-box": ('<geom type="box" size="0.1 0.1 0.1" mass="1"/>', None),
+}
+
+
+def primitive(name: str, common: dict) -> dict:
+    """A body dropped (or slid, rolled) on a plane, or on a fixed box, for 1 s: mbjax against
+    MuJoCo (its Euler step: semi-implicit Euler)."""
+    import mujoco
+
+    geom, qvel = PRIMITIVES[name]
+    under = '<geom type="box" size="0.2 0.2 0.1" pos="0 0 0.1"/>' if "on-box" in name else ""
+    xml = (f'<mujoco><worldbody><geom type="plane" size="5 5 .1"/>{under}'
+           f'<body pos="0 0 0.45"><freejoint/>{geom}</body></worldbody></mujoco>')
+    m = mujoco.MjModel.from_xml_string(xml)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        model = mbjax.model.from_mujoco(m)
+    steps = int(round(DURATION / m.opt.timestep))
+    d = mujoco.MjData(m)
+    if qvel is not None:
+        d.qvel[:] = qvel
+    positions = []
+    for _ in range(steps):
+        mujoco.mj_step(m, d)
+        positions.append(d.qpos[:3].copy())
+    positions = np.asarray(positions)
+    system, integrator = mujoco_step(m, model)
+    v0 = jnp.zeros(6) if qvel is None else state_from_mujoco(model, m.qpos0, np.asarray(qvel))[1]
+    sol = mbjax.simulate(system, integrator, jnp.asarray(m.qpos0), v0, dt=m.opt.timestep,
+                         t1=steps * m.opt.timestep)
+    ours = np.asarray(sol.qs[1:, :3])
+    slide = lambda p: float(np.linalg.norm(p[-1, :2] - p[0, :2]))  # noqa: E731
+    return {**common, "kind": "primitive", "model": name, "steps": steps,
+            "rest_height_mbjax_m": float(ours[-1, 2]), "rest_height_mujoco_m": float(positions[-1, 2]),
+            "rest_height_error_m": float(abs(ours[-1, 2] - positions[-1, 2])),
+            "slide_mbjax_m": slide(ours), "slide_mujoco_m": slide(positions),
+            "slide_error_m": abs(slide(ours) - slide(positions)),
+            "position_error_max_m": float(np.abs(ours - positions).max()),
+            "status": sol.messages()[0]}
+
+
+def memory(common: dict) -> dict:
+    """The Ant's rollout compiled for 1e3 and 1e5 steps (XLA's temporary bytes: the same), and
+    the process's peak resident memory across a 1e5-step run (saving its last state)."""
+    import resource
+
+    m, model, _ = load("ant")
+    system, integrator = mujoco_step(m, model)
+    q0, dt = jnp.asarray(m.qpos0), float(m.opt.timestep)
+
+    def rollout(steps):
+        return jax.jit(lambda v: mbjax.simulate(system, integrator, q0, v, dt=dt, t1=steps * dt,
+                                                saveat=[steps * dt]).qs[-1])
+
+    v0 = jnp.zeros(m.nv)
+    temp = {steps: rollout(steps).lower(v0).compile().memory_analysis().temp_size_in_bytes
+            for steps in (1_000, 100_000)}
+    run = rollout(100_000)
+    jax.block_until_ready(run(v0 + 1e-3))                        # compiled, and one run
+    before = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
+    start = time.perf_counter()
+    jax.block_until_ready(run(v0))
+    seconds = time.perf_counter() - start
+    after = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
+    return {**common, "kind": "memory", "model": "ant", "steps": 100_000,
+            "temp_bytes_1e3_steps": int(temp[1_000]), "temp_bytes_1e5_steps": int(temp[100_000]),
+            "peak_rss_growth_kb": int(after - before), "seconds": seconds}
+
+
 def throughput(batch: int, common: dict) -> list[dict]:
     import mujoco
     from mujoco import rollout
@@ -170,7 +250,11 @@ def run(out: Path, quick: bool = False) -> list[dict]:
     records = []
     for name in (("ant", "hopper") if quick else MODELS):
         records.append(agreement(name, common))
+    for name in (("sphere-drop", "box-on-box") if quick else PRIMITIVES):
+        records.append(primitive(name, common))
     records += throughput(64 if quick else 1024, common)
+    if not quick:
+        records.append(memory(common))
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     write_jsonl(out / f"{NAME}.jsonl", records)
