@@ -302,8 +302,8 @@ class ContactSystem(AbstractSystem):
             v: velocity, shape (nv,).
 
         Returns:
-            (v_dot (with `implicit_damping`, the step's), each constraint row's force (the contacts' pyramid edges, then the joint
-            limits), the candidate contacts).
+            (v_dot (with `implicit_damping`, the step's), each constraint row's force (the
+            contacts' pyramid edges, then the joint limits), the candidate contacts).
         """
         problem, found, _ = self._problem(t, q, v)
         a, forces = self.method.solve(*problem)
