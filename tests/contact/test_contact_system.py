@@ -241,3 +241,20 @@ def test_geoms_are_kept_from_mjcf_and_swept_as_data():
     swept = np.asarray(jax.jit(jax.vmap(slide))(mus))
     assert np.all(np.diff(swept) < 0)
     np.testing.assert_allclose(swept[1], float(slide(0.5)), rtol=1e-9)
+
+
+def test_locked_joints_carry_their_geoms():
+    """Locking the Ant's ankles welds each lower leg's capsule to its upper leg: the contacts
+    found are the same at the same pose."""
+    _, ant = _load(str(mbjax.data.ANT))
+    q = ant.neutral().at[2].set(0.4).at[7:].set(jnp.array([0.3, 1.0, -0.2, -1.0, 0.1, -1.0,
+                                                          0.0, 1.0]))
+    ankles = [name for name in ant.joint_names if name.startswith("ankle")]
+    reduced = ant.locked(ankles, q)
+    kept = np.r_[0:7, 7, 9, 11, 13]                       # the free joint and the hips
+    contacts = eqx.filter_jit(lambda system, q: system.contacts(q))
+    full = contacts(ContactSystem(TreeSystem(ant)), q)
+    welded = contacts(ContactSystem(TreeSystem(reduced)), q[kept])
+    assert reduced.geoms.n == ant.geoms.n and welded.geoms == full.geoms
+    np.testing.assert_allclose(welded.distance, full.distance, atol=1e-12)
+    np.testing.assert_allclose(welded.position, full.position, atol=1e-12)

@@ -83,6 +83,7 @@ def detect(geoms: Geoms, R: Array, p: Array) -> Contacts:
     return Contacts(dist, pos, frame, margin, tuple(map(tuple, index.tolist())))
 
 
+@eqx.filter_jit                   # one program, not an eager operation each (a second at first)
 def _invweights(model, q: Array) -> tuple[Array, Array]:
     """MuJoCo's `body_invweight0` (translational) and `dof_invweight0` at q: the mean diagonal
     of J M^-1 J^T for each body's centre of mass (its rotational mean where the translational

@@ -45,11 +45,14 @@ class Geoms(eqx.Module):
     pairs of geoms that may touch.
 
     Sizes follow MJCF: a plane (its half extents; an infinite plane for zeros, its normal the
-    geom's z axis), a sphere (radius), a capsule (radius, half length of its segment along z), an
-    ellipsoid (semi-axes), a cylinder (radius, half length along z), a box (half extents). Contact parameters are MuJoCo's (`friction` sliding, torsional, rolling;
-    `solref` (timeconst, dampratio) or (-stiffness, -damping); `solimp` (dmin, dmax, width, mid,
-    power); `margin` and `gap`; `solmix` the weight of a geom's solref and solimp in a pair);
-    two geoms' parameters combine as MuJoCo combines them (`pair_parameters`).
+    geom's z axis), a sphere (radius), a capsule (radius, half length of its segment along z),
+    an ellipsoid (semi-axes), a cylinder (radius, half length along z), a box (half extents).
+    Contact parameters are MuJoCo's (`friction` sliding, torsional, rolling; `solref`
+    (timeconst, dampratio) or (-stiffness, -damping); `solimp` (dmin, dmax, width, mid, power);
+    `margin` and `gap`; `solmix` the weight of a geom's solref and solimp in a pair); two geoms'
+    parameters combine as MuJoCo combines them (`pair_parameters`). Contacts are detected
+    between a plane and every other kind, and between spheres, capsules and boxes (cylinders
+    and ellipsoids on planes only).
 
     Args:
         kinds: each geom's kind, one of "plane", "sphere", "capsule", "ellipsoid", "cylinder",
@@ -73,8 +76,9 @@ class Geoms(eqx.Module):
 
     Raises:
         ValueError: naming the field: an unknown kind, a negative size, a sphere, capsule or
-            cylinder of zero radius, an ellipsoid with a zero semi-axis, negative friction, margin or solmix, a solref mixing signs, a
-            solimp outside MuJoCo's range, a condim other than 1 or 3, a pair out of range.
+            cylinder of zero radius, an ellipsoid with a zero semi-axis, negative friction,
+            margin or solmix, a solref mixing signs, a solimp outside MuJoCo's range, a condim
+            other than 1 or 3, a pair out of range.
     """
 
     kinds: tuple = eqx.field(static=True)

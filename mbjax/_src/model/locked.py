@@ -11,6 +11,7 @@ into the nearest kept ancestor (or the ground). The kept bodies keep their relat
 is parent-before-child and Pinocchio's numbering of the reduced model, and their joints keep their
 types, axes, names, limits, damping, springs, armature and friction (the kept coordinates' entries).
 
+Geoms move with their bodies into the kept ones (a pair that ends up on one body is dropped).
 Closures follow the bodies and coordinates: a `CutJoint`'s frames move with their bodies into the
 kept ones; a `Coupling` or `Prescribed` motion is renumbered to the kept coordinates, and a
 `Coupling` of two locked coordinates (a URDF mimic pair locked together) is dropped. One that
@@ -25,6 +26,7 @@ import numpy as np
 
 from mbjax._src.model.checks import combine
 from mbjax._src.model.closures import GROUND, Coupling, CutJoint, Prescribed
+from mbjax._src.model.geoms import Geoms
 from mbjax._src.model.joints import JOINT_TYPES
 from mbjax._src.model.model import Model
 
@@ -132,6 +134,17 @@ def lock_joints(model: Model, joint_names, q) -> Model:
 
     closures = tuple(c for c in (_remap(c, model, locked, host, new_index, q0, q_kept)
                                  for c in model.closures) if c is not None)
+    geoms = model.geoms
+    if geoms is not None:                   # each geom moves with its body into the host
+        placed = [in_host(b, R, p) for b, R, p in zip(geoms.bodies, np.asarray(geoms.rotation),
+                                                      np.asarray(geoms.position))]
+        bodies = [h for h, _, _ in placed]
+        geoms = Geoms(geoms.kinds, bodies, geoms.size, position=[p for _, _, p in placed],
+                      rotation=[R for _, R, _ in placed], friction=geoms.friction,
+                      solref=geoms.solref, solimp=geoms.solimp, solmix=geoms.solmix,
+                      margin=geoms.margin, gap=geoms.gap, condim=geoms.condim, names=geoms.names,
+                      pairs=[(i, j) for i, j in geoms.pairs if bodies[i] != bodies[j]
+                             and not (bodies[i] < 0 and bodies[j] < 0)])
     return Model(
         new_parents, [model.joint_types[k] for k in kept],
         mass=[m for m, _, _ in merged], com=[c for _, c, _ in merged],
@@ -146,7 +159,8 @@ def lock_joints(model: Model, joint_names, q) -> Model:
         friction=per("friction", v_kept),
         frame_names=[f[0] for f in frames], frame_parents=[f[1] for f in frames],
         frame_rotation=np.reshape([f[2] for f in frames], (-1, 3, 3)),
-        frame_translation=np.reshape([f[3] for f in frames], (-1, 3)), closures=closures)
+        frame_translation=np.reshape([f[3] for f in frames], (-1, 3)), closures=closures,
+        geoms=geoms)
 
 
 def _remap(closure, model: Model, locked: np.ndarray, host: list, new_index: np.ndarray,

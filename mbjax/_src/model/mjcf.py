@@ -115,9 +115,8 @@ _GEOM_KINDS = {0: "plane", 2: "sphere", 3: "capsule", 4: "ellipsoid", 5: "cylind
 
 def _geoms(m, mujoco, where) -> tuple[Geoms | None, list[str]]:
     """The model's geoms that mbjax detects contacts of (planes, spheres, capsules,
-    ellipsoids, cylinders, boxes), on
-    the mbjax bodies that carry them, with the pairs MuJoCo's broadphase would pass on; and
-    what is left out."""
+    ellipsoids, cylinders, boxes), on the mbjax bodies that carry them, with the pairs MuJoCo's
+    broadphase would pass on whose kinds are detected; and what is left out."""
     if not m.ngeom:
         return None, []
     filter_parent = not int(m.opt.disableflags) & int(mujoco.mjtDisableBit.mjDSBL_FILTERPARENT)

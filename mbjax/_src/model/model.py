@@ -123,7 +123,8 @@ class Model(eqx.Module):
             `mbjax.loops.CutJoint`s); `TreeSystem(model)` leaves them out and
             `ClosedSystem(TreeSystem(model), model.closures)` enforces them.
         geoms (mbjax.model.Geoms | None): the collision geometry (`load_mjcf` keeps an MJCF's
-            geoms), which `mbjax.contact.ContactSystem` detects contacts between; None for
+            geoms, `load_urdf` a URDF's `<collision>` shapes), which
+            `mbjax.contact.ContactSystem` detects contacts between; None for
             none.
         strict (bool): turn the mass-data warnings into errors.
 
