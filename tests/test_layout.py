@@ -35,9 +35,9 @@ LAYERS = (
 RANK = {name: rank for rank, names in enumerate(LAYERS) for name in names}
 NAMESPACES = ("lie", "model", "control", "integrate", "rigid", "flex", "loops", "tfe", "wrist",
               "trajopt", "scenes", "data", "contact")
-MAX_PUBLIC_NAMES = 175       # 150, the contact namespace (legged robots), multi-phase problems,
-#                              contacts that find themselves (geoms, their system and model)
-                             # and contact costs (issue 45)
+MAX_PUBLIC_NAMES = 177       # 150, the contact namespace (legged robots), multi-phase problems,
+                             # contacts that find themselves (geoms, their system and model,
+                             # the Ant's and HalfCheetah's files) and contact costs (issue 45)
 
 
 def _imports(path: Path):

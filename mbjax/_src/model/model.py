@@ -472,7 +472,7 @@ class Model(eqx.Module):
     def spring_stretch(self, q: Array) -> Array:
         """q - spring_reference at each velocity coordinate's position coordinate
         (`spring_index`; a spherical or free joint's entries, which have no stiffness, read
-        coordinate 0).
+        its own first coordinates).
 
         Args:
             q: configuration, shape (nq,).
@@ -480,7 +480,18 @@ class Model(eqx.Module):
         Returns:
             The springs' stretches, shape (nv,).
         """
-        return (q - self.spring_reference)[np.maximum(self.spring_index(), 0)]
+        return take(q - self.spring_reference, self._spring_gather())
+
+    def _spring_gather(self) -> np.ndarray:
+        """`spring_index` with a spherical or free joint's entries read from its own first
+        coordinates (a run of consecutive indices, where stiffness is zero), so that `take`
+        reads it as slices: no gather, and no scatter in its gradient."""
+        layout, index = _layout(self.joint_types), self.spring_index()
+        for kind, iq, iv in zip(self.joint_types, layout["q_start"], layout["v_start"]):
+            nq, nv = JOINT_TYPES[kind]
+            if nq != nv:
+                index[iv:iv + nv] = np.arange(iq, iq + nv)
+        return index
 
     # -- joints ---------------------------------------------------------------------------------
 

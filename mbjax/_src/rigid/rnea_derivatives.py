@@ -71,7 +71,7 @@ def rnea_jvp(model: Model, q: Array, v: Array, a: Array, dq: Array, dv: Array) -
     L = (_times(I, P2) - cross_force(P3, h) - _times(I, cross_motion(P3, V))
          - cross_force(V, _times(I, P3)) + own)
     dtau = jnp.einsum("kic,ki->kc", S, _inward_sum(model, L) - own)
-    spring = model.stiffness * dq[np.maximum(model.spring_index(), 0)]
+    spring = model.stiffness * take(dq, model._spring_gather())
     return model.flat_v(dtau) + model.damping * dv + spring
 
 
