@@ -195,7 +195,7 @@ def test_bad_geometry_is_named():
     with pytest.raises(ValueError, match="kinds"):
         Geoms(("torus",), (0,), [[0.1, 0, 0]])
     with pytest.raises(ValueError, match="condim"):
-        Geoms(("sphere",), (0,), [[0.1, 0, 0]], condim=[4])
+        Geoms(("sphere",), (0,), [[0.1, 0, 0]], condim=[2])
     with pytest.raises(ValueError, match="solimp"):
         Geoms(("sphere",), (0,), [[0.1, 0, 0]], solimp=[[0.9, 1.5, 0.001, 0.5, 2]])
     model = mbjax.model.random_tree(2, seed=0)
@@ -258,3 +258,43 @@ def test_locked_joints_carry_their_geoms():
     assert reduced.geoms.n == ant.geoms.n and welded.geoms == full.geoms
     np.testing.assert_allclose(welded.distance, full.distance, atol=1e-12)
     np.testing.assert_allclose(welded.position, full.position, atol=1e-12)
+
+
+@pytest.mark.parametrize("geom, qvel, spin", [
+    ('<geom type="box" size="0.1 0.2 0.05" mass="1" condim="4" friction="0.8 0.02 0"/>',
+     [0, 0, 0, 0, 0, 10.0], True),
+    ('<geom type="sphere" size="0.1" mass="1" condim="6" friction="0.8 0.01 0.005"/>',
+     [1.0, 0, 0, 0, 3.0, 2.0], False),
+], ids=["torsional-box", "rolling-sphere"])
+def test_torsional_and_rolling_friction_follow_mujoco(geom, qvel, spin):
+    """condim 4 and 6 (MuJoCo's pyramids over the spin and the rolling): a box spinning on the
+    floor slows as MuJoCo's does, to round-off; a ball rolling and spinning has MuJoCo's
+    accelerations at MuJoCo's own states."""
+    xml = (f'<mujoco><worldbody>{FLOOR}<body pos="0 0 {0.05 if spin else 0.1}"><freejoint/>'
+           f'{geom}</body></worldbody></mujoco>')
+    m, model = _load(xml)
+    assert model.geoms.condim[-1] == (4 if spin else 6)
+    system = ContactSystem(TreeSystem(model), timestep=m.opt.timestep)
+    acceleration = jax.jit(lambda q, v: system.acceleration(0.0, q, v))
+    d = mujoco.MjData(m)
+    d.qvel[:] = qvel
+    spins = []
+    for step in range(250):
+        mujoco.mj_step(m, d)
+        spins.append(d.qvel[5])
+        if step % 50 == 10:
+            mujoco.mj_forward(m, d)
+            q, v = state_from_mujoco(model, d.qpos, d.qvel)
+            a = np.asarray(acceleration(q, v))
+            # MuJoCo's (world linear; body angular) rates in mbjax's body twist (omega; v):
+            # v_body = R^T v_world, so its rate is R^T a_world - omega x v_body
+            R, omega, v_body = d.xmat[1].reshape(3, 3), np.asarray(v[:3]), np.asarray(v[3:])
+            expected = np.r_[d.qacc[3:], R.T @ d.qacc[:3] - np.cross(omega, v_body)]
+            assert d.nefc > 0
+            np.testing.assert_allclose(a, expected, atol=1e-9 * (1 + np.abs(a).max()))
+    if spin:
+        v0 = state_from_mujoco(model, m.qpos0, np.asarray(qvel, float))[1]
+        sol = mbjax.simulate(system, SemiImplicitEuler(), jnp.asarray(m.qpos0), v0,
+                             dt=m.opt.timestep, t1=0.5)
+        np.testing.assert_allclose(np.asarray(sol.us[1:, 2]), spins, atol=1e-9)
+        assert spins[-1] < 0.8 * qvel[5]                   # the torsional friction slows it

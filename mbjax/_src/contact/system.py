@@ -230,7 +230,8 @@ class ContactSystem(AbstractSystem):
 
     def _rows(self, q: Array, v: Array):
         """The constraint rows at (q, v): (J, position, invweight, solref, solimp, frictional)
-        of every contact's pyramid edges (or normal, condim 1) and every joint limit, and the
+        of every contact's pyramid edges (sliding, condim 3; and torsional, 4; and rolling, 6;
+        MuJoCo's pyramids) or normal (condim 1) and every joint limit, and the
         contacts."""
         model, geoms = self.model, self.geoms
         kin = body_kinematics(model, q, v)
@@ -240,29 +241,35 @@ class ContactSystem(AbstractSystem):
         if found.geoms:
             i, j = np.asarray(found.geoms).T
             body = np.asarray(geoms.bodies)
-            linear = point_columns(model, kin.S, found.position)[..., 3:]     # (c, nv, 3)
-
             def support(b: np.ndarray) -> np.ndarray:        # the columns on b's path, (c, nv)
                 return np.where(b[:, None] >= 0, path[np.maximum(b, 0)], 0.0)
 
-            relative = linear * (support(body[j]) - support(body[i]))[..., None]
-            J = found.frame @ jnp.swapaxes(relative, -1, -2)                  # (c, 3, nv)
+            columns = point_columns(model, kin.S, found.position)             # (c, nv, 6)
+            relative = columns * (support(body[j]) - support(body[i]))[..., None]
+            # the relative motion in the contact frame: (normal, tangents), then the turning
+            # about them (spin, rolling), (c, 3, nv) each
+            J = found.frame @ jnp.swapaxes(relative[..., 3:], -1, -2)
+            turning = found.frame @ jnp.swapaxes(relative[..., :3], -1, -2)
             friction, solref, solimp, _ = pair_parameters(geoms, i, j)
             condim = np.maximum(np.asarray(geoms.condim)[i], np.asarray(geoms.condim)[j])
             weight = self.invweight[np.maximum(body[i], 0)] * (body[i] >= 0) + \
                 self.invweight[np.maximum(body[j], 0)] * (body[j] >= 0)
             position = found.distance - found.margin
-            for dim in (1, 3):
+            for dim in (1, 3, 4, 6):
                 on = np.flatnonzero(condim == dim)
                 if not on.size:
                     continue
                 if dim == 1:
                     rows, scale = J[on, :1], weight[on][:, None]
-                else:           # a pair of pyramid edges per tangent: J_n +- mu J_t
-                    mu = friction[on, 0]               # sliding friction, the same both ways
-                    signs = jnp.stack([mu, -mu, mu, -mu], 1)
-                    rows = J[on, :1] + jnp.repeat(J[on, 1:], 2, axis=1) * signs[:, :, None]
-                    scale = (weight[on] * (1 + mu**2) * 2 * mu**2)[:, None]
+                else:           # a pair of pyramid edges per direction: J_n +- mu_k J_k
+                    directions = jnp.concatenate([J[on, 1:], turning[on, :dim - 3]], 1)
+                    f = friction[on]                   # sliding, torsional, rolling
+                    mu = jnp.stack([f[:, 0], f[:, 0], f[:, 1], f[:, 2], f[:, 2]], 1)[:, :dim - 1]
+                    signs = jnp.repeat(mu, 2, axis=1) * jnp.tile(jnp.array([1.0, -1.0]), dim - 1)
+                    rows = J[on, :1] + jnp.repeat(directions, 2, axis=1) * signs[:, :, None]
+                    # MuJoCo's common weight of a pyramid's edges, from its sliding friction
+                    slide = f[:, 0]
+                    scale = (weight[on] * (1 + slide**2) * 2 * slide**2)[:, None]
                 edges = rows.shape[1]
                 parts.append((rows.reshape(-1, model.nv), jnp.repeat(position[on], edges),
                               jnp.broadcast_to(scale, (on.size, edges)).reshape(-1),

@@ -63,7 +63,8 @@ class Geoms(eqx.Module):
         rotation: (n, 3, 3) each geom's axes in its body's frame; identity by default.
         friction, solref, solimp, solmix, margin, gap: contact parameters, (n, 3), (n, 2),
             (n, 5), (n,), (n,), (n,); MuJoCo's defaults.
-        condim: each geom's contact dimension, 1 (frictionless) or 3 (sliding friction); 3 by
+        condim: each geom's contact dimension, 1 (frictionless), 3 (sliding friction), 4 (and
+            torsional friction) or 6 (and rolling friction); a pair takes the larger; 3 by
             default.
         names: each geom's name; "geomK" by default.
         pairs: the pairs of geom indices that may touch, or None for every pair whose
@@ -78,7 +79,7 @@ class Geoms(eqx.Module):
         ValueError: naming the field: an unknown kind, a negative size, a sphere, capsule or
             cylinder of zero radius, an ellipsoid with a zero semi-axis, negative friction,
             margin or solmix, a solref mixing signs, a solimp outside MuJoCo's range, a condim
-            other than 1 or 3, a pair out of range.
+            other than 1, 3, 4 or 6, a pair out of range.
     """
 
     kinds: tuple = eqx.field(static=True)
@@ -108,9 +109,9 @@ class Geoms(eqx.Module):
                 raise ValueError(f"kinds: unknown geom kind {k!r}; choose from {KINDS}")
         self.names = tuple(names) if names is not None else tuple(f"geom{k}" for k in range(n))
         self.condim = (3,) * n if condim is None else tuple(int(c) for c in condim)
-        if any(c not in (1, 3) for c in self.condim):
-            raise ValueError(f"condim must be 1 (frictionless) or 3 (sliding friction), got "
-                             f"{self.condim}")
+        if any(c not in (1, 3, 4, 6) for c in self.condim):
+            raise ValueError(f"condim must be 1 (frictionless), 3 (sliding friction), 4 (and "
+                             f"torsional) or 6 (and rolling), got {self.condim}")
         self.size = _rows(size, None, n, 3, "size")
         self.position = _rows(position, 0.0, n, 3, "position")
         if rotation is None:

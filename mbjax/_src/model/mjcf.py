@@ -157,10 +157,8 @@ def _geoms(m, mujoco, where) -> tuple[Geoms | None, list[str]]:
                   solref=np.asarray(m.geom_solref)[kept], solimp=np.asarray(m.geom_solimp)[kept],
                   solmix=np.asarray(m.geom_solmix)[kept], margin=np.asarray(m.geom_margin)[kept],
                   gap=np.asarray(m.geom_gap)[kept],
-                  condim=[1 if int(m.geom_condim[g]) == 1 else 3 for g in kept],
+                  condim=[int(m.geom_condim[g]) for g in kept],
                   names=names, pairs=pairs)
-    if any(int(m.geom_condim[g]) not in (1, 3) for g in kept):
-        left.append("torsional and rolling friction (condim 4 and 6 geoms are condim 3)")
     return geoms, left
 
 
