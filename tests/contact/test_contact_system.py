@@ -121,7 +121,8 @@ def test_joint_limit_holds_as_mujoco():
 def test_derivatives_through_landing_and_sliding_match_central_differences():
     """A box dropped from 0.3 m with a forward speed lands and slides: the derivatives of where
     it ends in the drop height, the speed and the friction coefficient (the implicit function
-    theorem at each step's solution) agree with central differences; finite at first touch."""
+    theorem at each step's solution) agree with central differences, in forward and reverse
+    mode; finite at first touch."""
     _, model = _load(f'<mujoco><worldbody>{FLOOR}<body pos="0 0 0.3"><freejoint/>'
                      '<geom type="box" size="0.1 0.2 0.05" mass="1"/></body></worldbody></mujoco>')
     base = ContactSystem(TreeSystem(model))
@@ -145,6 +146,9 @@ def test_derivatives_through_landing_and_sliding_match_central_differences():
         np.testing.assert_allclose(J[:, k], (f(*up) - f(*down)) / (2 * h), rtol=1e-6, atol=1e-8)
     touching = np.stack(jacobian(0.05, 0.0, 0.3), 1)       # resting at first touch, at rest
     assert np.all(np.isfinite(touching))
+    # reverse mode (the solve's derivative rule transposed) gives the same gradient
+    gradient = jax.jit(jax.grad(lambda *x: stop(*x)[0], argnums=(0, 1, 2)))(*x)
+    np.testing.assert_allclose(np.asarray(gradient), J[0], rtol=1e-9, atol=1e-12)
 
 
 def eqx_set(system, mu):
