@@ -279,7 +279,7 @@ def _face_contacts(reference, incident, m: Array):
     xy, height = jax.vmap(plane)(corners_i)
     on_i = jnp.all(jnp.abs(xy) <= extent * (1 + 1e-9), axis=-1)
     corners_r = c_r + _SQUARE @ axes_r
-    lift = jnp.dot(c_i - corners_r, f) / jnp.dot(m, f)                 # along m to the incident face
+    lift = jnp.dot(c_i - corners_r, f) / jnp.dot(m, f)          # along m to the incident face
     under = corners_r + lift[:, None] * m
     span = jnp.linalg.norm(axes_i, axis=-1)
     local = (under - c_i) @ (axes_i / span[:, None]).T
@@ -311,8 +311,8 @@ def _closest_points(a0, a1, b0, b1):
     aa, bb, ab = jnp.dot(da, da), jnp.dot(db, db), jnp.dot(da, db)
     ar, br = jnp.dot(da, r), jnp.dot(db, r)
     det = aa * bb - ab * ab
-    s = jnp.clip(jnp.where(det > 1e-12 * aa * bb, (ab * br - bb * ar) / jnp.where(det > 0, det, 1.0),
-                           0.0), 0.0, 1.0)
+    s = jnp.where(det > 1e-12 * aa * bb, (ab * br - bb * ar) / jnp.where(det > 0, det, 1.0), 0.0)
+    s = jnp.clip(s, 0.0, 1.0)
     t = jnp.clip((ab * s + br) / jnp.maximum(bb, 1e-30), 0.0, 1.0)
     s = jnp.clip((ab * t - ar) / jnp.maximum(aa, 1e-30), 0.0, 1.0)
     return a0 + s * da, b0 + t * db

@@ -132,8 +132,9 @@ class Model(eqx.Module):
         ValueError: an invalid parents array, unknown joint type, wrong number of names, an
             array of the wrong shape, a non-finite value, a placement that is not a rotation,
             a zero or parallel joint axis, limits out of order, negative damping, stiffness,
-            armature or friction, a spring on a spherical or free joint, an invalid mass or inertia (see `ModelWarning`; with strict=True also the
-            implausible ones), or a frame whose parent is not a body.
+            armature or friction, a spring on a spherical or free joint, an invalid mass or
+            inertia (see `ModelWarning`; with strict=True also the implausible ones), or a
+            frame whose parent is not a body.
         TypeError: an array argument that is not real numbers.
     """
 

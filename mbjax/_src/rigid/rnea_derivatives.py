@@ -19,7 +19,8 @@ its columns (dq itself for a revolute or prismatic joint), U_j = V and B_j = A o
     (P2, P3) = the outward sums of (g2, g3)                         (one outward pass)
     o_k = s_k x* F_k
     L_k = I_k P2_k - P3_k x* h_k - I_k (P3_k x V_k) - V_k x* I_k P3_k + o_k
-    dtau_k = S_k^T (the sum of L over k's outward set - o_k) + damping_k dv_k + stiffness_k dq_k   (one inward pass)
+    dtau_k = S_k^T (the sum of L over k's outward set - o_k) + damping_k dv_k + stiffness_k dq_k
+                                                                           (one inward pass)
 
 The formulas are linear in the columns of S, so each joint enters through its two twists s and
 w. It is linear in (dq, dv), so reverse mode transposes it into the same two passes run the
@@ -51,9 +52,9 @@ def applies(model: Model) -> bool:
 
 
 def rnea_jvp(model: Model, q: Array, v: Array, a: Array, dq: Array, dv: Array) -> Array:
-    """d tau = d/de RNEA(model, q + e dq, v + e dv, a) at e = 0 (armature, damping and springs included),
-    for a tree of the joints `applies` accepts. dq is a tangent of the coordinates q (a
-    quaternion's included, as the RNEA reads it, normalized)."""
+    """d tau = d/de RNEA(model, q + e dq, v + e dv, a) at e = 0 (armature, damping and springs
+    included), for a tree of the joints `applies` accepts. dq is a tangent of the coordinates q
+    (a quaternion's included, as the RNEA reads it, normalized)."""
     F, kin, A = rnea_passes(model, q, v, a, None)
     S, V, I = kin.S, kin.V, kin.I                     # noqa: E741 (the papers' name)
     h = _times(I, V)
