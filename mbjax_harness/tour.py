@@ -699,7 +699,7 @@ def contacts_tour(out: Path, quick: bool) -> dict:
                    (f"{name}: MuJoCo", theirs, m.geom_size[shown, 0])]
     worst = max(run["height_error_max_m"] for run in runs.values())
     _save(drop_figure(plotted, f"dropped on the floor, contacts found each step: mbjax's root "
-                               f"heights within {worst * 1e3:.1f} mm of MuJoCo's on the same files"),
+                               f"heights within {worst:.1e} m of MuJoCo's on the same files"),
           out, "contacts.png")
     animation = geom_animation(out / "contacts.gif", plotted[CONTACT_ROBOTS[0]]["ts"], panels,
                                title="dropped with zero controls", frames=30 if quick else 60)
@@ -822,7 +822,7 @@ def look_at(name: str, scene: dict) -> str | None:
         worst = max(run["height_error_max_m"] for run in scene["runs"].values())
         return ("the Ant and the HalfCheetah landing on their legs and settling, their geoms "
                 "finding their own contacts each step; MuJoCo's runs of the same files (dashed) "
-                f"stay within {worst * 1e3:.1f} mm of mbjax's root heights (middle panel).")
+                f"stay within {worst:.1e} m of mbjax's root heights (middle panel).")
     if name == "models":
         text = "the unpowered arm falls through its joint limits (left panel) and the status says so"
         if not ran:
