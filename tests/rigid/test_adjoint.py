@@ -52,7 +52,8 @@ def _relative(a, b):
 
 
 def test_solve_with_the_factor_is_the_inverse_mass_matrix():
-    """aba.solve(factor, b) = M^-1 b, M from the dense operator form (Jerkovsky 1978 eq 55)."""
+    """aba.solve(factor, b) = M^-1 b, M from the composite-rigid-body algorithm (equal to
+    Jerkovsky 1978 eq 55's operator form: tests/rigid/test_tree_dynamics.py)."""
     q, v, tau, _ = _state(MODEL, 0)
     b = jnp.asarray(np.random.default_rng(1).standard_normal(MODEL.nv))
 

@@ -15,7 +15,7 @@ from mbjax._src.rigid.aba import aba
 from mbjax._src.rigid.adjoint import with_adjoint
 from mbjax._src.rigid.batching import aba_vmappable
 from mbjax._src.rigid.dense import dense_forward_dynamics
-from mbjax._src.rigid.operator import mass_matrix as _mass_matrix
+from mbjax._src.rigid.crba import composite_mass_matrix
 from mbjax._src.rigid.rnea import inverse_dynamics as _rnea
 from mbjax._src.system.dynamics import AbstractForwardDynamics, Auto, Recursive, as_dynamics
 
@@ -98,7 +98,8 @@ def inverse_dynamics(model: Model, q: Array, v: Array, v_dot: Array,
 
 @jax.jit
 def mass_matrix(model: Model, q: Array) -> Array:
-    """The generalized mass matrix mu_hat_ff (Jerkovsky 1978 eq 55).
+    """The generalized mass matrix mu_hat_ff (Jerkovsky 1978 eq 55), by the composite-rigid-body
+    algorithm (Featherstone's RBDA §6.2).
 
     Args:
         model: the tree.
@@ -112,4 +113,4 @@ def mass_matrix(model: Model, q: Array) -> Array:
         ValueError: q of the wrong shape.
     """
     _check(model, q=q)
-    return _mass_matrix(model, q)
+    return composite_mass_matrix(model, q)
