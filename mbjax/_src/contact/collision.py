@@ -124,17 +124,8 @@ def sphere_capsule(sphere, capsule):
 def capsule_capsule(a, b):
     (R1, p1, s1), (R2, p2, s2) = a, b
     d1, d2 = R1[:, 2] * s1[1], R2[:, 2] * s2[1]
-    # the closest points of the two segments p1 + s d1, p2 + t d2 (s, t in [-1, 1])
-    r = p1 - p2
-    a11, a22, a12 = jnp.dot(d1, d1), jnp.dot(d2, d2), jnp.dot(d1, d2)
-    b1, b2 = jnp.dot(d1, r), jnp.dot(d2, r)
-    det = a11 * a22 - a12 * a12
-    s = jnp.where(det > 1e-12 * a11 * a22, (a12 * b2 - a22 * b1) / jnp.where(det > 0, det, 1.0),
-                  0.0)
-    s = jnp.clip(s, -1.0, 1.0)
-    t = jnp.clip((a12 * s + b2) / jnp.maximum(a22, 1e-30), -1.0, 1.0)
-    s = jnp.clip((a12 * t - b1) / jnp.maximum(a11, 1e-30), -1.0, 1.0)
-    return _spheres(p1 + s * d1, s1[0], p2 + t * d2, s2[0])
+    c1, c2 = _closest_points(p1 - d1, p1 + d1, p2 - d2, p2 + d2)
+    return _spheres(c1, s1[0], c2, s2[0])
 
 
 def plane_ellipsoid(plane, ellipsoid):

@@ -44,6 +44,7 @@ from mbjax._src.rigid.rnea import rnea_passes
 from mbjax._src.rigid.tangents import instantiate, is_zero
 from mbjax._src.spatial import cross_force, cross_motion, skew
 from mbjax._src.tree import backward_pass, forward_pass, outward_sum
+from mbjax._src.rigid.crba import assemble, coordinate_paths
 from mbjax._src.tree.take import take
 
 def applies(model: Model) -> bool:
@@ -122,7 +123,6 @@ def rnea_partials(model: Model, q: Array, v: Array, a: Array) -> tuple[Array, Ar
     Ic, IVc, hc = outward_sum(model.topology, (I, IV, h))
     hn, hf = skew(hc[:, :3]), skew(hc[:, 3:])
     Cc = IVc + jnp.swapaxes(IVc, -1, -2) + jnp.block([[hn, hf], [hf, zero]])
-    pi = model.topology.path_matrix()                    # pi[k, j] = 1: j on k's path
     # per degree of freedom: its world column s and its body's quantities
     body = model.dof_body()
     s = jax.vmap(model.flat_v, in_axes=1, out_axes=1)(kin.S)             # (nv, 6)
@@ -137,12 +137,10 @@ def rnea_partials(model: Model, q: Array, v: Array, a: Array) -> tuple[Array, Ar
     Y = (jnp.einsum("rij,rj->ri", jnp.concatenate([Icd, Icd]), g2)
          + jnp.einsum("rij,rj->ri", jnp.concatenate([Ccd, Ccd]), g3) + o)   # (2 nv, 6)
     rows_I, rows_C = jnp.einsum("ri,rij->rj", s, Icd), jnp.einsum("ri,rij->rj", s, Ccd)
-    path = pi[np.ix_(body, body)]                                      # [r, c]: c's body on r's path
-    outward = path.T * (body[:, None] != body[None, :])                 # c's body outward of r's
+    path, outward = coordinate_paths(model)           # c's body on r's path; strictly outward
     path2, outward2 = np.tile(path, 2), np.tile(outward, 2)
     D = path2 * (rows_I @ g2.T + rows_C @ g3.T) + outward2 * (s @ Y.T)
-    inner = rows_I @ s.T
-    M = path * inner + outward * inner.T + jnp.diag(model.armature)
+    M = assemble(model, rows_I @ s.T)
     nv = model.nv
     return D[:, :nv] + jnp.diag(model.stiffness), D[:, nv:] + jnp.diag(model.damping), M
 
