@@ -2,7 +2,9 @@
 through contact phases), `solve` with a solver strategy (`ILQR`, `MultipleShooting`,
 `Shooting`), its `Result`, residuals for the common costs (contact forces and friction cones
 too), a `quasi_static` first guess, the contact wrenches along a solution (`knot_wrenches`), `optimal_cost` for co-design, and `sweep` for batches of
-problems or parameters."""
+problems or parameters; and model-predictive control: `MPC`, a receding-horizon controller
+whose `Plan` is carried explicitly, run against a plant by `closed_loop` (one jitted, vmappable,
+differentiable program) or tick by tick (`MPC.tick`, `follow`)."""
 
 from mbjax._src.trajopt.problem import Problem as Problem
 from mbjax._src.trajopt.solve import solve as solve
@@ -26,6 +28,12 @@ from mbjax._src.trajopt.knots import Knot as Knot
 from mbjax._src.trajopt.knots import Impulse as Impulse
 from mbjax._src.trajopt.quasi_static import quasi_static as quasi_static
 from mbjax._src.trajopt.wrenches import knot_wrenches as knot_wrenches
+from mbjax._src.trajopt.mpc import MPC as MPC
+from mbjax._src.trajopt.mpc import Plan as Plan
+from mbjax._src.trajopt.mpc import Tick as Tick
+from mbjax._src.trajopt.mpc import ClosedLoop as ClosedLoop
+from mbjax._src.trajopt.mpc import closed_loop as closed_loop
+from mbjax._src.trajopt.mpc import follow as follow
 
 __all__ = [
     "Problem", "solve", "AbstractSolver", "Result", "ILQR", "CROCODDYL_SCHEDULE",
@@ -34,4 +42,5 @@ __all__ = [
     "com_residual", "friction_cone_residual", "contact_force_residual", "barrier_residual",
     "wrench_cone_residual",
     "Knot", "Impulse", "quasi_static", "knot_wrenches",
+    "MPC", "Plan", "Tick", "ClosedLoop", "closed_loop", "follow",
 ]

@@ -4,8 +4,8 @@ Each suite is run(out: Path, quick: bool) -> list of records, written as out/SUI
 out/SUITE.png. Peers (MuJoCo, Pinocchio, exudyn, Crocoddyl) are measured in the same process when installed.
 """
 
-from mbjax_harness.bench import (accuracy, compile_time, contact, flexible, integrators, loops, rigid, speed,
-                         tfe, throughput, trajopt, wrist)
+from mbjax_harness.bench import (accuracy, compile_time, contact, flexible, integrators, loops, mpc,
+                                 rigid, speed, tfe, throughput, trajopt, wrist)
 
 SUITES = {
     accuracy.NAME: accuracy.run,
@@ -14,6 +14,7 @@ SUITES = {
     flexible.NAME: flexible.run,
     integrators.NAME: integrators.run,
     loops.NAME: loops.run,
+    mpc.NAME: mpc.run,
     rigid.NAME: rigid.run,
     speed.NAME: speed.run,
     tfe.NAME: tfe.run,

@@ -694,6 +694,49 @@ class Model(eqx.Module):
         from mbjax._src.model.locked import lock_joints
         return lock_joints(self, joint_names, q)
 
+    def with_payload(self, mass, *, body: int | str, point=(0.0, 0.0, 0.0)) -> "Model":
+        """The model with a point mass fixed to a body: a payload in a gripper.
+
+        The body's mass, centre of mass and inertia about it are combined with the point mass's
+        (parallel axes), differentiably in `mass` and `point`.
+
+        Args:
+            mass (ArrayLike): the payload's mass [kg], a scalar, zero or more.
+            body: the body carrying it, an index or a name (`Model.names`).
+            point (ArrayLike): where it sits in the body's frame, shape (3,) [m].
+
+        Returns:
+            The `Model` with the body's inertial data changed.
+
+        Raises:
+            ValueError: an unknown body, a point of the wrong shape, or a mass that is not a
+                scalar or is negative.
+        """
+        if isinstance(body, str):
+            if body not in self.names:
+                raise ValueError(f"body must be one of the model's bodies {self.names}, got "
+                                 f"{body!r}")
+            body = self.names.index(body)
+        if not (isinstance(body, int | np.integer) and -self.n <= body < self.n):
+            raise ValueError(f"body must be a body index below {self.n} or a name, got {body!r}")
+        mass, point = jnp.asarray(mass, dtype=float), jnp.asarray(point, dtype=float)
+        if mass.shape != () or point.shape != (3,):
+            raise ValueError(f"mass must be a scalar and point of shape (3,), got shapes "
+                             f"{mass.shape} and {point.shape}")
+        if not _traced(mass) and float(mass) < 0:
+            raise ValueError(f"mass must not be negative, got {float(mass)}")
+        m, c, J = self.mass[body], self.com[body], self.inertia[body]
+        total = m + mass
+        com = (m * c + mass * point) / total
+
+        def shifted(mass, d):
+            return mass * (d @ d * jnp.eye(3) - jnp.outer(d, d))
+
+        inertia = J + shifted(m, c - com) + shifted(mass, point - com)
+        return eqx.tree_at(lambda s: (s.mass, s.com, s.inertia), self,
+                           (self.mass.at[body].set(total), self.com.at[body].set(com),
+                            self.inertia.at[body].set(inertia)))
+
     def spatial_inertia(self) -> Array:
         """The spatial inertias about each body's origin, in body coordinates.
 

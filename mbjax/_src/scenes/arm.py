@@ -8,17 +8,21 @@ the arm-reach trajectory-optimisation problem (`mbjax.trajopt`).
 """
 
 import equinox as eqx
+import jax
 import jax.numpy as jnp
 import numpy as np
 from jax import Array
 
 from mbjax._src.control import PD, AbstractControl, CubicSpline
 from mbjax.data import ARM7
-from mbjax._src.integrate import RK4, simulate
+from mbjax._src.integrate import RK4, SemiImplicitEuler, simulate
 from mbjax._src.model import Model
 from mbjax._src.model.urdf import load_urdf
 from mbjax._src.rigid import TreeSystem, forward_kinematics, inverse_dynamics, mass_matrix
-from mbjax._src.trajopt import Problem
+from mbjax._src.trajopt import ILQR, Problem
+from mbjax._src.trajopt.ilqr import CROCODDYL_SCHEDULE
+from mbjax._src.trajopt.knots import Knot
+from mbjax._src.trajopt.mpc import MPC, Plan
 
 Q_REF = np.array([0.0, -0.4, 0.0, -2.0, 0.0, 1.6, 0.8])        # [rad], inside every joint's limits
 BANDWIDTH = 15.0                                                 # [rad/s] of each joint's servo
@@ -76,7 +80,8 @@ def flange(arm: Model, q: Array) -> Array:
 
 
 class Push(AbstractControl):
-    """A world force on the last body (at the system's `external_point`) from t = 0 to `duration`.
+    """A world force on the last body (at the system's `external_point`) from `start` for
+    `duration`.
 
     An `external=` load: called as (t, q, v), it returns wrenches (n_bodies, 6).
 
@@ -84,31 +89,37 @@ class Push(AbstractControl):
         force: the force in the world frame, shape (3,) [N].
         n_bodies: the model's number of bodies.
         duration: how long the push lasts [s].
+        start: when it starts [s].
     """
 
     force: Array
     n_bodies: int = eqx.field(static=True)
     duration: float = eqx.field(static=True)
+    start: float = eqx.field(static=True, default=0.0)
 
     def __call__(self, t, q, v):
-        on = (t < self.duration).astype(self.force.dtype)
+        on = ((t >= self.start) & (t < self.start + self.duration)).astype(self.force.dtype)
         return jnp.zeros((self.n_bodies, 6), self.force.dtype).at[-1, 3:].set(on * self.force)
 
 
-def pushed(arm: Model, force=(30.0, 0.0, 0.0), duration: float = 0.1) -> TreeSystem:
-    """The servoed arm pushed at its flange.
+def pushed(arm: Model, force=(30.0, 0.0, 0.0), duration: float = 0.1, start: float = 0.0,
+           control: AbstractControl | None = None) -> TreeSystem:
+    """The arm pushed at its flange, by default under its servo.
 
     Args:
         arm: the arm's model.
         force: the push in the world frame, shape (3,) [N].
         duration: how long the push lasts [s].
+        start: when it starts [s].
+        control: the arm's control; None for `servo(arm)`.
 
     Returns:
-        The `TreeSystem` with the servo as control and the push as external load.
+        The `TreeSystem` with the control and the push as external load.
     """
     points = jnp.zeros((arm.n, 3)).at[-1].set(jnp.asarray(FLANGE))
-    return TreeSystem(arm, servo(arm), external=Push(jnp.asarray(force, float), arm.n, duration),
-                      external_point=points)
+    control = servo(arm) if control is None else control
+    return TreeSystem(arm, control, external=Push(jnp.asarray(force, float), arm.n, duration,
+                                                  start), external_point=points)
 
 
 def build():
@@ -213,3 +224,150 @@ def hold(problem: Problem) -> Array:
     arm = problem.system.model
     return jnp.tile(inverse_dynamics(arm, problem.q0, problem.v0, problem.v0),
                     (problem.horizon, 1))
+
+
+# model-predictive tracking: the flange follows a circle under a receding-horizon controller
+TRACK_RADIUS, TRACK_PERIOD = 0.1, 2.0          # [m], [s]: the circle, in the y-z plane
+MPC_DT, MPC_HORIZON = 0.01, 50                 # 100 Hz ticks, a 0.5 s horizon
+PLANT_DT = 1e-3                                # [s]: the plant's RK4 step
+# Crocoddyl's weights w (cost w/2 |r|^2): the goal, the state's and the control's
+# regularization along the way; the goal and the velocity at the horizon's end
+TRACK_WEIGHTS = (100.0, 1e-2, 1e-4, 1e3, 1.0)
+
+
+def track_target(centre: Array, t) -> Array:
+    """The moving target at time t: a circle of TRACK_RADIUS in the y-z plane through
+    `centre` (where it starts), one turn in TRACK_PERIOD.
+
+    Args:
+        centre: the start [m], shape (3,).
+        t: the time [s], any shape.
+
+    Returns:
+        The target [m], shape t.shape + (3,).
+    """
+    phase = 2 * jnp.pi * jnp.asarray(t) / TRACK_PERIOD
+    return centre + TRACK_RADIUS * jnp.stack([jnp.zeros_like(phase), jnp.sin(phase),
+                                              1.0 - jnp.cos(phase)], axis=-1)
+
+
+def _track_running(q, v, u, *, arm, target, q_ref, gravity, weights):
+    w = jnp.sqrt(weights)
+    return jnp.concatenate([w[0] * (flange(arm, q) - target), w[1] * (q - q_ref), w[1] * v,
+                            w[2] * (u - gravity)])
+
+
+def _track_terminal(q, v, *, arm, target, weights):
+    w = jnp.sqrt(weights)
+    return jnp.concatenate([w[3] * (flange(arm, q) - target), w[4] * v])
+
+
+class Tracking(eqx.Module):
+    """The arm's tracking problem over a receding horizon, `MPC`'s problem(t, q, v): the flange
+    follows the circle `track_target(centre, .)` at each knot t + k MPC_DT of the horizon, with
+    Crocoddyl's residual costs weighted by `weights` (TRACK_WEIGHTS's order; differentiable), and
+    semi-implicit Euler steps (Crocoddyl's). The knots differ only in their targets: one phase.
+
+    Args:
+        arm: the controller's model of the arm.
+        centre: the circle's start [m], shape (3,); None for the flange's place at Q_REF.
+        weights: the five weights, shape (5,); None for TRACK_WEIGHTS.
+        horizon: the knots of the horizon (static).
+    """
+
+    arm: Model
+    centre: Array
+    weights: Array
+    horizon: int = eqx.field(static=True)
+
+    def __init__(self, arm: Model, centre=None, weights=None, horizon: int = MPC_HORIZON):
+        self.arm = arm
+        self.centre = (flange(arm, jnp.asarray(Q_REF)) if centre is None
+                       else jnp.asarray(centre, float))
+        self.weights = jnp.asarray(TRACK_WEIGHTS if weights is None else weights, float)
+        self.horizon = horizon
+
+    def __call__(self, t, q, v) -> Problem:
+        q_ref = jnp.asarray(Q_REF)
+        zero = jnp.zeros(self.arm.nv)
+        gravity = inverse_dynamics(self.arm, q_ref, zero, zero)
+        targets = track_target(self.centre, t + MPC_DT * jnp.arange(self.horizon + 1))
+        system = TreeSystem(self.arm)
+        knots = [Knot(system, eqx.Partial(_track_running, arm=self.arm, target=targets[k],
+                                          q_ref=q_ref, gravity=gravity, weights=self.weights))
+                 for k in range(self.horizon)]
+        return Problem(knots, q, v, dt=MPC_DT, integrator=SemiImplicitEuler(),
+                       terminal=eqx.Partial(_track_terminal, arm=self.arm,
+                                            target=targets[-1], weights=self.weights))
+
+
+def tracking_controller(arm: Model | None = None, centre=None, weights=None,
+                        horizon: int = MPC_HORIZON, solver=None) -> MPC:
+    """The arm's model-predictive controller: `Tracking`'s horizon re-solved at 100 Hz, one
+    FDDP iteration a tick by default.
+
+    Args:
+        arm: the controller's model; None for `model()`.
+        centre: the circle's start [m]; None for the flange's place at Q_REF.
+        weights: the cost weights (TRACK_WEIGHTS's order); None for TRACK_WEIGHTS.
+        horizon: the knots of the horizon.
+        solver: the solver of a tick; None for `MPC`'s default.
+
+    Returns:
+        The `mbjax.trajopt.MPC`.
+    """
+    arm = model() if arm is None else arm
+    return MPC(Tracking(arm, centre, weights, horizon), solver)
+
+
+def first_plan(controller: MPC) -> Plan:
+    """The controller's first plan from rest at Q_REF: its horizon solved to convergence
+    (Crocoddyl's schedule) from the torques that hold the pose.
+
+    Args:
+        controller: from `tracking_controller`.
+
+    Returns:
+        The `Plan` to start `closed_loop` from.
+    """
+    arm = controller.problem.arm
+    q0, v0 = jnp.asarray(Q_REF), jnp.zeros(arm.nv)
+    hold_torque = inverse_dynamics(arm, q0, v0, v0)
+    return controller.init(0.0, q0, v0, jnp.tile(hold_torque, (controller.problem.horizon, 1)),
+                           solver=ILQR(**CROCODDYL_SCHEDULE))
+
+
+def tracking_plant(arm: Model | None = None, payload=0.0, force=(0.0, 30.0, 0.0),
+                   start: float = 1.0, duration: float = 0.1) -> TreeSystem:
+    """The arm the tracking controller drives: a payload at its flange the controller does not
+    know of, and a push at the flange.
+
+    Args:
+        arm: the arm's model; None for `model()`.
+        payload: the mass at the flange [kg].
+        force: the push in the world frame [N].
+        start: when the push starts [s].
+        duration: how long it lasts [s].
+
+    Returns:
+        The plant, a `TreeSystem` (its control is replaced by the controller's).
+    """
+    arm = model() if arm is None else arm
+    arm = arm.with_payload(payload, body=arm.n - 1, point=FLANGE)
+    return pushed(arm, force, duration, start)
+
+
+def tracking_error(arm: Model, centre: Array, ts: Array, qs: Array) -> Array:
+    """The flange's distance to the target at each time.
+
+    Args:
+        arm: the arm's model.
+        centre: the circle's start [m], shape (3,).
+        ts: times [s], shape (n,).
+        qs: configurations, shape (n, 7).
+
+    Returns:
+        The distances [m], shape (n,).
+    """
+    flanges = jax.vmap(lambda q: flange(arm, q))(qs)
+    return jnp.linalg.norm(flanges - track_target(centre, ts), axis=1)

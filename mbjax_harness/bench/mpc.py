@@ -1,0 +1,475 @@
+"""`mbjax bench mpc`: model-predictive control, mbjax's `MPC` against Crocoddyl's MPC loop on the
+same problems and the same plant, in the same run.
+
+Problems (`SCENARIOS`):
+
+    arm-track       the shipped 7-dof arm's flange following a 0.1 m circle (one turn in 2 s) at
+                    100 Hz, a 0.5 s horizon (50 knots), pushed at its flange (30 N for 0.1 s
+                    at t = 1 s) and carrying 0.3 kg the controller does not know of
+                    (`mbjax.scenes.arm.tracking_controller`, `tracking_plant`)
+    kinova-payload  the Kinova arm of Crocoddyl's `arm_manipulation_fwddyn.py` (its start and
+                    target, the costs a position reach that settles) at 100 Hz, a 0.5 s
+                    horizon, with 0.5 kg in the gripper that the controller does not know of
+
+Each tick both controllers solve the horizon from the plant's state with one FDDP iteration
+(mbjax: `ILQR(iterations=1, **CROCODDYL_SCHEDULE)`, Crocoddyl: `SolverFDDP.solve(xs, us, 1,
+False)`), warm-started from their previous solution shifted by a knot (Crocoddyl's infeasible
+start), after a first solve to convergence from the controls that hold the start. The plant is
+the same mbjax system for both (RK4 at 1 ms, the controller's first control held with its
+feedback gains between ticks: `mbjax.trajopt.follow`), so the two loops differ only in their
+controllers. Both loops run in Python, a tick at a time, so that each tick's solve is timed
+(`solve_ms_median`, `solve_ms_max`: mbjax's jitted `MPC.tick`, Crocoddyl's reference update and
+`solve`, single-threaded); mbjax's jitted `closed_loop` runs the same loop as one program too
+(`closed_loop_s`, and `loop_agreement`, its largest state difference from the Python loop).
+
+`tracking_error` is the task error's root mean square over the ticks (the flange's or gripper's
+distance to its target [m]); `closed_loop_cost` is the sum over the ticks of the first knot's
+running cost at the plant's state and the applied control (the horizon problem's
+`Problem.step_cost`); `status` is the closed loop's (`ClosedLoop.status`) for both, on the same
+plant.
+
+Batch (`arm-track-batch`): `ROBOTS` arms, each its own circle (centres spread over a 0.1 m cube),
+as one vmapped `closed_loop` (the first plans solved as one vmapped program too, timed apart),
+against the same number of Crocoddyl loops one after the other.
+"""
+
+import os
+import platform
+import statistics
+import time
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Callable
+
+import equinox as eqx
+import jax
+import jax.numpy as jnp
+import numpy as np
+
+from mbjax import trajopt
+from mbjax.integrate import RK4, SemiImplicitEuler
+from mbjax.rigid import TreeSystem, inverse_dynamics
+from mbjax.scenes import arm
+from mbjax_harness import peers
+from mbjax_harness.timing import write_jsonl
+
+NAME = "mpc"
+TICKS, QUICK_TICKS = 300, 60
+ROBOTS, QUICK_ROBOTS = 64, 4
+BATCH_TICKS, QUICK_BATCH_TICKS = 100, 20
+KINOVA_PAYLOAD = 0.5          # [kg]
+ARM_PAYLOAD = 0.3             # [kg]
+
+
+@dataclass
+class Scenario:
+    """One MPC problem, for both engines."""
+
+    controller: trajopt.MPC
+    plan: trajopt.Plan          # the first plan (mbjax's solve to convergence)
+    plant: object               # the mbjax system both controllers drive
+    q0: np.ndarray
+    v0: np.ndarray
+    error: Callable             # (t, q) -> the task error [m]
+    crocoddyl: Callable         # () -> (SolverFDDP of the first horizon, update(t, x_pin))
+    to_pin: Callable            # mbjax (q, v) -> Crocoddyl's x
+    from_pin: Callable          # Crocoddyl's x -> mbjax x
+
+
+def _identity_pin(nq):
+    return (lambda q, v: np.concatenate([np.asarray(q), np.asarray(v)]),
+            lambda x: np.asarray(x))
+
+
+def arm_track(payload: float = ARM_PAYLOAD, centre=None) -> Scenario:
+    controller = arm.tracking_controller(centre=centre)
+    problem = controller.problem
+    plan = eqx.filter_jit(arm.first_plan)(controller)
+    q0, v0 = np.asarray(arm.Q_REF), np.zeros(7)
+    model = problem.arm
+
+    def error(t, q):
+        return float(jnp.linalg.norm(arm.flange(model, q) - arm.track_target(problem.centre, t)))
+
+    def crocoddyl():
+        return _crocoddyl_tracking(problem, plan)
+
+    return Scenario(controller, plan, arm.tracking_plant(payload=payload), q0, v0, error,
+                    crocoddyl, *_identity_pin(7))
+
+
+def _crocoddyl_tracking(tracking, plan):
+    """`mbjax.scenes.arm.Tracking`'s horizon as Crocoddyl's shooting problem, a goal residual
+    per knot (its reference moved each tick), and its FDDP solver warm from mbjax's first
+    plan's converged solve (solved again by Crocoddyl to convergence)."""
+    import crocoddyl
+    import pinocchio as pin
+
+    from mbjax.data import ARM7
+
+    model = pin.buildModelFromUrdf(str(ARM7))
+    frame = peers._crocoddyl_point(model, model.njoints - 1, arm.FLANGE, "flange")
+    state = crocoddyl.StateMultibody(model)
+    actuation = crocoddyl.ActuationModelFull(state)
+    nu, nv = actuation.nu, model.nv
+    q_ref = np.asarray(arm.Q_REF)
+    zero = jnp.zeros(nv)
+    gravity = np.asarray(inverse_dynamics(tracking.arm, jnp.asarray(q_ref), zero, zero))
+    x_ref = np.concatenate([q_ref, np.zeros(nv)])
+    w = np.asarray(tracking.weights)
+    goals, models = [], []
+    for k in range(tracking.horizon + 1):
+        goal = crocoddyl.ResidualModelFrameTranslation(state, frame, np.zeros(3), nu)
+        goals.append(goal)
+        if k < tracking.horizon:
+            terms = [("goal", goal, None, w[0]),
+                     ("state", crocoddyl.ResidualModelState(state, x_ref, nu), None, w[1]),
+                     ("control", crocoddyl.ResidualModelControl(state, gravity), None, w[2])]
+        else:
+            terms = [("goal", goal, None, w[3]),
+                     ("velocity", crocoddyl.ResidualModelState(state, x_ref, nu),
+                      np.r_[np.zeros(nv), np.ones(nv)], w[4])]
+        costs = peers._crocoddyl_terms(state, nu, terms)
+        dam = crocoddyl.DifferentialActionModelFreeFwdDynamics(state, actuation, costs)
+        models.append(crocoddyl.IntegratedActionModelEuler(
+            dam, arm.MPC_DT if k < tracking.horizon else 0.0))
+    centre = np.asarray(tracking.centre)
+
+    def update(t, x):
+        targets = np.asarray(arm.track_target(centre, t + arm.MPC_DT
+                                              * np.arange(tracking.horizon + 1)))
+        for goal, target in zip(goals, targets, strict=True):
+            goal.reference = target
+        problem.x0 = x
+
+    problem = crocoddyl.ShootingProblem(x_ref.copy(), models[:-1], models[-1])
+    problem.nthreads = 1
+    solver = crocoddyl.SolverFDDP(problem)
+    update(0.0, x_ref)
+    xs = [np.asarray(x) for x in np.asarray(plan.xs)]
+    us = [np.asarray(u) for u in np.asarray(plan.us)]
+    solver.solve(xs, us, 100, False)
+    return solver, update
+
+
+KINOVA_FRAME, KINOVA_TARGET = "j2s6s200_end_effector", np.array([0.6, 0.2, 0.5])
+# Crocoddyl's weights: the gripper's position, the configuration's and the velocity's
+# regularization, the control's (about the torque that holds the start); at the end, the
+# position and the velocity
+KINOVA_WEIGHTS = {"goal": 100.0, "q": 1e-3, "v": 0.1, "control": 1e-2, "goal_end": 1e3,
+                  "v_end": 1.0}
+
+
+def kinova_payload(payload: float = KINOVA_PAYLOAD, horizon: int = 50) -> Scenario:
+    """The Kinova arm (example-robot-data) from its `arm_up` pose, its gripper held at a point
+    0.25 m away under a payload it does not know of (Crocoddyl's `arm_manipulation_fwddyn.py`
+    arm and target, its costs made a position reach that settles: the wrists' velocities
+    regularized)."""
+    from mbjax.model import state_from_pinocchio, state_to_pinocchio
+    from mbjax.rigid import frame_pose
+    from mbjax.trajopt import control_residual, frame_residual, state_residual
+    from mbjax_harness.crocoddyl_examples import _load, _robot
+
+    robot = _robot("kinova")
+    model = _load(robot)
+    q_pin0 = robot.model.referenceConfigurations["arm_up"]
+    q0, v0 = (np.asarray(x) for x in state_from_pinocchio(model, q_pin0, np.zeros(model.nv)))
+    nv, w = model.nv, KINOVA_WEIGHTS
+    gravity = np.asarray(inverse_dynamics(model, jnp.asarray(q0), jnp.zeros(nv), jnp.zeros(nv)))
+    state_weights = np.r_[np.full(nv, w["q"]), np.full(nv, w["v"])]
+    end_weights = np.r_[np.zeros(nv), np.full(nv, w["v_end"])]
+    running = (frame_residual(model, KINOVA_FRAME, KINOVA_TARGET, weight=w["goal"]),
+               state_residual(model, q0, weight=state_weights),
+               control_residual(nv, gravity, weight=w["control"]))
+    terminal = (frame_residual(model, KINOVA_FRAME, KINOVA_TARGET, weight=w["goal_end"]),
+                state_residual(model, q0, weight=end_weights))
+
+    def horizon_problem(t, q, v):
+        return trajopt.Problem(TreeSystem(model), q, v, dt=arm.MPC_DT, horizon=horizon,
+                               running=running, terminal=terminal,
+                               integrator=SemiImplicitEuler())
+
+    controller = trajopt.MPC(horizon_problem)
+    plan = eqx.filter_jit(controller.init)(0.0, q0, v0, np.tile(gravity, (horizon, 1)),
+                                           trajopt.ILQR(**trajopt.CROCODDYL_SCHEDULE))
+    index = model.frame_names.index(KINOVA_FRAME)
+    plant = TreeSystem(model.with_payload(payload, body=model.frame_parents[index],
+                                          point=model.frame_translation[index]))
+
+    def error(t, q):
+        return float(jnp.linalg.norm(frame_pose(model, q, KINOVA_FRAME)[1] - KINOVA_TARGET))
+
+    def to_pin(q, v):
+        return np.concatenate([np.asarray(a) for a in state_to_pinocchio(model, q, v)])
+
+    def from_pin(x):
+        q, v = state_from_pinocchio(model, x[:-nv], x[-nv:])
+        return np.concatenate([np.asarray(q), np.asarray(v)])
+
+    def crocoddyl():
+        import crocoddyl as croc
+
+        state = croc.StateMultibody(robot.model)
+        actuation = croc.ActuationModelFull(state)
+        x0 = np.concatenate([q_pin0, np.zeros(nv)])
+        goal = croc.ResidualModelFrameTranslation(
+            state, robot.model.getFrameId(KINOVA_FRAME), KINOVA_TARGET, nv)
+        regularization = croc.ResidualModelState(state, x0, nv)
+        running = [("goal", goal, None, w["goal"]),
+                   ("state", regularization, state_weights, 1.0),
+                   ("control", croc.ResidualModelControl(state, gravity), None, w["control"])]
+        terminal = [("goal", goal, None, w["goal_end"]),
+                    ("velocity", regularization, end_weights, 1.0)]
+        problem = peers._crocoddyl_shooting(state, actuation, x0, arm.MPC_DT, horizon, running,
+                                            terminal)
+        problem.nthreads = 1
+        solver = croc.SolverFDDP(problem)
+        solver.solve([to_pin(*np.split(x, [model.nq])) for x in np.asarray(plan.xs)],
+                     [np.asarray(u) for u in np.asarray(plan.us)], 100, False)
+
+        def update(t, x):
+            problem.x0 = x
+        return solver, update
+
+    return Scenario(controller, plan, plant, q0, v0, error, crocoddyl, to_pin, from_pin)
+
+
+SCENARIOS = {"arm-track": arm_track, "kinova-payload": kinova_payload}
+
+
+def _period(scenario: Scenario, dt: float, steps: int):
+    @jax.jit
+    def period(plan, t, q, v):
+        return trajopt.follow(scenario.controller, plan, scenario.plant, t, q, v, dt=dt,
+                              steps=steps, integrator=RK4())
+    return period
+
+
+def _stage(scenario: Scenario):
+    """(t, q, v, u) -> the horizon's first running cost (times dt) at the plant's state."""
+    @jax.jit
+    def stage(t, q, v, u):
+        problem = scenario.controller.horizon(t, q, v)
+        return problem.step_cost(problem.x0, u, 0)[1]
+    return stage
+
+
+def _summary(scenario, engine, ts, qs, vs, us, solve_s, stage, status) -> dict:
+    errors = np.array([scenario.error(t, q) for t, q in zip(ts, qs, strict=True)])
+    cost = float(sum(stage(t, q, v, u) for t, q, v, u in zip(ts[:-1], qs[:-1], vs[:-1], us,
+                                                          strict=True)))
+    return {"engine": engine, "solve_ms_median": 1e3 * statistics.median(solve_s),
+            "solve_ms_max": 1e3 * max(solve_s), "tracking_error": float(np.sqrt(np.mean(errors**2))),
+            "closed_loop_cost": cost, "status": status}
+
+
+def _mbjax_loop(scenario: Scenario, ticks: int, period, dt: float, steps: int):
+    """mbjax's loop a tick at a time: (states, controls, solve seconds per tick, plans)."""
+    tick = eqx.filter_jit(scenario.controller.tick)
+    plan = scenario.plan
+    q, v = jnp.asarray(scenario.q0), jnp.asarray(scenario.v0)
+    qs, vs, us, seconds = [q], [v], [], []
+    jax.block_until_ready(tick(plan, jnp.asarray(0.0), q, v))          # compiled
+    for i in range(ticks):
+        t = jnp.asarray(i * steps * dt)
+        start = time.perf_counter()
+        plan, report = jax.block_until_ready(tick(plan, t, q, v))
+        seconds.append(time.perf_counter() - start)
+        q, v, applied = period(plan, t, q, v)
+        qs.append(q), vs.append(v), us.append(applied[0])
+    return np.asarray(qs), np.asarray(vs), np.asarray(us), seconds
+
+
+def _crocoddyl_loop(scenario: Scenario, ticks: int, period, dt: float, steps: int):
+    """Crocoddyl's loop, on the same plant: (states, controls, solve seconds per tick)."""
+    solver, update = scenario.crocoddyl()
+    H = len(solver.problem.runningModels)
+    q, v = jnp.asarray(scenario.q0), jnp.asarray(scenario.v0)
+    qs, vs, us, seconds, last = [q], [v], [], [], []
+    for i in range(ticks):
+        t = i * steps * dt
+        x = scenario.to_pin(q, v)
+        start = time.perf_counter()
+        update(t, x)
+        xs = list(solver.xs)[1:] + [solver.xs[-1]]
+        xs[0] = x
+        us_ = list(solver.us)[1:] + [solver.us[-1]]
+        solver.solve(xs, us_, 1, False)
+        seconds.append(time.perf_counter() - start)
+        # the plan's first state is the measured one (Crocoddyl's x0), taken in mbjax's layout
+        # as it is: converted back, a continuous joint's angle would come back wrapped
+        x_plan = np.concatenate([np.asarray(q), np.asarray(v)])
+        # Crocoddyl's control law is u = u_k - K_k (x (-) x_k): mbjax's gains are -K
+        plan = trajopt.Plan(jnp.asarray(t), jnp.tile(x_plan, (H + 1, 1)),
+                            jnp.tile(np.asarray(solver.us[0]), (H, 1)),
+                            -jnp.tile(np.asarray(solver.K[0]), (H, 1, 1)))
+        q, v, applied = period(plan, jnp.asarray(t), q, v)
+        qs.append(q), vs.append(v), us.append(applied[0]), last.append(applied[-1])
+    return np.asarray(qs), np.asarray(vs), np.asarray(us), seconds, np.asarray(last)
+
+
+def single(name: str, ticks: int, common: dict) -> list[dict]:
+    scenario = SCENARIOS[name]()
+    dt = arm.PLANT_DT
+    control_period = scenario.controller.period(0.0, scenario.q0, scenario.v0)
+    steps = int(round(control_period / dt))
+    period, stage = _period(scenario, dt, steps), _stage(scenario)
+    ts = np.arange(ticks + 1) * control_period
+    base = {**common, "problem": name, "control_rate_hz": 1.0 / control_period, "ticks": ticks,
+            "horizon": scenario.plan.us.shape[0]}
+    records = []
+
+    start = time.perf_counter()
+    run = trajopt.closed_loop(scenario.controller, scenario.plant, scenario.q0, scenario.v0,
+                              ticks=ticks, dt=dt, plan=scenario.plan)
+    jax.block_until_ready(run)
+    compiled = time.perf_counter() - start
+    start = time.perf_counter()
+    run = jax.block_until_ready(trajopt.closed_loop(
+        scenario.controller, scenario.plant, scenario.q0, scenario.v0, ticks=ticks, dt=dt,
+        plan=scenario.plan))
+    closed_s = time.perf_counter() - start
+    status = run.messages()[0]
+
+    qs, vs, us, seconds = _mbjax_loop(scenario, ticks, period, dt, steps)
+    record = {**base, **_summary(scenario, "mbjax", ts, qs, vs, us, seconds, stage, status),
+              "closed_loop_s": closed_s, "closed_loop_compile_s": compiled - closed_s,
+              "loop_agreement": float(np.max(np.abs(np.asarray(run.qs) - qs))),
+              "iterations_mean": float(np.mean(np.asarray(run.iterations)))}
+    records.append(record)
+    if (why := peers.crocoddyl_working()) is None:
+        qs, vs, us, seconds, us_last = _crocoddyl_loop(scenario, ticks, period, dt, steps)
+        plant_status = _plant_status(scenario, ts, qs, vs, us_last)
+        records.append({**base, **_summary(scenario, "crocoddyl", ts, qs, vs, us, seconds,
+                                           stage, plant_status)})
+    else:
+        records.append({**base, "engine": "crocoddyl", "skipped": why})
+    return records
+
+
+def _plant_status(scenario, ts, qs, vs, us) -> str:
+    """The closed loop's status words for states not from `closed_loop` (Crocoddyl's loop):
+    the plant's own flags at the ticks under the control last applied, and NONFINITE, as
+    `ClosedLoop.status` counts them."""
+    from mbjax import Status
+    from mbjax.control import Constant
+
+    flags = 0
+    for t, q, v, u in zip(ts[1:], qs[1:], vs[1:], us, strict=True):
+        flags |= int(scenario.plant.with_control(Constant(u)).check(t, jnp.asarray(q),
+                                                                  jnp.asarray(v)))
+    if not (np.all(np.isfinite(qs)) and np.all(np.isfinite(vs))):
+        flags |= int(Status.NONFINITE)
+    words = [f.name.lower().replace("_", " ") for f in Status if f and flags & f]
+    return ", ".join(words) or "success"
+
+
+def _centres(n: int, seed: int = 0) -> np.ndarray:
+    rng = np.random.default_rng(seed)
+    base = np.asarray(arm.flange(arm.model(), jnp.asarray(arm.Q_REF)))
+    return base + rng.uniform(-0.05, 0.05, (n, 3))
+
+
+def batch(robots: int, ticks: int, common: dict) -> list[dict]:
+    """`robots` arms, each its own circle, one vmapped closed loop against Crocoddyl's loops
+    one after the other."""
+    centres = _centres(robots)
+    dt = arm.PLANT_DT
+    plant = arm.tracking_plant(payload=ARM_PAYLOAD)
+    q0, v0 = jnp.asarray(arm.Q_REF), jnp.zeros(7)
+    base = {**common, "problem": "arm-track-batch", "ticks": ticks}
+
+    @jax.jit
+    def plans(centres):
+        return jax.vmap(lambda c: arm.first_plan(arm.tracking_controller(centre=c)))(centres)
+
+    @jax.jit
+    def loops(centres, plans):
+        def one(c, plan):
+            run = trajopt.closed_loop(arm.tracking_controller(centre=c), plant, q0, v0,
+                                      ticks=ticks, dt=dt, plan=plan)
+            return run.qs, run.status
+        return jax.vmap(one)(centres, plans)
+
+    first = jax.block_until_ready(plans(centres))
+    start = time.perf_counter()
+    first = jax.block_until_ready(plans(centres))
+    plans_s = time.perf_counter() - start
+    jax.block_until_ready(loops(centres, first))
+    start = time.perf_counter()
+    qs, status = jax.block_until_ready(loops(centres, first))
+    seconds = time.perf_counter() - start
+    records = [{**base, "engine": "mbjax", "robots": robots, "seconds": seconds,
+                "first_plans_s": plans_s, "failed": int(np.sum(np.asarray(status) != 0))}]
+    if (why := peers.crocoddyl_working()) is not None:
+        return records + [{**base, "engine": "crocoddyl", "skipped": why}]
+    total, first_total = 0.0, 0.0
+    for c in centres:
+        start = time.perf_counter()
+        scenario = arm_track(centre=c)
+        solver, update = scenario.crocoddyl()
+        first_total += time.perf_counter() - start
+        scenario.crocoddyl = lambda solver=solver, update=update: (solver, update)
+        period = _period(scenario, dt, int(round(arm.MPC_DT / dt)))
+        start = time.perf_counter()
+        _crocoddyl_loop(scenario, ticks, period, dt, int(round(arm.MPC_DT / dt)))
+        total += time.perf_counter() - start
+    records.append({**base, "engine": "crocoddyl", "robots": robots, "seconds": total})
+    return records
+
+
+def table(records: list[dict]) -> str:
+    lines = ["| problem | engine | rate | solve median | solve max | tracking error | "
+             "closed-loop cost | status |", "| --- | --- | --- | --- | --- | --- | --- | --- |"]
+    for r in records:
+        if "solve_ms_median" in r:
+            lines.append(f"| {r['problem']} | {r['engine']} | {r['control_rate_hz']:.0f} Hz | "
+                         f"{r['solve_ms_median']:.2f} ms | {r['solve_ms_max']:.2f} ms | "
+                         f"{r['tracking_error'] * 1e3:.3f} mm | {r['closed_loop_cost']:.6g} | "
+                         f"{r['status']} |")
+    for r in records:
+        if "robots" in r:
+            lines.append(f"| {r['problem']} | {r['engine']} | {r['robots']} robots | "
+                         f"{r['seconds']:.2f} s | | | | |")
+    return "\n".join(lines)
+
+
+def plot(records: list[dict], path: Path) -> None:
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    rows = [r for r in records if "solve_ms_median" in r]
+    fig, ax = plt.subplots(figsize=(7, 3.5))
+    for i, r in enumerate(rows):
+        colour = "C0" if r["engine"] == "mbjax" else "C1"
+        ax.barh(i, r["solve_ms_median"], color=colour)
+        ax.plot([r["solve_ms_max"]], [i], "k|", markersize=12)
+    ax.axvline(1e3 / rows[0]["control_rate_hz"] if rows else 10.0, color="r", ls="--",
+               label="control period")
+    ax.set_yticks(range(len(rows)), [f"{r['problem']} {r['engine']}" for r in rows])
+    ax.set_xlabel("solve per tick [ms] (bar median, tick max)")
+    ax.legend()
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+
+
+def run(out: Path, quick: bool = False) -> list[dict]:
+    common = {"suite": NAME, "machine": platform.machine(), "cpus": os.cpu_count(),
+              "jax": jax.__version__, "date": time.strftime("%Y-%m-%d")}
+    records = []
+    ticks = QUICK_TICKS if quick else TICKS
+    records += single("arm-track", ticks, common)
+    if (why := peers.missing("example_robot_data")) is None:
+        records += single("kinova-payload", ticks, common)
+    else:
+        records.append({**common, "problem": "kinova-payload", "skipped": why})
+    records += batch(QUICK_ROBOTS if quick else ROBOTS,
+                     QUICK_BATCH_TICKS if quick else BATCH_TICKS, common)
+    out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    write_jsonl(out / f"{NAME}.jsonl", records)
+    plot(records, out / f"{NAME}.png")
+    print(table(records))
+    return records
