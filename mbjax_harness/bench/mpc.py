@@ -29,8 +29,9 @@ running cost at the plant's state and the applied control (the horizon problem's
 plant.
 
 Batch (`arm-track-batch`): `ROBOTS` arms, each its own circle (centres spread over a 0.1 m cube),
-as one vmapped `closed_loop` (the first plans solved as one vmapped program too, timed apart),
-against the same number of Crocoddyl loops one after the other.
+their first plans and closed loops as one program split over the CPU's devices (`jax.vmap`
+through `mbjax.trajopt.sweep`, and `lax.map` on each device), against the same number of
+Crocoddyl loops one after the other (their first solves not timed).
 """
 
 import os
@@ -46,7 +47,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from mbjax import trajopt
+from mbjax import Status, trajopt
 from mbjax.integrate import RK4, SemiImplicitEuler
 from mbjax.rigid import TreeSystem, inverse_dynamics
 from mbjax.scenes import arm
@@ -237,12 +238,17 @@ def kinova_payload(payload: float = KINOVA_PAYLOAD, horizon: int = 50) -> Scenar
 SCENARIOS = {"arm-track": arm_track, "kinova-payload": kinova_payload}
 
 
+@eqx.filter_jit
+def _follow(controller, plant, plan, t, q, v, dt: float, steps: int):
+    return trajopt.follow(controller, plan, plant, t, q, v, dt=dt, steps=steps,
+                          integrator=RK4())
+
+
 def _period(scenario: Scenario, dt: float, steps: int):
-    @jax.jit
-    def period(plan, t, q, v):
-        return trajopt.follow(scenario.controller, plan, scenario.plant, t, q, v, dt=dt,
-                              steps=steps, integrator=RK4())
-    return period
+    """(plan, t, q, v) -> the plant over a control period (one compiled program for every
+    scenario of the same shapes)."""
+    return lambda plan, t, q, v: _follow(scenario.controller, scenario.plant, plan, t, q, v,
+                                         dt, steps)
 
 
 def _stage(scenario: Scenario):
@@ -351,7 +357,6 @@ def _plant_status(scenario, ts, qs, vs, us) -> str:
     """The closed loop's status words for states not from `closed_loop` (Crocoddyl's loop):
     the plant's own flags at the ticks under the control last applied, and NONFINITE, as
     `ClosedLoop.status` counts them."""
-    from mbjax import Status
     from mbjax.control import Constant
 
     flags = 0
@@ -371,50 +376,68 @@ def _centres(n: int, seed: int = 0) -> np.ndarray:
 
 
 def batch(robots: int, ticks: int, common: dict) -> list[dict]:
-    """`robots` arms, each its own circle, one vmapped closed loop against Crocoddyl's loops
-    one after the other."""
-    centres = _centres(robots)
+    """`robots` arms, each its own circle, in one program against Crocoddyl's loops one after
+    the other. Two ways of running mbjax's: `jax.vmap` of the closed loop split over the CPU's
+    devices (`mbjax.trajopt.sweep`), and `lax.map` over each device's share (on a CPU a vmapped
+    iteration of w members costs about w iterations: what pays is the cores)."""
+    from jax.sharding import Mesh, PartitionSpec
+
+    centres = jnp.asarray(_centres(robots))
     dt = arm.PLANT_DT
     plant = arm.tracking_plant(payload=ARM_PAYLOAD)
     q0, v0 = jnp.asarray(arm.Q_REF), jnp.zeros(7)
-    base = {**common, "problem": "arm-track-batch", "ticks": ticks}
+    base = {**common, "problem": "arm-track-batch", "ticks": ticks,
+            "devices": len(jax.devices())}
 
-    @jax.jit
-    def plans(centres):
-        return jax.vmap(lambda c: arm.first_plan(arm.tracking_controller(centre=c)))(centres)
+    def first(centre):
+        return arm.first_plan(arm.tracking_controller(centre=centre))
 
-    @jax.jit
-    def loops(centres, plans):
-        def one(c, plan):
-            run = trajopt.closed_loop(arm.tracking_controller(centre=c), plant, q0, v0,
-                                      ticks=ticks, dt=dt, plan=plan)
-            return run.qs, run.status
-        return jax.vmap(one)(centres, plans)
+    def one(inputs):
+        centre, plan = inputs
+        run = trajopt.closed_loop(arm.tracking_controller(centre=centre), plant, q0, v0,
+                                  ticks=ticks, dt=dt, plan=plan)
+        return run.qs, run.status
 
-    first = jax.block_until_ready(plans(centres))
+    # the first plans (a solve to convergence each) apart: Crocoddyl's are not timed either
+    plans = jax.block_until_ready(trajopt.sweep(first, centres, devices=jax.devices()))
     start = time.perf_counter()
-    first = jax.block_until_ready(plans(centres))
+    plans = jax.block_until_ready(trajopt.sweep(first, centres, devices=jax.devices()))
     plans_s = time.perf_counter() - start
-    jax.block_until_ready(loops(centres, first))
-    start = time.perf_counter()
-    qs, status = jax.block_until_ready(loops(centres, first))
-    seconds = time.perf_counter() - start
-    records = [{**base, "engine": "mbjax", "robots": robots, "seconds": seconds,
-                "first_plans_s": plans_s, "failed": int(np.sum(np.asarray(status) != 0))}]
+    mesh = Mesh(np.asarray(jax.devices()), ("robots",))
+    mapped = jax.jit(jax.shard_map(lambda x: jax.lax.map(one, x), mesh=mesh,
+                                   in_specs=PartitionSpec("robots"),
+                                   out_specs=PartitionSpec("robots"), check_vma=False))
+    runs = {"vmap": lambda: trajopt.sweep(one, (centres, plans), devices=jax.devices()),
+            "map": lambda: mapped((centres, plans))}
+    records, finals = [], {}
+    for how, fn in runs.items():
+        jax.block_until_ready(fn())
+        start = time.perf_counter()
+        qs, status = jax.block_until_ready(fn())
+        seconds = time.perf_counter() - start
+        finals[how] = np.asarray(qs)
+        failed = int(np.sum((np.asarray(status) & int(Status.failures())) != 0))
+        records.append({**base, "engine": "mbjax", "how": how, "robots": robots,
+                        "seconds": seconds, "first_plans_s": plans_s, "failed": failed})
     if (why := peers.crocoddyl_working()) is not None:
         return records + [{**base, "engine": "crocoddyl", "skipped": why}]
-    total, first_total = 0.0, 0.0
-    for c in centres:
-        start = time.perf_counter()
+    total, solving, agreement = 0.0, 0.0, 0.0
+    steps = int(round(arm.MPC_DT / dt))
+    for i, c in enumerate(np.asarray(centres)):
         scenario = arm_track(centre=c)
-        solver, update = scenario.crocoddyl()
-        first_total += time.perf_counter() - start
+        solver, update = scenario.crocoddyl()            # its first solve, not timed
         scenario.crocoddyl = lambda solver=solver, update=update: (solver, update)
-        period = _period(scenario, dt, int(round(arm.MPC_DT / dt)))
+        period = _period(scenario, dt, steps)
         start = time.perf_counter()
-        _crocoddyl_loop(scenario, ticks, period, dt, int(round(arm.MPC_DT / dt)))
+        qs, _, _, seconds, _ = _crocoddyl_loop(scenario, ticks, period, dt, steps)
         total += time.perf_counter() - start
-    records.append({**base, "engine": "crocoddyl", "robots": robots, "seconds": total})
+        solving += sum(seconds)
+        agreement = max(agreement, float(np.max(np.abs(qs - finals["map"][i]))))
+    # `seconds` counts Crocoddyl's solves alone: its loop's plant is mbjax's, called from
+    # Python a period at a time (`loop_seconds`, the whole), which is not Crocoddyl's to pay
+    records.append({**base, "engine": "crocoddyl", "how": "loop", "robots": robots,
+                    "seconds": solving, "loop_seconds": total,
+                    "largest_state_difference_from_mbjax": agreement})
     return records
 
 
@@ -429,8 +452,8 @@ def table(records: list[dict]) -> str:
                          f"{r['status']} |")
     for r in records:
         if "robots" in r:
-            lines.append(f"| {r['problem']} | {r['engine']} | {r['robots']} robots | "
-                         f"{r['seconds']:.2f} s | | | | |")
+            lines.append(f"| {r['problem']} | {r['engine']} ({r['how']}) | {r['robots']} "
+                         f"robots | {r['seconds']:.2f} s | | | | |")
     return "\n".join(lines)
 
 

@@ -129,6 +129,7 @@ TOUR_GROUPS = {
     "carpal-wrist": ("carpal-wrist", "models", "trajectory-optimisation"),
     "legged-gait": ("legged-gait",),
     "contacts": ("contacts",),
+    "mpc": ("mpc",),
 }
 
 
@@ -141,7 +142,8 @@ def test_tour_groups_cover_every_scene():
     assert sorted(s for group in TOUR_GROUPS.values() for s in group) == sorted(TOUR)
     assert set(TOUR) == {"torque-free-body", "heavy-top", "rigid-chain", "time-elements",
                          "closed-loops", "flexible-bodies", "carpal-wrist", "controls", "models",
-                         "trajectory-optimisation", "floating-base", "legged-gait", "contacts"}
+                         "trajectory-optimisation", "floating-base", "legged-gait", "contacts",
+                         "mpc"}
 
 
 def test_tour_rejects_an_unknown_scene(capsys):
@@ -320,9 +322,21 @@ def _check_contacts(scenes):
         assert run["status"] == "success" and run["height_error_max_m"] < 1e-9
 
 
+def _check_mpc(scenes):
+    # the arm follows its circle through the push within a few millimetres, every tick solved
+    # within the control period at the median; Crocoddyl's loop on the same plant tracks alike
+    scene = scenes["mpc"]
+    run = scene["runs"]["mbjax"]
+    assert run["tracking_error_rms_m"] < 0.01 and run["solve_ms_median"] < 10.0
+    record = scene["peers"]["crocoddyl"]
+    if peers.crocoddyl_working() is None:
+        assert abs(record["tracking_error_rms_m"] - run["tracking_error_rms_m"]) < (
+            0.01 * run["tracking_error_rms_m"])
+
+
 TOUR_CHECKS = {"rigid": _check_rigid, "time-elements": _check_time_elements,
                "carpal-wrist": _check_carpal_wrist, "legged-gait": _check_legged_gait,
-               "contacts": _check_contacts}
+               "contacts": _check_contacts, "mpc": _check_mpc}
 
 
 @pytest.mark.slow     # a benchmark script: the library is tested in tests/wrist

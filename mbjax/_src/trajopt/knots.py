@@ -66,6 +66,12 @@ class AbstractKnot(eqx.Module):
         """The time from this knot to the next."""
         return dt if self.rate else 0.0
 
+    def vectorizable(self) -> bool:
+        """Whether a phase of such knots may be `vmap`ped over its knots (`Schedule.map`): not
+        where its step factorizes matrices (a stance's or an impulse's contact solve), whose
+        batched LAPACK calls can deadlock XLA's CPU thread pool."""
+        return False
+
 
 class Knot(AbstractKnot):
     """A step of a system under a control held over it: a knot of a contact phase (its
@@ -115,6 +121,11 @@ class Knot(AbstractKnot):
         if not is_stance(self.system):
             return None
         return contact_wrenches(self._held(t, q, v, u), t, q, v)
+
+    def vectorizable(self) -> bool:
+        """A step of a system without contacts is vectorized over the phase's knots, as a
+        one-system problem's steps are."""
+        return not is_stance(self.system)
 
 
 class Impulse(AbstractKnot):
@@ -220,20 +231,26 @@ class Schedule(eqx.Module):
         return jax.lax.switch(phase, branches, index, *args)
 
     def map(self, fn: Callable, *args):
-        """fn(knot k, *args[k]) for every knot k, a loop (`lax.map`) over each phase's knots:
-        each phase compiles once. args are arrays with a first axis of one entry per knot.
+        """fn(knot k, *args[k]) for every knot k, over each phase's knots: each phase compiles
+        once. args are arrays with a first axis of one entry per knot.
 
-        A loop, not a `vmap`: vmapped over knots, a stance's Cholesky factors and solves become
-        batched LAPACK calls, which jaxlib 0.10.2 splits over XLA's CPU thread pool and waits
-        for; two at once on a two-thread pool wait for each other forever (the ANYmal walk's
-        iterations hung so). The loop also compiles faster (benchmarks/README.md)."""
+        A loop (`lax.map`) over a phase of stances or impulses, not a `vmap`: vmapped over
+        knots, a stance's Cholesky factors and solves become batched LAPACK calls, which jaxlib
+        0.10.2 splits over XLA's CPU thread pool and waits for; two at once on a two-thread pool
+        wait for each other forever (the ANYmal walk's iterations hung so). The loop also
+        compiles faster (benchmarks/README.md). A phase of knots without contacts
+        (`AbstractKnot.vectorizable`) is vmapped, as a one-system problem's steps are: the
+        arm's tracking horizon of 50 knots ticks in 1.1 ms instead of 1.9."""
         outs, order = [], []
         for p, template in enumerate(self.templates):
             ks = self.members(p)
             shared, stacked = _split(self.arrays[p], self.axes[p])
-            outs.append(jax.lax.map(
-                lambda xs, t=template, shared=shared: fn(eqx.combine(shared, xs[0], t), *xs[1:]),
-                (stacked, *(a[ks] for a in args))))
+
+            def one(xs, t=template, shared=shared):
+                return fn(eqx.combine(shared, xs[0], t), *xs[1:])
+            inputs = (stacked, *(a[ks] for a in args))
+            outs.append(jax.vmap(one)(inputs) if template.vectorizable()
+                        else jax.lax.map(one, inputs))
             order.append(ks)
         if len(outs) == 1:
             return outs[0]
