@@ -30,6 +30,7 @@ from mbjax._src.trajopt.quasi_static import quasi_static as quasi_static
 from mbjax._src.trajopt.wrenches import knot_wrenches as knot_wrenches
 from mbjax._src.trajopt.mpc import MPC as MPC
 from mbjax._src.trajopt.mpc import Plan as Plan
+from mbjax._src.trajopt.mpc import Cycle as Cycle
 from mbjax._src.trajopt.mpc import Tick as Tick
 from mbjax._src.trajopt.mpc import ClosedLoop as ClosedLoop
 from mbjax._src.trajopt.mpc import closed_loop as closed_loop
@@ -42,5 +43,5 @@ __all__ = [
     "com_residual", "friction_cone_residual", "contact_force_residual", "barrier_residual",
     "wrench_cone_residual",
     "Knot", "Impulse", "quasi_static", "knot_wrenches",
-    "MPC", "Plan", "Tick", "ClosedLoop", "closed_loop", "follow",
+    "MPC", "Plan", "Cycle", "Tick", "ClosedLoop", "closed_loop", "follow",
 ]

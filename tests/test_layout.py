@@ -35,11 +35,11 @@ LAYERS = (
 RANK = {name: rank for rank, names in enumerate(LAYERS) for name in names}
 NAMESPACES = ("lie", "model", "control", "integrate", "rigid", "flex", "loops", "tfe", "wrist",
               "trajopt", "scenes", "data", "contact")
-MAX_PUBLIC_NAMES = 183       # 150, the contact namespace (legged robots), multi-phase problems,
+MAX_PUBLIC_NAMES = 184       # 150, the contact namespace (legged robots), multi-phase problems,
                              # contacts that find themselves (geoms, their system and model,
                              # the Ant's and HalfCheetah's files) and contact costs (issue 45),
-                             # model-predictive control (MPC, Plan, Tick, ClosedLoop,
-                             # closed_loop, follow)
+                             # model-predictive control (MPC, Plan, Cycle, Tick,
+                             # ClosedLoop, closed_loop, follow)
 
 
 def _imports(path: Path):

@@ -10,13 +10,19 @@ Problems (`SCENARIOS`):
     kinova-payload  the Kinova arm of Crocoddyl's `arm_manipulation_fwddyn.py` (its start and
                     target, the costs a position reach that settles) at 100 Hz, a 0.5 s
                     horizon, with 0.5 kg in the gripper that the controller does not know of
+    anymal-trot     ANYmal (example-robot-data) trotting in place at 50 Hz: Crocoddyl's trot
+                    (its knots, the touchdown impulses left out) as a cycle of 24 knots of
+                    10 ms, a 0.2 s horizon; the plant finds its own contacts (the feet's spheres
+                    on a floor, `mbjax.contact.ContactSystem`, semi-implicit Euler at 1 ms);
+                    the task error is the base's drift from where it stood
 
 Each tick both controllers solve the horizon from the plant's state with one FDDP iteration
 (mbjax: `ILQR(iterations=1, **CROCODDYL_SCHEDULE)`, Crocoddyl: `SolverFDDP.solve(xs, us, 1,
-False)`), warm-started from their previous solution shifted by a knot (Crocoddyl's infeasible
-start), after a first solve to convergence from the controls that hold the start. The plant is
-the same mbjax system for both (RK4 at 1 ms, the controller's first control held with its
-feedback gains between ticks: `mbjax.trajopt.follow`), so the two loops differ only in their
+False)`), warm-started from their previous solution shifted by the knots of a tick (Crocoddyl's
+infeasible start), after a first solve to convergence from the controls that hold the start
+(the trot's from its quasi-static controls, `mbjax.trajopt.quasi_static`). The plant is the same
+mbjax system for both (RK4 at 1 ms for the arms, the plan's controls held with its feedback
+gains between ticks: `mbjax.trajopt.follow`), so the two loops differ only in their
 controllers. Both loops run in Python, a tick at a time, so that each tick's solve is timed
 (`solve_ms_median`, `solve_ms_max`: mbjax's jitted `MPC.tick`, Crocoddyl's reference update and
 `solve`, single-threaded); mbjax's jitted `closed_loop` runs the same loop as one program too
@@ -75,6 +81,8 @@ class Scenario:
     crocoddyl: Callable         # () -> (SolverFDDP of the first horizon, update(t, x_pin))
     to_pin: Callable            # mbjax (q, v) -> Crocoddyl's x
     from_pin: Callable          # Crocoddyl's x -> mbjax x
+    gains: Callable = None      # Crocoddyl's K (nu, ndx) -> mbjax's gains; None for -K
+    integrator: object = None   # the plant's integrator; None for RK4
 
 
 def _identity_pin(nq):
@@ -235,20 +243,137 @@ def kinova_payload(payload: float = KINOVA_PAYLOAD, horizon: int = 50) -> Scenar
     return Scenario(controller, plan, plant, q0, v0, error, crocoddyl, to_pin, from_pin)
 
 
-SCENARIOS = {"arm-track": arm_track, "kinova-payload": kinova_payload}
+TROT_DT, TROT_HORIZON, TROT_STEP_KNOTS, TROT_SUPPORT_KNOTS, TROT_HEIGHT = 0.01, 20, 10, 2, 0.1
+TROT_SHIFT = 2                      # two knots of 10 ms a tick: 50 Hz
+TROT_TICKS = 100                    # 2 s
+
+
+def anymal_trot() -> Scenario:
+    """ANYmal trotting in place at 50 Hz: Crocoddyl's trot (`createTrottingProblem`'s knots:
+    double supports, then each diagonal pair's swing, its feet lifted 0.1 m; no touchdown
+    impulses in the horizon, the plant's contacts stop the feet) as a cycle of 24 knots of
+    10 ms, a 0.2 s horizon moved two knots a tick. The plant finds its own contacts: the feet's
+    spheres on a floor (`mbjax.contact.ContactSystem`, MuJoCo's soft contacts, friction 0.7),
+    semi-implicit Euler at 1 ms."""
+    import mbjax
+    from mbjax.contact import ContactSystem
+    from mbjax.model import Geoms, ground_plane, state_from_pinocchio
+    from mbjax.trajopt import Cycle, quasi_static
+    from mbjax_harness.crocoddyl_gaits import FEET, MU, _anymal_start, _converter
+
+    robot, model, q_pin0, q0, v0, feet, com, gait = _anymal_start()
+    lf, rf, lh, rh = FEET
+    support = [gait.knot(FEET) for _ in range(TROT_SUPPORT_KNOTS)]
+
+    def step(legs, swing):          # a diagonal pair's swing, its touchdown impulse left out
+        return gait.footsteps(np.array(com), dict(feet), 0.0, TROT_HEIGHT, TROT_STEP_KNOTS,
+                              legs, swing)[0][:-1]
+
+    cycle = Cycle(support + step([lf, rh], [rf, lh]) + support + step([rf, lh], [lf, rh]),
+                  TROT_DT)
+    terminal = (gait.regularisation(gait.state_weights), *gait.bounds)
+
+    def horizon_problem(t, q, v):
+        return trajopt.Problem(cycle.window(t, TROT_HORIZON), q, v, dt=TROT_DT,
+                               terminal=terminal, integrator=SemiImplicitEuler())
+
+    controller = trajopt.MPC(horizon_problem, shift=TROT_SHIFT)
+    q0, v0 = jnp.asarray(q0), jnp.asarray(v0)
+    us0 = quasi_static(horizon_problem(0.0, q0, v0))
+    plan = eqx.filter_jit(controller.init)(0.0, q0, v0, us0,
+                                           trajopt.ILQR(iterations=50,
+                                                        **trajopt.CROCODDYL_SCHEDULE))
+    # the plant: the feet's spheres (the URDF's collision geometry) on a floor under them
+    g = model.geoms
+    spheres = [i for i, kind in enumerate(g.kinds) if kind == "sphere"]
+    R, p = mbjax.rigid.forward_kinematics(model, q0)
+    floor = min(float((p[g.bodies[i]] + R[g.bodies[i]] @ g.position[i])[2] - g.size[i][0])
+                for i in spheres)
+    friction = [MU, 0.005, 1e-4]
+    geoms = Geoms(("sphere",) * len(spheres), [g.bodies[i] for i in spheres],
+                  np.asarray(g.size)[spheres], position=np.asarray(g.position)[spheres],
+                  friction=[friction] * len(spheres)).join(ground_plane(height=floor,
+                                                                        friction=friction))
+    plant = ContactSystem(TreeSystem(model, actuation=range(6, model.nv)), geoms,
+                          timestep=arm.PLANT_DT)
+    to_pin_all = _converter(model)
+
+    def to_pin(q, v):
+        return to_pin_all(np.concatenate([np.asarray(q), np.asarray(v)])[None])[0]
+
+    def from_pin(x):
+        q, v = state_from_pinocchio(model, x[:model.nq], x[model.nq:])
+        return np.concatenate([np.asarray(q), np.asarray(v)])
+
+    nv = model.nv
+    tangent = np.r_[3:6, 0:3, 6:nv]                  # mbjax's free-joint order (angular first)
+    columns = np.r_[tangent, nv + tangent]
+
+    def gains(K):
+        return -np.asarray(K)[:, columns]
+
+    def error(t, q):
+        return float(jnp.linalg.norm(q[:3] - q0[:3]))
+
+    def crocoddyl():
+        import crocoddyl as croc
+        import pinocchio as pin
+        from crocoddyl.utils.quadruped import SimpleQuadrupedalGaitProblem
+
+        builder = SimpleQuadrupedalGaitProblem(robot.model, *FEET)
+        data = robot.model.createData()
+        pin.forwardKinematics(robot.model, data, q_pin0)
+        pin.updateFramePlacements(robot.model, data)
+        ids = {f: robot.model.getFrameId(f) for f in FEET}
+        at = {f: data.oMf[ids[f]].translation.copy() for f in FEET}
+        com_ref = np.mean([at[f] for f in FEET], axis=0)
+        com_ref[2] = pin.centerOfMass(robot.model, data, q_pin0)[2].item()
+        double = [builder.createSwingFootModel(TROT_DT, [ids[f] for f in FEET])
+                  for _ in range(TROT_SUPPORT_KNOTS)]
+
+        def footstep(legs, swing):
+            return builder.createFootstepModels(
+                com_ref.copy(), [at[f].copy() for f in swing], 0.0, TROT_HEIGHT, TROT_DT,
+                TROT_STEP_KNOTS, [ids[f] for f in legs], [ids[f] for f in swing])[:-1]
+
+        models = double + footstep([lf, rh], [rf, lh]) + double + footstep([rf, lh], [lf, rh])
+        x0 = np.concatenate([q_pin0, np.zeros(robot.model.nv)])
+        problem = croc.ShootingProblem(x0, models[:TROT_HORIZON],
+                                       builder.createSwingFootModel(TROT_DT, list(ids.values())))
+        problem.nthreads = 1
+        solver = croc.SolverFDDP(problem)
+        solver.solve(list(to_pin_all(np.asarray(plan.xs))),
+                     [np.asarray(u) for u in np.asarray(plan.us)], 100, False)
+        following = [TROT_HORIZON]
+
+        def update(t, x):
+            offset = int(round(t / TROT_DT))
+            while following[0] < offset + TROT_HORIZON:
+                model_ = models[following[0] % len(models)]
+                problem.circularAppend(model_, model_.createData())
+                following[0] += 1
+            problem.x0 = x
+        return solver, update
+
+    return Scenario(controller, plan, plant, np.asarray(q0), np.asarray(v0), error, crocoddyl,
+                    to_pin, from_pin, gains, SemiImplicitEuler())
+
+
+SCENARIOS = {"arm-track": arm_track, "kinova-payload": kinova_payload, "anymal-trot": anymal_trot}
 
 
 @eqx.filter_jit
-def _follow(controller, plant, plan, t, q, v, dt: float, steps: int):
+def _follow(controller, plant, integrator, plan, t, q, v, dt: float, steps: int):
     return trajopt.follow(controller, plan, plant, t, q, v, dt=dt, steps=steps,
-                          integrator=RK4())
+                          integrator=integrator)
 
 
 def _period(scenario: Scenario, dt: float, steps: int):
     """(plan, t, q, v) -> the plant over a control period (one compiled program for every
     scenario of the same shapes)."""
-    return lambda plan, t, q, v: _follow(scenario.controller, scenario.plant, plan, t, q, v,
-                                         dt, steps)
+    integrator = scenario.integrator or RK4()
+    return lambda plan, t, q, v: _follow(scenario.controller, scenario.plant, integrator, plan,
+                                         t, q, v, dt, steps)
 
 
 def _stage(scenario: Scenario):
@@ -287,9 +412,13 @@ def _mbjax_loop(scenario: Scenario, ticks: int, period, dt: float, steps: int):
 
 
 def _crocoddyl_loop(scenario: Scenario, ticks: int, period, dt: float, steps: int):
-    """Crocoddyl's loop, on the same plant: (states, controls, solve seconds per tick)."""
+    """Crocoddyl's loop, on the same plant: (states, controls, solve seconds per tick, the
+    controls last applied in each period). Each tick shifts its warm start by the knots the
+    horizon moves (`update` moves the problem's models along), solves one FDDP iteration, and
+    hands its first knots' controls and gains to the plant."""
     solver, update = scenario.crocoddyl()
     H = len(solver.problem.runningModels)
+    gains = scenario.gains or (lambda K: -np.asarray(K))
     q, v = jnp.asarray(scenario.q0), jnp.asarray(scenario.v0)
     qs, vs, us, seconds, last = [q], [v], [], [], []
     for i in range(ticks):
@@ -297,18 +426,21 @@ def _crocoddyl_loop(scenario: Scenario, ticks: int, period, dt: float, steps: in
         x = scenario.to_pin(q, v)
         start = time.perf_counter()
         update(t, x)
-        xs = list(solver.xs)[1:] + [solver.xs[-1]]
+        shift = scenario.controller.shift if i else 0       # the first plan is for t = 0
+        xs = list(solver.xs)[shift:] + [solver.xs[-1]] * shift
         xs[0] = x
-        us_ = list(solver.us)[1:] + [solver.us[-1]]
+        us_ = list(solver.us)[shift:] + [solver.us[-1]] * shift
         solver.solve(xs, us_, 1, False)
         seconds.append(time.perf_counter() - start)
         # the plan's first state is the measured one (Crocoddyl's x0), taken in mbjax's layout
         # as it is: converted back, a continuous joint's angle would come back wrapped
-        x_plan = np.concatenate([np.asarray(q), np.asarray(v)])
+        used = scenario.controller.shift               # the knots the plant runs through
+        x_plan = [np.concatenate([np.asarray(q), np.asarray(v)])] + [
+            scenario.from_pin(np.asarray(solver.xs[k])) for k in range(1, used)]
         # Crocoddyl's control law is u = u_k - K_k (x (-) x_k): mbjax's gains are -K
-        plan = trajopt.Plan(jnp.asarray(t), jnp.tile(x_plan, (H + 1, 1)),
-                            jnp.tile(np.asarray(solver.us[0]), (H, 1)),
-                            -jnp.tile(np.asarray(solver.K[0]), (H, 1, 1)))
+        plan = trajopt.Plan(jnp.asarray(t), jnp.asarray(x_plan + [x_plan[-1]] * (H + 1 - used)),
+                            jnp.asarray([np.asarray(solver.us[k]) for k in range(H)]),
+                            jnp.asarray([gains(solver.K[k]) for k in range(H)]))
         q, v, applied = period(plan, jnp.asarray(t), q, v)
         qs.append(q), vs.append(v), us.append(applied[0]), last.append(applied[-1])
     return np.asarray(qs), np.asarray(vs), np.asarray(us), seconds, np.asarray(last)
@@ -325,15 +457,16 @@ def single(name: str, ticks: int, common: dict) -> list[dict]:
             "horizon": scenario.plan.us.shape[0]}
     records = []
 
+    integrator = scenario.integrator or RK4()
     start = time.perf_counter()
     run = trajopt.closed_loop(scenario.controller, scenario.plant, scenario.q0, scenario.v0,
-                              ticks=ticks, dt=dt, plan=scenario.plan)
+                              ticks=ticks, dt=dt, plan=scenario.plan, integrator=integrator)
     jax.block_until_ready(run)
     compiled = time.perf_counter() - start
     start = time.perf_counter()
     run = jax.block_until_ready(trajopt.closed_loop(
         scenario.controller, scenario.plant, scenario.q0, scenario.v0, ticks=ticks, dt=dt,
-        plan=scenario.plan))
+        plan=scenario.plan, integrator=integrator))
     closed_s = time.perf_counter() - start
     status = run.messages()[0]
 
@@ -484,10 +617,11 @@ def run(out: Path, quick: bool = False) -> list[dict]:
     records = []
     ticks = QUICK_TICKS if quick else TICKS
     records += single("arm-track", ticks, common)
-    if (why := peers.missing("example_robot_data")) is None:
-        records += single("kinova-payload", ticks, common)
-    else:
-        records.append({**common, "problem": "kinova-payload", "skipped": why})
+    for name in ("kinova-payload",) if quick else ("kinova-payload", "anymal-trot"):
+        if (why := peers.missing("example_robot_data")) is None:
+            records += single(name, ticks if name != "anymal-trot" else TROT_TICKS, common)
+        else:
+            records.append({**common, "problem": name, "skipped": why})
     records += batch(QUICK_ROBOTS if quick else ROBOTS,
                      QUICK_BATCH_TICKS if quick else BATCH_TICKS, common)
     out = Path(out)

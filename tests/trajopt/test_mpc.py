@@ -164,3 +164,30 @@ def test_payload_identities():
         model.with_payload(-1.0, body=0)
     with pytest.raises(ValueError, match="point of shape"):
         model.with_payload(1.0, body=0, point=(0.0, 0.0))
+
+
+def test_cycle_windows_wrap_and_refuse_what_does_not_group():
+    """`Cycle.window(t, n)` is the n knots from the knot of t on, the cycle repeated (t may be
+    traced); knots that would make two phases, and impulses, are refused by name."""
+    from mbjax.rigid import TreeSystem
+
+    model = arm.model()
+    system = TreeSystem(model)
+    knots = [trajopt.Knot(system, eqx.Partial(_offset, c=jnp.asarray(float(k)))) for k in range(4)]
+    cycle = trajopt.Cycle(knots, 0.1)
+    assert cycle.period == 4
+    window = jax.jit(lambda t: jnp.stack([k.running.keywords["c"] for k in cycle.window(t, 6)]))
+    np.testing.assert_array_equal(window(0.3), [3, 0, 1, 2, 3, 0])
+    np.testing.assert_array_equal(window(0.5), [1, 2, 3, 0, 1, 2])
+    with pytest.raises(ValueError, match="alike but for their arrays"):
+        trajopt.Cycle([knots[0], trajopt.Knot(system, _other)], 0.1)
+    with pytest.raises(TypeError, match="knots\\[1\\] must be a Knot"):
+        trajopt.Cycle([knots[0], trajopt.Impulse(model, [], _other)], 0.1)
+
+
+def _offset(q, v, u, *, c):
+    return jnp.concatenate([q - c, v])
+
+
+def _other(q, v, u):
+    return v

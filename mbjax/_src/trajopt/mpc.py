@@ -16,7 +16,7 @@ from mbjax._src.integrate.base import AbstractIntegrator
 from mbjax._src.system.status import Status, WithStatus
 from mbjax._src.system.system import AbstractSystem
 from mbjax._src.trajopt.ilqr import CROCODDYL_SCHEDULE, ILQR
-from mbjax._src.trajopt.knots import Knot
+from mbjax._src.trajopt.knots import AbstractKnot, Knot, Schedule
 from mbjax._src.trajopt.problem import Problem
 from mbjax._src.trajopt.result import AbstractIterativeSolver
 
@@ -52,6 +52,60 @@ class Tick(eqx.Module):
     status: Array
 
 
+class Cycle(eqx.Module):
+    """A periodic schedule of knots, a gait's cycle, for a receding horizon: `window(t, n)` is
+    the n knots from time t on, the cycle repeated, as `MPC`'s problem(t, q, v) builds its
+    horizon. The knots must be alike but for their arrays (a stance's contacts in the air as
+    `active=False`, targets, weights), so that every window is one phase and compiles once,
+    whatever t is (t may be traced).
+
+    Args:
+        knots: one cycle's knots, `Knot`s alike but for their arrays.
+        dt: the knots' step [s].
+
+    Raises:
+        TypeError: a knot that is not a `Knot`.
+        ValueError: no knots, or knots that are not alike (they would make several phases).
+    """
+
+    schedule: Schedule
+    dt: float = eqx.field(static=True)
+
+    def __init__(self, knots, dt: float):
+        knots = list(knots)
+        for i, knot in enumerate(knots):
+            if not isinstance(knot, AbstractKnot) or not knot.rate:
+                raise TypeError(f"knots[{i}] must be a Knot(system, running) (impulses take no "
+                                f"time and have no place in a cycle of steps), got "
+                                f"{type(knot).__name__}")
+        self.schedule = Schedule(knots, dt)
+        if len(self.schedule.templates) > 1:
+            first = self.schedule.phase.index(1)
+            raise ValueError(f"knots must be alike but for their arrays (one phase); knots[0] "
+                             f"and knots[{first}] differ in their structure or static data: "
+                             f"write every knot over the same contacts and costs, those not "
+                             f"in use inactive or weighted 0")
+        self.dt = float(dt)
+
+    @property
+    def period(self) -> int:
+        """The number of knots in the cycle."""
+        return len(self.schedule.phase)
+
+    def window(self, t, n: int) -> list:
+        """The n knots from time t on (the knot of t, rounded to the step, first).
+
+        Args:
+            t: the time [s], may be traced.
+            n: the number of knots (static).
+
+        Returns:
+            The knots, a list for `Problem`.
+        """
+        offset = jnp.round(jnp.asarray(t) / self.dt).astype(int)
+        return [self.schedule.knot(0, (offset + k) % self.period) for k in range(n)]
+
+
 def _zero(q, v, u):
     return jnp.zeros((), q.dtype)
 
@@ -60,7 +114,7 @@ class MPC(eqx.Module):
     """A receding-horizon (model-predictive) controller.
 
     At each tick it builds the horizon's problem from the measured state, warm-starts the
-    solver from the previous plan shifted by the knots the horizon moved (its states and
+    solver from the previous plan shifted by the knots the horizon moved since (its states and
     controls, the last repeated: Crocoddyl's infeasible start, FDDP), runs at most the solver's
     `iterations`, and keeps the new plan. Until the next tick the control is the plan's, with its
     feedback gains: u = clip(u_k + K_k difference(x_k, x)) at the plan's knot k of the current
@@ -141,9 +195,13 @@ class MPC(eqx.Module):
     def tick(self, plan: Plan, t, q: Array, v: Array) -> tuple[Plan, Tick]:
         """One control tick: the horizon from (q, v) at time t solved warm from `plan` shifted.
 
+        The warm start is the plan moved on by the knots between its time and t (`shift` a
+        tick; none on a first tick at the plan's own time), its last knot repeated, its first
+        state replaced by the measured one.
+
         Args:
             plan: the previous tick's plan (or `init`'s).
-            t: the time [s], the plan's shifted by one period.
+            t: the time [s].
             q: the measured configuration, shape (nq,).
             v: the measured velocity, shape (nv,).
 
@@ -152,7 +210,8 @@ class MPC(eqx.Module):
         """
         q, v = jnp.asarray(q, float), jnp.asarray(v, float)
         problem = self.horizon(t, q, v)
-        xs, us = _shifted(plan.xs, self.shift), _shifted(plan.us, self.shift)
+        moved = jnp.round((t - plan.t) / problem.dt).astype(int)
+        xs, us = _shifted(plan.xs, moved), _shifted(plan.us, moved)
         solver = self.solver
         state = jax.lax.while_loop(solver.running, lambda s: solver.step(problem, s),
                                    solver.init(problem, problem.initial_controls(us), xs))
@@ -183,9 +242,11 @@ class MPC(eqx.Module):
         return jnp.clip(u, problem.lower, problem.upper)
 
 
-def _shifted(x: Array, shift: int) -> Array:
-    """x moved `shift` entries forward along its first axis, its last entry repeated."""
-    return jnp.concatenate([x[shift:], jnp.repeat(x[-1:], shift, axis=0)])
+def _shifted(x: Array, shift) -> Array:
+    """x moved `shift` entries forward along its first axis (shift may be traced), its last
+    entry repeated."""
+    n = x.shape[0]
+    return x[jnp.clip(jnp.arange(n) + shift, 0, n - 1)]
 
 
 class ClosedLoop(WithStatus):
