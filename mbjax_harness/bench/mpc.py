@@ -11,8 +11,8 @@ Problems (`SCENARIOS`):
                     target, the costs a position reach that settles) at 100 Hz, a 0.5 s
                     horizon, with 0.5 kg in the gripper that the controller does not know of
     anymal-trot     ANYmal (example-robot-data) trotting in place at 50 Hz: Crocoddyl's trot
-                    (its knots, the touchdown impulses left out) as a cycle of 24 knots of
-                    10 ms, a 0.2 s horizon; the plant finds its own contacts (the feet's spheres
+                    (its knots, the touchdown impulses left out; swings of 15 knots, the feet
+                    lifted 5 cm) as a cycle of 34 knots of 10 ms, a 0.2 s horizon; the plant finds its own contacts (the feet's spheres
                     on a floor, `mbjax.contact.ContactSystem`, semi-implicit Euler at 1 ms);
                     the task error is the base's drift from where it stood
 
@@ -243,18 +243,23 @@ def kinova_payload(payload: float = KINOVA_PAYLOAD, horizon: int = 50) -> Scenar
     return Scenario(controller, plan, plant, q0, v0, error, crocoddyl, to_pin, from_pin)
 
 
-TROT_DT, TROT_HORIZON, TROT_STEP_KNOTS, TROT_SUPPORT_KNOTS, TROT_HEIGHT = 0.01, 20, 10, 2, 0.1
+# a swing of 15 knots lifting the feet 5 cm: with 10 knots and 10 cm, on MuJoCo's default
+# contacts (solref 0.02 s), both engines' loops blew up after 0.5 s (stable on stiffer ones)
+TROT_DT, TROT_HORIZON, TROT_STEP_KNOTS, TROT_SUPPORT_KNOTS, TROT_HEIGHT = 0.01, 20, 15, 2, 0.05
 TROT_SHIFT = 2                      # two knots of 10 ms a tick: 50 Hz
 TROT_TICKS = 100                    # 2 s
 
 
-def anymal_trot() -> Scenario:
-    """ANYmal trotting in place at 50 Hz: Crocoddyl's trot (`createTrottingProblem`'s knots:
-    double supports, then each diagonal pair's swing, its feet lifted 0.1 m; no touchdown
-    impulses in the horizon, the plant's contacts stop the feet) as a cycle of 24 knots of
-    10 ms, a 0.2 s horizon moved two knots a tick. The plant finds its own contacts: the feet's
-    spheres on a floor (`mbjax.contact.ContactSystem`, MuJoCo's soft contacts, friction 0.7),
-    semi-implicit Euler at 1 ms."""
+def anymal_trot(step_length: float = 0.0) -> Scenario:
+    """ANYmal trotting at 50 Hz: Crocoddyl's trot (`createTrottingProblem`'s knots: double
+    supports, then each diagonal pair's swing, its feet lifted 5 cm; no touchdown impulses in
+    the horizon, the plant's contacts stop the feet), knots of 10 ms, a 0.2 s horizon moved two
+    knots a tick. In place, a cycle of 34 knots repeated; walking forward, `step_length` a step
+    (the first a half step, as Crocoddyl's), the steps laid out for the whole run (the CoM's
+    and the feet's targets move on). The plant finds its own contacts: the feet's spheres on a
+    floor (`mbjax.contact.ContactSystem`, MuJoCo's soft contacts, friction 0.7), semi-implicit
+    Euler at 1 ms. The task error is the base's distance from where a steady walk at the
+    commanded speed (none in place) would have it."""
     import mbjax
     from mbjax.contact import ContactSystem
     from mbjax.model import Geoms, ground_plane, state_from_pinocchio
@@ -265,12 +270,23 @@ def anymal_trot() -> Scenario:
     lf, rf, lh, rh = FEET
     support = [gait.knot(FEET) for _ in range(TROT_SUPPORT_KNOTS)]
 
-    def step(legs, swing):          # a diagonal pair's swing, its touchdown impulse left out
-        return gait.footsteps(np.array(com), dict(feet), 0.0, TROT_HEIGHT, TROT_STEP_KNOTS,
-                              legs, swing)[0][:-1]
+    targets = (np.array(com), dict(feet))         # moved on by each step (`_Gait.footsteps`)
 
-    cycle = Cycle(support + step([lf, rh], [rf, lh]) + support + step([rf, lh], [lf, rh]),
-                  TROT_DT)
+    def step(legs, swing, length):  # a diagonal pair's swing, its touchdown impulse left out
+        return gait.footsteps(*targets, length, TROT_HEIGHT, TROT_STEP_KNOTS, legs,
+                              swing)[0][:-1]
+
+    def cycle_of(first):
+        return (support + step([lf, rh], [rf, lh], first * step_length) + support
+                + step([rf, lh], [lf, rh], step_length))
+
+    knots = cycle_of(0.5)
+    cycle_knots = len(knots)
+    if step_length:                  # the whole run's steps, and a horizon more
+        while len(knots) < TROT_TICKS * TROT_SHIFT + TROT_HORIZON:
+            knots += cycle_of(1.0)
+    cycle = Cycle(knots, TROT_DT)
+    speed = step_length / (cycle_knots * TROT_DT)
     terminal = (gait.regularisation(gait.state_weights), *gait.bounds)
 
     def horizon_problem(t, q, v):
@@ -313,7 +329,7 @@ def anymal_trot() -> Scenario:
         return -np.asarray(K)[:, columns]
 
     def error(t, q):
-        return float(jnp.linalg.norm(q[:3] - q0[:3]))
+        return float(jnp.linalg.norm(q[:3] - q0[:3] - jnp.array([speed * t, 0.0, 0.0])))
 
     def crocoddyl():
         import crocoddyl as croc
@@ -331,12 +347,18 @@ def anymal_trot() -> Scenario:
         double = [builder.createSwingFootModel(TROT_DT, [ids[f] for f in FEET])
                   for _ in range(TROT_SUPPORT_KNOTS)]
 
-        def footstep(legs, swing):
+        def footstep(legs, swing, length):      # moves com_ref and the swing feet on
             return builder.createFootstepModels(
-                com_ref.copy(), [at[f].copy() for f in swing], 0.0, TROT_HEIGHT, TROT_DT,
+                com_ref, [at[f] for f in swing], length, TROT_HEIGHT, TROT_DT,
                 TROT_STEP_KNOTS, [ids[f] for f in legs], [ids[f] for f in swing])[:-1]
 
-        models = double + footstep([lf, rh], [rf, lh]) + double + footstep([rf, lh], [lf, rh])
+        def cycle_of(first):
+            return (double + footstep([lf, rh], [rf, lh], first * step_length) + double
+                    + footstep([rf, lh], [lf, rh], step_length))
+
+        models = cycle_of(0.5)
+        while step_length and len(models) < len(knots):
+            models += cycle_of(1.0)
         x0 = np.concatenate([q_pin0, np.zeros(robot.model.nv)])
         problem = croc.ShootingProblem(x0, models[:TROT_HORIZON],
                                        builder.createSwingFootModel(TROT_DT, list(ids.values())))
@@ -359,7 +381,11 @@ def anymal_trot() -> Scenario:
                     to_pin, from_pin, gains, SemiImplicitEuler())
 
 
-SCENARIOS = {"arm-track": arm_track, "kinova-payload": kinova_payload, "anymal-trot": anymal_trot}
+TROT_FORWARD = 0.1                 # [m] a step: 0.29 m/s
+
+
+SCENARIOS = {"arm-track": arm_track, "kinova-payload": kinova_payload, "anymal-trot": anymal_trot,
+             "anymal-trot-forward": lambda: anymal_trot(TROT_FORWARD)}
 
 
 @eqx.filter_jit
@@ -617,9 +643,10 @@ def run(out: Path, quick: bool = False) -> list[dict]:
     records = []
     ticks = QUICK_TICKS if quick else TICKS
     records += single("arm-track", ticks, common)
-    for name in ("kinova-payload",) if quick else ("kinova-payload", "anymal-trot"):
+    for name in (("kinova-payload",) if quick else
+                 ("kinova-payload", "anymal-trot", "anymal-trot-forward")):
         if (why := peers.missing("example_robot_data")) is None:
-            records += single(name, ticks if name != "anymal-trot" else TROT_TICKS, common)
+            records += single(name, TROT_TICKS if name.startswith("anymal") else ticks, common)
         else:
             records.append({**common, "problem": name, "skipped": why})
     records += batch(QUICK_ROBOTS if quick else ROBOTS,

@@ -4,7 +4,9 @@ flange, and sampled the way MuJoCo applies a control (a zero-order hold per step
 
 `build()` gives the servoed arm; `reach_loss` is the rollout loss whose gradient with respect to
 the spline's knots and a link mass the tour, the tests and notebook 09 take; `reach_problem` is
-the arm-reach trajectory-optimisation problem (`mbjax.trajopt`).
+the arm-reach trajectory-optimisation problem (`mbjax.trajopt`); `tracking_controller` is a
+model-predictive controller whose flange follows a circle (`Tracking`, `first_plan`), and
+`tracking_plant` the arm it drives, with a payload and a push it does not know of.
 """
 
 import equinox as eqx
