@@ -773,3 +773,26 @@ def test_reproduce_trajopt(tmp_path):
     for gif_name in data["animations"].values():
         with Image.open(tmp_path / gif_name) as gif:
             assert gif.format == "GIF" and gif.n_frames >= 15
+
+
+@pytest.mark.slow     # a benchmark script: MPC is tested in tests/trajopt/test_mpc.py
+def test_bench_mpc_quick(tmp_path):
+    """`mbjax bench mpc --quick` writes mpc.jsonl with the issue's keys: a row per problem and
+    engine (problem, engine, control_rate_hz, solve_ms_median, solve_ms_max, tracking_error,
+    status) and a row per engine for the batch (problem, engine, robots, seconds); the two
+    engines' loops on the same plant track alike."""
+    assert main(["bench", "mpc", "--quick", "--out", str(tmp_path)]) == 0
+    records = [json.loads(line) for line in (tmp_path / "mpc.jsonl").read_text().splitlines()]
+    rows = [r for r in records if "solve_ms_median" in r]
+    assert {r["engine"] for r in rows} >= {"mbjax"} and rows
+    for r in rows:
+        assert {"problem", "engine", "control_rate_hz", "solve_ms_median", "solve_ms_max",
+                "tracking_error", "status"} <= set(r)
+    batch = [r for r in records if "robots" in r]
+    assert batch and all({"problem", "engine", "robots", "seconds"} <= set(r) for r in batch)
+    if peers.crocoddyl_working() is None:
+        for problem in {r["problem"] for r in rows}:
+            ours, theirs = (next(r for r in rows if r["problem"] == problem and r["engine"] == e)
+                            for e in ("mbjax", "crocoddyl"))
+            assert abs(ours["tracking_error"] - theirs["tracking_error"]) < (
+                0.01 * theirs["tracking_error"])
