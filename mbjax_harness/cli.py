@@ -278,7 +278,7 @@ def _summary_markdown(summary: dict) -> str:
 
 
 def _one_device_per_core() -> None:
-    """The throughput and trajopt suites split batches over one XLA CPU device per core, as the
+    """The throughput, trajopt and mpc suites split batches over one XLA CPU device per core, as the
     peers' batches run one thread per core. Host devices are fixed when JAX starts its backend, so this only takes effect
     before that (as here, from the command line) and where XLA_FLAGS does not set them already."""
     import os
@@ -320,7 +320,7 @@ def _run(parser, args, reproductions: dict, suites: dict, scenes: dict) -> int:
                   f"written: {error.strerror or error}; set JAX_COMPILATION_CACHE_DIR or run "
                   "mbjax --no-cache", file=sys.stderr)
             return 2
-    if args.command == "bench" and args.suite in ("throughput", "trajopt"):
+    if args.command == "bench" and args.suite in ("throughput", "trajopt", "mpc"):
         _one_device_per_core()
     from mbjax_harness.progress import progress
 

@@ -625,9 +625,10 @@ CONTACT_ROBOTS = ("Ant", "HalfCheetah")
 
 
 def mpc_tour(out: Path, quick: bool) -> dict:
-    """The 7-dof arm's flange following a circle under model-predictive control: pushed at its
-    flange (30 N for 0.1 s at t = 1 s) and carrying 0.3 kg that its controller does not know
-    of. `mbjax.scenes.arm.tracking_controller` re-solves a 0.5 s horizon at 100 Hz from the
+    """The arm tracking a circle by MPC at 100 Hz under a push and a payload.
+
+    The flange is pushed (30 N for 0.1 s at t = 1 s) and carries 0.3 kg that its controller
+    does not know of. `mbjax.scenes.arm.tracking_controller` re-solves a 0.5 s horizon at 100 Hz from the
     measured state, one FDDP iteration a tick warm-started from the last plan; the plant is RK4
     at 1 ms with the plan's feedback gains between ticks. The ticks run one at a time, so each
     solve is timed; where Crocoddyl is installed its MPC loop runs on the same plant

@@ -1,5 +1,6 @@
-"""`mbjax bench mpc`: model-predictive control, mbjax's `MPC` against Crocoddyl's MPC loop on the
-same problems and the same plant, in the same run.
+"""`mbjax bench mpc`: model-predictive control against Crocoddyl's MPC loop on the same plant.
+
+mbjax's `MPC` and Crocoddyl's loop run the same problems on the same plant, in the same run.
 
 Problems (`SCENARIOS`):
 

@@ -239,8 +239,7 @@ class Schedule(eqx.Module):
         0.10.2 splits over XLA's CPU thread pool and waits for; two at once on a two-thread pool
         wait for each other forever (the ANYmal walk's iterations hung so). The loop also
         compiles faster (benchmarks/README.md). A phase of knots without contacts
-        (`AbstractKnot.vectorizable`) is vmapped, as a one-system problem's steps are: the
-        arm's tracking horizon of 50 knots ticks in 1.1 ms instead of 1.9."""
+        (`AbstractKnot.vectorizable`) is vmapped, as a one-system problem's steps are."""
         outs, order = [], []
         for p, template in enumerate(self.templates):
             ks = self.members(p)

@@ -95,10 +95,19 @@ def sweep(fn, params, *, devices=None, trim: bool = True):
     return jax.tree.map(lambda x: x[:n], out) if pad and trim else out
 
 
-@functools.lru_cache(maxsize=64)
 def _compiled(fn, sharding):
-    """jit(vmap(fn)), made once per function and sharding: a fresh `jax.vmap(fn)` each call
-    would be a new function to `jax.jit`, traced and compiled again (a second sweep of the
-    arm's closed loops took 10 s instead of 0.1)."""
+    """jit(vmap(fn)), made once per function and sharding where fn can be a cache key: a fresh
+    `jax.vmap(fn)` each call would be a new function to `jax.jit`, traced and compiled again.
+    A function that cannot be hashed (a module holding arrays) is wrapped anew."""
+    try:
+        return _cached(fn, sharding)
+    except TypeError:                              # unhashable
+        return _wrapped(fn, sharding)
+
+
+def _wrapped(fn, sharding):
     mapped = jax.vmap(fn)
     return jax.jit(mapped) if sharding is None else jax.jit(mapped, out_shardings=sharding)
+
+
+_cached = functools.lru_cache(maxsize=64)(_wrapped)
