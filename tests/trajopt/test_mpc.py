@@ -1,8 +1,8 @@
 """Model-predictive control (`mbjax.trajopt.MPC`, `closed_loop`): the jitted closed loop equals
 its ticks run one at a time; a tick equals one iteration of Crocoddyl's FDDP from the same warm
 start (an independent solver, where installed); the closed loop's gradient in a plant's payload
-equals central differences; a vmapped batch equals its members; bad input is named. The arm's
-horizon is cut to 10 knots so that the programs compile in seconds."""
+equals central differences; a vmapped batch equals its members; bad input is named. The
+closed loop is the README's (the same programs: the run's compilation cache serves both)."""
 
 import equinox as eqx
 import jax
@@ -15,18 +15,18 @@ from mbjax_harness import peers
 from mbjax.rigid import inverse_dynamics, mass_matrix
 from mbjax.scenes import arm
 
-HORIZON, TICKS = 10, 12
+TICKS = 12                   # the short loops (gradient, batch)
 Q0, V0 = np.asarray(arm.Q_REF), np.zeros(7)
 
 
 @pytest.fixture(scope="module")
 def controller():
-    return arm.tracking_controller(horizon=HORIZON)
+    return arm.tracking_controller()
 
 
 @pytest.fixture(scope="module")
 def plan(controller):
-    return eqx.filter_jit(arm.first_plan)(controller)
+    return arm.first_plan(controller)
 
 
 def _run(controller, plan, payload=0.3, force=(0.0, 10.0, 0.0)):
@@ -36,42 +36,48 @@ def _run(controller, plan, payload=0.3, force=(0.0, 10.0, 0.0)):
 
 
 def test_closed_loop_equals_its_ticks(controller, plan):
-    """`closed_loop` is `MPC.tick` then `follow` over the control period, tick after tick; the
-    feedback acts between ticks (the applied controls change within a period), and the push
-    and payload leave the flange on its circle within 2 cm."""
-    run = _run(controller, plan)
+    """`closed_loop` (the README's: 1.5 s, 0.3 kg unknown, a 30 N push at 1 s) is `MPC.tick`
+    then `follow` over the control period, tick after tick; the feedback acts between ticks
+    (the applied controls change within a period); one FDDP iteration a tick keeps the flange
+    within 1 cm of its circle (rms) through the payload and the push."""
+    plant = arm.tracking_plant(payload=0.3)
+    run = trajopt.closed_loop(controller, plant, arm.Q_REF, jnp.zeros(7), ticks=150,
+                              dt=1e-3, plan=plan)
     assert run.messages() == ["success"]
-    plant = arm.tracking_plant(payload=0.3, force=(0.0, 10.0, 0.0), start=0.02)
     tick = eqx.filter_jit(controller.tick)
     steps = int(round(arm.MPC_DT / arm.PLANT_DT))
-    follow = eqx.filter_jit(lambda p, t, q, v: trajopt.follow(controller, p, plant, t, q, v,
-                                                              dt=arm.PLANT_DT, steps=steps))
+    follow = eqx.filter_jit(lambda plan, t, q, v: trajopt.follow(
+        controller, plan, plant, t, q, v, dt=arm.PLANT_DT, steps=steps))
     q, v, current = jnp.asarray(Q0), jnp.asarray(V0), plan
-    for i in range(TICKS):
+    acted = 0.0
+    for i in range(150):
         t = jnp.asarray(i * arm.MPC_DT)
         current, report = tick(current, t, q, v)
         assert int(report.iterations) == int(run.iterations[i]) == 1
         q, v, us = follow(current, t, q, v)
         np.testing.assert_allclose(us[0], run.us[i], atol=1e-10)
         np.testing.assert_allclose(q, run.qs[i + 1], atol=1e-10)
-    assert float(jnp.max(jnp.abs(us[-1] - us[0]))) > 1e-6          # the gains act
+        acted = max(acted, float(jnp.max(jnp.abs(us[-1] - us[0]))))
+    assert acted > 1e-3                                              # the gains act
     errors = arm.tracking_error(controller.problem.arm, controller.problem.centre, run.ts,
                                 run.qs)
-    assert float(errors.max()) < 0.02
+    assert float(jnp.sqrt(jnp.mean(errors**2))) < 0.01 and float(errors.max()) < 0.03
 
 
 @pytest.mark.skipif(peers.crocoddyl_working() is not None, reason="Crocoddyl unavailable")
 def test_tick_is_one_crocoddyl_iteration():
     """A tick from a plan shifted and a measured state off the plan equals one iteration of
     Crocoddyl's FDDP (its `SolverFDDP.solve(xs, us, 1, False)`) on the same horizon from the
-    same warm start: the cost to 1e-7, the first control to 1e-5 N m (of 30) and the gains
-    (Crocoddyl's -K) to 1e-4 (of 600). The control weight is raised to 0.1 here: with the
-    scene's 1e-4 (Q_uu's smallest eigenvalue about 1e-6) the two solvers' steps differ by
-    1e-4 relative in the flat directions while the trajectories' costs agree to 1e-14."""
+    same warm start: the cost to 1e-6 relative (3e-7 measured), the first control to 1e-5 N m
+    of 30 (2e-6 measured) and the gains (Crocoddyl's -K) to 1e-4 of 600 (7e-5 measured); a
+    different step length would move the cost by 1e-3. The control weight is raised to 0.1
+    here: with the scene's 1e-4 (Q_uu's smallest eigenvalue about 1e-6) the two solvers' steps
+    differ by 1e-4 relative in the flat directions while the trajectories' costs agree to
+    1e-14."""
     from mbjax_harness.bench.mpc import _crocoddyl_tracking
 
-    controller = arm.tracking_controller(horizon=HORIZON, weights=(100.0, 1e-2, 1e-1, 1e3, 1.0))
-    plan = eqx.filter_jit(arm.first_plan)(controller)
+    controller = arm.tracking_controller(weights=(100.0, 1e-2, 1e-1, 1e3, 1.0))
+    plan = arm.first_plan(controller)
     solver, update = _crocoddyl_tracking(controller.problem, plan)
     np.testing.assert_allclose(np.asarray(solver.us), plan.us, atol=1e-5)   # the first solve
     q = Q0 + 0.01 * np.sin(np.arange(7.0))
@@ -84,7 +90,7 @@ def test_tick_is_one_crocoddyl_iteration():
     xs[0] = x
     us = [np.asarray(a) for a in np.asarray(plan.us)][1:] + [np.asarray(plan.us[-1])]
     solver.solve(xs, us, 1, False)
-    np.testing.assert_allclose(float(report.cost), solver.cost, rtol=1e-7)
+    np.testing.assert_allclose(float(report.cost), solver.cost, rtol=1e-6)
     np.testing.assert_allclose(new.us[0], solver.us[0], atol=1e-5)
     np.testing.assert_allclose(new.feedback[0], -solver.K[0], atol=1e-4)
 
@@ -106,14 +112,14 @@ def test_gradient_in_payload(controller, plan):
 
 
 def test_vmapped_loops_equal_their_members(controller, plan):
-    """Two arms with their own circles in one vmapped closed loop run as each alone."""
+    """Two arms with their own circles in one vmapped closed loop run as each alone (both
+    from the first plan of the first circle)."""
     centres = controller.problem.centre + jnp.array([[0.0, 0.0, 0.0], [0.02, -0.03, 0.01]])
     plant = arm.tracking_plant(payload=0.3, force=(0.0, 10.0, 0.0), start=0.02)
 
     def one(centre):
-        c = arm.tracking_controller(centre=centre, horizon=HORIZON)
-        return trajopt.closed_loop(c, plant, Q0, V0, ticks=TICKS, dt=arm.PLANT_DT,
-                                   plan=arm.first_plan(c))
+        c = arm.tracking_controller(centre=centre)
+        return trajopt.closed_loop(c, plant, Q0, V0, ticks=TICKS, dt=arm.PLANT_DT, plan=plan)
 
     batch = jax.jit(jax.vmap(one))(centres)
     assert batch.messages() == ["success"] * 2
@@ -130,7 +136,7 @@ def test_errors_are_named(controller, plan):
     with pytest.raises(ValueError, match="shift must be a positive int"):
         trajopt.MPC(controller.problem, shift=0)
     with pytest.raises(ValueError, match="must be longer than shift"):
-        trajopt.MPC(controller.problem, shift=HORIZON).init(0.0, Q0, V0)
+        trajopt.MPC(arm.Tracking(controller.problem.arm, horizon=3), shift=3).init(0.0, Q0, V0)
     with pytest.raises(TypeError, match="must return a mbjax.trajopt.Problem"):
         trajopt.MPC(lambda t, q, v: None).init(0.0, Q0, V0)
     with pytest.raises(TypeError, match="plant must be an mbjax system"):
