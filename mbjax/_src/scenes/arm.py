@@ -322,9 +322,10 @@ def tracking_controller(arm: Model | None = None, centre=None, weights=None,
     return MPC(Tracking(arm, centre, weights, horizon), solver)
 
 
+@eqx.filter_jit
 def first_plan(controller: MPC) -> Plan:
     """The controller's first plan from rest at Q_REF: its horizon solved to convergence
-    (Crocoddyl's schedule) from the torques that hold the pose.
+    (Crocoddyl's schedule) from the torques that hold the pose, in one compiled program.
 
     Args:
         controller: from `tracking_controller`.
