@@ -86,7 +86,7 @@ class Scenario:
     integrator: object = None   # the plant's integrator; None for RK4
 
 
-def _identity_pin(nq):
+def _identity_pin():
     return (lambda q, v: np.concatenate([np.asarray(q), np.asarray(v)]),
             lambda x: np.asarray(x))
 
@@ -105,7 +105,7 @@ def arm_track(payload: float = ARM_PAYLOAD, centre=None) -> Scenario:
         return _crocoddyl_tracking(problem, plan)
 
     return Scenario(controller, plan, arm.tracking_plant(payload=payload), q0, v0, error,
-                    crocoddyl, *_identity_pin(7))
+                    crocoddyl, *_identity_pin())
 
 
 def _crocoddyl_tracking(tracking, plan):
