@@ -641,8 +641,8 @@ def mpc_tour(out: Path, quick: bool) -> dict:
     ticks = 150 if quick else 300
     scenario = mpc.arm_track()
     dt, steps = arm.PLANT_DT, int(round(arm.MPC_DT / arm.PLANT_DT))
-    period = mpc._period(scenario, dt, steps)
-    qs, vs, us, seconds = mpc._mbjax_loop(scenario, ticks, period, dt, steps)
+    period = mpc.plant_period(scenario, dt, steps)
+    qs, vs, us, seconds = mpc.mbjax_loop(scenario, ticks, period, dt, steps)
     ts = np.arange(ticks + 1) * arm.MPC_DT
     problem = scenario.controller.problem
     flange = np.asarray(jax.jit(jax.vmap(lambda q: arm.flange(problem.arm, q)))(qs))
@@ -657,7 +657,7 @@ def mpc_tour(out: Path, quick: bool) -> dict:
     peers_record = {}
     why = peers.crocoddyl_working()
     if why is None:
-        cqs, _, _, cseconds, _ = mpc._crocoddyl_loop(scenario, ticks, period, dt, steps)
+        cqs, _, _, cseconds, _ = mpc.crocoddyl_loop(scenario, ticks, period, dt, steps)
         cflange = np.asarray(jax.jit(jax.vmap(lambda q: arm.flange(problem.arm, q)))(cqs))
         cerror = np.linalg.norm(cflange - target, axis=1)
         peers_record["crocoddyl"] = {

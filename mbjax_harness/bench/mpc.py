@@ -102,13 +102,13 @@ def arm_track(payload: float = ARM_PAYLOAD, centre=None) -> Scenario:
         return float(jnp.linalg.norm(arm.flange(model, q) - arm.track_target(problem.centre, t)))
 
     def crocoddyl():
-        return _crocoddyl_tracking(problem, plan)
+        return crocoddyl_tracking(problem, plan)
 
     return Scenario(controller, plan, arm.tracking_plant(payload=payload), q0, v0, error,
                     crocoddyl, *_identity_pin())
 
 
-def _crocoddyl_tracking(tracking, plan):
+def crocoddyl_tracking(tracking, plan):
     """`mbjax.scenes.arm.Tracking`'s horizon as Crocoddyl's shooting problem, a goal residual
     per knot (its reference moved each tick), and its FDDP solver warm from mbjax's first
     plan's converged solve (solved again by Crocoddyl to convergence)."""
@@ -395,7 +395,7 @@ def _follow(controller, plant, integrator, plan, t, q, v, dt: float, steps: int)
                           integrator=integrator)
 
 
-def _period(scenario: Scenario, dt: float, steps: int):
+def plant_period(scenario: Scenario, dt: float, steps: int):
     """(plan, t, q, v) -> the plant over a control period (one compiled program for every
     scenario of the same shapes)."""
     integrator = scenario.integrator or RK4()
@@ -421,7 +421,7 @@ def _summary(scenario, engine, ts, qs, vs, us, solve_s, stage, status) -> dict:
             "closed_loop_cost": cost, "status": status}
 
 
-def _mbjax_loop(scenario: Scenario, ticks: int, period, dt: float, steps: int):
+def mbjax_loop(scenario: Scenario, ticks: int, period, dt: float, steps: int):
     """mbjax's loop a tick at a time: (states, controls, solve seconds per tick, plans)."""
     tick = eqx.filter_jit(scenario.controller.tick)
     plan = scenario.plan
@@ -438,7 +438,7 @@ def _mbjax_loop(scenario: Scenario, ticks: int, period, dt: float, steps: int):
     return np.asarray(qs), np.asarray(vs), np.asarray(us), seconds
 
 
-def _crocoddyl_loop(scenario: Scenario, ticks: int, period, dt: float, steps: int):
+def crocoddyl_loop(scenario: Scenario, ticks: int, period, dt: float, steps: int):
     """Crocoddyl's loop, on the same plant: (states, controls, solve seconds per tick, the
     controls last applied in each period). Each tick shifts its warm start by the knots the
     horizon moves (`update` moves the problem's models along), solves one FDDP iteration, and
@@ -478,7 +478,7 @@ def single(name: str, ticks: int, common: dict) -> list[dict]:
     dt = arm.PLANT_DT
     control_period = scenario.controller.period(0.0, scenario.q0, scenario.v0)
     steps = int(round(control_period / dt))
-    period, stage = _period(scenario, dt, steps), _stage(scenario)
+    period, stage = plant_period(scenario, dt, steps), _stage(scenario)
     ts = np.arange(ticks + 1) * control_period
     base = {**common, "problem": name, "control_rate_hz": 1.0 / control_period, "ticks": ticks,
             "horizon": scenario.plan.us.shape[0]}
@@ -497,14 +497,14 @@ def single(name: str, ticks: int, common: dict) -> list[dict]:
     closed_s = time.perf_counter() - start
     status = run.messages()[0]
 
-    qs, vs, us, seconds = _mbjax_loop(scenario, ticks, period, dt, steps)
+    qs, vs, us, seconds = mbjax_loop(scenario, ticks, period, dt, steps)
     record = {**base, **_summary(scenario, "mbjax", ts, qs, vs, us, seconds, stage, status),
               "closed_loop_s": closed_s, "closed_loop_compile_s": compiled - closed_s,
               "loop_agreement": float(np.max(np.abs(np.asarray(run.qs) - qs))),
               "iterations_mean": float(np.mean(np.asarray(run.iterations)))}
     records.append(record)
     if (why := peers.crocoddyl_working()) is None:
-        qs, vs, us, seconds, us_last = _crocoddyl_loop(scenario, ticks, period, dt, steps)
+        qs, vs, us, seconds, us_last = crocoddyl_loop(scenario, ticks, period, dt, steps)
         plant_status = _plant_status(scenario, ts, qs, vs, us_last)
         records.append({**base, **_summary(scenario, "crocoddyl", ts, qs, vs, us, seconds,
                                            stage, plant_status)})
@@ -598,7 +598,7 @@ def batch(robots: int, ticks: int, common: dict, repeats: int = 1) -> list[dict]
             solver.setCandidate(*first, False)       # each round from the first solve
             scenario.crocoddyl = lambda solver=solver, update=update: (solver, update)
             start = time.perf_counter()
-            qs, _, _, seconds, _ = _crocoddyl_loop(scenario, ticks, _period(scenario, dt, steps),
+            qs, _, _, seconds, _ = crocoddyl_loop(scenario, ticks, plant_period(scenario, dt, steps),
                                                    dt, steps)
             total += time.perf_counter() - start
             solving += sum(seconds)

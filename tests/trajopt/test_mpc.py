@@ -74,11 +74,11 @@ def test_tick_is_one_crocoddyl_iteration():
     here: with the scene's 1e-4 (Q_uu's smallest eigenvalue about 1e-6) the two solvers' steps
     differ by 1e-4 relative in the flat directions while the trajectories' costs agree to
     1e-14."""
-    from mbjax_harness.bench.mpc import _crocoddyl_tracking
+    from mbjax_harness.bench.mpc import crocoddyl_tracking
 
     controller = arm.tracking_controller(weights=(100.0, 1e-2, 1e-1, 1e3, 1.0))
     plan = arm.first_plan(controller)
-    solver, update = _crocoddyl_tracking(controller.problem, plan)
+    solver, update = crocoddyl_tracking(controller.problem, plan)
     np.testing.assert_allclose(np.asarray(solver.us), plan.us, atol=1e-5)   # the first solve
     q = Q0 + 0.01 * np.sin(np.arange(7.0))
     v = 0.05 * np.cos(np.arange(7.0))
