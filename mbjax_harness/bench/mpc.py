@@ -33,7 +33,9 @@ controllers. Both loops run in Python, a tick at a time, so that each tick's sol
 distance to its target [m]); `closed_loop_cost` is the sum over the ticks of the first knot's
 running cost at the plant's state and the applied control (the horizon problem's
 `Problem.step_cost`); `status` is the closed loop's (`ClosedLoop.status`) for both, on the same
-plant.
+plant. Crocoddyl's row also has `lockstep_ticks` and `lockstep_cost_rtol` (`lockstep`: both
+controllers fed the same states, the ticks before their controls part and their costs' largest
+difference until then).
 
 Batch (`arm-track-batch`): `ROBOTS` arms, each its own circle (centres spread over a 0.1 m cube),
 their first plans and closed loops as one program split over the CPU's devices (`jax.vmap`
@@ -473,6 +475,37 @@ def crocoddyl_loop(scenario: Scenario, ticks: int, period, dt: float, steps: int
     return np.asarray(qs), np.asarray(vs), np.asarray(us), seconds, np.asarray(last)
 
 
+def lockstep(scenario: Scenario, ticks: int, period, dt: float, steps: int) -> dict:
+    """Both controllers fed the same measured states (the plant driven by mbjax's plans):
+    `lockstep_ticks`, the ticks before their first controls part by more than 1 % of the
+    control's norm (all of them if they never do), and `lockstep_cost_rtol`, the largest
+    relative difference of their horizon costs over those ticks. Each warm-starts from its own
+    previous solution, so where one line search takes another step than the other's, the two
+    chains part for good: this tells a controller that computes otherwise from one whose
+    one-iteration solves took a different branch."""
+    tick = eqx.filter_jit(scenario.controller.tick)
+    solver, update = scenario.crocoddyl()
+    plan = scenario.plan
+    q, v = jnp.asarray(scenario.q0), jnp.asarray(scenario.v0)
+    agree, worst = ticks, 0.0
+    for i in range(ticks):
+        t = i * steps * dt
+        plan, report = tick(plan, jnp.asarray(t), q, v)
+        x = scenario.to_pin(q, v)
+        update(t, x)
+        shift = scenario.controller.shift if i else 0
+        xs = list(solver.xs)[shift:] + [solver.xs[-1]] * shift
+        xs[0] = x
+        solver.solve(xs, list(solver.us)[shift:] + [solver.us[-1]] * shift, 1, False)
+        u = np.asarray(plan.us[0])
+        if np.linalg.norm(u - np.asarray(solver.us[0])) > 1e-2 * np.linalg.norm(u):
+            agree = i
+            break
+        worst = max(worst, abs(float(report.cost) - solver.cost) / abs(solver.cost))
+        q, v, _ = period(plan, jnp.asarray(t), q, v)
+    return {"lockstep_ticks": agree, "lockstep_cost_rtol": worst}
+
+
 def single(name: str, ticks: int, common: dict) -> list[dict]:
     scenario = SCENARIOS[name]()
     dt = arm.PLANT_DT
@@ -507,7 +540,8 @@ def single(name: str, ticks: int, common: dict) -> list[dict]:
         qs, vs, us, seconds, us_last = crocoddyl_loop(scenario, ticks, period, dt, steps)
         plant_status = _plant_status(scenario, ts, qs, vs, us_last)
         records.append({**base, **_summary(scenario, "crocoddyl", ts, qs, vs, us, seconds,
-                                           stage, plant_status)})
+                                           stage, plant_status),
+                        **lockstep(scenario, ticks, period, dt, steps)})
     else:
         records.append({**base, "engine": "crocoddyl", "skipped": why})
     return records
@@ -621,18 +655,26 @@ def batch(robots: int, ticks: int, common: dict, repeats: int = 1) -> list[dict]
 
 def table(records: list[dict]) -> str:
     lines = ["| problem | engine | rate | solve median | solve max | tracking error | "
-             "closed-loop cost | status |", "| --- | --- | --- | --- | --- | --- | --- | --- |"]
+             "closed-loop cost | status | same plans |",
+             "| --- | --- | --- | --- | --- | --- | --- | --- | --- |"]
     for r in records:
         if "solve_ms_median" in r:
             lines.append(f"| {r['problem']} | {r['engine']} | {r['control_rate_hz']:.0f} Hz | "
                          f"{r['solve_ms_median']:.2f} ms | {r['solve_ms_max']:.2f} ms | "
                          f"{r['tracking_error'] * 1e3:.3f} mm | {r['closed_loop_cost']:.6g} | "
-                         f"{r['status']} |")
+                         f"{r['status']} | {_lockstep_words(r)} |")
     for r in records:
         if "robots" in r:
             lines.append(f"| {r['problem']} | {r['engine']} ({r['how']}) | {r['robots']} "
-                         f"robots | {r['seconds']:.2f} s | | | | |")
+                         f"robots | {r['seconds']:.2f} s | | | | | |")
     return "\n".join(lines)
+
+
+def _lockstep_words(record: dict) -> str:
+    if "lockstep_ticks" not in record:
+        return ""
+    return (f"{record['lockstep_ticks']} of {record['ticks']} ticks "
+            f"(costs to {record['lockstep_cost_rtol']:.0e})")
 
 
 def plot(records: list[dict], path: Path) -> None:

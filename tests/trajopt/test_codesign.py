@@ -20,7 +20,7 @@ def _build(mass):
 def test_optimal_cost_gradient_matches_differences_of_re_solved_problems():
     mass = jnp.asarray(float(scene.model().mass[3]))
     assert solve(_build(mass), SOLVER).messages() == ["success"]
-    cost, grad = jax.value_and_grad(lambda m: optimal_cost(_build, m, SOLVER))(mass)
+    cost, grad = jax.jit(jax.value_and_grad(lambda m: optimal_cost(_build, m, SOLVER)))(mass)
     assert float(cost) == float(solve(_build(mass), SOLVER).cost)
     h = 1e-3 * float(mass)
     central = (float(optimal_cost(_build, mass + h, SOLVER))
