@@ -41,6 +41,31 @@ def test_the_condition_measure_vanishes_on_approach_to_either_kind():
         assert values[0] > values[1] > values[2] and values[2] < 1e-2 * values[0], values
 
 
+def test_the_measures_agree_at_the_symmetric_poses():
+    """theta = (t, t, t): where the knees' projections meet in one point (rho_i = rb - l cos t = 0
+    together, t = arccos(rb / l)) K is singular, and the direct measure reads 0 there (it read 1,
+    all rho_i being equal, while the condition read 5e-18); legs up (t = pi / 2) is the inverse
+    singularity. Everywhere the condition vanishes exactly where one of the two measures does,
+    and K's smallest singular value (numpy's, from the knees' positions) with the direct one."""
+    rb, length = float(WRIST.base_radius), float(WRIST.link_length)
+    meet = np.arccos(rb / length)
+    grid = np.concatenate([np.linspace(0.05, 3.0, 60), [meet, np.pi / 2]])
+    m = jax.vmap(lambda t: WRIST.singularity_measures(jnp.full(3, t)))(jnp.asarray(grid))
+    direct, inverse, condition = (np.asarray(x) for x in (m.direct, m.inverse, m.condition))
+    knees = np.asarray(jax.vmap(lambda t: kin.knees(WRIST, jnp.full(3, t)))(jnp.asarray(grid)))
+    K = np.concatenate([np.ones((len(grid), 3, 1)), knees[:, :, :2]], axis=2)
+    smallest = np.linalg.svd(K, compute_uv=False)[:, -1]
+    assert direct[-2] < 1e-12 and condition[-2] < 1e-12 and smallest[-2] < 1e-12
+    assert abs(inverse[-1]) < 1e-12 and condition[-1] < 1e-12
+    nearest = np.minimum(np.abs(inverse), np.abs(direct))
+    assert np.all((condition < 1e-9) == (nearest < 1e-9)), (grid, condition, nearest)
+    assert np.all((direct < 1e-9) == (smallest < 1e-9))
+    away = nearest > 0.05
+    assert np.all(condition[away] > 1e-4), condition[away].min()
+    system = WristSystem(WRIST)
+    assert int(system.check(0.0, jnp.full(3, meet), jnp.zeros(3))) & Status.SINGULAR
+
+
 def test_simulate_reports_singular_and_not_far_away():
     system = WristSystem(WRIST)
     at = simulate(system, RK4(), LEGS_UP, jnp.zeros(3), dt=1e-3, t1=0.01)

@@ -250,8 +250,11 @@ class SingularityMeasures(eqx.Module):
     inverse: min_i sqrt(1 - a_i^2) = -D_ii / (l sqrt(1 + k_i^2)), the sine of the angle between
     leg i's knee circle and the midplane (0: the circle touches the plane, the workspace boundary;
     negative: that knee is on the knees-in branch). direct: (rho1 rho2 + rho2 rho3 + rho3 rho1) /
-    (rho1^2 + rho2^2 + rho3^2), proportional to det K (0: knees collinear with the plane's
-    vertical, the parallel singularity; 1: all rho_i equal). condition: the smallest singular
+    max(rho1^2 + rho2^2 + rho3^2, 3 rb^2), det K (the knees' projections' triangle, 2 / sqrt(3)
+    its area) over its largest for the triangle's size, or for the legs-up pose's (rho_i = rb)
+    where the triangle is smaller: 0 where the knees' projections are collinear or meet in one
+    point (rho_i = 0 together, at theta_i = arccos(rb / l)), the parallel singularity; 1 where all
+    rho_i are equal and at least rb. condition: the smallest singular
     value of J (eq 6.34, J = dN/dg K^-1 D) over the largest of J_max = dN/dg K^-1 D_max, the
     Jacobian with every leg at its largest gain |D_ii| = l sqrt(1 + k_i^2), so in [0, 1]: 0 at
     an inverse singularity (a D_ii = 0: J loses rank), and at a direct one (det K = 0: J_max
@@ -271,7 +274,8 @@ def singularity_measures(wrist, theta: Array) -> SingularityMeasures:
     k = _dot(leg_directions(wrist), g)
     leg = (jnp.cos(theta) - k * jnp.sin(theta)) / jnp.sqrt(1 + k * k)
     rho = wrist.base_radius - wrist.link_length * jnp.cos(theta)
-    direct = (rho[0] * rho[1] + rho[1] * rho[2] + rho[2] * rho[0]) / jnp.sum(rho * rho)
+    direct = ((rho[0] * rho[1] + rho[1] * rho[2] + rho[2] * rho[0])
+              / jnp.maximum(jnp.sum(rho * rho), 3 * wrist.base_radius**2))
     sv = jnp.linalg.svd(jacobian_closed_form(wrist, theta), compute_uv=False)
     K_inv = _inverse3(_knee_matrix(wrist, theta))
     J_max = _normal_plunge_rows(g, K_inv * (wrist.link_length * jnp.sqrt(1 + k * k)))
