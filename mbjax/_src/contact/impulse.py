@@ -11,7 +11,8 @@ from mbjax._src.contact.contact import AbstractContact, wrenches
 from mbjax._src.contact.stance import _contacts
 from mbjax._src.loops.constraints import Loops
 from mbjax._src.loops.kkt import implicit_kkt
-from mbjax._src.model.model import Model
+from mbjax._src.lie.inputs import check_unit_quaternions
+from mbjax._src.model.model import Model, coordinates
 from mbjax._src.rigid import rnea_derivatives
 from mbjax._src.rigid.rnea import inverse_dynamics
 from mbjax._src.rigid.system import TreeSystem
@@ -73,8 +74,11 @@ def impulse(model: Model, q: Array, v: Array, contacts: Sequence[AbstractContact
     Raises:
         TypeError: contacts are not contacts.
         KeyError: a contact's frame is not in the model.
+        ValueError: q or v of another shape, or a quaternion in q not of unit norm.
     """
-    return _impulse(model, jnp.asarray(q, float), jnp.asarray(v, float), _contacts(contacts))
+    q, v = coordinates(model, q, "q"), coordinates(model, v, "v")
+    check_unit_quaternions(q, model.quaternions(), "q")
+    return _impulse(model, q, v, _contacts(contacts))
 
 
 _impulse = jax.jit(impulse_map)

@@ -12,6 +12,7 @@ from mbjax._src.contact.impulse import impulse
 from mbjax._src.contact.stance import _contacts, contact_wrenches, stance
 from mbjax._src.integrate.base import AbstractIntegrator
 from mbjax._src.integrate.simulate import simulate
+from mbjax._src.system.accuracy import number
 from mbjax._src.system.status import Status, WithStatus
 from mbjax._src.system.tree_system import AbstractTreeSystem
 
@@ -82,10 +83,14 @@ def simulate_schedule(tree: AbstractTreeSystem, integrator: AbstractIntegrator, 
             run.
 
     Raises:
-        ValueError: an empty schedule, a duration that is not a positive whole number of steps.
+        ValueError: an empty schedule, a duration that is not a positive whole number of steps,
+            or dt not a positive number.
         TypeError: a phase that is not (contacts, duration).
         KeyError: a contact's frame is not in the model.
     """
+    dt = number(dt, "dt")
+    if not dt > 0:
+        raise ValueError(f"dt must be a positive step [s], got {dt}")
     phases = list(schedule)
     if not phases:
         raise ValueError("schedule must hold at least one phase (contacts, duration)")

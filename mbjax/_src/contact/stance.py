@@ -12,7 +12,8 @@ from mbjax._src.contact.contact import AbstractContact, wrenches
 from mbjax._src.loops.coupled import Coupled
 from mbjax._src.loops.method import AbstractLoopMethod
 from mbjax._src.loops.system import ClosedSystem
-from mbjax._src.model.model import Model
+from mbjax._src.lie.inputs import check_unit_quaternions
+from mbjax._src.model.model import Model, coordinates
 from mbjax._src.system.status import Status
 from mbjax._src.system.tree_system import AbstractTreeSystem
 
@@ -81,13 +82,16 @@ def stance(tree: AbstractTreeSystem, q: Array, contacts: Sequence[AbstractContac
     Raises:
         TypeError: tree is not a rigid tree system, or contacts are not contacts.
         KeyError: a contact's frame is not in the model.
-        ValueError: mu is not positive.
+        ValueError: mu is not positive, q is not of shape (nq,), or a quaternion in q is not of
+            unit norm.
     """
     if not (isinstance(tree, AbstractTreeSystem) and isinstance(getattr(tree, "model", None), Model)):
         raise TypeError(f"tree must be a rigid tree system such as TreeSystem(model), got "
                         f"{type(tree).__name__}")
     contacts = _contacts(contacts)
-    closures = tuple(c.closure(tree.model, jnp.asarray(q, float)) for c in contacts)
+    q = coordinates(tree.model, q, "q")
+    check_unit_quaternions(q, tree.model.quaternions(), "q")
+    closures = tuple(c.closure(tree.model, q) for c in contacts)
     method = Coupled(baumgarte=CROCODDYL_GAINS) if method is None else method
     watch = Grip(contacts, None if mu is None else friction(mu))
     return ClosedSystem(tree, closures, method, projection, watch=watch)

@@ -42,6 +42,8 @@ def _vee_antisym(R: Array) -> Array:
 def active_flag(active, name: str) -> Array:
     """A joint's `active` flag as a float scalar array (1.0 held, 0.0 let go), or a ValueError
     naming it where it is concrete and not a boolean scalar."""
+    if isinstance(active, str | bytes):
+        raise TypeError(f"{name} must be True or False, got the string {active!r}")
     value = jnp.asarray(active, dtype=float)
     if value.ndim != 0:
         raise ValueError(f"{name} must be True or False, got shape {value.shape}")

@@ -555,9 +555,8 @@ class Model(eqx.Module):
 
         q + v for revolute, prismatic and universal joints; on the rotation group for spherical
         joints and on SE(3) for free joints (the body twist's exponential), equal to
-        Pinocchio's `integrate` after `mbjax.model.state_to_pinocchio` (see
-        `mbjax._src.model.joints.joint_integrate`). Differentiable, with finite derivatives at
-        zero and half turns.
+        Pinocchio's `integrate` after `mbjax.model.state_to_pinocchio`. Differentiable, with
+        finite derivatives at zero and half turns.
 
         Args:
             q: configuration, shape (nq,).
@@ -565,7 +564,11 @@ class Model(eqx.Module):
 
         Returns:
             The configuration, shape (nq,).
+
+        Raises:
+            ValueError: q or v of another shape.
         """
+        q, v = coordinates(self, q, "q"), coordinates(self, v, "v")
         if self.euclidean:
             return q + v
         return self._flat_q(self._per_type(
@@ -590,7 +593,11 @@ class Model(eqx.Module):
 
         Returns:
             v, shape (nv,).
+
+        Raises:
+            ValueError: q0 or q1 of another shape.
         """
+        q0, q1 = coordinates(self, q0, "q0"), coordinates(self, q1, "q1")
         layout, width = _layout(self.joint_types), self.width
         continuous = (jnp.isinf(self.lower) & jnp.isinf(self.upper)) if wrap else \
             jnp.zeros(self.nq, bool)
@@ -769,3 +776,15 @@ def _traced(value) -> bool:
     """Whether value (an array, or nested lists of numbers and arrays) holds a tracer of jit,
     grad or vmap."""
     return any(isinstance(leaf, jax.core.Tracer) for leaf in jax.tree.leaves(value))
+
+
+def coordinates(model: Model, x, name: str) -> Array:
+    """x as a float array of shape (nq,) (a name starting with q) or (nv,) (any other: v, u, a
+    tangent), or a ValueError naming the argument."""
+    x = jnp.asarray(x, dtype=float)
+    which = "nq" if name.startswith("q") else "nv"
+    size = model.nq if which == "nq" else model.nv
+    if x.shape != (size,):
+        raise ValueError(f"{name} must have shape ({which},) = ({size},) for this model (nq = "
+                         f"{model.nq}, nv = {model.nv}), got {x.shape}; use jax.vmap for batches")
+    return x
