@@ -48,3 +48,25 @@ def test_a_phase_that_is_not_a_pair_and_a_string_flag_are_named():
 def test_a_batch_is_refused_with_the_vmap_hint_not_broadcast():
     with pytest.raises(ValueError, match="use jax.vmap for batches"):
         ARM.integrate(jnp.zeros((2, 7)), jnp.zeros((2, 7)))
+
+
+def test_a_contact_that_knows_its_ground_is_not_held_in_the_air():
+    """The probe's foot 0.5 m above the ground, held there carrying the weight: with the ground's
+    height the stance and the impulse refuse it, naming the contact and the gap; on the ground
+    the stance is the one without a height."""
+    up = BODY.neutral().at[2].set(0.5)
+    grounded = [PointContact("body0", height=0.0)]
+    with pytest.raises(ValueError, match=r"contacts\[0\] \('body0'\) is 0.5 m above its ground"):
+        stance(TreeSystem(BODY), up, grounded)
+    with pytest.raises(ValueError, match="is 0.5 m above its ground"):
+        impulse(BODY, up, jnp.zeros(6), grounded)
+    tilted = [PointContact("body0", normal=(0.0, 1.0, 1.0), height=-0.1)]
+    with pytest.raises(ValueError, match=r"is 0.1 m above"):
+        stance(TreeSystem(BODY), BODY.neutral(), tilted)
+    assert float(PointContact("body0", height=0.2).clearance(BODY, up)) == pytest.approx(0.3)
+    held = stance(TreeSystem(BODY), BODY.neutral(), grounded)
+    free = stance(TreeSystem(BODY), BODY.neutral(), FOOT)
+    assert jnp.allclose(held.closures[0].origin_b, free.closures[0].origin_b)
+    stance(TreeSystem(BODY), up, [PointContact("body0", active=False, height=0.0)])  # in the air
+    with pytest.raises(ValueError, match="height must be a scalar"):
+        PointContact("body0", height=[0.0, 1.0])

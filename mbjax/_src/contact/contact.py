@@ -16,6 +16,42 @@ from mbjax._src.rigid.frames import frame_placement, frame_pose
 from mbjax._src.tree.take import take
 
 
+# how far from its ground (`AbstractContact.height`) a contact's frame may be when a stance or
+# an impulse starts to hold it [m]
+GROUND_TOLERANCE = 1e-3
+
+
+def _height(height) -> Array:
+    """The ground's height as a float scalar; a ValueError naming it where it is concrete and
+    not a finite scalar."""
+    h = jnp.asarray(height, dtype=float)
+    if h.ndim != 0:
+        raise ValueError(f"height must be a scalar [m], got shape {h.shape}")
+    if not isinstance(h, jax.core.Tracer) and not np.isfinite(float(h)):
+        raise ValueError(f"height must be finite, got {float(h)}")
+    return h
+
+
+def on_ground(model: Model, q: Array, contacts) -> None:
+    """A ValueError naming the first active contact whose frame is farther than
+    `GROUND_TOLERANCE` from its ground in configuration q (where q, active and the height are
+    concrete; contacts without a height pass)."""
+    for i, contact in enumerate(contacts):
+        gap = contact.clearance(model, q)
+        if gap is None:
+            continue
+        try:
+            gap, active = float(gap), bool(contact.active)
+        except jax.errors.ConcretizationTypeError:
+            continue                                   # traced: nobody can raise
+        if active and not abs(gap) <= GROUND_TOLERANCE:
+            raise ValueError(
+                f"contacts[{i}] ({contact.frame!r}) is {gap:.4g} m "
+                f"{'above' if gap > 0 else 'below'} its ground (height {float(contact.height):.4g} m along its normal): a stance "
+                f"holds a frame where it is, so start it where the frame is on the ground (within "
+                f"{GROUND_TOLERANCE:g} m), or give the contact no height to hold it where it is")
+
+
 def _normal(normal) -> Array:
     """The ground's normal as a unit 3-vector; a ValueError naming it where it is concrete and
     not finite or zero."""
@@ -41,10 +77,15 @@ class AbstractContact(eqx.Module):
             the air: its constraint rows vanish and its wrench is zero. An array, so that the
             stances of a gait made of the same contacts, some in the air, share one compiled
             program (`mbjax.trajopt.Problem` compiles each distinct phase once).
+        height (ArrayLike | None): where the ground is, the plane normal . x = height [m];
+            `stance` and `impulse` then refuse to hold the frame where it is not on it (farther
+            than `GROUND_TOLERANCE`). None (the default): the ground is wherever the frame is
+            when the stance starts.
 
     Raises:
         TypeError: frame is not a name.
-        ValueError: the normal is not a finite nonzero 3-vector, or active is not a boolean.
+        ValueError: the normal is not a finite nonzero 3-vector, active is not a boolean, or
+            height is not a finite scalar.
 
     Attributes:
         size: the number of constraints (3 for a point, 6 for a surface).
@@ -55,15 +96,32 @@ class AbstractContact(eqx.Module):
     frame: str = eqx.field(static=True)
     normal: Array
     active: Array
+    height: Array | None
     size: ClassVar[int]
     kind: ClassVar[str]
 
-    def __init__(self, frame: str, normal=(0.0, 0.0, 1.0), active=True):
+    def __init__(self, frame: str, normal=(0.0, 0.0, 1.0), active=True, height=None):
         if not isinstance(frame, str):
             raise TypeError(f"frame must be a frame's name, got {type(frame).__name__}")
         self.frame = frame
         self.normal = _normal(normal)
         self.active = active_flag(active, "active")
+        self.height = None if height is None else _height(height)
+
+    def clearance(self, model: Model, q: Array) -> Array | None:
+        """How far the frame is above its ground in configuration q (negative: below), along
+        the normal; None where the contact has no height.
+
+        Args:
+            model: the robot.
+            q: a configuration, shape (nq,).
+
+        Returns:
+            The distance [m], a scalar, or None.
+        """
+        if self.height is None:
+            return None
+        return jnp.dot(self.normal, frame_pose(model, q, self.frame)[1]) - self.height
 
     def closure(self, model: Model, q: Array) -> CutJoint:
         """The cut joint that holds the frame at its pose in configuration q.
@@ -95,6 +153,8 @@ class PointContact(AbstractContact):
             Normalized. The friction cone and the normal force are measured along it.
         active (ArrayLike): True (the default) for a foot on the ground, False for one in the
             air (see `AbstractContact`).
+        height (ArrayLike | None): the ground's height along the normal [m], checked where a
+            stance starts (see `AbstractContact`); None: wherever the frame is.
 
     Raises:
         ValueError: the normal is not a finite nonzero 3-vector, or active is not a boolean.
@@ -128,6 +188,8 @@ class SurfaceContact(AbstractContact):
         normal (ArrayLike): the ground's normal, world components, shape (3,); z by default.
         active (ArrayLike): True (the default) for a sole on the ground, False for one in the
             air (see `AbstractContact`).
+        height (ArrayLike | None): the ground's height along the normal [m] (see
+            `AbstractContact`); None: wherever the sole is.
         spatial (bool): hold the sole's spatial acceleration, as Pinocchio and Crocoddyl do
             (see above); static.
 
@@ -138,9 +200,9 @@ class SurfaceContact(AbstractContact):
     spatial: bool = eqx.field(static=True)
     size: ClassVar[int] = 6
 
-    def __init__(self, frame: str, normal=(0.0, 0.0, 1.0), active=True, *,
+    def __init__(self, frame: str, normal=(0.0, 0.0, 1.0), active=True, height=None, *,
                  spatial: bool = False):
-        super().__init__(frame, normal, active)
+        super().__init__(frame, normal, active, height)
         self.spatial = bool(spatial)
 
     @property

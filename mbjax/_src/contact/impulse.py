@@ -7,7 +7,7 @@ import jax
 import jax.numpy as jnp
 from jax import Array
 
-from mbjax._src.contact.contact import AbstractContact, wrenches
+from mbjax._src.contact.contact import AbstractContact, on_ground, wrenches
 from mbjax._src.contact.stance import _contacts
 from mbjax._src.loops.constraints import Loops
 from mbjax._src.loops.kkt import implicit_kkt
@@ -74,11 +74,14 @@ def impulse(model: Model, q: Array, v: Array, contacts: Sequence[AbstractContact
     Raises:
         TypeError: contacts are not contacts.
         KeyError: a contact's frame is not in the model.
-        ValueError: q or v of another shape, or a quaternion in q not of unit norm.
+        ValueError: q or v of another shape, a quaternion in q not of unit norm, or a contact
+            with a height not on its ground.
     """
     q, v = coordinates(model, q, "q"), coordinates(model, v, "v")
     check_unit_quaternions(q, model.quaternions(), "q")
-    return _impulse(model, q, v, _contacts(contacts))
+    contacts = _contacts(contacts)
+    on_ground(model, q, contacts)
+    return _impulse(model, q, v, contacts)
 
 
 _impulse = jax.jit(impulse_map)

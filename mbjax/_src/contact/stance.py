@@ -8,7 +8,7 @@ import jax.numpy as jnp
 import numpy as np
 from jax import Array
 
-from mbjax._src.contact.contact import AbstractContact, wrenches
+from mbjax._src.contact.contact import AbstractContact, on_ground, wrenches
 from mbjax._src.loops.coupled import Coupled
 from mbjax._src.loops.method import AbstractLoopMethod
 from mbjax._src.loops.system import ClosedSystem
@@ -82,8 +82,8 @@ def stance(tree: AbstractTreeSystem, q: Array, contacts: Sequence[AbstractContac
     Raises:
         TypeError: tree is not a rigid tree system, or contacts are not contacts.
         KeyError: a contact's frame is not in the model.
-        ValueError: mu is not positive, q is not of shape (nq,), or a quaternion in q is not of
-            unit norm.
+        ValueError: mu is not positive, q is not of shape (nq,), a quaternion in q is not of
+            unit norm, or a contact with a height is not on its ground.
     """
     if not (isinstance(tree, AbstractTreeSystem) and isinstance(getattr(tree, "model", None), Model)):
         raise TypeError(f"tree must be a rigid tree system such as TreeSystem(model), got "
@@ -91,6 +91,7 @@ def stance(tree: AbstractTreeSystem, q: Array, contacts: Sequence[AbstractContac
     contacts = _contacts(contacts)
     q = coordinates(tree.model, q, "q")
     check_unit_quaternions(q, tree.model.quaternions(), "q")
+    on_ground(tree.model, q, contacts)
     closures = tuple(c.closure(tree.model, q) for c in contacts)
     method = Coupled(baumgarte=CROCODDYL_GAINS) if method is None else method
     watch = Grip(contacts, None if mu is None else friction(mu))
