@@ -29,7 +29,7 @@ def variants(n: int):
 
 def holding_torques(params):
     """The torques (7,) that hold the arm, its link masses scaled by params["scale"], at rest at
-    the scene's pose (`mbjax._src.scenes.arm.Q_REF`)."""
+    the scene's pose (`mbjax.scenes.arm.Q_REF`)."""
     import equinox as eqx
     import jax.numpy as jnp
 

@@ -1,6 +1,8 @@
-"""Time integration: fixed-step integrators (strategies passed to `simulate`), the `simulate`
-driver with its `Solution`, and diffrax's adaptive solvers as the reference."""
+"""Time integration: fixed-step integrators (strategies passed to `simulate`; `INTEGRATORS`
+names them), the `simulate` driver with its `Solution`, and diffrax's adaptive solvers as the
+reference."""
 
+from mbjax._src.integrate import INTEGRATORS as INTEGRATORS
 from mbjax._src.integrate.base import AbstractIntegrator as AbstractIntegrator
 from mbjax._src.integrate.explicit_euler import ExplicitEuler as ExplicitEuler
 from mbjax._src.integrate.semi_implicit_euler import SemiImplicitEuler as SemiImplicitEuler
@@ -13,5 +15,5 @@ from mbjax._src.integrate.reference import solve_reference as solve_reference
 
 __all__ = [
     "AbstractIntegrator", "ExplicitEuler", "SemiImplicitEuler", "RK4", "ImplicitMidpoint", "RKMK4",
-    "simulate", "Solution", "solve_reference"
+    "INTEGRATORS", "simulate", "Solution", "solve_reference"
 ]

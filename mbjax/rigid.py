@@ -12,6 +12,7 @@ from mbjax._src.rigid.dynamics import mass_matrix as mass_matrix
 from mbjax._src.rigid.batched import batched_forward_dynamics as batched_forward_dynamics
 from mbjax._src.rigid.kinematics import forward_kinematics as forward_kinematics
 from mbjax._src.rigid.frames import frame_pose as frame_pose
+from mbjax._src.rigid.frames import frame_poses as frame_poses
 from mbjax._src.rigid.frames import frame_jacobian as frame_jacobian
 from mbjax._src.rigid.centre import center_of_mass as center_of_mass
 from mbjax._src.rigid.energy import kinetic_energy as kinetic_energy
@@ -23,6 +24,6 @@ from mbjax._src.rigid.torque_free import torque_free_motion as torque_free_motio
 __all__ = [
     "RigidBody", "TreeSystem", "MomentumSystem", "BatchTreeSystem", "forward_dynamics",
     "inverse_dynamics", "mass_matrix", "batched_forward_dynamics", "forward_kinematics",
-    "frame_pose", "frame_jacobian", "center_of_mass", "kinetic_energy", "potential_energy",
-    "transformation_operator", "constraint_forces", "torque_free_motion"
+    "frame_pose", "frame_poses", "frame_jacobian", "center_of_mass", "kinetic_energy",
+    "potential_energy", "transformation_operator", "constraint_forces", "torque_free_motion"
 ]

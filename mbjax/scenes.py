@@ -1,8 +1,10 @@
 """Ready-made scenes: the papers' mechanisms and the examples the tests, benchmarks, notebooks and
 the `mbjax` command share. Each is a module with `build(...)` returning (system, q0, u0) and the
 scene's constants; the two built for trajectory optimisation only, `acrobot` and `slewing_beam`,
-have `model()` and a `Problem` builder instead."""
+have `model()` and a `Problem` builder instead. `TOLERANCE` is the accuracy the tour and the
+reproductions ask of a run (`simulate(..., **TOLERANCE)`)."""
 
+from mbjax._src.scenes import TOLERANCE as TOLERANCE
 from mbjax._src.scenes import acrobot as acrobot
 from mbjax._src.scenes import andrews_squeezer as andrews_squeezer
 from mbjax._src.scenes import arm as arm
@@ -20,7 +22,7 @@ from mbjax._src.scenes import torque_free_body as torque_free_body
 from mbjax._src.scenes import vertical_top as vertical_top
 
 __all__ = [
-    "acrobot", "andrews_squeezer", "arm", "bricard", "carpal_wrist", "closed_chain",
+    "TOLERANCE", "acrobot", "andrews_squeezer", "arm", "bricard", "carpal_wrist", "closed_chain",
     "flexible_slider_crank", "four_bar", "heavy_top", "rigid_chain", "slewing_beam", "slider_crank",
     "spin_up_beam", "torque_free_body", "vertical_top",
 ]

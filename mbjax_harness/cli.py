@@ -8,7 +8,7 @@
 Every long command shows a running clock on stderr and ends by naming the files it wrote and the
 peers it skipped (and why).
 
-Compiled programs are kept on disk between runs (`mbjax._src.cache`; `mbjax --no-cache ...` or
+Compiled programs are kept on disk between runs (`mbjax.use_compilation_cache`; `mbjax --no-cache ...` or
 MBJAX_NO_CACHE=1 turns that off), except by `mbjax bench`, which times the compiles. Outputs are
 written whole or not at all (`mbjax_harness.outputs`): an interrupted run leaves the previous
 run's files. Unknown names, bad options and an output or cache folder that cannot be written
@@ -31,7 +31,7 @@ def _parser(reproductions, suites, scenes) -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(prog="mbjax", description=__doc__.split("\n\n")[0])
     parser.add_argument("--version", action="version", version=_version())
     parser.add_argument("--no-cache", action="store_true",
-                        help="do not keep compiled programs on disk (mbjax._src.cache)")
+                        help="do not keep compiled programs on disk (mbjax.use_compilation_cache)")
     commands = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
 
     tour = commands.add_parser("tour", help="run every scene: figures, animations and a summary "
@@ -310,7 +310,7 @@ def main(argv=None) -> int:
 
 def _run(parser, args, reproductions: dict, suites: dict, scenes: dict) -> int:
     """The parsed command `args`; its exit status."""
-    from mbjax._src.cache import use_compilation_cache
+    from mbjax import use_compilation_cache
 
     if not args.no_cache and args.command != "bench":   # benchmarks time the compiles themselves
         try:

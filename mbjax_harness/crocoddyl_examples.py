@@ -27,11 +27,11 @@ import jax.numpy as jnp
 import numpy as np
 
 from mbjax import load_urdf
-from mbjax._src.model.model import Model
-from mbjax._src.integrate import SemiImplicitEuler
-from mbjax._src.model.states import state_from_pinocchio, state_to_pinocchio
-from mbjax._src.rigid import TreeSystem, inverse_dynamics
-from mbjax._src.trajopt import Problem, control_residual, frame_residual, state_residual
+from mbjax.model import Model
+from mbjax.integrate import SemiImplicitEuler
+from mbjax.model import state_from_pinocchio, state_to_pinocchio
+from mbjax.rigid import TreeSystem, inverse_dynamics
+from mbjax.trajopt import Problem, control_residual, frame_residual, state_residual
 
 
 @dataclass

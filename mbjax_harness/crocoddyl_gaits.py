@@ -28,8 +28,8 @@ import numpy as np
 
 from mbjax.contact import PointContact, SurfaceContact, stance
 from mbjax.loops import Coupled
-from mbjax._src.integrate import SemiImplicitEuler
-from mbjax._src.model.states import state_from_pinocchio
+from mbjax.integrate import SemiImplicitEuler
+from mbjax.model import state_from_pinocchio
 from mbjax.rigid import TreeSystem, center_of_mass, frame_pose
 from mbjax.trajopt import (Impulse, Knot, Problem, barrier_residual, com_residual,
                            control_residual, frame_residual, friction_cone_residual,

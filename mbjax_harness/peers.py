@@ -11,7 +11,6 @@ import importlib.util
 import jax.numpy as jnp
 import numpy as np
 
-from mbjax._src.model.joints import JOINT_TYPES
 
 MUJOCO_INTEGRATORS = ("Euler", "RK4", "implicit", "implicitfast")
 
@@ -121,7 +120,7 @@ def _exudyn_solve(mbs, ts, dt: float, spectral_radius: float, absolute_tolerance
 def exudyn_spin_up_beam(n_elements: int, dt: float, ts, *, length=10.0, E=7.0e10, A=4.0e-4,
                         I=2.0e-7, mass=12.0, T_s=15.0, omega_s=6.0,  # noqa: E741 (the paper's I)
                         spectral_radius=0.8):
-    """Kane's spin-up beam (as `mbjax._src.flex.references.spin_up_beam_reference`) in exudyn: n
+    """Kane's spin-up beam (as `mbjax.scenes.spin_up_beam.reference`) in exudyn: n
     `ObjectANCFCable2D` elements along x, the root's position fixed and its slope direction
     prescribed by theta(t) through a `GenericJoint` (x, y and the rotation about z locked) with an
     offset user function, so the root's stretch stays free; implicit generalized-alpha at fixed
@@ -171,7 +170,7 @@ def exudyn_spin_up_beam(n_elements: int, dt: float, ts, *, length=10.0, E=7.0e10
 def exudyn_slider_crank(n_elements: int, dt: float, ts, *, crank=6 * 0.0254, rod=12 * 0.0254,
                         diameter=0.25 * 0.0254, E=3.0e7 * 4.4482216152605 / 0.0254**2,
                         mass=0.1667 * 0.45359237, Omega=125.6, spectral_radius=0.8):
-    """Anderson 1993's flexible slider-crank (as `mbjax._src.flex.references.slider_crank_reference`) in
+    """Anderson 1993's flexible slider-crank (as `mbjax.scenes.flexible_slider_crank.reference`) in
     exudyn: the rod as n `ObjectANCFCable2D` elements from P to Q, P's coordinates prescribed on
     the crank circle (two `CoordinateConstraint`s with offset user functions), Q's y held at 0
     (the massless slider), both slopes and Q's x free; started straight and unstrained with the
@@ -303,7 +302,7 @@ def _crocoddyl_shooting(state, actuation, x0, dt: float, horizon: int, running, 
 
 
 def crocoddyl_reach(urdf: str, q0, target, gravity_torque, flange, dt: float, horizon: int):
-    """`mbjax._src.scenes.arm.reach_problem`'s costs in Crocoddyl's terms (mbjax's residual c r, cost
+    """`mbjax.scenes.arm.reach_problem`'s costs in Crocoddyl's terms (mbjax's residual c r, cost
     1/2 c^2 |r|^2, is Crocoddyl's residual r with weight c^2):
     running 0.02 |p - target|^2 / 2 + 2e-4 |x - x0|^2 / 2 + 2e-4 |u - g|^2 / 2, terminal
     2e4 |p - target|^2 / 2 + 2 |v|^2 / 2, p the flange. Returns (problem, set_target)."""
@@ -333,7 +332,7 @@ def crocoddyl_reach(urdf: str, q0, target, gravity_torque, flange, dt: float, ho
 
 
 def crocoddyl_swingup(urdf: str, q0, goal, length: float, dt: float, horizon: int):
-    """`mbjax._src.scenes.acrobot.swingup_problem`'s costs in Crocoddyl's terms: running
+    """`mbjax.scenes.acrobot.swingup_problem`'s costs in Crocoddyl's terms: running
     0.01 |p - goal|^2 / 2 + 1e-4 |v|^2 / 2 + 0.01 u^2 / 2, terminal 1e4 |p - goal|^2 / 2 +
     100 |v|^2 / 2, p the tip; the elbow alone actuated (Crocoddyl's own double-pendulum
     actuation, `crocoddyl.utils.pendulum`, a Python model called at every knot)."""
@@ -361,15 +360,18 @@ def pinocchio_maps(model, pin_model):
     by name. Pinocchio's free flyer has q = (xyz, quaternion xyzw) and v = (v_local; omega_local),
     mbjax's (xyz, wxyz) and (omega; v); a continuous joint has q = (cos, sin) in Pinocchio."""
     v_index, q_parts = [], []
+    nvs = np.bincount(model.dof_body(), minlength=model.n)        # each joint's velocities
     for k, kind in enumerate(model.joint_types):
         jid = pin_model.getJointId(model.joint_names[k])
         assert jid < pin_model.njoints, model.joint_names[k]
         iv, iq, nq = pin_model.idx_vs[jid], pin_model.idx_qs[jid], pin_model.nqs[jid]
-        v_index += [iv + j for j in ((3, 4, 5, 0, 1, 2) if kind == "free"
-                                      else range(JOINT_TYPES[kind].nv))]
+        v_index += [iv + j for j in ((3, 4, 5, 0, 1, 2) if kind == "free" else range(nvs[k]))]
         q_parts.append((iq, nq, kind))
 
-    q_start = np.cumsum([0] + [JOINT_TYPES[k].nq for k in model.joint_types])
+    # each joint's positions: its velocities, and one more where a quaternion stands for a
+    # rotation's three (spherical and free joints)
+    nqs = nvs + np.isin(model.joint_types, ("spherical", "free"))
+    q_start = np.cumsum([0, *nqs])
 
     def to_pin(q):
         q = np.asarray(q)

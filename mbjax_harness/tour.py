@@ -21,11 +21,11 @@ import numpy as np
 import mbjax
 from mbjax_harness import peers
 from mbjax_harness.timing import measure
-from mbjax._src.integrate import INTEGRATORS, simulate, solve_reference
-from mbjax._src.scenes import TOLERANCE
-from mbjax._src.scenes import heavy_top as top
-from mbjax._src.scenes import rigid_chain as rc
-from mbjax._src.scenes import torque_free_body as tfb
+from mbjax.integrate import INTEGRATORS, simulate, solve_reference
+from mbjax.scenes import TOLERANCE
+from mbjax.scenes import heavy_top as top
+from mbjax.scenes import rigid_chain as rc
+from mbjax.scenes import torque_free_body as tfb
 
 
 def _max_abs(x) -> float:
@@ -129,7 +129,7 @@ def rigid_chain_tour(out: Path, quick: bool) -> dict:
     (rtol 1e-12). On a revolute chain the configuration space is a vector space, so RKMK4 is RK4
     and lands on the same points."""
     from mbjax_harness.plot.trees import rigid_chain_figure
-    from mbjax._src.rigid import TreeSystem, forward_kinematics
+    from mbjax.rigid import TreeSystem, forward_kinematics
 
     model, q0, v0 = rc.build()
     system = TreeSystem(model)
@@ -207,10 +207,10 @@ def closed_loops_tour(out: Path, quick: bool) -> dict:
     projection after every step, and Anderson 1993's O(n + m^3) route, the error being the largest
     joint-angle error after 1 s against an adaptive Dopri8 reference (rtol 1e-12), with the
     constraint residual |Phi| reached."""
-    from mbjax._src.integrate import RK4
-    from mbjax._src.loops import ClosedSystem, Coupled, Stabilized
+    from mbjax.integrate import RK4
+    from mbjax.loops import ClosedSystem, Coupled, Stabilized
     from mbjax_harness.plot.loops import closed_loops_tour_figure
-    from mbjax._src.scenes import closed_chain as cc
+    from mbjax.scenes import closed_chain as cc
 
     chain, q0, v0 = cc.build(12)
     duration = cc.DURATION
@@ -272,10 +272,9 @@ def flexible_bodies_tour(out: Path, quick: bool) -> dict:
     the flexible body, so each mode count compiles once for both runs. Then the most modes once
     more with the simplified implicit midpoint at 50 ms, 14 times RK4's limit (the axial mode's
     759 rad/s bounds RK4's step, not the tip's motion)."""
-    from mbjax._src.flex.references import spin_up_beam_reference
-    from mbjax._src.integrate import ImplicitMidpoint
+    from mbjax.integrate import ImplicitMidpoint
     from mbjax_harness.plot.flex import flexible_tour_figure
-    from mbjax._src.scenes import spin_up_beam as sub
+    from mbjax.scenes import spin_up_beam as sub
 
     duration = QUICK_FLEX_DURATION if quick else FLEX_DURATION
     saveat_every = 0.1
@@ -307,7 +306,7 @@ def flexible_bodies_tour(out: Path, quick: bool) -> dict:
     rows[name] = {"seconds": timing.run_s, "compile_seconds": timing.compile_s,
                   "status": sol.messages()[0], "dt": FLEX_IMPLICIT_DT}
     start = time.perf_counter()
-    ref = spin_up_beam_reference(n_elements=FLEX_REFERENCE_ELEMENTS, ts=np.asarray(ts))
+    ref = sub.reference(n_elements=FLEX_REFERENCE_ELEMENTS, ts=np.asarray(ts))
     ref_seconds = time.perf_counter() - start
     ref_tip = np.asarray(ref.tip_deflection)
     ref_peak = float(ref_tip.min())
@@ -345,7 +344,7 @@ def carpal_wrist_tour(out: Path, quick: bool) -> dict:
     from mbjax_harness.plot.wrist import integrator_figure
     from mbjax_harness.plot.animate import wrist_animation
     from mbjax_harness.reproduce import carpal_wrist as cwr
-    from mbjax._src.scenes import carpal_wrist as cws
+    from mbjax.scenes import carpal_wrist as cws
 
     seconds = {}
     # quick: the chapter's explicit Euler against RK4 only (each method compiles two wrist rollouts)
@@ -367,15 +366,15 @@ def carpal_wrist_tour(out: Path, quick: bool) -> dict:
 
 def controls_tour(out: Path, quick: bool) -> dict:
     """A URDF arm under a servo and sampled torques, with jax.grad through it. The 7-dof arm
-    (`mbjax._src.scenes.arm`) is held by a PD servo with gravity feed-forward and pushed at its
+    (`mbjax.scenes.arm`) is held by a PD servo with gravity feed-forward and pushed at its
     flange for 0.1 s; driven by a torque history sampled per step as MuJoCo applies it, against
     `mujoco.rollout` (when installed); and `jax.grad` of a reach loss with respect to a torque
     spline's knots and a link mass is checked against central differences."""
 
-    from mbjax._src.control import ZeroOrderHold
+    from mbjax.control import ZeroOrderHold
     from mbjax_harness.plot.scenes import controls_figure
-    from mbjax._src.rigid import TreeSystem
-    from mbjax._src.scenes import arm as scene
+    from mbjax.rigid import TreeSystem
+    from mbjax.scenes import arm as scene
 
     arm = scene.model()
     duration = 0.5 if quick else 1.0
@@ -433,7 +432,7 @@ def _mujoco_sampled(arm, q0, history, actuated, dt, steps):
     import mujoco
     from mujoco import rollout
 
-    from mbjax._src.model.urdf import to_urdf
+    from mbjax.model import to_urdf
 
     mj = mujoco.MjModel.from_xml_string(to_urdf(arm))
     mj.opt.timestep, mj.opt.integrator = dt, mujoco.mjtIntegrator.mjINT_RK4
@@ -456,10 +455,9 @@ def models_tour(out: Path, quick: bool) -> dict:
     Jacobian by name, its joint limits as data that `simulate`'s status checks (the unpowered arm
     falls through them), and the same arm through MuJoCo's compiler (`mbjax.model.from_mujoco`)
     and Pinocchio, when installed, against their dynamics."""
-    from mbjax._src.model.limits import excess
     from mbjax_harness.plot.scenes import models_figure
-    from mbjax._src.rigid import TreeSystem, frame_jacobian, frame_pose
-    from mbjax._src.scenes import arm as scene
+    from mbjax.rigid import TreeSystem, frame_jacobian, frame_pose
+    from mbjax.scenes import arm as scene
 
     arm = scene.model()
     duration = 0.6 if quick else 1.5
@@ -468,7 +466,12 @@ def models_tour(out: Path, quick: bool) -> dict:
     fall = simulate(TreeSystem(arm), INTEGRATORS["rk4"](), q0, jnp.zeros(arm.nv), dt=scene.DT,
                     t1=duration, saveat=ts)
     flange = jax.jit(jax.vmap(lambda q: frame_pose(arm, q, "flange")[1]))(fall.qs)
-    beyond = jax.vmap(lambda q, v: excess(arm, q, v))(fall.qs, fall.us)
+    # how far each saved state lies beyond the arm's position and velocity limits (`Model.lower`,
+    # `upper`, `velocity_limit`; what `simulate`'s status checks)
+    qs, us = np.asarray(fall.qs), np.asarray(fall.us)
+    beyond = np.concatenate([np.maximum(np.asarray(arm.lower) - qs, 0.0)
+                             + np.maximum(qs - np.asarray(arm.upper), 0.0),
+                             np.maximum(np.abs(us) - np.asarray(arm.velocity_limit), 0.0)], axis=1)
     first = int(np.argmax(np.asarray(beyond).max(axis=1) > 0))
     J = frame_jacobian(arm, q0, "flange")
     manipulability = float(jnp.sqrt(jnp.linalg.det(J[3:] @ J[3:].T)))
@@ -488,12 +491,12 @@ def models_tour(out: Path, quick: bool) -> dict:
 
 def trajectory_optimisation_tour(out: Path, quick: bool) -> dict:
     """The 7-dof arm's reach solved by iLQR: cost, flange approach and torques. The problem
-    (`mbjax._src.scenes.arm.reach_problem`) asks the flange 0.4 m sideways at rest after 1 s, in
+    (`mbjax.scenes.arm.reach_problem`) asks the flange 0.4 m sideways at rest after 1 s, in
     100 knots of 0.01 s; iLQR (`mbjax.trajopt`) starts from the torques that hold the start
     pose."""
     from mbjax_harness.plot.trajopt import reach_figure
-    from mbjax._src.scenes import arm
-    from mbjax._src.trajopt import ILQR, solve
+    from mbjax.scenes import arm
+    from mbjax.trajopt import ILQR, solve
 
     problem = arm.reach_problem()
     result, timing = measure(partial(solve, problem, ILQR(), arm.hold(problem)), repeats=3)
@@ -523,7 +526,7 @@ def floating_base_tour(out: Path, quick: bool) -> dict:
     and 1 m up in 33 knots of 0.03 s."""
     from mbjax_harness.crocoddyl_examples import TARGET, hector, quadrotor_problem
     from mbjax_harness.plot.trajopt import floating_base_figure
-    from mbjax._src.trajopt import ILQR, solve
+    from mbjax.trajopt import ILQR, solve
 
     model = hector()
     problem, us0 = quadrotor_problem(model, bounded=True)
@@ -560,9 +563,7 @@ def legged_gait_tour(out: Path, quick: bool) -> dict:
     pairs of feet step 0.25 m in turn, a multi-phase problem of stances and touchdown impulses)
     solved from its quasi-static guess; the ground's force on each foot along the solution; the
     same problem solved by Crocoddyl's FDDP from the same guess where Crocoddyl is installed."""
-    from mbjax._src.trajopt import ILQR, solve
-    from mbjax._src.trajopt.ilqr import CROCODDYL_SCHEDULE
-    from mbjax.trajopt import knot_wrenches
+    from mbjax.trajopt import CROCODDYL_SCHEDULE, ILQR, knot_wrenches, solve
     from mbjax_harness.crocoddyl_gaits import FEET, MU, anymal_trot
     from mbjax_harness.plot.animate import gait_animation
     from mbjax_harness.plot.trajopt import gait_figure
@@ -795,7 +796,7 @@ def _model_peers() -> dict:
     def mujoco():
         import mujoco
 
-        from mbjax._src.model.mjcf import from_mujoco
+        from mbjax.model import from_mujoco
         from mbjax_harness.reproduce import mjcf_corpus
         mj = mujoco.MjModel.from_xml_path(str(ARM7))
         return mjcf_corpus.compare(mj, from_mujoco(mj))["qacc"]
@@ -923,9 +924,9 @@ def _animate_beam(out: Path, n_bending: int, ts, qs, quick: bool) -> str:
     """Write flexible-bodies.gif: the spun beam's centreline in the hub's rotating frame seen from
     above (21 points along it, the deformation magnified `BEAM_MAGNIFICATION` times, as the title
     says), q = (hub angle, modal coordinates)."""
-    from mbjax._src.flex import centreline
+    from mbjax.flex import centreline
     from mbjax_harness.plot.animate import stick_animation
-    from mbjax._src.scenes import spin_up_beam as sub
+    from mbjax.scenes import spin_up_beam as sub
 
     structure = sub.beam(sub.N_ELEMENTS)                # the mesh behind `sub.run`'s modes
     basis = sub.modes(structure, n_bending, 1)

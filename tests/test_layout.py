@@ -35,11 +35,13 @@ LAYERS = (
 RANK = {name: rank for rank, names in enumerate(LAYERS) for name in names}
 NAMESPACES = ("lie", "model", "control", "integrate", "rigid", "flex", "loops", "tfe", "wrist",
               "trajopt", "scenes", "data", "contact")
-MAX_PUBLIC_NAMES = 184       # 150, the contact namespace (legged robots), multi-phase problems,
+MAX_PUBLIC_NAMES = 189       # 150, the contact namespace (legged robots), multi-phase problems,
                              # contacts that find themselves (geoms, their system and model,
                              # the Ant's and HalfCheetah's files) and contact costs (issue 45),
                              # model-predictive control (MPC, Plan, Cycle, Tick,
-                             # ClosedLoop, closed_loop, follow)
+                             # ClosedLoop, closed_loop, follow), the private door closed (issue
+                             # 60): integrate.INTEGRATORS, scenes.TOLERANCE, flex.centreline,
+                             # flex.geometric_stiffness, rigid.frame_poses
 
 
 def _imports(path: Path):
@@ -154,6 +156,83 @@ def test_import_mbjax_loads_no_harness_or_plotting():
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True,
                          cwd=ROOT)
     assert out.stdout.strip() == "", out.stdout
+
+
+PRIVATE = "mbjax._src"
+
+
+def test_nothing_outside_the_library_and_tests_names_the_private_package():
+    """The harness, the benchmarks, the notebooks, the documentation and the README reach mbjax
+    through its public API only, and their prose names public objects (or, for an
+    implementation detail, its file: mbjax/_src/x.py, a location, not an import)."""
+    import json
+
+    texts = [(path, path.read_text()) for path in sorted(HARNESS.rglob("*.py"))]
+    texts += [(path, path.read_text()) for path in sorted((ROOT / "benchmarks").rglob("*"))
+              if path.suffix in (".py", ".md")]
+    texts += [(path, path.read_text()) for path in sorted((ROOT / "docs").rglob("*.md"))]
+    texts.append((ROOT / "README.md", (ROOT / "README.md").read_text()))
+    offences = []
+    for path, text in texts:
+        offences += [f"{path.relative_to(ROOT)}:{n}: {line.strip()}"
+                     for n, line in enumerate(text.splitlines(), 1) if PRIVATE in line]
+    for path in sorted((ROOT / "notebooks").glob("*.ipynb")):
+        for k, cell in enumerate(json.loads(path.read_text())["cells"]):
+            source = "".join(cell["source"])
+            offences += [f"{path.relative_to(ROOT)}: cell {k}, line {n}: {line.strip()}"
+                         for n, line in enumerate(source.splitlines(), 1) if PRIVATE in line]
+    assert not offences, "\n".join(offences)
+
+
+def _public_items():
+    """(public name, object) for `mbjax`'s and each namespace's `__all__`, and for each class
+    its public methods and properties."""
+    import inspect
+
+    items = [(f"mbjax.{x}", getattr(mbjax, x)) for x in mbjax.__all__]
+    for name in NAMESPACES:
+        namespace = importlib.import_module(f"mbjax.{name}")
+        items += [(f"mbjax.{name}.{x}", getattr(namespace, x)) for x in namespace.__all__]
+    for name, obj in list(items):
+        if inspect.isclass(obj):
+            items += [(f"{name}.{attr}", member) for attr, member in vars(obj).items()
+                      if not attr.startswith("_") and (callable(member) or isinstance(
+                          member, property | staticmethod | classmethod))]
+    return items
+
+
+def _raised_strings(tree: ast.AST):
+    """(line, text) of every string constant and f-string part in what a `raise` raises and in
+    the arguments of `eqx.error_if`, `eqx.branched_error_if`, `warnings.warn` and
+    `raise_on_failure` (whose `who` an error names)."""
+    calls = ("error_if", "branched_error_if", "warn", "raise_on_failure")
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Raise) and node.exc is not None:
+            parts = [node.exc]
+        elif isinstance(node, ast.Call) and (getattr(node.func, "attr", None) in calls
+                                             or getattr(node.func, "id", None) in calls):
+            parts = [*node.args, *(k.value for k in node.keywords)]
+        else:
+            continue
+        for part in parts:
+            for leaf in ast.walk(part):
+                if isinstance(leaf, ast.Constant) and isinstance(leaf.value, str):
+                    yield leaf.lineno, leaf.value
+
+
+def test_no_public_docstring_or_error_message_names_the_private_package():
+    """What a user reads, a public object's docstring (`help`, the API reference) and an error
+    or warning the library raises, names public objects, never the private package."""
+    import inspect
+
+    offences = [f"{name}: its docstring names {PRIVATE}" for name, obj in _public_items()
+                if PRIVATE in (inspect.getdoc(obj.fget if isinstance(obj, property) else obj)
+                               or "")]
+    for path in sorted(SRC.rglob("*.py")):
+        offences += [f"{path.relative_to(ROOT)}:{line}: {text!r}"
+                     for line, text in _raised_strings(ast.parse(path.read_text()))
+                     if PRIVATE in text]
+    assert not offences, "\n".join(offences)
 
 
 def test_scenes_do_not_import_the_harness():

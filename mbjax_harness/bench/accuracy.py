@@ -34,12 +34,11 @@ RTOL = 1e-3
 
 def _cases():
     """(name, system, integrator, q0, u0, dt, t1, the step that resolves it) for each case."""
-    from mbjax._src.control import PD
-    from mbjax._src.integrate import RK4, ImplicitMidpoint, SemiImplicitEuler
-    from mbjax._src.model.builders import chain
-    from mbjax._src.model.mjcf import load_mjcf
-    from mbjax._src.rigid.system import TreeSystem
-    from mbjax._src.scenes import heavy_top as top
+    from mbjax.control import PD
+    from mbjax.integrate import RK4, ImplicitMidpoint, SemiImplicitEuler
+    from mbjax.model import chain, load_mjcf
+    from mbjax.rigid import TreeSystem
+    from mbjax.scenes import heavy_top as top
 
     link = chain(1)                         # a 0.3 m, 1 kg rod: I = m l^2 / 3 about its joint
     inertia = 0.3**2 / 3
@@ -69,7 +68,7 @@ def _cases():
 
 
 def _caught(records: list[dict], quick: bool) -> None:
-    from mbjax._src.integrate import RK4, simulate
+    from mbjax.integrate import RK4, simulate
 
     for name, system, integrator, q0, u0, dt, t1, fine_dt in _cases():
         if quick and "chain" in name:
@@ -92,9 +91,9 @@ def _time_elements(records: list[dict]) -> None:
     """The vertical top at 1.01 Omega_c, 2-node elements of 0.5 s about the steady rotation
     over 20 s (tests/tfe/test_accuracy.py): the primal form's tilt grows, the mixed form's does
     not; the error is the final attitude's against the mixed form at 0.125 s."""
-    from mbjax._src import lie
-    from mbjax._src.scenes import vertical_top as vt
-    from mbjax._src.tfe import Element, Mixed, PrimalUnsymmetric, initial_state, solve_tfe
+    from mbjax import lie
+    from mbjax.scenes import vertical_top as vt
+    from mbjax.tfe import Element, Mixed, PrimalUnsymmetric, initial_state, solve_tfe
     from mbjax_harness.reproduce import top_long_run as tlr
 
     body = vt.build()
@@ -118,9 +117,9 @@ def _time_elements(records: list[dict]) -> None:
 
 def _cost(records: list[dict], quick: bool) -> None:
     """simulate against the bare loop on the 7-link chain (see the module docstring)."""
-    from mbjax._src.integrate import RK4, simulate
-    from mbjax._src.model.builders import chain
-    from mbjax._src.rigid.system import TreeSystem
+    from mbjax.integrate import RK4, simulate
+    from mbjax.model import chain
+    from mbjax.rigid import TreeSystem
 
     system, integrator = TreeSystem(chain(7)), RK4()
     q0, u0, dt, n = jnp.full(7, 0.3), jnp.zeros(7), 0.01, 200

@@ -52,7 +52,7 @@ import jax
 jax.config.update("jax_enable_x64", True)
 import numpy as np
 import mbjax
-from mbjax._src.model import chain
+from mbjax.model import chain
 
 model = chain(7)
 q, v, tau = (np.random.default_rng(k).uniform(-1, 1, 7) for k in range(3))

@@ -1,7 +1,7 @@
 """`mbjax bench flexible`: work against precision on Anderson 1993's two flexible scenes. The
 modal bodies against geometrically nonlinear ANCF beams (mbjax's own and exudyn's), one run.
 
-Kane's spin-up beam (`mbjax._src.scenes.spin_up_beam`, 0-20 s; --quick 0-8 s), records with
+Kane's spin-up beam (`mbjax.scenes.spin_up_beam`, 0-20 s; --quick 0-8 s), records with
 "scene": "spin-up":
 - mbjax's modal model: Craig-Bampton modes of a `N_ELEMENTS`-element beam (1, 4, 8 in-plane
   bending + 1 axial mode; the basis mesh sets the stiffening's accuracy, O(h^2): 10 elements
@@ -13,7 +13,7 @@ Kane's spin-up beam (`mbjax._src.scenes.spin_up_beam`, 0-20 s; --quick 0-8 s), r
   bending modes (the spin passes the first bending frequency and the tip diverges: the error is
   reported, non-finite samples are counted, not fatal). Error = max |tip deflection - reference|
   over the span (the whole history), tip deflection along the rotating y axis, every 0.1 s.
-- The reference: mbjax's ANCF beam (`spin_up_beam_reference`, RK4 at half its stable step), 8
+- The reference: mbjax's ANCF beam (`spin_up_beam.reference`, RK4 at half its stable step), 8
   elements (converged: 16 elements move the tip by 2.6e-5 m), and a coarser one (half the
   elements), both timed ("kind": "ancf").
   Their RK4 loop is jitted inside each call, so every call compiles: run_s is the wall time of a
@@ -22,7 +22,7 @@ Kane's spin-up beam (`mbjax._src.scenes.spin_up_beam`, 0-20 s; --quick 0-8 s), r
 - exudyn (optional peer, same process): the same beam as `ObjectANCFCable2D` elements (as many as
   the reference), implicit generalized-alpha at `EXUDYN_STEPS`.
 
-The slider-crank with a flexible rod (`mbjax._src.scenes.flexible_slider_crank`, 0-0.15 s; --quick one
+The slider-crank with a flexible rod (`mbjax.scenes.flexible_slider_crank`, 0-0.15 s; --quick one
 revolution, 0.05 s), records with "scene": "slider-crank": the modal rod (2 and 3 elements, all
 in-plane modes; --quick 2) with RK4 at its stable step and with the simplified implicit midpoint
 at `CRANK_IMPLICIT_STEPS`; mbjax's ANCF rod (4 elements, the reference, and 2); exudyn's ANCF
@@ -46,7 +46,7 @@ import numpy as np
 
 from mbjax_harness import peers
 from mbjax_harness.timing import measure, write_jsonl
-from mbjax._src.integrate import RK4, simulate
+from mbjax.integrate import RK4, simulate
 
 NAME = "flexible"
 MODES, QUICK_MODES = (1, 4, 8), (1, 4)
@@ -70,7 +70,7 @@ def largest_step(frequencies) -> float:
 
 
 def implicit():
-    from mbjax._src.integrate import ImplicitMidpoint
+    from mbjax.integrate import ImplicitMidpoint
     return ImplicitMidpoint(simplified=True, newton_iterations=4)
 
 
@@ -89,7 +89,7 @@ def _timed(system, integrator, q0, v0, dt, t1, saveat, repeats):
 
 def spin_up_modal(n_bending: int, stiffening: bool, dt: float, t1: float, ref, repeats: int,
                   common, integrator=None) -> dict:
-    from mbjax._src.scenes import spin_up_beam
+    from mbjax.scenes import spin_up_beam
 
     system, q0, v0 = spin_up_beam.build(n_bending, 1, N_ELEMENTS, stiffening,
                                         projection=integrator is not None)
@@ -123,10 +123,10 @@ def _timed_reference(call, ts):
 
 
 def spin_up_ancf(n_elements: int, ts, common) -> tuple[dict, object]:
-    from mbjax._src.flex.references import spin_up_beam_reference
+    from mbjax.scenes import spin_up_beam
 
     ref, compile_s, run_s, wall = _timed_reference(
-        lambda t: spin_up_beam_reference(n_elements, t), ts)
+        lambda t: spin_up_beam.reference(n_elements, t), ts)
     tip = np.asarray(ref.tip_deflection)
     k = int(np.argmin(tip))
     return ({**common, "scene": "spin-up", "kind": "ancf", "engine": "mbjax", "model": "ANCF",
@@ -157,7 +157,7 @@ def _exudyn(solve, reference, steps, repeats, base) -> list[dict]:
 
 
 def spin_up(common, quick: bool) -> list[dict]:
-    from mbjax._src.scenes import spin_up_beam
+    from mbjax.scenes import spin_up_beam
 
     t1, n_ref = (8.0, 8) if quick else (spin_up_beam.DURATION, 8)
     repeats = 1 if quick else 3
@@ -190,8 +190,7 @@ def spin_up(common, quick: bool) -> list[dict]:
 
 
 def slider_crank(common, quick: bool) -> list[dict]:
-    from mbjax._src.flex.references import slider_crank_reference
-    from mbjax._src.scenes import flexible_slider_crank as scene
+    from mbjax.scenes import flexible_slider_crank as scene
 
     t1 = 0.05 if quick else scene.DURATION
     repeats = 1 if quick else 3
@@ -200,7 +199,7 @@ def slider_crank(common, quick: bool) -> list[dict]:
     records, ref = [], None
     for n in (4, 2):
         result, compile_s, run_s, wall = _timed_reference(
-            lambda t: slider_crank_reference(n, t), ts)
+            lambda t: scene.reference(n, t), ts)
         d = np.asarray(result.midpoint_deflection)
         ref = d if ref is None else ref
         records.append({**base, "kind": "ancf", "engine": "mbjax", "model": "ANCF",

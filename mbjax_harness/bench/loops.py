@@ -22,9 +22,9 @@ import jax.numpy as jnp
 import numpy as np
 
 from mbjax_harness.timing import measure, write_jsonl
-from mbjax._src.integrate import RK4, simulate, solve_reference
-from mbjax._src.loops import ClosedSystem, Coupled, Momentum, Stabilized
-from mbjax._src.scenes import closed_chain
+from mbjax.integrate import RK4, simulate, solve_reference
+from mbjax.loops import ClosedSystem, Coupled, Momentum, Stabilized
+from mbjax.scenes import closed_chain
 
 NAME = "loops"
 STEPS = (4e-3, 2e-3, 1e-3, 5e-4)

@@ -12,7 +12,7 @@ One run measures, for regular n-link revolute chains (`mbjax.model.chain(n)`, fl
    of 1. too, for the batched crossover); dense only where its (n, n, 6, 6)
    operator blocks fit in memory (B n^2 <= DENSE_MAX_BN2; skipped configurations are recorded
    with the reason).
-3. Peers on the same chain (`mbjax._src.model.urdf.to_urdf`, identical q ordering): Pinocchio's
+3. Peers on the same chain (`mbjax.model.to_urdf`, identical q ordering): Pinocchio's
    `pin.aba` and MuJoCo's `mj_forward` (the whole pipeline: CRB mass matrix, its factorization,
    bias forces), each called once per state from a Python loop. The same loop with the call
    replaced by a no-op (Pinocchio) or with only the state copies (MuJoCo) gives the loop overhead,
@@ -45,10 +45,9 @@ import numpy as np
 from mbjax import Dense, Recursive
 from mbjax_harness import peers
 from mbjax_harness.timing import Timing, measure, write_jsonl
-from mbjax._src.integrate import RK4, simulate
-from mbjax._src.model import chain
-from mbjax._src.model.urdf import to_urdf
-from mbjax._src.rigid import TreeSystem, forward_dynamics
+from mbjax.integrate import RK4, simulate
+from mbjax.model import chain, to_urdf
+from mbjax.rigid import TreeSystem, forward_dynamics
 
 NAME = "rigid"
 # the peers compared with where installed, left out of the records where not: the

@@ -9,8 +9,9 @@ mbjax and Pinocchio only). Every library reads the same URDF; float64, CPU. Per 
 - call: one jitted forward-dynamics call from Python (model passed as an argument, as a user
   writes `jax.jit(mbjax.forward_dynamics)(model, q, v, tau)`; call_closed_s with the model
   closed over), the median of many; its fixed cost is call - eval. Every JAX library runs with
-  the CPU settings `import mbjax` makes (`mbjax._src.runtime`: synchronous dispatch, XLA's
-  concurrency scheduler off), recorded in each line;
+  the CPU settings `import mbjax` makes (the `mbjax` module's docstring; mbjax/_src/runtime.py:
+  synchronous dispatch, XLA's concurrency scheduler off), recorded in each line (xla_flag: the
+  process's XLA_FLAGS; synchronous_dispatch: JAX's CPU async dispatch off);
 - eval: one forward-dynamics evaluation inside a jitted rollout, a `lax.scan` of STEPS
   semi-implicit Euler steps (the same loop for every JAX library; mbjax also through
   `simulate(TreeSystem(model), RK4())`, per evaluation = run / (4 STEPS));
@@ -32,6 +33,7 @@ Pinocchio: `aba` per call (the C++ estimate: Python loop time minus an empty loo
 step inside them. The summary record holds the speed targets met or missed.
 """
 
+import os
 import re
 import time
 from functools import partial
@@ -42,13 +44,11 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from mbjax._src import runtime
 from mbjax_harness.bench.rigid import pinocchio_loop, relative_difference, timed
 from mbjax_harness.bench.throughput import pinocchio_parallel
-from mbjax._src.integrate import RK4, simulate
-from mbjax._src.model import chain
-from mbjax._src.model.urdf import load_urdf, to_urdf
-from mbjax._src.rigid import TreeSystem, forward_dynamics
+from mbjax.integrate import RK4, simulate
+from mbjax.model import chain, load_urdf, to_urdf
+from mbjax.rigid import TreeSystem, forward_dynamics
 from mbjax_harness.timing import write_jsonl
 
 NAME = "speed"
@@ -87,7 +87,7 @@ def kernel_counts(hlo: str) -> dict:
     """Kernels in a compiled HLO module: per call in the entry computation, and in every while
     loop's body that runs kernel by kernel (the tree passes: one iteration per body or depth
     level). A loop XLA compiled as one kernel (a call marked xla_cpu_small_call, see
-    `mbjax._src.runtime`) counts as one kernel where it is called; `one_kernel_loops` counts them."""
+    mbjax/_src/runtime.py) counts as one kernel where it is called; `one_kernel_loops` counts them."""
     blocks = dict(re.findall(r"\n(?:ENTRY )?%?([\w.\-]+) [^\n]*\{\n(.*?)\n\}", "\n" + hlo, re.S))
     entry = re.search(r"ENTRY %?([\w.\-]+)", hlo).group(1)
 
@@ -238,8 +238,8 @@ def run(out: Path, quick: bool = False) -> list[dict]:
     steps, batch = (QUICK_STEPS, QUICK_BATCH) if quick else (STEPS, BATCH)
     repeats, budget = (3, 2.0) if quick else (10, 10.0)
     common = {"suite": NAME, "jax": jax.__version__, "steps": steps, "batch": batch,
-              "xla_flag": runtime.FLAG if runtime.applied() else None,
-              "synchronous_dispatch": runtime.synchronous()}
+              "xla_flag": os.environ.get("XLA_FLAGS") or None,
+              "synchronous_dispatch": not jax.config.read("jax_cpu_enable_async_dispatch")}
     records = []
     for name, urdf, floating in robots(quick):
         model = load_urdf(urdf, floating_base=floating, min_mass=1e-4 if floating else 0.0)

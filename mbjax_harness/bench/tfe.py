@@ -21,11 +21,11 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from mbjax._src import lie
+from mbjax import lie
 from mbjax_harness.timing import measure, write_jsonl
-from mbjax._src.integrate import INTEGRATORS, simulate, solve_reference
-from mbjax._src.scenes import heavy_top, torque_free_body
-from mbjax._src.tfe import Body, Element, Mixed, PrimalUnsymmetric, initial_state, solve_tfe
+from mbjax.integrate import INTEGRATORS, simulate, solve_reference
+from mbjax.scenes import heavy_top, torque_free_body
+from mbjax.tfe import Body, Element, Mixed, PrimalUnsymmetric, initial_state, solve_tfe
 
 NAME = "tfe"
 FORMS = {"primal": PrimalUnsymmetric(), "mixed": Mixed()}

@@ -4,7 +4,8 @@ Forward dynamics, rollouts and rollout gradients, against Pinocchio, MuJoCo and 
 For regular n-link chains (`mbjax.model.chain(n)`, n = 7, 30, 100; float64 unless said, CPU):
 
 1. Forward dynamics of B = 1 ... 4096 states: mbjax's throughput layout `batch_aba`
-   (`mbjax._src.rigid.batched`, batch last, structure of arrays), in float64 and float32, and
+   (`mbjax.rigid.batched_forward_dynamics`: batch last inside, structure of arrays; its source is
+   mbjax/_src/rigid/batched.py), in float64 and float32, and
    `jit(vmap(forward_dynamics))` of the one-state recursion; against Pinocchio's `aba` called once
    per state from Python, and Pinocchio's batched API `abaInParallel` (OpenMP, one thread per
    core). Time per state; accelerations checked against Pinocchio's.
@@ -42,10 +43,9 @@ from mbjax import Recursive
 from mbjax_harness import peers
 from mbjax_harness.bench.rigid import pinocchio_loop, relative_difference, states, timed
 from mbjax_harness.timing import write_jsonl
-from mbjax._src.integrate import RK4, simulate
-from mbjax._src.model import chain
-from mbjax._src.model.urdf import to_urdf
-from mbjax._src.rigid import TreeSystem, batch_aba, forward_dynamics
+from mbjax.integrate import RK4, simulate
+from mbjax.model import chain, to_urdf
+from mbjax.rigid import TreeSystem, batched_forward_dynamics, forward_dynamics
 
 NAME = "throughput"
 # the peers compared with where installed, left out of the records where not: the
@@ -80,7 +80,9 @@ def shard_batch(x, devices, axis: int = -1):
 
 def _batch_fn(dtype):
     def run(model, q, v, tau):
-        return batch_aba(model, q.T, v.T, tau.T)
+        # batched_forward_dynamics(...).T: the throughput layout's own (n, B) result, as the
+        # records have always timed it (the transposes cancel in the compiled program)
+        return batched_forward_dynamics(model, q, v, tau).T
     return jax.jit(run) if dtype == "float64" else jax.jit(
         lambda model, q, v, tau: run(model, *(x.astype(jnp.float32) for x in (q, v, tau))))
 
@@ -287,7 +289,7 @@ def _rollout_records(ns, batches, steps: int, repeats: int, budget_s: float, mjx
 
 def _loss_fn(model, steps: int, checkpoint: bool):
     """sum q(T)^2 of one trajectory through `TreeSystem`, whose forward dynamics carries the
-    derivatives of `mbjax._src.rigid.adjoint` (the batched layout has none of its own)."""
+    derivatives of mbjax/_src/rigid/adjoint.py (the batched layout has none of its own)."""
     def loss(q0, v0):
         sol = simulate(TreeSystem(model), RK4(), q0, v0, dt=DT, t1=steps * DT,
                        saveat=np.array([steps * DT]), checkpoint=checkpoint)

@@ -58,10 +58,9 @@ import numpy as np
 from mbjax_harness import peers
 from mbjax_harness.crocoddyl_examples import EXAMPLES, Example
 from mbjax_harness.crocoddyl_gaits import GAITS
-from mbjax._src.integrate import SemiImplicitEuler
+from mbjax.integrate import SemiImplicitEuler
 from mbjax_harness.timing import in_turns, measure, write_jsonl
-from mbjax._src.trajopt import ILQR, solve
-from mbjax._src.trajopt.ilqr import CROCODDYL_SCHEDULE
+from mbjax.trajopt import CROCODDYL_SCHEDULE, ILQR, solve
 
 NAME = "trajopt"
 TOLERANCE = 1e-6
@@ -84,8 +83,8 @@ def targets(n: int, seed: int = 0) -> np.ndarray:
 def arm_reach():
     """(mbjax problem, first guess, final error of a final q, Crocoddyl builder)."""
     from mbjax.data import ARM7
-    from mbjax._src.rigid import inverse_dynamics
-    from mbjax._src.scenes import arm
+    from mbjax.rigid import inverse_dynamics
+    from mbjax.scenes import arm
 
     problem = arm.reach_problem(integrator=SemiImplicitEuler())
     model = problem.system.model
@@ -112,8 +111,8 @@ def arm_example() -> Example:
 
 
 def acrobot_example() -> Example:
-    from mbjax._src.model.urdf import to_urdf
-    from mbjax._src.scenes import acrobot
+    from mbjax.model import to_urdf
+    from mbjax.scenes import acrobot
 
     problem = acrobot.swingup_problem(integrator=SemiImplicitEuler())
     model = problem.system.model
@@ -298,7 +297,7 @@ def _looped(solve_one, inputs) -> tuple[float, list[int], list[bool]]:
 def many(n: int, repeats: int, common: dict, loop: bool = True) -> list[dict]:
     """The arm's reach to n targets: mbjax vmapped, mbjax one by one (unless not `loop`: on a
     GPU each solve is thousands of small kernels), Crocoddyl in a loop."""
-    from mbjax._src.scenes import arm
+    from mbjax.scenes import arm
 
     problem, us0, _, build = arm_reach()
     model = problem.system.model
@@ -351,8 +350,8 @@ def sweep_acrobot(n: int, common: dict) -> list[dict]:
     """The acrobot's swing-up for n variants, both links' masses scaled by factors in
     [0.8, 1.2]: mbjax's batched solve (a working set per device), a loop of one jitted solve,
     Crocoddyl's FDDP in a loop (its problems built beforehand, not timed)."""
-    from mbjax._src.model.urdf import to_urdf
-    from mbjax._src.scenes import acrobot
+    from mbjax.model import to_urdf
+    from mbjax.scenes import acrobot
 
     base = acrobot.model()
     scales = np.linspace(0.8, 1.2, n)

@@ -24,12 +24,10 @@ import jax.numpy as jnp
 import numpy as np
 
 from mbjax_harness.timing import measure, write_jsonl
-from mbjax._src.integrate import RK4, simulate
-from mbjax._src.scenes import carpal_wrist as cw
-from mbjax._src.synthesis import sweeps
-from mbjax._src.trajopt.sweep import size
+from mbjax.integrate import RK4, simulate
+from mbjax.scenes import carpal_wrist as cw
 from mbjax.trajopt import sweep as sweep_variants
-from mbjax._src.synthesis.baseline import ToolPath
+from mbjax.wrist import ToolPath, grid, peak_torque
 
 NAME = "wrist"
 STEPS = (0.04, 0.02, 0.01, 5e-3, 2e-3)
@@ -77,10 +75,11 @@ def sweep(variants_per_axis: int, repeats, common) -> list[dict]:
     w = cw.wrist()
     path = ToolPath(cw.START, cw.GOAL, cw.DURATION)
     k = variants_per_axis
-    wrists, _ = sweeps.grid(w, tool_mass=np.linspace(0.5, 3.0, k),
-                            tool_com=[(0.01, -0.005, z) for z in np.linspace(0.0, 0.15, k)],
-                            link_length=np.linspace(0.09, 0.12, k))
-    fn = partial(sweeps.peak_torque, path=path)
+    wrists, shape = grid(w, tool_mass=np.linspace(0.5, 3.0, k),
+                         tool_com=[(0.01, -0.005, z) for z in np.linspace(0.0, 0.15, k)],
+                         link_length=np.linspace(0.09, 0.12, k))
+    variants = int(np.prod(shape))
+    fn = partial(peak_torque, path=path)
     records = []
     peaks = {}
     layouts = {"vmap, 1 device": None}
@@ -89,9 +88,9 @@ def sweep(variants_per_axis: int, repeats, common) -> list[dict]:
     for name, devices in layouts.items():
         out, timing = measure(partial(sweep_variants, fn, wrists, devices=devices), repeats=repeats)
         peaks[name] = np.asarray(out)
-        records.append({**common, "kind": "sweep", "layout": name, "variants": size(wrists),
+        records.append({**common, "kind": "sweep", "layout": name, "variants": variants,
                         "compile_s": timing.compile_s, "run_s": timing.run_s,
-                        "us_per_variant": timing.run_s / size(wrists) * 1e6,
+                        "us_per_variant": timing.run_s / variants * 1e6,
                         "peak_torque_max": float(np.max(out)), "peak_torque_min": float(np.min(out))})
     first = next(iter(peaks.values()))
     for r, p in zip(records, peaks.values()):

@@ -114,6 +114,15 @@ def stick_animation(path: Path, ts, R, p, parents, *, title: str = "",
     return write_gif(path, fig, draw, len(keep), fps)
 
 
+def _holder(model, name: str) -> int:
+    """The body that the frame, body or joint called `name` moves with, looked up as
+    `mbjax.rigid.frame_pose` does: a named frame's body (`Model.frame_parents`), else the body or
+    the joint's body."""
+    if name in model.frame_names:
+        return int(model.frame_parents[model.frame_names.index(name)])
+    return (model.names if name in model.names else model.joint_names).index(name)
+
+
 def gait_animation(path: Path, tree, ts, qs, feet: Sequence[str], forces, mu: float, *,
                    title: str = "", frames: int = 60, reach: float = 0.3) -> Path:
     """Write a GIF of a legged robot walking: its bodies as sticks down to its feet (the
@@ -123,7 +132,6 @@ def gait_animation(path: Path, tree, ts, qs, feet: Sequence[str], forces, mu: fl
 
     ts (T,): times; qs (T, nq): configurations; feet: the feet's frame names; forces (T, F, 3):
     the ground's force on each foot [N], zero where the foot is in the air."""
-    from mbjax._src.rigid.frames import frame_placement
     from mbjax.rigid import frame_pose
 
     step(f"animation {Path(path).name}")
@@ -133,7 +141,7 @@ def gait_animation(path: Path, tree, ts, qs, feet: Sequence[str], forces, mu: fl
     parents = np.asarray(model.topology.parents, dtype=int)
     n = len(parents)
     p = np.asarray(p)[:, :n]
-    holders = [int(frame_placement(model, f)[0]) for f in feet]
+    holders = [_holder(model, f) for f in feet]
     feet = np.asarray(jax.jit(jax.vmap(lambda q: jax.numpy.stack(
         [frame_pose(model, q, f)[1] for f in feet])))(qs))
     keep = np.unique(np.linspace(0, len(ts) - 1, min(frames, len(ts))).round().astype(int))

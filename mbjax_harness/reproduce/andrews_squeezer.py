@@ -2,7 +2,7 @@
 
 The seven-body mechanism of Hairer & Wanner II §VII.7 (test set problem `andrews`), built from
 mbjax bodies, revolute joints, three `point_on_line` cut joints, a spring and a motor torque
-(`mbjax._src.scenes.andrews_squeezer`), integrated by RK4 with the coupled Lagrange multipliers
+(`mbjax.scenes.andrews_squeezer`), integrated by RK4 with the coupled Lagrange multipliers
 (`ClosedSystem` with `Coupled()`, Jerkovsky 1978 eqs 89-93) from the test set's initial values to t = 0.03 s, and compared
 with the test set's reference solution (its `SOLN`, PSIDE at tolerance 1e-14).
 
@@ -34,9 +34,9 @@ import jax.numpy as jnp
 import numpy as np
 
 from mbjax_harness.timing import measure
-from mbjax._src.integrate import RK4, simulate
-from mbjax._src.loops import Coupled, Stabilized
-from mbjax._src.scenes import andrews_squeezer as scene
+from mbjax.integrate import RK4, simulate
+from mbjax.loops import Coupled, Stabilized
+from mbjax.scenes import andrews_squeezer as scene
 
 NAME = "andrews-squeezer"
 STEPS_PER_SAVE = 60                       # the history: 61 states, every 0.5 ms

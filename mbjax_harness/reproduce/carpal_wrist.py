@@ -1,6 +1,6 @@
 """`mbjax reproduce carpal-wrist`: Canfield 1997's Carpal Wrist: time response, synthesis, Newton-Euler.
 The time response, its stated purpose (trajectory synthesis), and the Newton-Euler check, on the
-scene `mbjax._src.scenes.carpal_wrist`.
+scene `mbjax.scenes.carpal_wrist`.
 
 1. Integrators (§6.4). The chapter's scheme (eq 6.45, explicit Euler) and the foundation's
    semi-implicit Euler, RK4 and implicit midpoint, at each step dt of STEPS:
@@ -33,13 +33,11 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
+from mbjax.control import CubicSpline
+from mbjax.integrate import INTEGRATORS, RK4, simulate
+from mbjax.scenes import carpal_wrist as scene
+from mbjax.wrist import ToolPath, WristSystem, feedforward_torques, pose_error, synthesize
 from mbjax_harness.timing import measure
-from mbjax._src.integrate import INTEGRATORS, RK4, simulate
-from mbjax._src.scenes import carpal_wrist as scene
-from mbjax._src.synthesis.baseline import ToolPath, feedforward_torques
-from mbjax._src.control import CubicSpline
-from mbjax._src.synthesis.synthesis import goal_pose, rollout, synthesize
-from mbjax._src.wrist import kinematics
 
 NAME = "carpal-wrist"
 METHODS = ("explicit_euler", "semi_implicit_euler", "rk4", "implicit_midpoint")
@@ -47,6 +45,20 @@ STEPS = (0.001, 0.002, 0.004, 0.005, 0.008, 0.01, 0.02, 0.04)
 QUICK_STEPS = (0.002, 0.005, 0.01, 0.02, 0.04)
 REFERENCE_DT = 1e-4
 ITERATIONS, QUICK_ITERATIONS = 400, 60
+
+
+def goal_pose(wrist, goal):
+    """The tool's `Pose` at goal = (plunge, slope), the midplane chart's coordinates: the
+    forward kinematics of the inverse kinematics' input angles."""
+    return wrist.forward_kinematics(wrist.solve_inverse_kinematics(*goal)[0])
+
+
+def rollout(wrist, law, theta0, duration: float, steps: int, integrator=RK4()):
+    """The final (theta, theta_dot, status) of the wrist driven by the torque law `law` from rest
+    at theta0, `steps` steps to `duration` (what `synthesize` scores a law by)."""
+    sol = simulate(WristSystem(wrist, law), integrator, theta0, jnp.zeros_like(theta0),
+                   dt=duration / steps, t1=duration, saveat=np.array([duration]))
+    return sol.qs[-1], sol.us[-1], sol.status
 
 
 def masked_rollout(system, integrator, q0, u0, dts, duration: float, monitor, timings: dict | None = None):
@@ -176,7 +188,7 @@ def trajectory_study(iterations: int) -> dict:
 
     def miss(law, steps):
         q, _, _ = rollout(w, law, theta0, scene.DURATION, steps, RK4())
-        return float(kinematics.pose_error(w, w.forward_kinematics(q), goal))
+        return float(pose_error(w, w.forward_kinematics(q), goal))
 
     init = CubicSpline.fit(ts, tau_ff, 12, scene.DURATION, scene.TORQUE_LIMIT)
     result = synthesize(w, theta0, scene.GOAL, duration=scene.DURATION, torque_limit=scene.TORQUE_LIMIT,

@@ -1,7 +1,7 @@
 """`mbjax reproduce closed-chain`: a chain with both ends fixed under each stabilization. Its loop
 is held by each stabilization, and unstabilized integration fails (Anderson 1993 §3.3, Fig. 8).
 
-The (n/2)-body chain with both ends fixed (`mbjax._src.scenes.closed_chain`), simulated (RK4, 1 ms;
+The (n/2)-body chain with both ends fixed (`mbjax.scenes.closed_chain`), simulated (RK4, 1 ms;
 1 s for n <= 44, 0.1 s above, the time then scaled to 1 s) by Anderson 1993's O(n + m^3) route (`Stabilized()`: the O(n) recursion, m + 1
 passes) and by the coupled Lagrange multipliers with the dense mass matrix, O(n^3)
 (`Coupled()`, Jerkovsky 1978 eqs 89-93); run time of each after compilation (median of 3 calls), and
@@ -31,9 +31,9 @@ import jax.numpy as jnp
 import numpy as np
 
 from mbjax_harness.timing import measure
-from mbjax._src.integrate import RK4, ImplicitMidpoint, simulate
-from mbjax._src.loops import ClosedSystem, Coupled, Stabilized
-from mbjax._src.scenes import TOLERANCE, closed_chain
+from mbjax.integrate import RK4, ImplicitMidpoint, simulate
+from mbjax.loops import ClosedSystem, Coupled, Stabilized
+from mbjax.scenes import TOLERANCE, closed_chain
 
 NAME = "closed-chain"
 NS = (4, 12, 20, 28, 36, 44, 100, 200, 400)

@@ -2,19 +2,19 @@
 Its midpoint deflection against a nonlinear ANCF rod over three crank turns (Anderson 1993 §3.1,
 Figs. 4-5).
 
-The slider-crank with a flexible connecting rod (`mbjax._src.scenes.flexible_slider_crank`: 6 in rigid
+The slider-crank with a flexible connecting rod (`mbjax.scenes.flexible_slider_crank`: 6 in rigid
 crank at 125.6 rad/s, 12 in steel rod of 0.25 in diameter, massless slider), the rod modelled by
 1, 2 and 3 beam elements with all their in-plane modes and geometric stiffening, solved by Anderson
 1993's O(n + m^3) route with projection, RK4; the rod's midpoint deflection from the chord PQ in
 inches, positive away from O at t = 0, over three crank revolutions (0.15 s).
 
 The slider's constraint load stiffens the rod as a child's reaction would (Anderson 1993 eq 33, through
-the grid point's second-order displacement, `mbjax._src.flex.kinematics.grid_point`): without it the
+the grid point's second-order displacement, `grid_point` in mbjax/_src/flex/kinematics.py): without it the
 3-element rod departed from the reference after the first revolution (0.087 in over 0.15 s against
 a 0.145 in amplitude); with it the whole history stays within `HISTORY_TOLERANCE`.
 
 The reference is an independent model: the geometrically nonlinear ANCF rod of
-`mbjax._src.flex.references.slider_crank_reference` (absolute nodal coordinates, exact strains), 4
+`mbjax.scenes.flexible_slider_crank.reference` (absolute nodal coordinates, exact strains), 4
 elements, at the same save times.
 
 RK4 steps: the 3-element model's highest mode needs dt <= 1e-5 s; 1 and 2 elements are stable at
@@ -39,10 +39,9 @@ from pathlib import Path
 
 import numpy as np
 
-from mbjax._src.flex.references import slider_crank_reference
 from mbjax_harness.progress import step
 from mbjax_harness.reproduce.spin_up_beam import history_status
-from mbjax._src.scenes import flexible_slider_crank as scene
+from mbjax.scenes import flexible_slider_crank as scene
 
 NAME = "flexible-slider-crank"
 ELEMENTS, QUICK_ELEMENTS = (1, 2, 3), (1, 2)
@@ -79,7 +78,7 @@ def reproduce(out: Path, quick: bool = False) -> dict:
     ts = runs[str(elements[0])][0]
     n_ref = QUICK_REFERENCE_ELEMENTS if quick else REFERENCE_ELEMENTS
     start = time.perf_counter()
-    ref = slider_crank_reference(n_elements=n_ref, ts=ts)
+    ref = scene.reference(n_elements=n_ref, ts=ts)
     ref_seconds = time.perf_counter() - start
     ref_d = np.asarray(ref.midpoint_deflection)
     ref_peak = float(np.max(np.abs(ref_d)))
@@ -92,7 +91,8 @@ def reproduce(out: Path, quick: bool = False) -> dict:
         "by_elements": {n: finite_list(d) for n, (_, d, _, _) in runs.items()},
         "reference": {"t": np.asarray(ref.ts).tolist(), "midpoint_deflection_in": finite_list(ref_d),
                       "n_elements": n_ref,
-                      "model": "geometrically nonlinear ANCF beam (mbjax._src.flex.references)",
+                      "model": "geometrically nonlinear ANCF beam "
+                               "(mbjax.scenes.flexible_slider_crank.reference)",
                       "seconds": ref_seconds},
         "peaks": peaks,
         "reference_peak": ref_peak,

@@ -30,17 +30,17 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from mbjax._src.control import PD, Constant, CubicSpline
-from mbjax._src.flex import Beam, FlexibleModel, FlexibleSystem, beam_body, craig_bampton
-from mbjax._src.integrate import INTEGRATORS, simulate
-from mbjax._src.loops import ClosedSystem, Coupled, Momentum, Stabilized
-from mbjax._src.model import Model, chain
+from mbjax.control import PD, Constant, CubicSpline
+from mbjax.flex import Beam, FlexibleModel, FlexibleSystem, beam_body, craig_bampton
+from mbjax.integrate import INTEGRATORS, simulate
+from mbjax.loops import ClosedSystem, Coupled, Momentum, Stabilized
+from mbjax.model import Model, chain
 from mbjax_harness.progress import step
-from mbjax._src.rigid import RigidBody, TreeSystem
-from mbjax._src.scenes import carpal_wrist as cw
-from mbjax._src.scenes import flexible_slider_crank as fsc
-from mbjax._src.scenes import four_bar
-from mbjax._src.wrist import WristSystem
+from mbjax.rigid import RigidBody, TreeSystem
+from mbjax.scenes import carpal_wrist as cw
+from mbjax.scenes import flexible_slider_crank as fsc
+from mbjax.scenes import four_bar
+from mbjax.wrist import WristSystem
 
 NAME = "gradient-matrix"
 STEP = 1e-5                # central differences: truncation ~1e-10, round-off ~1e-11

@@ -15,10 +15,10 @@ import jax.numpy as jnp
 import numpy as np
 
 from mbjax_harness.timing import measure
-from mbjax._src.integrate import INTEGRATORS, simulate
-from mbjax._src.scenes import TOLERANCE
-from mbjax._src.scenes import heavy_top as top
-from mbjax._src.scenes import torque_free_body as tfb
+from mbjax.integrate import INTEGRATORS, simulate
+from mbjax.scenes import TOLERANCE
+from mbjax.scenes import heavy_top as top
+from mbjax.scenes import torque_free_body as tfb
 
 NAME = "integrators"
 

@@ -11,8 +11,9 @@ random qvel and qfrc_applied) `compare` sets both engines side by side:
     qacc            mbjax's `forward_dynamics`, mapped to MuJoCo's qvel coordinates by `jax.jvp`
                     of `state_to_mujoco`, against `mj_forward`'s qacc: max |difference| /
                     max(1, max |qacc|);
-    poses           every body's and site's world pose (`frame_pose`'s lookup) against
-                    xpos/xmat and site_xpos/site_xmat: max abs difference.
+    poses           every body's and site's world pose (looked up as `frame_pose` does: a
+                    named frame, from `frame_poses`, else a body, from `forward_kinematics`)
+                    against xpos/xmat and site_xpos/site_xmat: max abs difference.
 
 MuJoCo computes what mbjax models and nothing else: `comparable` disables contacts, constraints
 (limits, dry friction, equality) and actuator forces by flag (mjDSBL_CONTACT,
@@ -37,13 +38,9 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from mbjax._src.model import Model
-from mbjax._src.model.checks import ModelWarning
-from mbjax._src.model.mjcf import from_mujoco, object_name, site_frame_name
-from mbjax._src.model.states import state_from_mujoco, state_to_mujoco
+from mbjax.model import Model, ModelWarning, from_mujoco, state_from_mujoco, state_to_mujoco
+from mbjax.rigid import forward_dynamics, forward_kinematics, frame_poses
 from mbjax_harness.progress import step
-from mbjax._src.rigid import forward_dynamics, frame_placement
-from mbjax._src.rigid.kinematics import forward_kinematics
 
 TOLERANCE = 1e-8
 # (package, folder in it, glob): where the MJCF files are
@@ -106,14 +103,30 @@ def comparable(mjmodel):
 
 @jax.jit
 def _mbjax_side(model: Model, qpos, qvel, qfrc_applied):
-    """MuJoCo's qacc as mbjax computes it, and the body poses, at MuJoCo's state. Compiled: one
-    jit per model costs 1-2.5 s on the 2-core CI machine, the same model eagerly 2-10 s."""
+    """MuJoCo's qacc as mbjax computes it, the body poses and the named frames' (the sites), at
+    MuJoCo's state. Compiled: one jit per model costs 1-2.5 s on the 2-core CI machine, the same
+    model eagerly 2-10 s."""
     q, v = state_from_mujoco(model, qpos, qvel)
     to_qvel = lambda q_, v_: state_to_mujoco(model, q_, v_)[1]  # noqa: E731
     tau = jax.vjp(lambda v_: to_qvel(q, v_), v)[1](qfrc_applied)[0]    # tau = T^T qfrc_applied
     a = forward_dynamics(model, q, v, tau)
     qacc = jax.jvp(to_qvel, (q, v), (model.q_dot(q, v), a))[1]
-    return qacc, forward_kinematics(model, q)
+    return qacc, forward_kinematics(model, q), frame_poses(model, q)
+
+
+def object_name(mjmodel, kind: str, i: int) -> str:
+    """The name of MuJoCo object i of `kind` ("body", "site"), or kind + index where it has
+    none (as `from_mujoco` names it)."""
+    import mujoco
+
+    obj = {"body": mujoco.mjtObj.mjOBJ_BODY, "site": mujoco.mjtObj.mjOBJ_SITE}[kind]
+    return mujoco.mj_id2name(mjmodel, obj, i) or f"{kind}{i}"
+
+
+def site_frame_name(model: Model, site: str) -> str:
+    """The named frame `from_mujoco` makes of a MuJoCo site: "site/NAME" where the site's name
+    is taken (by a body, a joint or another frame), else the site's name."""
+    return f"site/{site}" if f"site/{site}" in model.frame_names else site
 
 
 def random_state(mjmodel, seed: int):
@@ -137,17 +150,26 @@ def compare(mjmodel, model: Model, seed: int = 0) -> dict:
     random state of `comparable(mjmodel)`."""
     m, d = random_state(mjmodel, seed)
 
-    qacc, (R, p) = _mbjax_side(model, *(jnp.asarray(x) for x in (d.qpos, d.qvel,
-                                                                  d.qfrc_applied)))
+    qacc, bodies, frames = _mbjax_side(model, *(jnp.asarray(x) for x in (d.qpos, d.qvel,
+                                                                          d.qfrc_applied)))
     qacc_error = float(np.max(np.abs(np.asarray(qacc) - d.qacc)) / max(1.0, np.abs(d.qacc).max()))
-    R, p = np.asarray(R), np.asarray(p)
+    R, p, R_frames, p_frames = (np.asarray(x) for x in (*bodies, *frames))
+
+    def pose(name):
+        """The world pose of a named frame (a site, a welded body or one whose joint is off its
+        origin), else of a body: `frame_pose`'s lookup."""
+        if name in model.frame_names:
+            i = model.frame_names.index(name)
+            return R_frames[i], p_frames[i]
+        k = model.names.index(name)
+        return R[k], p[k]
+
     pose_error = 0.0
     targets = [(object_name(m, "body", b), d.xmat[b], d.xpos[b]) for b in range(1, m.nbody)]
     targets += [(site_frame_name(model, object_name(m, "site", s)), d.site_xmat[s],
                  d.site_xpos[s]) for s in range(m.nsite)]
     for name, xmat, xpos in targets:
-        k, R_f, p_f = (np.asarray(x) for x in frame_placement(model, name))
-        R_w, p_w = (R_f, p_f) if k < 0 else (R[k] @ R_f, p[k] + R[k] @ p_f)
+        R_w, p_w = pose(name)
         pose_error = max(pose_error, np.abs(R_w.reshape(9) - xmat).max(),
                          np.abs(p_w - xpos).max())
     return {"qacc": qacc_error, "poses": float(pose_error)}

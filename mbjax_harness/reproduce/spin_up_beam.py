@@ -2,7 +2,7 @@
 The modal tip with and without geometric stiffening against a nonlinear ANCF beam (Anderson 1993
 §3.2, eq 109).
 
-The hub-clamped cantilever (L = 10 m, `mbjax._src.scenes.spin_up_beam`) spun up in its own plane, omega
+The hub-clamped cantilever (L = 10 m, `mbjax.scenes.spin_up_beam`) spun up in its own plane, omega
 rising from 0 to 6 rad/s over 15 s and held; omega passes the first bending frequency (3.8 rad/s)
 at t = 8.5 s. The modal model (20 beam elements, the lowest `N_BENDING` in-plane bending modes and
 one axial mode, Craig-Bampton, clamped at the hub) is solved by Anderson 1993's O(n + m^3) route with
@@ -11,7 +11,7 @@ K - omega^2 M_yy softens and turns indefinite, and the tip runs away (about 70 m
 1e20 m at 20 s); with stiffening the tip lags by at most 0.57 m and settles once omega is steady.
 
 The reference is an independent model: the geometrically nonlinear ANCF beam of
-`mbjax._src.flex.references.spin_up_beam_reference` (absolute nodal coordinates, exact strains, no
+`mbjax.scenes.spin_up_beam.reference` (absolute nodal coordinates, exact strains, no
 modal truncation), `REFERENCE_ELEMENTS` elements, at the same save times.
 
 The whole history is held to `HISTORY_TOLERANCE` (1e-3 m against a 0.57 m peak): the modes' beam
@@ -47,9 +47,8 @@ from pathlib import Path
 import numpy as np
 
 from mbjax_harness.timing import measure
-from mbjax._src.flex import geometric_stiffness
-from mbjax._src.flex.references import spin_up_beam_reference
-from mbjax._src.scenes import spin_up_beam as scene
+from mbjax.flex import geometric_stiffness
+from mbjax.scenes import spin_up_beam as scene
 
 NAME = "spin-up-beam"
 DT = 2e-3                      # RK4 step of the modal model
@@ -114,7 +113,7 @@ def reproduce(out: Path, quick: bool = False) -> dict:
     (_, tip_free, _, sol_free), _ = modal_run(n_bending, duration, stiffening=False,
                                              repeats=0)
     start = time.perf_counter()
-    ref = spin_up_beam_reference(n_elements=n_ref, ts=ts)
+    ref = scene.reference(n_elements=n_ref, ts=ts)
     ref_tip = np.asarray(ref.tip_deflection)
     ref_seconds = time.perf_counter() - start
 
@@ -131,7 +130,7 @@ def reproduce(out: Path, quick: bool = False) -> dict:
         "omega": np.asarray(scene.omega(ts)).tolist(),
         "reference": {"t": np.asarray(ref.ts).tolist(), "tip_deflection": finite_list(ref_tip),
                       "tip_axial": finite_list(ref.tip_axial), "n_elements": n_ref,
-                      "model": "geometrically nonlinear ANCF beam (mbjax._src.flex.references)",
+                      "model": "geometrically nonlinear ANCF beam (mbjax.scenes.spin_up_beam.reference)",
                       "seconds": ref_seconds},
         "peak": peak, "peak_time": float(ts[k]),
         "reference_peak": ref_peak, "reference_peak_time": float(ts[k_ref]),

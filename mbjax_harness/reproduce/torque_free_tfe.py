@@ -1,7 +1,7 @@
 """`mbjax reproduce torque-free-tfe`: time elements on the torque-free body against its closed form.
 As in Borri 1990 §8.1, Fig. 1 a-e.
 
-The torque-free symmetric body (`mbjax._src.scenes.torque_free_body`: J_t / J_a = 1.875, 15 rad/s
+The torque-free symmetric body (`mbjax.scenes.torque_free_body`: J_t / J_a = 1.875, 15 rad/s
 about the symmetry axis and 10 rad/s about a transverse one, 6 s, about 100 rad of rotation)
 marched with the primal form of eq 4.1 and the mixed form of eq 4.9 (the two the paper
 discretizes, §5) on 2-, 3- and 4-node elements 0.015 s between nodes (Fig. 1 a-c) and 4-node
@@ -21,9 +21,9 @@ import jax
 import numpy as np
 
 from mbjax_harness.timing import measure
-from mbjax._src.scenes import TOLERANCE
-from mbjax._src.scenes import torque_free_body as tfb
-from mbjax._src.tfe import Body, Element, Mixed, PrimalUnsymmetric, initial_state, solve_tfe
+from mbjax.scenes import TOLERANCE
+from mbjax.scenes import torque_free_body as tfb
+from mbjax.tfe import Body, Element, Mixed, PrimalUnsymmetric, initial_state, solve_tfe
 
 NAME = "torque-free-tfe"
 PANELS = ((2, 0.015), (3, 0.015), (4, 0.015), (4, 0.030), (4, 0.045))

@@ -13,17 +13,17 @@ final_error is the problem's own task error at the end (the flange's distance to
 [m] for the arm).
 
 Problems: `arm-reach`, the 7-dof arm (`mbjax.data.ARM7`) from rest to a flange target
-0.4 m away, at rest after 1 s (dt = 0.01 s, 100 knots; `mbjax._src.scenes.arm.reach_problem`);
+0.4 m away, at rest after 1 s (dt = 0.01 s, 100 knots; `mbjax.scenes.arm.reach_problem`);
 `acrobot-swingup`, the double pendulum driven at its elbow from hanging to upright at rest in
-3 s (dt = 0.01 s, 300 knots, zero torque as the first guess; `mbjax._src.scenes.acrobot`);
+3 s (dt = 0.01 s, 300 knots, zero torque as the first guess; `mbjax.scenes.acrobot`);
 `carpal-wrist`, the Carpal Wrist from START to GOAL at rest in 0.5 s under its 1.8 N m torque
 limit (100 knots; the inverse-dynamics feed-forward along a minimum-jerk path, clipped, as the
-first guess; `mbjax._src.scenes.carpal_wrist.synthesis_problem`), final_error the pose error
-(`mbjax._src.wrist.kinematics.pose_error`), by iLQR only (see SHOOTING); `four-bar`, the closed
+first guess; `mbjax.scenes.carpal_wrist.synthesis_problem`), final_error the pose error
+(`mbjax.wrist.pose_error`), by iLQR only (see SHOOTING); `four-bar`, the closed
 loop on a table turned by its crank a quarter turn, rest to rest in 1 s with least effort,
-projection on (`mbjax._src.scenes.four_bar.crank_problem`), final_error the crank angle's miss
+projection on (`mbjax.scenes.four_bar.crank_problem`), final_error the crank angle's miss
 [rad]; `slewing-beam`, the hub of a flexible arm slewed a quarter turn in 1 s with least torque
-and no vibration left (`mbjax._src.scenes.slewing_beam`; the rigid arm's least-effort torque as the
+and no vibration left (`mbjax.scenes.slewing_beam`; the rigid arm's least-effort torque as the
 first guess), final_error the tip's largest deflection [m] while the arm coasts for 1 s after.
 """
 
@@ -34,7 +34,7 @@ import jax.numpy as jnp
 import numpy as np
 
 from mbjax_harness.timing import measure
-from mbjax._src.trajopt import ILQR, MultipleShooting, Shooting, solve
+from mbjax.trajopt import ILQR, MultipleShooting, Shooting, solve
 
 NAME = "trajopt"
 SOLVERS = {"ilqr": ILQR(iterations=300), "multiple-shooting": MultipleShooting(iterations=600),
@@ -49,7 +49,7 @@ QUICK_SOLVERS = {"ilqr": ILQR(iterations=300),
 
 def arm_reach():
     """(problem, first guess, final_error(result))."""
-    from mbjax._src.scenes import arm
+    from mbjax.scenes import arm
 
     problem = arm.reach_problem()
     model = problem.system.model
@@ -63,7 +63,7 @@ def arm_reach():
 
 def acrobot_swingup():
     """(problem, first guess, final_error(result)): the tip's distance to upright [m]."""
-    from mbjax._src.scenes import acrobot
+    from mbjax.scenes import acrobot
 
     problem = acrobot.swingup_problem()
     model = problem.system.model
@@ -76,26 +76,25 @@ def acrobot_swingup():
 
 
 def carpal_wrist():
-    """(problem, first guess, final_error(result)): the pose error (`wrist.kinematics.
-    pose_error`) of the final pose against GOAL."""
-    from mbjax._src.scenes import carpal_wrist as cw
-    from mbjax._src.synthesis.synthesis import goal_pose
-    from mbjax._src.wrist import kinematics
+    """(problem, first guess, final_error(result)): the pose error (`mbjax.wrist.pose_error`) of
+    the final pose against GOAL."""
+    from mbjax.scenes import carpal_wrist as cw
+    from mbjax.wrist import pose_error
+    from mbjax_harness.reproduce.carpal_wrist import goal_pose
 
     problem = cw.synthesis_problem()
     wrist = problem.system.model
     goal = goal_pose(wrist, cw.GOAL)
 
     def final_error(result):
-        pose = kinematics.forward_kinematics(wrist, result.qs[-1])
-        return float(kinematics.pose_error(wrist, pose, goal))
+        return float(pose_error(wrist, wrist.forward_kinematics(result.qs[-1]), goal))
 
     return problem, cw.synthesis_guess(problem), final_error
 
 
 def four_bar():
     """(problem, first guess, final_error(result)): the crank angle's miss [rad]."""
-    from mbjax._src.scenes import four_bar as fb
+    from mbjax.scenes import four_bar as fb
 
     problem = fb.crank_problem()
 
@@ -108,7 +107,7 @@ def four_bar():
 def slewing_beam():
     """(problem, first guess, final_error(result)): the residual vibration, the tip's largest
     deflection [m] while the arm coasts for 1 s after the slew."""
-    from mbjax._src.scenes import slewing_beam as sb
+    from mbjax.scenes import slewing_beam as sb
 
     problem = sb.slew_problem()
 
@@ -141,7 +140,7 @@ def _animate(out: Path, name: str, problem, result, quick: bool) -> str:
     ts = np.arange(problem.horizon + 1) * problem.dt
     title, frames = f"{name} by iLQR", 20 if quick else 50
     if name == "slewing-beam":
-        from mbjax._src.scenes import slewing_beam as sb
+        from mbjax.scenes import slewing_beam as sb
 
         p = sb.centreline(problem.system.model, result.qs, magnification=10.0)
         R = np.broadcast_to(np.eye(3), (*p.shape[:2], 3, 3))

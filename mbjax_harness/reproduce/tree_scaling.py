@@ -32,8 +32,7 @@ import numpy as np
 
 from mbjax_harness import peers
 from mbjax_harness.bench.rigid import loop_length, looped_fn, states, timed
-from mbjax._src.model import chain
-from mbjax._src.model.urdf import to_urdf
+from mbjax.model import chain, to_urdf
 
 NAME = "tree-scaling"
 # the peers compared with where installed, left out of the records where not: the

@@ -23,11 +23,11 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from mbjax._src.model.states import state_to_pinocchio
-from mbjax._src.model.urdf import load_urdf
+from mbjax import Recursive
+from mbjax.model import load_urdf, state_to_pinocchio
+from mbjax.rigid import (forward_dynamics, forward_kinematics, frame_jacobian, frame_poses,
+                         inverse_dynamics, mass_matrix)
 from mbjax_harness.progress import step
-from mbjax._src.rigid import aba, forward_kinematics, inverse_dynamics, mass_matrix
-from mbjax._src.rigid.frames import frame_jacobian, frame_poses
 
 # Above this condition number of the mass matrix, forward dynamics are compared by their backward
 # error: cond(M) eps exceeds 1e-10 there, so neither engine's accelerations are accurate to it.
@@ -59,7 +59,7 @@ def _pinocchio(path: Path, floating: bool):
 
 @jax.jit
 def _mbjax(model, q, v, tau):
-    a = aba(model, q, v, tau)
+    a = forward_dynamics(model, q, v, tau, method=Recursive())          # the ABA
     return (a, inverse_dynamics(model, q, v, a), mass_matrix(model, q), frame_poses(model, q),
             forward_kinematics(model, q))
 

@@ -1,9 +1,9 @@
 """`mbjax reproduce vertical-top`: time elements' stability on a vertical top at its critical speed.
 As in Borri 1990 Tables 1-2, with the boundaries of eq 7.10.
 
-The vertical top (`mbjax._src.scenes.vertical_top`, omega = 5/3) spins at its critical speed; each
+The vertical top (`mbjax.scenes.vertical_top`, omega = 5/3) spins at its critical speed; each
 element's transition matrix about that steady motion (eqs 6.8, 6.12, from jacfwd of the full
-3-D residual, `mbjax._src.tfe.stability`) gives exponents ln(lambda) / h, h = (nodes - 1) dt the
+3-D residual, `mbjax.tfe.stability`) gives exponents ln(lambda) / h, h = (nodes - 1) dt the
 element length. Reported is the transverse exponent with positive imaginary part and the
 largest real part (the exact ones are +- i 5/3, a double pair at the critical speed):
 
@@ -27,9 +27,9 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
+from mbjax.scenes import vertical_top as vt
+from mbjax.tfe import Element, Mixed, PrimalUnsymmetric, Reference, stability
 from mbjax_harness.progress import step
-from mbjax._src.scenes import vertical_top as vt
-from mbjax._src.tfe import Element, Mixed, PrimalUnsymmetric, make_reference, stability
 
 NAME = "vertical-top"
 DTS = tuple(round(0.02 * k, 2) for k in range(1, 11))
@@ -64,13 +64,21 @@ PAPER = {
 RADIUS_TOL = 1e-7
 
 
+def moving_with(body, R1, p_hat1) -> Reference:
+    """The reference moving with the top's initial velocity (`solve_tfe`'s "constant_velocity",
+    Borri 1990 eqs 2.2-2.3): from R1, at the angular velocity of the momentum p_hat1 about the
+    fixed point."""
+    omega = body.momentum_to_velocity(R1, p_hat1)[:3]
+    return Reference(R1, jnp.zeros(3), omega, jnp.zeros(3))
+
+
 @partial(jax.jit, static_argnames=("form", "element"))
 def top_transition(spin, dt, *, form, element):
     """Transition matrix of one element about the top spinning steadily at `spin` (eq 7.1)."""
     body = vt.build()
     R1 = jnp.eye(3)
     p_hat1 = body.mass_matrix(R1) @ jnp.array([0.0, 0.0, 1.0]) * spin
-    ref = make_reference("constant_velocity", body, R1, jnp.zeros(3), p_hat1)
+    ref = moving_with(body, R1, p_hat1)
     q1 = jnp.zeros(3)
     z1 = jnp.concatenate([form.to_form(body, q1, p_hat1), q1])
     return stability.transition_matrix(form, body, ref, element, dt, z1)

@@ -13,11 +13,15 @@ need.
 - `PD` (gains, targets, feed-forward), `MLPPolicy`: `feedback`
 """
 
-from mbjax._src.control.base import AbstractControl, Constant, Function, Saturated, Sum, as_control, saturate
-from mbjax._src.control.feedback import PD, MLPPolicy
-from mbjax._src.control.hold import SampleAndHold, ZeroOrderHold
-from mbjax._src.control.spline import CubicSpline, bspline_basis
-
-__all__ = ["PD", "AbstractControl", "Constant", "CubicSpline", "Function", "MLPPolicy",
-           "SampleAndHold", "Saturated", "Sum", "ZeroOrderHold", "as_control", "bspline_basis",
-           "saturate"]
+from mbjax._src.control.base import (
+    AbstractControl as AbstractControl,
+    Constant as Constant,
+    Function as Function,
+    Saturated as Saturated,
+    Sum as Sum,
+    as_control as as_control,
+    saturate as saturate,
+)
+from mbjax._src.control.feedback import PD as PD, MLPPolicy as MLPPolicy
+from mbjax._src.control.hold import SampleAndHold as SampleAndHold, ZeroOrderHold as ZeroOrderHold
+from mbjax._src.control.spline import CubicSpline as CubicSpline, bspline_basis as bspline_basis

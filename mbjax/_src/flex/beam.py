@@ -336,7 +336,18 @@ def geometric_stiffness(beam: Beam, axial_force, torsion=True):
     eq (32) gives N_e times the integral of uy'^2 + uz'^2 (+ (Iy + Iz)/A rx'^2 with `torsion`) over
     the element, with the element's own interpolation; the small axial (ux'^2) and section-rotation
     (Iz/A rz'^2, Iy/A ry'^2) terms are dropped as well. For Euler-Bernoulli the bending part is
-    N/(30 Le) [36, 3Le, -36, 3Le; ...], the standard consistent form."""
+    N/(30 Le) [36, 3Le, -36, 3Le; ...], the standard consistent form.
+
+    Args:
+        beam: the beam.
+        axial_force: each element's axial force N_e [N], tension positive, shape (n_elements,).
+        torsion (bool): include the torsional term (Iy + Iz)/A rx'^2.
+
+    Returns:
+        K_G, shape (n_dofs, n_dofs), in the beam's dof order (6 per node; see `Beam`) and linear
+            in the axial forces: with unit forces and torsion=False, q^T K_G q / 2 is the axial
+            shortening (1/2) int (uy'^2 + uz'^2) dx of a deflection q.
+    """
     kg = _unit_geometric_stiffness(beam, torsion)
     return _assemble(beam, jnp.asarray(axial_force)[:, None, None] * kg)
 

@@ -63,7 +63,7 @@ class ModalBody(eqx.Module):
     cut joints attach.
 
     Build it with `mbjax.flex.beam_body` (from a beam and its modal basis),
-    `ModalBody.from_points` (a `mbjax._src.flex.points.MassPoints` cloud and the reduced
+    `ModalBody.from_points` (a `MassPoints` cloud, `mbjax/_src/flex/points.py`, and the reduced
     stiffness) or `ModalBody.rigid` (a rigid body in the same form); the constructor takes the
     fields below directly. Body-frame components throughout, the frame at the joint grid J^k.
 
@@ -116,7 +116,7 @@ class ModalBody(eqx.Module):
 
     Geometric stiffening:
         Geometric stiffening (eqs 32-33, 46, Table 1) enters the modal equation as K_G q with
-        K_G = sum_q s_q K_q (21 inertial unit loads, `mbjax._src.flex.stiffening`) plus the
+        K_G = sum_q s_q K_q (21 inertial unit loads, `mbjax/_src/flex/stiffening.py`) plus the
         distal bodies' loads; the temporal scalars s are linear in the body's acceleration, so
         K_G q = G_s A + g_s.
     """

@@ -34,7 +34,7 @@ class FlexibleModel(eqx.Module):
     stacked `ModalBody`. A flexible body's mass, centre of mass and
     inertia are its ModalBody's (its rigid-body terms); the rigid `model`'s values for that body
     are not used. A rigid part that moves with the body (a hub at the clamp) goes into the
-    ModalBody (`rotary`, as `mbjax._src.scenes.slewing_beam` does); a rigid mass that differs
+    ModalBody (`rotary`, as `mbjax.scenes.slewing_beam` does); a rigid mass that differs
     from the ModalBody's by more than `MASS_MISMATCH` (relative) gets a warning, so that such a
     part is not dropped unseen.
 

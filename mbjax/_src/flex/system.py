@@ -57,7 +57,7 @@ class FlexibleSystem(AbstractTreeSystem):
 
     Loads and stiffening:
         A load at a marker on a grid point bends the body and stiffens it (Anderson 1993 eq 33,
-        `mbjax._src.flex.kinematics.grid_point`), as a cut joint's constraint load there does.
+        `grid_point` in `mbjax/_src/flex/kinematics.py`), as a cut joint's constraint load there does.
 
         Geometric stiffening adds acceleration-dependent loads, so the equations are not
         M v_dot + bias = 0 with a symmetric M (`symmetric_dynamics` is False): closed loops go

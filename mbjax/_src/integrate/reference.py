@@ -59,7 +59,7 @@ def solve_reference(system: AbstractSystem, q0: Array, u0: Array, ts, *, rtol: f
         if times.ndim != 1 or times.size < 2 or not np.all(np.diff(times) > 0):
             raise ValueError(f"ts must be at least two increasing times, got {ts!r}")
     return raise_on_failure(_solve(system, q0, u0, ts, rtol, atol, solver, max_steps), throw,
-                            "mbjax.solve_reference")
+                            "mbjax.integrate.solve_reference")
 
 
 @eqx.filter_jit

@@ -131,7 +131,7 @@ def simulate(system: AbstractSystem, integrator: AbstractIntegrator, q0: Array, 
     Default accuracy check:
         Always on. At every step the rollout estimates the step times the motion's fastest rate from
         consecutive increments of the state, |d_k - d_(k-1)| / |d_(k-1)|, the least over the
-        configuration's and the velocity's (`mbjax._src.system.accuracy.step_ratio`), and sets
+        configuration's and the velocity's (`step_ratio` in `mbjax/_src/system/accuracy.py`), and sets
         INACCURATE where it stays above 1 (about six steps per period of an oscillation) for 3 steps
         in a row: a method past its stability limit (1.2 to 3.5 measured) or a step far too long for
         the motion, caught before the state overflows. `Solution.resolution` is its largest value.
@@ -158,7 +158,7 @@ def simulate(system: AbstractSystem, integrator: AbstractIntegrator, q0: Array, 
         The second measure sees what step doubling misses: the drift of the invariants the system
         has (`AbstractSystem.invariants`: a passive system's energy, a floating tree's momenta; the
         constraint residual is the closed loops' own status) over the start and the saved states,
-        relative to the motion's scale (`mbjax._src.system.invariants`), is `Solution.drift`, and
+        relative to the motion's scale (`mbjax/_src/system/invariants.py`), is `Solution.drift`, and
         INACCURATE is also set where it exceeds a positive rtol (atol, in the state's units, does
         not apply to it).
     """

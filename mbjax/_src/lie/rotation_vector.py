@@ -218,7 +218,7 @@ def log(R: Array, check: bool = True) -> Array:
             `jit`. Pass False where R is a rotation by construction (a product of rotations):
             the run-time test is a host callback, which keeps a compiled program out of the
             persistent compilation cache and a loop around it from compiling as one kernel
-            (`mbjax._src.runtime`).
+            (see the `mbjax` module's runtime settings).
 
     Returns:
         The rotation vector r, |r| <= pi, shape (3,).

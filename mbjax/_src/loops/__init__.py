@@ -13,17 +13,35 @@ after every step (differentiable, by the implicit function theorem) and of initi
 `stabilized_acceleration`.
 """
 
-from mbjax._src.model.closures import GROUND, Coupling, CutJoint, Prescribed
-from mbjax._src.loops.constraints import Loops
-from mbjax._src.loops.coupled import Coupled, coupled_acceleration
-from mbjax._src.loops.method import AbstractLoopMethod
-from mbjax._src.loops.momentum import Momentum, loop_momentum_rate
-from mbjax._src.loops.multipliers import multipliers, numerical_rank
-from mbjax._src.loops.projection import consistent_state, gauss_newton, project_configuration, project_velocity
-from mbjax._src.loops.stabilized import Stabilized, eta_and_gamma, stabilized_acceleration
-from mbjax._src.loops.system import ClosedSystem
-
-__all__ = ["GROUND", "AbstractLoopMethod", "ClosedSystem", "Coupled", "Coupling", "CutJoint", "Loops",
-           "Momentum", "Prescribed", "Stabilized", "consistent_state", "coupled_acceleration",
-           "eta_and_gamma", "gauss_newton", "loop_momentum_rate", "multipliers", "numerical_rank",
-           "project_configuration", "project_velocity", "stabilized_acceleration"]
+from mbjax._src.model.closures import (
+    GROUND as GROUND,
+    Coupling as Coupling,
+    CutJoint as CutJoint,
+    Prescribed as Prescribed,
+)
+from mbjax._src.loops.constraints import Loops as Loops
+from mbjax._src.loops.coupled import (
+    Coupled as Coupled,
+    coupled_acceleration as coupled_acceleration,
+)
+from mbjax._src.loops.method import AbstractLoopMethod as AbstractLoopMethod
+from mbjax._src.loops.momentum import (
+    Momentum as Momentum,
+    loop_momentum_rate as loop_momentum_rate,
+)
+from mbjax._src.loops.multipliers import (
+    multipliers as multipliers,
+    numerical_rank as numerical_rank,
+)
+from mbjax._src.loops.projection import (
+    consistent_state as consistent_state,
+    gauss_newton as gauss_newton,
+    project_configuration as project_configuration,
+    project_velocity as project_velocity,
+)
+from mbjax._src.loops.stabilized import (
+    Stabilized as Stabilized,
+    eta_and_gamma as eta_and_gamma,
+    stabilized_acceleration as stabilized_acceleration,
+)
+from mbjax._src.loops.system import ClosedSystem as ClosedSystem

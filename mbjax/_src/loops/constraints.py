@@ -36,9 +36,9 @@ class Loops(eqx.Module):
         d/dt (A v + B) at fixed v, the "A_dot u + B_dot" of Anderson 1993 eq 92. Derivatives follow
         q along q_dot = tree.q_dot(q, v), so quaternion joints need no special case. Where the
         tree writes its bodies' motion out (`body_motion`, a rigid tree, whose derivatives are
-        written out too: `mbjax._src.rigid.motion`), `rate`, `jacobian`, `drift` (A v_dot + b)
+        written out too: `mbjax/_src/rigid/motion.py`), `rate`, `jacobian`, `drift` (A v_dot + b)
         and `force` (A^t K), the terms the KKT system's derivatives differentiate
-        (`mbjax._src.loops.kkt`), take a cut joint's rates from its residual along its two
+        (`mbjax/_src/loops/kkt.py`), take a cut joint's rates from its residual along its two
         frames' velocities and accelerations, and A^t K from the tree's inward pass of the
         wrenches on them (`body_forces`): no nested derivative of the tree's kinematics. Cut
         joints alike but for their arrays and bodies (a stance's feet) are one `vmap`

@@ -83,11 +83,11 @@ class Coupled(AbstractLoopMethod):
 
         With nu = mu^-1 the inverse mass matrix, the unconstrained acceleration a_free = nu (K^a -
         Y) (= -nu bias, the tree's applied forces included) and the constraint rows A v_dot + b = 0
-        (`mbjax._src.loops.constraints`), eqs 89-92 give the multipliers K_c from (A nu A^t) K_c =
+        (`mbjax/_src/loops/constraints.py`), eqs 89-92 give the multipliers K_c from (A nu A^t) K_c =
         -(A a_free + b) and eq 93 the motion v_dot = a_free + nu A^t K_c. Baumgarte's stabilization
         adds 2 alpha (A v + B) + beta^2 Phi to b, so the constraint errors obey e_ddot + 2 alpha
         e_dot + beta^2 e = 0 instead of drifting. The mass matrix is dense here (O(n^3));
-        `mbjax._src.loops.stabilized` is Anderson 1993's O(n + m^3) route.
+        `mbjax/_src/loops/stabilized.py` is Anderson 1993's O(n + m^3) route.
     """
 
     baumgarte: tuple = eqx.field(static=True, default=(0.0, 0.0), converter=_gains)

@@ -38,7 +38,7 @@ class Momentum(AbstractLoopMethod):
         The state is the generalized momentum G = mu v: G_dot = K^a - X + A^t K_c (eq 87), with X =
         Y - mu_dot v (eq 99), so K^a - X = -bias + mu_dot v, and the multipliers of eq 98, (A nu
         A^t) K_c = -(A nu (K^a - X) + b + A nu_dot G), nu_dot G = -nu mu_dot v; eq 99 makes them
-        equal to eq 92's (`mbjax._src.loops.coupled`), which the tests check.
+        equal to eq 92's (`mbjax/_src/loops/coupled.py`), which the tests check.
     """
 
     def validate(self, tree):

@@ -68,7 +68,7 @@ class Stabilized(AbstractLoopMethod):
         flexible). The constraint loads f_c follow from A u_dot + b = 0:
 
         - epsilon = 0: (A Gamma) f_c = A eta + b, an m x m solve, O(m^3) (regularized and rank-checked
-          as in `mbjax._src.loops.multipliers`);
+          as in `mbjax/_src/loops/multipliers.py`);
         - epsilon > 0, Anderson 1993's epsilon-dynamics (eqs 89-93): f_c is a state with
           epsilon f_c_dot + A Gamma f_c = A eta + b, which relaxes onto the algebraic value on the time
           scale epsilon / eig(A Gamma); its integral keeps A u + B - epsilon f_c constant (zero when
@@ -82,7 +82,7 @@ class Stabilized(AbstractLoopMethod):
           and gains a slow one, 1 / kappa.
 
         Total cost O(n m + m^3) = O(n + m^3) for a fixed number of loops. Here f_c = -K_c of
-        `mbjax._src.loops.coupled` (Anderson 1993 counts the loads with the opposite sign).
+        `mbjax/_src/loops/coupled.py` (Anderson 1993 counts the loads with the opposite sign).
     """
 
     epsilon: float = eqx.field(static=True, default=0.0)

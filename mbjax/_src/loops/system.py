@@ -66,7 +66,7 @@ class ClosedSystem(AbstractSystem):
         method: an `AbstractLoopMethod` instance; None: `Coupled()` for trees with a symmetric
             mass matrix, `Stabilized()` otherwise.
         projection: after every step, project (q, v) onto Phi = 0 and A v + B = 0
-            (differentiably; `mbjax._src.loops.projection`); static.
+            (differentiably; `mbjax/_src/loops/projection.py`); static.
         tolerance: the residual |Phi| past which `check` reports
             `Status.CONSTRAINT_VIOLATED`; static.
         control (Callable | Array | None): the tree's control, if not given to the tree (as in

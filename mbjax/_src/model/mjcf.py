@@ -217,7 +217,7 @@ def from_mujoco(mjmodel, *, strict: bool = False) -> Model:
 
     Args:
         mjmodel (mujoco.MjModel): the compiled `mujoco.MjModel`.
-        strict: make implausible inertias errors (`mbjax._src.model.checks`), not the features
+        strict: make implausible inertias errors (`mbjax.model.ModelWarning`), not the features
             mbjax leaves out.
 
     Returns:

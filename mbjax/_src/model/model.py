@@ -71,11 +71,11 @@ class Model(eqx.Module):
     differentiated, vmapped and swept without recompiling. Per-body arrays have a leading axis
     of n bodies; a per-body argument given for one body is broadcast to all of them.
 
-    Limits are data (bounds for trajectory optimisation, `mbjax._src.model.limits.excess`,
-    checked by `TreeSystem.check` in `simulate`'s status), not contact forces. Bodies with
+    Limits are data (bounds for trajectory optimisation, checked by `TreeSystem.check` in
+    `simulate`'s status, `Status.LIMIT_EXCEEDED`), not contact forces. Bodies with
     implausible but computable mass data (a triangle-inequality violation, negative moments, a
-    massless leaf without armature) load with a `ModelWarning` (`mbjax._src.model.checks`);
-    `strict=True` makes it an error.
+    massless leaf without armature) load with a `ModelWarning`; `strict=True` makes it an
+    error.
 
     Args:
         parents (Sequence[int] | Topology): each body's parent, shape (n,), parents[k] < k or -1 for

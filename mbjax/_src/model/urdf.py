@@ -170,7 +170,7 @@ def load_urdf(source: str | bytes | os.PathLike, *, floating_base: bool = False,
         dummy root, sensor and contact frames welded by fixed joints load whatever their data.
         Implausible but computable data (CAD inertias that break the triangle inequality, round-off
         negatives, a massless leaf on a moving joint) loads with a `ModelWarning` naming the link
-        and the fix (`strict=True`: an error; `mbjax._src.model.checks`); non-finite or unparsable
+        and the fix (`strict=True`: an error; see `mbjax.model.ModelWarning`); non-finite or unparsable
         numbers are errors.
 
     Joint data:

@@ -129,7 +129,16 @@ def on_bodies(R: Array, p: Array, bodies, rotation: Array, translation: Array):
 
 @jax.jit
 def frame_poses(model: Model, q: Array) -> tuple[Array, Array]:
-    """World orientations (m, 3, 3) and origins (m, 3) of all the named frames
-    (`Model.frame_names`) at once."""
+    """World poses of all the model's named frames at once (Pinocchio's
+    `framesForwardKinematics`).
+
+    Args:
+        model: the tree.
+        q: configuration, shape (nq,).
+
+    Returns:
+        (R, p): the frames' rotations (frame to world), shape (m, 3, 3), and their origins in
+            the world [m], shape (m, 3), in the order of `Model.frame_names`.
+    """
     R, p = forward_kinematics(model, q)
     return on_bodies(R, p, model.frame_parents, model.frame_rotation, model.frame_translation)

@@ -51,7 +51,7 @@ class TreeSystem(AbstractTreeSystem):
     Jerkovsky 1978 eq 74 (`method`, as in `mbjax.forward_dynamics`).
 
     The state is (q, v), shapes (nq,) and (nv,). Its derivatives, of any order, come from the
-    adjoint rule of `mbjax._src.rigid.adjoint`.
+    adjoint rule of `mbjax/_src/rigid/adjoint.py`.
 
     Args:
         model: the tree, a `mbjax.Model`.
@@ -96,14 +96,14 @@ class TreeSystem(AbstractTreeSystem):
 
     def body_motion(self, q, v, v_dot=None):
         """The bodies' poses, spatial velocities and (without gravity) accelerations at the world
-        origin (`mbjax._src.rigid.motion`: derivatives written out)."""
+        origin (`mbjax/_src/rigid/motion.py`: derivatives written out)."""
         if v_dot is None:
             R, p, V, _ = body_motion(self.model, q, v, jnp.zeros_like(v))
             return R, p, V, None
         return body_motion(self.model, q, v, v_dot)
 
     def body_forces(self, q, wrenches):
-        """S^T of the wrenches summed over each joint's outward set (`mbjax._src.rigid.motion`)."""
+        """S^T of the wrenches summed over each joint's outward set (`mbjax/_src/rigid/motion.py`)."""
         return body_forces(self.model, q, wrenches)
 
     def quaternions(self):
@@ -112,7 +112,8 @@ class TreeSystem(AbstractTreeSystem):
 
     def check(self, t, q, u):
         """`Status.LIMIT_EXCEEDED` where the state or the control is beyond the model's joint
-        limits (`mbjax._src.model.limits`); limits are data here, not contact forces.
+        limits (`Model.lower`, `upper`, `velocity_limit`, `effort_limit`); limits are data here, not
+        contact forces.
 
         Args:
             t: time [s], a scalar.
@@ -126,7 +127,7 @@ class TreeSystem(AbstractTreeSystem):
         return jnp.where(over, int(Status.LIMIT_EXCEEDED), 0).astype(jnp.int32)
 
     def culprit(self, t, q, u):
-        """The first coordinate beyond its limit (`mbjax._src.model.limits.first_exceeded`)."""
+        """The first coordinate beyond its limit (`first_exceeded` in `mbjax/_src/model/limits.py`)."""
         return first_exceeded(self.model, q, u, self.applied(t, q, u))
 
     def culprit_names(self):
@@ -167,7 +168,7 @@ class TreeSystem(AbstractTreeSystem):
 
     def acceleration(self, t, q, u):
         """`mbjax.forward_dynamics` under the control and the external wrenches (its derivatives
-        by the adjoint rule of `mbjax._src.rigid.adjoint`).
+        by the adjoint rule of `mbjax/_src/rigid/adjoint.py`).
 
         Args:
             t: time [s], a scalar.
@@ -214,7 +215,7 @@ class BatchTreeSystem(AbstractSystem):
             shape (nv, B).
 
     Throughput:
-        The one scan runs with the throughput layout of `mbjax._src.rigid.batched`: the same
+        The one scan runs with the throughput layout of `mbjax.rigid.batched_forward_dynamics`: the same
         trajectories as `jax.vmap` of a `TreeSystem` simulation.
     """
 

@@ -3,11 +3,10 @@
 Each scene module has `build(...)` returning (system, q0, u0) and the scene's constants.
 """
 
-from mbjax._src.scenes import heavy_top, torque_free_body
+from mbjax._src.scenes import heavy_top as heavy_top, torque_free_body as torque_free_body
 
-# What the tour and the reproductions ask of a run unless a scene says otherwise: its final
-# state to 1e-3 (relative) or 1e-4 (absolute) and its invariants to 1e-3 (`simulate`'s rtol and
-# atol); a run past it is reported INACCURATE, whatever else it shows.
 TOLERANCE = {"rtol": 1e-3, "atol": 1e-4}
-
-__all__ = ["TOLERANCE", "heavy_top", "torque_free_body"]
+"""What the tour and the reproductions ask of a run unless a scene says otherwise, as
+`simulate(..., **TOLERANCE)`: its final state to 1e-3 (relative) or 1e-4 (absolute) and its
+invariants to 1e-3 (`simulate`'s rtol and atol); a run past it is reported INACCURATE, whatever
+else it shows."""

@@ -9,7 +9,7 @@ The cut joint is, by default, a planar pin: a `point_on_line` cut joint (the cou
 rocker's z line through its tip), 2 equations of full rank. `closure="revolute"` uses the spatial
 revolute cut joint instead, 5 equations of which only 2 are independent in a planar loop: the
 redundancy that `Status.REDUNDANT` reports (Jerkovsky 1978 §VI's multipliers then come from the
-least-squares solve of `mbjax._src.loops.multipliers`).
+least-squares solve of `mbjax/_src/loops/multipliers.py`).
 
 `joint_angles(theta)` is the closed-form position analysis (two circles' intersection, elbow-up
 branch), the minimal-coordinate reference of the tests.

@@ -6,7 +6,7 @@ The beam is an aluminium strip, 1 m long with a 50 x 3 mm section (0.41 kg), ben
 plane of motion about its thin axis: its clamped bending frequencies are 15.5 and 97 rad/s
 (2.5 and 15.5 Hz). mbjax's model is a modal body on a revolute joint, solved by the O(n)
 flexible recursion of `mbjax.flex` with its geometric stiffening (the flexible-multibody
-paper's eqs 32-33): one flexible body (`mbjax._src.flex.beam`, `N_ELEMENTS` beam elements, Craig-Bampton modes clamped at the hub, the
+paper's eqs 32-33): one flexible body (`mbjax/_src/flex/beam.py`, `N_ELEMENTS` beam elements, Craig-Bampton modes clamped at the hub, the
 lowest `n_bending` in-plane bending modes, no axial one) whose rigid inertia includes the hub's
 `HUB_INERTIA`. q = (hub angle, modal coordinates), the modes mass-normalized, so the vibration
 energy is 1/2 sum(omega_i^2 eta_i^2 + eta_i'^2).

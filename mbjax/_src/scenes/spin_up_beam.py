@@ -8,7 +8,7 @@ axial motion; no gravity. The first bending frequency is 3.8 rad/s, so the spin 
 modal model without geometric stiffening (eqs 32-33) softens, K - omega^2 M_yy turns indefinite,
 and the tip diverges; with stiffening the deflection stays small and bounded.
 
-mbjax's model: one flexible body (beam elements, `mbjax._src.flex.beam`, Craig-Bampton modes clamped at
+mbjax's model: one flexible body (beam elements, `mbjax/_src/flex/beam.py`, Craig-Bampton modes clamped at
 the hub, the lowest `n_bending` in-plane bending and `n_axial` axial modes) on a revolute joint
 about z, whose angle is the prescribed motion theta(t) (a rheonomic `Prescribed` constraint, Anderson
 1993 eq 87) solved by Anderson 1993's route (`ClosedSystem(..., method=Stabilized())`, eqs 101-108). The tip deflection is

@@ -5,13 +5,11 @@ frame B is stored as a 6x6 matrix; X^T maps forces back from B to A.
 """
 
 from mbjax._src.spatial.algebra import (
-    check_inertia,
-    cross_force,
-    cross_motion,
-    inertia_matrix,
-    plucker,
-    shift_force,
-    skew,
+    check_inertia as check_inertia,
+    cross_force as cross_force,
+    cross_motion as cross_motion,
+    inertia_matrix as inertia_matrix,
+    plucker as plucker,
+    shift_force as shift_force,
+    skew as skew,
 )
-
-__all__ = ["check_inertia", "cross_force", "cross_motion", "inertia_matrix", "plucker", "shift_force", "skew"]

@@ -206,7 +206,7 @@ def train_controller(controller: NeuralController, wrist, episodes: Episodes, *,
     (speed, the coupling of the legs, gravity away from theta*).
 
     Reverse-mode gradients by default: the network's weights outnumber what forward mode does
-    cheaply (see `mbjax._src.trajopt.descent.adam_descent`). The whole descent is one jitted
+    cheaply (see `adam_descent` in `mbjax/_src/trajopt/descent.py`). The whole descent is one jitted
     `lax.scan`.
 
     Args:

@@ -210,7 +210,7 @@ class AbstractSystem(eqx.Module):
     def invariants(self, t: Array, q: Array, u: Array) -> Invariants | None:
         """The quantities the exact motion conserves at a state.
 
-        The energy of a passive system, a free tree's momentum (`mbjax._src.system.invariants`):
+        The energy of a passive system, a free tree's momentum (`mbjax/_src/system/invariants.py`):
         their drift is what `simulate(..., rtol=)` holds to rtol.
 
         Args:

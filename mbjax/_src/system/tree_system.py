@@ -126,7 +126,7 @@ class AbstractTreeSystem(AbstractDrivenSystem):
 
     def body_motion(self, q: Array, v: Array, v_dot: Array | None = None):
         """The frames' motion written out, for closures differentiated without nested autodiff
-        (`mbjax._src.loops.constraints`): None where the tree does not offer it (closures then go
+        (`mbjax/_src/loops/constraints.py`): None where the tree does not offer it (closures then go
         through `frames`).
 
         Args:

@@ -8,22 +8,33 @@ stability by transition matrices (`mbjax._src.tfe.stability`) and the hand tange
 (`mbjax._src.tfe.tangents`) against which the autodiff ones are checked.
 """
 
-from mbjax._src.tfe.body import Body
-from mbjax._src.tfe.elements import QUADRATURES, Element, gauss_legendre, lagrange
-from mbjax._src.tfe.form import AbstractForm
-from mbjax._src.tfe.mixed import Mixed, MixedUnsymmetric
-from mbjax._src.tfe.newton import NewtonInfo, newton
-from mbjax._src.tfe.primal import PrimalSymmetric, PrimalUnsymmetric
-from mbjax._src.tfe.reference import REFERENCES, Reference, make_reference
-from mbjax._src.tfe.solve import State, TFESolution, element_map, initial_state, solve_tfe
-from mbjax._src.tfe.three_field import ThreeField
-from mbjax._src.tfe import stability, tangents
+from mbjax._src.tfe.body import Body as Body
+from mbjax._src.tfe.elements import (
+    QUADRATURES as QUADRATURES,
+    Element as Element,
+    gauss_legendre as gauss_legendre,
+    lagrange as lagrange,
+)
+from mbjax._src.tfe.form import AbstractForm as AbstractForm
+from mbjax._src.tfe.mixed import Mixed as Mixed, MixedUnsymmetric as MixedUnsymmetric
+from mbjax._src.tfe.newton import NewtonInfo as NewtonInfo, newton as newton
+from mbjax._src.tfe.primal import (
+    PrimalSymmetric as PrimalSymmetric,
+    PrimalUnsymmetric as PrimalUnsymmetric,
+)
+from mbjax._src.tfe.reference import (
+    REFERENCES as REFERENCES,
+    Reference as Reference,
+    make_reference as make_reference,
+)
+from mbjax._src.tfe.solve import (
+    State as State,
+    TFESolution as TFESolution,
+    element_map as element_map,
+    initial_state as initial_state,
+    solve_tfe as solve_tfe,
+)
+from mbjax._src.tfe.three_field import ThreeField as ThreeField
+from mbjax._src.tfe import stability as stability, tangents as tangents
 
 FORMS = {cls.name: cls for cls in (PrimalUnsymmetric, PrimalSymmetric, Mixed, MixedUnsymmetric, ThreeField)}
-
-__all__ = [
-    "AbstractForm", "Body", "Element", "FORMS", "Mixed", "MixedUnsymmetric", "NewtonInfo", "PrimalSymmetric",
-    "PrimalUnsymmetric", "QUADRATURES", "REFERENCES", "Reference", "State", "TFESolution",
-    "ThreeField", "element_map", "gauss_legendre", "initial_state", "lagrange",
-    "make_reference", "newton", "solve_tfe", "stability", "tangents",
-]

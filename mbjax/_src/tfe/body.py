@@ -182,7 +182,7 @@ class Body(eqx.Module):
             p_hat: spatial momentum about O', shape (nq,).
 
         Returns:
-            The invariants with their scales (`mbjax._src.system.invariants.Invariants`).
+            The invariants with their scales (`Invariants` in `mbjax/_src/system/invariants.py`).
         """
         h = p_hat[:3]
         orbital = jnp.zeros(3, h.dtype) if self.fixed_point else jnp.cross(x, p_hat[3:])

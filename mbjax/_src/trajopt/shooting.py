@@ -34,7 +34,7 @@ class Shooting(AbstractSolver):
 
     The method:
         Single shooting: the controls are the unknowns, the objective is the problem's cost of their
-        rollout, and its gradient is reverse mode through the rollout (`mbjax._src.rigid.adjoint`
+        rollout, and its gradient is reverse mode through the rollout (`mbjax/_src/rigid/adjoint.py`
         for trees: a few rollouts' cost, whatever the horizon).
 
         `Shooting("lbfgs")` takes optax's L-BFGS with its zoom line search (Nocedal and Wright, Alg.

@@ -60,7 +60,7 @@ def solve(problem: Problem, solver: AbstractSolver = ILQR(), us0: Array | None =
         problem's builder returns it) is solved in one program too. An iterative solver (`ILQR`)
         runs it through a working set of `width` problems: a member that stops leaves, and the next
         problem takes its slot, so the batch costs about its members' total iterations, not its
-        slowest member's for everyone (`mbjax._src.trajopt.batch`), and with several devices (the
+        slowest member's for everyone (`mbjax/_src/trajopt/batch.py`), and with several devices (the
         CPU's cores made devices, GPUs) the batch is split over them, a working set on each. Other
         solvers are `jax.vmap`ped. `jax.vmap(solve)` stays the plain map.
 
@@ -88,7 +88,7 @@ def solve(problem: Problem, solver: AbstractSolver = ILQR(), us0: Array | None =
 def _solve(problem: Problem, solver: AbstractSolver, us0: Array | None, states0: Array | None,
            throw: bool) -> Result:
     result = solver.solve(problem, problem.initial_controls(us0), states0)
-    return raise_on_failure(checked(result, problem.jumps()), throw, "mbjax._src.trajopt.solve")
+    return raise_on_failure(checked(result, problem.jumps()), throw, "mbjax.trajopt.solve")
 
 
 @eqx.filter_jit
@@ -109,7 +109,7 @@ def _solve_batch(problems: Problem, solver: AbstractSolver, us0: Array | None,
                           in_axes=(0, 0, None if states0 is None else 0))(params, us, states0)
     jumps = problems.jumps()
     return raise_on_failure(jax.vmap(lambda r: checked(r, jumps))(result), throw,
-                            "mbjax._src.trajopt.solve")
+                            "mbjax.trajopt.solve")
 
 
 def _split(fn, params, us: Array):

@@ -1,7 +1,7 @@
 """Every status the `mbjax` command's runs report, with the default accuracy check's measure.
 
-    python benchmarks/status_census.py LOG.jsonl tour [--out DIR] [--jobs 1]
-    python benchmarks/status_census.py LOG.jsonl reproduce NAME [--out DIR]
+    python tests/tools/status_census.py LOG.jsonl tour [--out DIR] [--jobs 1]
+    python tests/tools/status_census.py LOG.jsonl reproduce NAME [--out DIR]
 
 runs the command in this process with every `simulate`, `solve_tfe` and `mbjax.trajopt.solve`
 result logged to LOG.jsonl as it is made (its type, the harness line that made it, its
