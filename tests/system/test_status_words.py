@@ -72,6 +72,32 @@ def test_a_solution_prints_its_status_in_words():
                if part[0].isdigit()) == 2
 
 
+def test_a_status_prints_its_flags_in_words_and_computes_as_an_integer_array():
+    """`sol.status` printed 32; now its words, as diffrax's RESULTS, while it still computes as
+    the integer array it is, eagerly, under jit and under vmap."""
+    model = eqx.tree_at(lambda m: (m.lower, m.upper), chain(3),
+                        (jnp.full(3, -LIMIT), jnp.full(3, LIMIT)))
+
+    def run(q0):
+        return simulate(TreeSystem(model), RK4(), q0, jnp.array([0.0, 3.0, 0.0]), dt=0.01, t1=1.0)
+
+    sol = run(jnp.array([0.0, 0.3, 0.0]))
+    assert repr(sol.status) == str(sol.status) == "Flags<limit exceeded>"
+    assert int(sol.status) == Status.LIMIT_EXCEEDED and bool(sol.status == Status.LIMIT_EXCEEDED)
+    assert int(sol.status & Status.LIMIT_EXCEEDED) and not int(sol.status & Status.NONFINITE)
+    assert np.asarray(sol.status).dtype.kind == "i" and jnp.asarray(sol.status).shape == ()
+    marked = sol.status | Status.INACCURATE
+    assert str(marked) == "Flags<limit exceeded, inaccurate>" and int(marked) == 96
+    jitted = jax.jit(run)(jnp.array([0.0, 0.3, 0.0]))
+    assert str(jitted.status) == "Flags<limit exceeded>"
+    assert int(jax.jit(lambda status: jnp.where(status == 0, 1, status))(sol.status)) == 32
+    batch = jax.vmap(run)(jnp.array([[0.0, 0.3, 0.0], [0.0, 0.0, 0.0]]))
+    assert batch.status.shape == (2,) and str(batch.status).startswith(
+        "Flags<shape (2,): limit exceeded; ")
+    assert str(batch.status[0]) == "Flags<limit exceeded>"
+    assert np.asarray(batch.status).tolist() == [int(s) for s in batch.status]
+
+
 def test_home_lies_inside_every_limit_of_every_example_robot():
     """`Model.home()` is inside [lower, upper] on every URDF of example-robot-data (the Panda's
     elbow, whose range excludes zero, among those it moves), and equals `neutral()` where zero

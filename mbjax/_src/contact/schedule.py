@@ -13,7 +13,7 @@ from mbjax._src.contact.stance import _contacts, contact_wrenches, stance
 from mbjax._src.integrate.base import AbstractIntegrator
 from mbjax._src.integrate.simulate import simulate
 from mbjax._src.system.accuracy import number
-from mbjax._src.system.status import Status, WithStatus
+from mbjax._src.system.status import Flags, flags, Status, WithStatus
 from mbjax._src.system.tree_system import AbstractTreeSystem
 
 
@@ -40,8 +40,8 @@ class ContactSolution(WithStatus):
     vs: Array
     wrenches: Array
     phases: Array
-    status: Array
-    phase_status: Array
+    status: Flags = eqx.field(converter=flags)
+    phase_status: Flags = eqx.field(converter=flags)
     frames: tuple = eqx.field(static=True)
 
     def notes(self, i: int) -> dict:

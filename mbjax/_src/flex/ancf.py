@@ -37,7 +37,7 @@ import jax.numpy as jnp
 import numpy as np
 from jax import Array
 
-from mbjax._src.system.status import Status, WithStatus, raise_on_failure
+from mbjax._src.system.status import Flags, flags, Status, WithStatus, raise_on_failure
 
 
 def _hermite(xi, l):  # noqa: E741 (the element length, as in the ANCF papers)
@@ -215,7 +215,7 @@ class AncfSolution(WithStatus):
     ts: Array       # (n_saves,)
     e: Array        # (n_saves, n_coordinates)
     e_dot: Array    # (n_saves, n_coordinates)
-    status: Array
+    status: Flags = eqx.field(converter=flags)
     dt: float = eqx.field(static=True)      # the largest RK4 step used
 
 

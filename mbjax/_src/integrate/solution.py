@@ -3,7 +3,7 @@
 import equinox as eqx
 from jax import Array
 
-from mbjax._src.system.status import WithStatus, accuracy_notes
+from mbjax._src.system.status import Flags, flags, WithStatus, accuracy_notes
 
 
 class Solution(WithStatus):
@@ -16,15 +16,16 @@ class Solution(WithStatus):
         ts: save times [s], shape (T,).
         qs: configurations, shape (T, nq).
         us: velocity coordinates, shape (T, nv).
-        status: an integer array of `Status` flags (one per solution; batched under vmap).
+        status: the `Status` flags, one per solution (batched under vmap), as `Flags`: an
+            integer array that prints in words.
         error: the estimated global error of the final state (largest component, in the
             state's units) where the run was asked for a tolerance (`simulate(..., rtol=,
             atol=)`), else NaN.
         drift: the largest relative drift of the system's invariants (its energy, its
-            momenta: `mbjax._src.system.invariants`) over the start and the states the rollout
+            momenta: `mbjax/_src/system/invariants.py`) over the start and the states the rollout
             checks; NaN where it has none.
         resolution: the step times the motion's fastest rate, held over `SUSTAINED` steps,
-            at its largest along the run (`mbjax._src.system.accuracy.step_ratio`); above
+            at its largest along the run (`step_ratio` in `mbjax/_src/system/accuracy.py`); above
             `RESOLUTION_LIMIT` (1) the steps do not resolve the motion.
         drifting: the index of the invariant that drifted most (-1 where none).
         flagged_at: the time [s] each `Status` flag (1, 2, 4, ... in order) was first raised,
@@ -40,7 +41,7 @@ class Solution(WithStatus):
     ts: Array
     qs: Array
     us: Array
-    status: Array
+    status: Flags = eqx.field(converter=flags)
     error: Array = float("nan")
     drift: Array = float("nan")
     resolution: Array = float("nan")

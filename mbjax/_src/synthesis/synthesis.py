@@ -21,7 +21,7 @@ import numpy as np
 from jax import Array
 
 from mbjax._src.integrate import RK4, simulate
-from mbjax._src.system.status import WithStatus, raise_on_failure
+from mbjax._src.system.status import Flags, flags, WithStatus, raise_on_failure
 from mbjax._src.trajopt.descent import adam_descent
 from mbjax._src.control import CubicSpline
 from mbjax._src.wrist import WristSystem, kinematics
@@ -48,7 +48,7 @@ class Synthesis(WithStatus):
     final_pose_error: Array
     effort: Array
     peak_torque: Array
-    status: Array
+    status: Flags = eqx.field(converter=flags)
 
 
 def rollout(wrist, law, theta0: Array, duration: float, steps: int, integrator=RK4()):

@@ -12,9 +12,10 @@ from jax import Array
 
 
 class Status(enum.IntFlag):
-    """Flags OR-ed into a result's integer `status` (`Solution.status`, one per run; batched
-    under vmap); 0 means success without remarks. Test a flag with `status & Status.X`, and a
-    run with `result.ok`; `result.messages()` spells the flags out.
+    """Flags OR-ed into a result's `status` (`Solution.status`, one per run; batched under
+    vmap), an integer array that prints in words (`Flags<limit exceeded>`); 0 means success
+    without remarks. Test a flag with `status & Status.X`, and a run with `result.ok`;
+    `result.messages()` spells the flags out with their causes.
 
     Attributes:
         SUCCESS: 0, no flag set.
@@ -25,7 +26,8 @@ class Status(enum.IntFlag):
         REDUNDANT: a note, not a failure: the constraint Jacobian lost rank (redundant closures
             or a singular configuration); least-squares loads were used.
         LIMIT_EXCEEDED: a note: a saved state or control is beyond the model's joint limits
-            (position, velocity or effort; `mbjax._src.model.limits`).
+            (position, velocity or effort: `Model.lower`, `upper`, `velocity_limit`,
+            `effort_limit`).
         INACCURATE: the steps do not resolve the motion (the default check,
             `Solution.resolution` above 1), or the estimated error or the invariants' drift
             exceeds the tolerance asked for (`simulate`'s rtol and atol; `Solution.error`,
@@ -76,6 +78,105 @@ class Status(enum.IntFlag):
 FLAGS = tuple(flag for flag in Status if flag)
 
 
+def _code(other):
+    return other.code if isinstance(other, Flags) else other
+
+
+class Flags(eqx.Module):
+    """A result's `status`: `Status` flags OR-ed into an integer array (one per run, batched
+    under vmap) that prints in words (`Flags<limit exceeded>`), as diffrax's `RESULTS` does, and
+    still computes as the integer array: `status & Status.X`, `status == 0`, `int(status)`,
+    `jnp.where(..., status, ...)` and `np.asarray(status)` under jit and vmap alike.
+
+    Args:
+        code: the flags, an integer array (or `Flags`).
+    """
+
+    code: Array
+
+    def __init__(self, code):
+        code = jnp.asarray(_code(code))
+        self.code = code if jnp.issubdtype(code.dtype, jnp.integer) else code.astype(jnp.int32)
+
+    def __jax_array__(self) -> Array:
+        return self.code
+
+    def __array__(self, dtype=None, copy=None) -> np.ndarray:
+        return np.asarray(self.code, dtype=dtype)
+
+    def __and__(self, other) -> Array:
+        return self.code & _code(other)
+
+    __rand__ = __and__
+
+    def __or__(self, other) -> "Flags":
+        return Flags(self.code | _code(other))
+
+    __ror__ = __or__
+
+    def __eq__(self, other) -> Array:
+        return self.code == _code(other)
+
+    def __ne__(self, other) -> Array:
+        return self.code != _code(other)
+
+    __hash__ = None
+
+    def __int__(self) -> int:
+        return int(self.code)
+
+    __index__ = __int__
+
+    def __bool__(self) -> bool:
+        return bool(self.code)
+
+    def __getitem__(self, index) -> "Flags":
+        return Flags(self.code[index])
+
+    def __len__(self) -> int:
+        return len(self.code)
+
+    def __iter__(self):
+        return (self[i] for i in range(len(self)))
+
+    @property
+    def shape(self) -> tuple:
+        return self.code.shape
+
+    @property
+    def ndim(self) -> int:
+        return self.code.ndim
+
+    @property
+    def dtype(self):
+        return self.code.dtype
+
+    def astype(self, dtype) -> Array:
+        return self.code.astype(dtype)
+
+    def item(self) -> int:
+        return int(self.code)
+
+    def tolist(self):
+        return np.asarray(self.code).tolist()
+
+    def __repr__(self) -> str:
+        if isinstance(self.code, jax.core.Tracer):
+            return f"Flags<{self.code.aval.str_short()}>"
+        codes = np.asarray(self.code)
+        if codes.ndim == 0:
+            return f"Flags<{describe(int(codes), {})}>"
+        words = [describe(int(c), {}) for c in codes.ravel()]
+        return f"Flags<shape {codes.shape}: " + "; ".join(words) + ">"
+
+    __str__ = __repr__
+
+
+def flags(code) -> Flags:
+    """code as `Flags` (a result's status field converter)."""
+    return code if isinstance(code, Flags) else Flags(code)
+
+
 def raise_on_failure(result, throw: bool, who: str):
     """`result` (a `WithStatus`) as it is, or, with throw=True, an error (`eqx.error_if`, so also
     under jit and vmap) naming the first failure flag set in its status, as diffrax's
@@ -121,7 +222,7 @@ class WithStatus(eqx.Module):
     def __str__(self) -> str:
         """The status in words, as `print(result)` shows it: "Solution: success", or each flag
         with its cause (`messages()`); a batch counts its runs per message."""
-        if isinstance(self.status, jax.core.Tracer):
+        if isinstance(_code(self.status), jax.core.Tracer):
             return repr(self)
         words = self.messages()
         if len(words) == 1:

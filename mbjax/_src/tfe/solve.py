@@ -21,7 +21,7 @@ from jax import Array
 from mbjax._src.lie.inputs import check_point, check_rotation
 from mbjax._src.system.accuracy import DRIFT_LIMIT, doubled, sample_indices, tolerances
 from mbjax._src.system.invariants import drifts
-from mbjax._src.system.status import (DRIFTED, ESTIMATED, FLAGS, Status, WithStatus,
+from mbjax._src.system.status import (Flags, flags, DRIFTED, ESTIMATED, FLAGS, Status, WithStatus,
                                       accuracy_notes, raise_on_failure)
 from mbjax._src.tfe.body import Body
 from mbjax._src.tfe.elements import Element
@@ -82,7 +82,7 @@ class TFESolution(WithStatus):
         p_hat: spatial momenta about O', shape (n_elements + 1, nq).
         iterations: Newton iterations per element, shape (n_elements,).
         residual: each element's final residual norm, shape (n_elements,).
-        status: the `Status` flags, an integer array.
+        status: the `Status` flags, as `Flags` (an integer array that prints in words).
         error: the estimated error of the final state, as `mbjax.integrate.Solution`'s (NaN
             where no tolerance was asked).
         drift: the invariants' largest relative drift over the boundaries, as
@@ -99,7 +99,7 @@ class TFESolution(WithStatus):
     p_hat: Array
     iterations: Array
     residual: Array
-    status: Array
+    status: Flags = eqx.field(converter=flags)
     error: Array = float("nan")
     drift: Array = float("nan")
     drifting: Array = -1

@@ -13,7 +13,7 @@ from jax import Array
 from mbjax._src.control import Constant
 from mbjax._src.integrate import RK4
 from mbjax._src.integrate.base import AbstractIntegrator
-from mbjax._src.system.status import Status, WithStatus
+from mbjax._src.system.status import Flags, flags, Status, WithStatus
 from mbjax._src.system.system import AbstractSystem
 from mbjax._src.trajopt.ilqr import CROCODDYL_SCHEDULE, ILQR
 from mbjax._src.trajopt.knots import AbstractKnot, Knot, Schedule
@@ -49,7 +49,7 @@ class Tick(eqx.Module):
 
     iterations: Array
     cost: Array
-    status: Array
+    status: Flags = eqx.field(converter=flags)
 
 
 class Cycle(eqx.Module):
@@ -275,7 +275,7 @@ class ClosedLoop(WithStatus):
     iterations: Array
     costs: Array
     solves: Array
-    status: Array
+    status: Flags = eqx.field(converter=flags)
 
 
 def closed_loop(controller: MPC, plant: AbstractSystem, q0: Array, v0: Array, *, ticks: int,

@@ -10,7 +10,7 @@ from jax import Array
 
 from mbjax._src.system.accuracy import RESOLUTION_LIMIT
 from mbjax._src.system.accuracy import resolution as accuracy_resolution
-from mbjax._src.system.status import RESOLVED, Status, WithStatus, accuracy_notes
+from mbjax._src.system.status import Flags, flags, RESOLVED, Status, WithStatus, accuracy_notes
 from mbjax._src.trajopt.problem import Problem
 
 
@@ -54,7 +54,7 @@ class Result(WithStatus):
     costs: Array
     iterations: Array
     feedback: Array
-    status: Array
+    status: Flags = eqx.field(converter=flags)
     resolution: Array = float("nan")
     inaccurate_by: Array = 0
 
