@@ -2,7 +2,7 @@
 
     python benchmarks/bench_accuracy.py [--out DIR] [--quick]
 
-is `mbjax bench accuracy`; the suite itself is mbjax_harness/bench/accuracy.py, so that the
+is `mbjax bench accuracy`; the suite itself is harness/mbjax_harness/bench/accuracy.py, so that the
 installed `mbjax` command runs it too.
 """
 

@@ -4,7 +4,7 @@ outside `jax.jit`.
 
     python benchmarks/bench_compile.py [--out DIR]
 
-is `mbjax bench compile`; the suite itself is mbjax_harness/bench/compile_time.py, so that the installed
+is `mbjax bench compile`; the suite itself is harness/mbjax_harness/bench/compile_time.py, so that the installed
 `mbjax` command runs it too.
 """
 

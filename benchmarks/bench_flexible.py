@@ -2,7 +2,7 @@
 
     python benchmarks/bench_flexible.py [--out DIR] [--quick]
 
-is `mbjax bench flexible`; the suite itself is mbjax_harness/bench/flexible.py, so that the installed `mbjax`
+is `mbjax bench flexible`; the suite itself is harness/mbjax_harness/bench/flexible.py, so that the installed `mbjax`
 command runs it too.
 """
 

@@ -2,7 +2,7 @@
 
     python benchmarks/bench_integrators.py [--out DIR] [--quick]
 
-is `mbjax bench integrators`; the suite itself is mbjax_harness/bench/integrators.py, so that the
+is `mbjax bench integrators`; the suite itself is harness/mbjax_harness/bench/integrators.py, so that the
 installed `mbjax` command runs it too.
 """
 

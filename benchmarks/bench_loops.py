@@ -2,7 +2,7 @@
 
     python benchmarks/bench_loops.py [--out DIR] [--quick]
 
-is `mbjax bench loops`; the suite itself is mbjax_harness/bench/loops.py, so that the installed `mbjax`
+is `mbjax bench loops`; the suite itself is harness/mbjax_harness/bench/loops.py, so that the installed `mbjax`
 command runs it too.
 """
 

@@ -4,7 +4,7 @@ process.
 
     python benchmarks/bench_rigid.py [--out DIR] [--quick]
 
-is `mbjax bench rigid`; the suite itself is mbjax_harness/bench/rigid.py, so that the installed `mbjax`
+is `mbjax bench rigid`; the suite itself is harness/mbjax_harness/bench/rigid.py, so that the installed `mbjax`
 command runs it too.
 """
 

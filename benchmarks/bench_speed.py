@@ -4,7 +4,7 @@ process.
 
     python benchmarks/bench_speed.py [--out DIR] [--quick]
 
-is `mbjax bench speed`; the suite itself is mbjax_harness/bench/speed.py, so that the installed `mbjax`
+is `mbjax bench speed`; the suite itself is harness/mbjax_harness/bench/speed.py, so that the installed `mbjax`
 command runs it too.
 """
 

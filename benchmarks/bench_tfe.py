@@ -2,7 +2,7 @@
 
     python benchmarks/bench_tfe.py [--out DIR] [--quick]
 
-is `mbjax bench tfe`; the suite itself is mbjax_harness/bench/tfe.py, so that the installed `mbjax`
+is `mbjax bench tfe`; the suite itself is harness/mbjax_harness/bench/tfe.py, so that the installed `mbjax`
 command runs it too.
 """
 

@@ -3,7 +3,7 @@ Pinocchio (aba per call, abaInParallel), mujoco.rollout and MJX, in one run.
 
     python benchmarks/bench_throughput.py [--out DIR] [--quick]
 
-is `mbjax bench throughput`; the suite itself is mbjax_harness/bench/throughput.py. On a machine with a
+is `mbjax bench throughput`; the suite itself is harness/mbjax_harness/bench/throughput.py. On a machine with a
 GPU (jax[cuda]) the same command runs the mbjax side there.
 """
 

@@ -3,7 +3,7 @@ a time and 64 reach targets at once.
 
     python benchmarks/bench_trajopt.py [--out DIR] [--quick]
 
-is `mbjax bench trajopt`; the suite itself is mbjax_harness/bench/trajopt.py. Its GPU side:
+is `mbjax bench trajopt`; the suite itself is harness/mbjax_harness/bench/trajopt.py. Its GPU side:
 benchmarks/trajopt_gpu.py.
 """
 

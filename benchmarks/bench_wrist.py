@@ -4,7 +4,7 @@ parameter sweep on one device and sharded over several.
     python benchmarks/bench_wrist.py [--out DIR] [--quick]
     XLA_FLAGS=--xla_force_host_platform_device_count=2 python benchmarks/bench_wrist.py
 
-is `mbjax bench wrist`; the suite itself is mbjax_harness/bench/wrist.py.
+is `mbjax bench wrist`; the suite itself is harness/mbjax_harness/bench/wrist.py.
 """
 
 import sys

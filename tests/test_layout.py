@@ -4,6 +4,7 @@ harness (command line, tour, benchmarks, reproductions, plotting)."""
 
 import ast
 import importlib
+import re
 import subprocess
 import sys
 from pathlib import Path
@@ -13,7 +14,7 @@ import mbjax
 ROOT = Path(__file__).parent.parent
 PACKAGE = ROOT / "mbjax"
 SRC = PACKAGE / "_src"
-HARNESS = ROOT / "mbjax_harness"
+HARNESS = ROOT / "harness" / "mbjax_harness"
 
 # mbjax/_src's packages and modules, lowest first: each may import its own layer and those below
 # (and `mbjax.data`, the model files shipped with the package)
@@ -151,11 +152,29 @@ def test_public_names_have_google_style_docstrings():
 
 
 def test_import_mbjax_loads_no_harness_or_plotting():
-    code = ("import sys, mbjax; print(' '.join(sorted(m for m in sys.modules if m == 'matplotlib' "
-            "or m.startswith(('matplotlib.', 'mbjax_harness')))))")
+    code = ("import sys, mbjax; print(' '.join(sorted(m for m in sys.modules if m in "
+            "('matplotlib', 'diffrax') or m.startswith(('matplotlib.', 'diffrax.', "
+            "'mbjax_harness')))))")
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True,
                          cwd=ROOT)
     assert out.stdout.strip() == "", out.stdout
+
+
+def test_the_library_alone_requires_neither_plotting_nor_diffrax():
+    """The library's distribution (the repository root) needs jax, equinox, optax and numpy; the
+    harness (harness/, the `mbjax` command) is a distribution of its own that brings matplotlib
+    and diffrax, and `solve_reference`'s diffrax is the `reference` extra."""
+    import tomllib
+
+    library = tomllib.loads((ROOT / "pyproject.toml").read_text())["project"]
+    names = [re.split(r"[<>=;\[ ]", r)[0] for r in library["dependencies"]]
+    assert names == ["jax", "jaxlib", "equinox", "optax", "numpy"], names
+    assert "scripts" not in library
+    assert library["optional-dependencies"]["reference"] == ["diffrax>=0.6"]
+    harness = tomllib.loads((HARNESS.parent / "pyproject.toml").read_text())["project"]
+    assert harness["scripts"] == {"mbjax": "mbjax_harness.cli:main"}
+    assert {re.split(r"[<>=]", r)[0] for r in harness["dependencies"]} >= {
+        "mbjax", "matplotlib", "diffrax"}
 
 
 PRIVATE = "mbjax._src"

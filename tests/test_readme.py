@@ -73,8 +73,8 @@ def test_the_readme_is_short_and_leads_with_code():
     assert len(text.split()) <= MAX_WORDS
     first = text.splitlines().index("```python") + 1
     assert first <= FIRST_LINES, first
-    assert "pip install . && mbjax tour --quick" in text
-    assert 'pip install ".[test]" && python -m pytest' in text
+    assert "pip install . ./harness && mbjax tour --quick" in text
+    assert 'pip install ".[test]" ./harness && python -m pytest' in text
     assert len(BLOCKS) >= 5
 
 

@@ -1,6 +1,8 @@
-"""Adaptive, error-controlled reference solutions through diffrax."""
+"""Adaptive, error-controlled reference solutions through diffrax (an optional dependency:
+`pip install "mbjax[reference]"`)."""
 
-import diffrax
+import importlib
+
 import equinox as eqx
 import jax
 import jax.numpy as jnp
@@ -40,6 +42,7 @@ def solve_reference(system: AbstractSystem, q0: Array, u0: Array, ts, *, rtol: f
             interval's solve failed (too many steps, say).
 
     Raises:
+        ImportError: diffrax is not installed (`pip install "mbjax[reference]"`).
         ValueError: ts (when concrete) is not at least two increasing times.
         equinox.EquinoxRuntimeError: with throw=True, the solve failed.
 
@@ -54,6 +57,7 @@ def solve_reference(system: AbstractSystem, q0: Array, u0: Array, ts, *, rtol: f
         rate Gamma^-1 is singular and only fixed-step drivers, which rescale after each step,
         pass.
     """
+    _diffrax()
     if not isinstance(ts, jax.core.Tracer):
         times = np.asarray(ts, dtype=float)
         if times.ndim != 1 or times.size < 2 or not np.all(np.diff(times) > 0):
@@ -62,8 +66,18 @@ def solve_reference(system: AbstractSystem, q0: Array, u0: Array, ts, *, rtol: f
                             "mbjax.integrate.solve_reference")
 
 
+def _diffrax():
+    """diffrax, imported where a reference is asked for, or an ImportError saying how to get it."""
+    try:
+        return importlib.import_module("diffrax")
+    except ImportError as error:
+        raise ImportError("mbjax.integrate.solve_reference runs diffrax's adaptive solvers: "
+                          'pip install "mbjax[reference]" (or pip install diffrax)') from error
+
+
 @eqx.filter_jit
 def _solve(system, q0, u0, ts, rtol, atol, solver, max_steps):
+    diffrax = _diffrax()
     ts = jnp.asarray(ts)
     term = diffrax.ODETerm(
         lambda t, y, args: (system.kinematics(y[0], y[1]), system.acceleration(t, y[0], y[1])))
