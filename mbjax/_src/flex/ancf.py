@@ -71,28 +71,7 @@ class AncfBeam(eqx.Module):
     Raises:
         ValueError: n_elements < 1 or n_gauss < 3.
 
-    The element:
-        The planar gradient-deficient beam of Berzeri & Shabana (J. Sound Vib. 235, 2000) with
-        the "elastic line" strain measures of Gerstmayr & Irschik (J. Sound Vib. 318, 2008):
-
-        - node coordinates (x, y, dx/ds, dy/ds); element coordinates e_k = (r_A, r_A', r_B,
-          r_B') of its two nodes, global index 4 * node + i, so element k owns the contiguous
-          slice 4k ... 4k + 7;
-        - cubic Hermite interpolation r(s) = S(xi) e_k, xi = s_local / l,
-          S = [h1 I, h2 I, h3 I, h4 I];
-        - constant consistent mass matrix M = int rhoA S^T S ds (exact with the Gauss rule
-          below);
-        - U(e) = 1/2 int (EA eps^2 + EI kappa^2) ds with the engineering axial strain
-          eps = |r'| - 1 and the curvature kappa = (r' x r'')_z / |r'|^3. Linearised about the
-          straight state, eps -> u' and kappa -> v'', so small-strain frequencies are
-          Euler-Bernoulli's; the axial law is linear in the stretch (Green strain would add an
-          artificial hardening at large stretch). |r'| - 1 couples transverse slopes into the
-          axial strain (eps ~ u' + v'^2 / 2), which is the geometric stiffening that Anderson
-          1993 adds to modal models by eqs 32-33.
-        - Gauss-Legendre quadrature with `n_gauss` points per element (default 5: exact for the
-          mass matrix (degree 6), and for eps and kappa, which are not polynomials, converged:
-          the stiffness at the straight state is a degree-4 polynomial, exact from 3 points
-          on).
+    More on the element: the documentation site's Details page (docs/details.md).
     """
 
     length: Array

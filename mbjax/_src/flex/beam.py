@@ -61,7 +61,7 @@ class Beam(eqx.Module):
     """Uniform straight beam along the body x axis, n_elements equal 2-node, 12-dof elements.
 
     The structural model M x_dd + K x = 0 of Anderson 1993 eq (9) (`matrices`), with the dof
-    conventions below. Array fields are differentiable leaves (float64);
+    conventions in docs/details.md. Array fields are differentiable leaves (float64);
     `n_elements` and `timoshenko` are static. `Beam.round` and `Beam.rectangle` build solid
     sections.
 
@@ -84,22 +84,7 @@ class Beam(eqx.Module):
     Raises:
         ValueError: a parameter that is not positive and finite, or a bad n_elements.
 
-    Conventions:
-        - The beam runs from node 0 at the body-frame origin along the body x axis; the element
-          frame is the body frame, so no rotation between local and body components is needed.
-        - Node dofs are ordered (ux, uy, uz, rx, ry, rz): displacements, then small rotations,
-          so global dof 6 i + d belongs to node i. For Euler-Bernoulli bending rz = duy/dx and
-          ry = -duz/dx.
-        - Bending in the xy plane (uy, rz) uses Iz; bending in the xz plane (uz, ry) uses Iy;
-          torsion (rx) uses G J for stiffness and the polar moment Iy + Iz for inertia.
-        - Timoshenko elements use the interdependent interpolation (Przemieniecki's stiffness;
-          the shape functions of Friedman and Kosmatka) with Phi = 12 E I / (kappa G A Le^2);
-          Phi = 0 is Euler-Bernoulli.
-
-        The decoupled dof groups of a straight beam (axial ux; torsion rx; xy bending uy, rz;
-        xz bending uz, ry) are solved as separate eigenproblems, so that the equal frequencies
-        of the two bending planes of a symmetric section do not make eigenvector gradients
-        singular.
+    More on conventions: the documentation site's Details page (docs/details.md).
     """
 
     L: jax.Array

@@ -58,7 +58,7 @@ for i, j, k in ((0, 1, 2), (1, 2, 0), (2, 0, 1)):
 
 class ModalBody(eqx.Module):
     """The time-invariant coefficients of a flexible body with mu modal coordinates (Anderson
-    1993's Appendix; the coefficients below), its modal stiffness and damping, the
+    1993's Appendix; the coefficients in docs/details.md), its modal stiffness and damping, the
     geometric-stiffening matrices, and the modal shapes at the grid points where other bodies or
     cut joints attach.
 
@@ -84,41 +84,8 @@ class ModalBody(eqx.Module):
         distal_stiffening: eq 33's K_check_Gh for loads at each attachment point, shape
             (H, 6, mu, mu).
 
-    The coefficients:
-        Anderson 1993 lumps the body's mass and rotary inertia at points P (eqs 36-42): a point
-        at undeformed position rho_p (from the joint grid J, the body frame's origin) moves to
-        xi_p = rho_p + phi_p q (eq 5) and turns by psi_p q (eq 8), q the modal coordinates. With
-        A_p = [rho_p, phi_p] (3 x (1 + mu)) and q_bar = (1, q), every mass integral the
-        equations need is a contraction of four time-invariant coefficients, computed once (the
-        Appendix, eqs A1-A39, in tensor form):
-
-            mass          m      = sum_p m_p
-            first         S      = sum_p m_p A_p                        (3, 1 + mu)
-            second        P      = sum_p m_p A_p (x) A_p                (3, 1 + mu, 3, 1 + mu)
-            rotary        I_0    = sum_p I_p,   I_psi = sum_p I_p psi_p
-            modal mass    M_ff   = sum_p m_p phi_p^T phi_p + psi_p^T I_p psi_p
-
-        so that sum_p m_p xi_p = S q_bar and sum_p m_p xi_p xi_p^T = P : (q_bar, q_bar). The
-        body's generalized mass in (omega, v, u) (body-frame angular velocity and velocity of
-        the origin, modal rates; eqs 41-42, 51-53) is then
-
-            [[J(q),       xi~(q),  C(q)],          J = tr(Q) 1 - Q + I_0,  Q = P : (q_bar, q_bar)
-             [xi~(q)^T,   m 1,     S_1 ],          xi~ = skew(S q_bar),    S_1 = S[:, 1:]
-             [C(q)^T,     S_1^T,   M_ff]]          C = sum_p m_p xi_p~ phi_p + I_psi
-
-        with no sum over the points at run time. The velocity terms are not expanded by hand
-        (the Appendix's long list of remainder terms): the kinetic energy T = w^T M(q) w / 2
-        gives them by autodiff through the Boltzmann-Hamel equations of the floating frame,
-
-            d/dt dT/dV + V x* dT/dV = f,        d/dt dT/du - dT/dq = Q,
-
-        i.e. M(q) w_dot + M_dot w + (V x* h; -dT/dq) with h = M w, M_dot = dM/dq . u.
-
-    Geometric stiffening:
-        Geometric stiffening (eqs 32-33, 46, Table 1) enters the modal equation as K_G q with
-        K_G = sum_q s_q K_q (21 inertial unit loads, `mbjax/_src/flex/stiffening.py`) plus the
-        distal bodies' loads; the temporal scalars s are linear in the body's acceleration, so
-        K_G q = G_s A + g_s.
+    More on the coefficients, geometric stiffening: the documentation site's Details page
+    (docs/details.md).
     """
 
     mass: Array

@@ -37,8 +37,8 @@ class ModalBasis(eqx.Module):
         shapes: phi in full beam dofs (zero on held dofs), shape (6N, mu).
         frequencies: angular frequency of each column [rad/s], shape (mu,) (nan for constraint
             and static columns that were not orthonormalized).
-        kinds: per column "normal", "constraint", "static" or "reduced" (the kinds below);
-            static.
+        kinds: per column "normal", "constraint", "static" or "reduced" (the kinds in
+            docs/details.md); static.
 
     Kinds:
         "normal": a fixed-interface normal mode; "constraint": a constraint mode; "static": a
@@ -89,7 +89,8 @@ def craig_bampton(beam: Beam, *, clamped_node=0, interface_nodes=(), n_modes=Non
     """Craig-Bampton basis of `beam` clamped at `clamped_node` (Anderson 1993 sec. 2.2, eq (10)).
 
     The columns are the fixed-interface normal modes, then the constraint modes of the
-    interface nodes, then the static-correction modes of `static_load_nodes` (the basis below).
+    interface nodes, then the static-correction modes of `static_load_nodes` (the basis in
+    docs/details.md).
 
     Args:
         beam: the beam.
@@ -112,25 +113,7 @@ def craig_bampton(beam: Beam, *, clamped_node=0, interface_nodes=(), n_modes=Non
         ValueError: both or neither of n_modes and cutoff, nodes outside the beam or repeated,
             an empty basis, no interior dofs, or (orthonormalized) linearly dependent columns.
 
-    The basis:
-        The body frame is clamped at the joint grid J^k (`clamped_node`), so rigid motion stays
-        in the joint coordinates and the modal basis holds deformation only (Anderson 1993 eqs
-        (5)-(7) measure phi relative to J^k; here phi is zero at J^k by construction). The
-        basis columns are, in this order:
-
-        - fixed-interface normal modes (J^k and all interface-node dofs held), the lowest
-          `n_modes` or those with angular frequency <= `cutoff`;
-        - constraint modes: static shape for a unit displacement of each free dof of each
-          interface node, the other interface dofs held (Craig and Bampton 1968);
-        - static-correction modes: static shape for a unit load at each free dof of each
-          `static_load_nodes` node, interface held (Anderson 1993 sec. 2.2).
-
-        With `orthonormalize=True` (default) the assembled basis is rotated by the eigenvectors
-        of the reduced problem (phi^T K phi, phi^T M phi), so M_r = I and
-        K_r = diag(frequencies^2), sorted ascending; `kinds` is then "reduced" for every column
-        (a column mixes origins). When the basis holds only normal modes no rotation is needed
-        or done (kinds "normal"). With `orthonormalize=False` the columns keep their origin in
-        `kinds` and `frequencies` is nan for constraint and static columns.
+    More on the basis: the documentation site's Details page (docs/details.md).
     """
     if (n_modes is None) == (cutoff is None):
         raise ValueError("craig_bampton: give exactly one of n_modes or cutoff")

@@ -98,7 +98,7 @@ def simulate(system: AbstractSystem, integrator: AbstractIntegrator, q0: Array, 
             grows like sqrt(T) rather than T, for about one more forward pass. The values
             computed are the same.
         rtol: relative tolerance on the final state's error and on the invariants' drift
-            (see Accuracy with a tolerance, below); None for 0 where atol is given.
+            (see Accuracy with a tolerance in docs/details.md); None for 0 where atol is given.
         atol: absolute tolerance on the final state's error, in the state's units.
         throw: raise an error naming the failure (`Status.failures()`) instead of returning a
             solution whose status carries it (also under `jit` and `vmap`, through
@@ -118,49 +118,8 @@ def simulate(system: AbstractSystem, integrator: AbstractIntegrator, q0: Array, 
         equinox.EquinoxRuntimeError: with throw=True, the run failed (raised when the compiled
             program runs).
 
-    The rollout:
-        The steps run as a `lax.scan` nested in blocks whose length is the greatest common divisor
-        of the save indices, so only saved states are kept (memory O(len(saveat)) for uniform
-        saves). The returned `Solution.status` flags non-finite states and unconverged implicit
-        steps, and whatever the system's `check` reports at the start and at the ends of the blocks
-        (every saved state). Each step runs the system as `system.hold(t, q, u)` gives it (sampled
-        controls frozen at the step's start), and the system's `constrain` after it. A batched
-        system (`BatchTreeSystem`) has a status per copy. `Solution.messages()` says each flag in
-        words with what tripped it and when it was first raised (`Solution.flagged_at`).
-
-    Default accuracy check:
-        Always on. At every step the rollout estimates the step times the motion's fastest rate from
-        consecutive increments of the state, |d_k - d_(k-1)| / |d_(k-1)|, the least over the
-        configuration's and the velocity's (`step_ratio` in `mbjax/_src/system/accuracy.py`), and sets
-        INACCURATE where it stays above 1 (about six steps per period of an oscillation) for 3 steps
-        in a row: a method past its stability limit (1.2 to 3.5 measured) or a step far too long for
-        the motion, caught before the state overflows. `Solution.resolution` is its largest value.
-        Its cost is a few vector operations per step (benchmarks/README.md, section "accuracy",
-        measures it and its false alarms over every scene and reproduction: none). It does not see
-        errors that grow slowly through a resolved motion (a chaotic chain's, an energy drift): the
-        tolerance does (Accuracy with a tolerance, below).
-
-    Accuracy with a tolerance:
-        Given rtol or atol, the solution carries an error estimate (`Solution.error`) and the status
-        INACCURATE where it exceeds the tolerance: the root mean square over the state's components
-        of error / (atol + rtol |y|) above 1, the norm of Hairer, Norsett and Wanner (Solving ODEs
-        I, II.4) that diffrax and SciPy use. The estimate is step doubling (Richardson) at up to
-        `ERROR_SAMPLES` states along the run (the start, the saved states, and where those are
-        sparse, states the rollout keeps for it at evenly spaced steps): from each, one step of dt
-        against two of dt / 2 gives the local error of a step, 2^p / (2^p - 1) times their
-        difference for a method of order p, and the global error is estimated as the sum of the
-        local errors over the run's steps (their mean over the samples times the number of steps;
-        errors amplified by an unstable or chaotic motion are not seen). It costs three steps per
-        sample and a second compilation of the step. For a symplectic method the estimate is
-        conservative (its local errors cancel along an oscillation instead of adding up), so its
-        INACCURATE errs on the safe side; see benchmarks/README.md.
-
-        The second measure sees what step doubling misses: the drift of the invariants the system
-        has (`AbstractSystem.invariants`: a passive system's energy, a floating tree's momenta; the
-        constraint residual is the closed loops' own status) over the start and the saved states,
-        relative to the motion's scale (`mbjax/_src/system/invariants.py`), is `Solution.drift`, and
-        INACCURATE is also set where it exceeds a positive rtol (atol, in the state's units, does
-        not apply to it).
+    More on the rollout, default accuracy check, accuracy with a tolerance: the documentation
+    site's Details page (docs/details.md).
     """
     if not isinstance(system, AbstractSystem):
         hint = (" (wrap a Model in TreeSystem(model))" if type(system).__name__ == "Model"

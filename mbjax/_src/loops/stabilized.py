@@ -47,42 +47,12 @@ class Stabilized(AbstractLoopMethod):
     Args:
         epsilon (float): the epsilon-dynamics' parameter (>= 0; 0: algebraic loads); static.
         kappa (float): position feedback (>= 0, needs epsilon > 0): the position error then stays
-            below epsilon |f_c| / kappa (see The method, below); static.
+            below epsilon |f_c| / kappa (see The method in docs/details.md); static.
 
     Raises:
         ValueError: a negative epsilon or kappa, or kappa without epsilon.
 
-    The method:
-        Anderson 1993's constraint stabilization on top of the O(n) recursion (§2.4, eqs 89-108).
-
-        The unconstrained recursion gives eta, the accelerations with every constraint load removed
-        (eq 101); the same recursion driven by unit generalized constraint loads, the rows of A,
-        with no gravity and no velocity gives the columns of Gamma (eqs 102-107: zeta = -Gamma f_c),
-        so
-
-        ```text
-        u_dot + Gamma f_c = eta                                                   (eq 108)
-        ```
-
-        costs one triangularization and m + 1 force passes of O(n) (the tree's `responses`, rigid or
-        flexible). The constraint loads f_c follow from A u_dot + b = 0:
-
-        - epsilon = 0: (A Gamma) f_c = A eta + b, an m x m solve, O(m^3) (regularized and rank-checked
-          as in `mbjax/_src/loops/multipliers.py`);
-        - epsilon > 0, Anderson 1993's epsilon-dynamics (eqs 89-93): f_c is a state with
-          epsilon f_c_dot + A Gamma f_c = A eta + b, which relaxes onto the algebraic value on the time
-          scale epsilon / eig(A Gamma); its integral keeps A u + B - epsilon f_c constant (zero when
-          f_c starts from eq 89). The velocity error is then epsilon f_c: the paper's constraints are
-          nonholonomic, and for holonomic ones the position error Phi grows like the integral of
-          epsilon f_c (linearly under a steady load such as gravity).
-        - kappa > 0 (an addition to the paper, for holonomic constraints): eq 89 applied to the
-          error A u + B + kappa Phi instead, so epsilon f_c_dot + A Gamma f_c = A eta + b + kappa (A u + B)
-          and Phi_dot + kappa Phi = epsilon f_c: the position error stays bounded by
-          epsilon |f_c| / kappa. The load equation keeps its fast time scale epsilon / eig(A Gamma)
-          and gains a slow one, 1 / kappa.
-
-        Total cost O(n m + m^3) = O(n + m^3) for a fixed number of loops. Here f_c = -K_c of
-        `mbjax/_src/loops/coupled.py` (Anderson 1993 counts the loads with the opposite sign).
+    More on the method: the documentation site's Details page (docs/details.md).
     """
 
     epsilon: float = eqx.field(static=True, default=0.0)

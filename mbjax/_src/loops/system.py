@@ -54,8 +54,8 @@ def _with_forces(tree: AbstractTreeSystem, control, external, external_point) ->
 class ClosedSystem(AbstractSystem):
     """A tree closed by `closures`, solved by a loop method, as a system for `mbjax.simulate`.
 
-    Its state is the tree's configuration q and the method's velocity state u (see The state,
-    below): make u with `initial_state(q, v)` after putting the initial conditions on the
+    Its state is the tree's configuration q and the method's velocity state u (see The state in
+    docs/details.md): make u with `initial_state(q, v)` after putting the initial conditions on the
     constraints with `consistent_state`.
 
     Args:
@@ -87,12 +87,7 @@ class ClosedSystem(AbstractSystem):
             a control or external load given both here and to the tree, tolerance <= 0 or
             iterations < 1.
 
-    The state:
-        The configuration is the tree's q, shape (nq,). The velocity state u is the method's:
-        the joint velocities v (`Coupled`, `Stabilized()`), the momenta M v (`Momentum`), or v
-        and the loads (`Stabilized(epsilon > 0)`, shape (nv + m,)); make it with
-        `initial_state(q, v)` and read v back with `velocity(q, u)`. Put initial conditions on
-        the constraints first with `consistent_state`.
+    More on the state: the documentation site's Details page (docs/details.md).
     """
 
     loops: Loops

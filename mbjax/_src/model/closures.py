@@ -54,7 +54,8 @@ def active_flag(active, name: str) -> Array:
 
 class CutJoint(eqx.Module):
     """A joint between frame A in body `body_a` and frame B in body `body_b` (-1: the ground),
-    cut to make the mechanism a tree; its residual Phi(q, t) = 0 per kind is listed below.
+    cut to make the mechanism a tree; its residual Phi(q, t) = 0 per kind is listed in
+    docs/details.md.
 
     A closed chain is modelled as a spanning tree (`mbjax.model.Model`) plus cut joints. Each
     frame is a placement (rotation, origin) in its body's frame; the joint's axis is the frame's
@@ -83,23 +84,7 @@ class CutJoint(eqx.Module):
             `active` that is not a boolean scalar.
         TypeError: body indices that are not ints.
 
-    Residuals:
-        Holonomic constraints Phi(q, t) = 0 (Jerkovsky 1978 eq 85, Anderson 1993 eq 87), from
-        the poses of the two frames (ground components), with their number of equations:
-
-            spherical      p_A - p_B                                                     3
-            revolute       p_A - p_B, z_A . x_B, z_A . y_B                                5
-            universal      p_A - p_B, x_A . y_B          (cross axes x_A and y_B)         4
-            weld           p_A - p_B, vee(R_B^T R_A - R_A^T R_B) / 2                      6
-            spatial_weld   (R_A + R_B)^T (p_A - p_B) / 2, vee(R_B^T R_A - R_A^T R_B) / 2    6
-                           (on the weld its rate is A's twist in A's axes and its second
-                           derivative A's spatial acceleration, omega x v from the weld's)
-            prismatic      (p_A - p_B) . x_B, (p_A - p_B) . y_B, vee(...) / 2  (along z_B) 5
-            point_on_line  (p_A - p_B) . x_B, (p_A - p_B) . y_B  (p_A on the line z_B)   2
-            point_on_plane (p_A - p_B) . z_B                     (p_A on the plane z_B)  1
-
-        Planar mechanisms built from revolute cut joints carry redundant equations (a planar
-        loop needs only two); the solvers detect the rank and report it.
+    More on residuals: the documentation site's Details page (docs/details.md).
     """
 
     kind: str = eqx.field(static=True)

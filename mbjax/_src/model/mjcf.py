@@ -399,50 +399,8 @@ def load_mjcf(source: str | os.PathLike, *, strict: bool = False) -> Model:
         ValueError: MuJoCo's compiler rejects the file, a model without joints, or
             (strict=True) implausible inertial data.
 
-    The compiler:
-        MuJoCo is the reference parser: `load_mjcf` compiles the file or string with
-        `mujoco.MjModel.from_xml_path` / `from_xml_string`, and `from_mujoco` reads the compiled
-        mjModel arrays. Everything the compiler resolves is therefore handled as MuJoCo handles it:
-        defaults and classes, `<include>`, every orientation form (quat, euler with eulerseq,
-        axisangle, xyaxes, zaxis, compiler angle="degree"/"radian"), inertias inferred from geoms,
-        fullinertia/diaginertia, mass and inertia bounds, joint ref positions.
-
-    The mapping:
-        MuJoCo body frames, joints and names to mbjax:
-
-        - A MuJoCo body with k joints becomes k bodies, the first k - 1 massless and named
-          "body/joint", applied in MuJoCo's order. An mbjax joint sits at its body's origin, so each
-          body's frame is put at its joint's anchor (jnt_pos; same orientation as MuJoCo's) and the
-          centre of mass, child placements and frames are shifted by -anchor. A hinge or slide joint
-          with a ref position is offset so that q is MuJoCo's qpos. q and v follow qpos and qvel
-          (`mbjax.model.state_from_mujoco` converts the free joints' velocities).
-        - A body without joints is welded to its parent: its mass merges into the parent (parallel
-          axes; a body welded to the world is part of the ground) and its name becomes a named frame.
-          Sites become named frames, and so does a body whose last joint is off its origin, so that
-          `mbjax.rigid.frame_pose(model, q, name)` is MuJoCo's xpos/xmat for every body and
-          site_xpos/site_xmat for every site (a site named like a body is "site/NAME").
-        - hinge -> revolute, slide -> prismatic, ball -> spherical, free -> free.
-        - Joint data: jnt_range of limited hinges and slides as lower/upper, dof_armature plus the
-          armature of actuators on the joint (gear^2-scaled, MuJoCo >= 4) as armature, dof_damping
-          plus such actuators' damping as damping (zero where the model disables dampers),
-          jnt_stiffness and qpos_spring of hinges and slides as stiffness and spring_reference
-          (zero where the model disables springs),
-          dof_frictionloss as friction, jnt_actfrcrange of force-limited joints as effort_limit;
-          opt.gravity (zero where disabled). Limits and friction are data, not forces. A free
-          joint's translational armature is left out: MuJoCo adds it to the world-frame linear
-          velocity, whose rate in mbjax's body-frame velocity has a term omega x v that a diagonal
-          armature cannot give (its damping and rotational armature map exactly).
-        - Active connect and weld equality constraints (body or site semantics) become
-          `mbjax.loops.CutJoint`s ("spherical", "weld") with the same zero set as MuJoCo's residual:
-          the model's `closures`.
-
-    Not modelled:
-        What mbjax does not model (actuator forces, tendons, ball and free joints' springs,
-        polynomial springs and damping, gravity compensation, fluid forces, flexes, plugins,
-        ball joint limits, other equality constraints, free joints' translational armature),
-        and what `TreeSystem(model)` leaves to `mbjax.contact.ContactSystem` (contacts), is
-        named in one `ModelWarning`, also with `strict=True`, which makes only implausible
-        inertias errors.
+    More on the compiler, the mapping, not modelled: the documentation site's Details page
+    (docs/details.md).
     """
     mujoco = _mujoco()
     text = str(source)

@@ -131,7 +131,7 @@ def load_urdf(source: str | bytes | os.PathLike, *, floating_base: bool = False,
         floating_base: add a free joint above the root link (else it is welded to the ground).
         gravity (Array): gravitational acceleration in the world frame [m/s^2], shape (3,).
         sibling_order: "name" (Pinocchio's numbering) or "document" (MuJoCo's; see The
-            mapping, below).
+            mapping in docs/details.md).
         armature (float | Array): rotor inertia on every joint coordinate [kg m^2 or kg], a
             number or an (nv,) array.
         min_mass: lower bound on every body's mass [kg] (MuJoCo's boundmass), a remedy for
@@ -153,44 +153,8 @@ def load_urdf(source: str | bytes | os.PathLike, *, floating_base: bool = False,
             tree, no movable joint, an unknown sibling_order, or (strict=True) implausible
             inertial data.
 
-    The mapping:
-        Links with `<inertial>` become bodies; revolute and continuous joints become revolute
-        joints, prismatic joints prismatic ones and floating joints free joints; a fixed joint
-        merges its child link (mass, centre of mass and inertia, and the placements of the joints
-        beyond it) into the parent body, and keeps the link and the joint as named frames
-        (`mbjax.rigid.frame_pose`). The root link is welded to the ground unless
-        `floating_base=True` adds a free joint. Bodies are numbered depth-first from the root, as
-        Pinocchio numbers its joints, so q and v line up with Pinocchio's. Pinocchio (through
-        urdfdom, which keeps joints in a name-sorted map) visits the children of a link in order of
-        joint name; that is the default here. `sibling_order="document"` visits them in document
-        order instead, as MuJoCo's URDF import does.
-
-    Inertial data:
-        Masses and inertias are checked on the bodies after the merge, as MuJoCo checks them, so a
-        dummy root, sensor and contact frames welded by fixed joints load whatever their data.
-        Implausible but computable data (CAD inertias that break the triangle inequality, round-off
-        negatives, a massless leaf on a moving joint) loads with a `ModelWarning` naming the link
-        and the fix (`strict=True`: an error; see `mbjax.model.ModelWarning`); non-finite or unparsable
-        numbers are errors.
-
-    Joint data:
-        `<limit>` gives position (revolute, prismatic), effort and velocity limits (a revolute or
-        prismatic joint without `<limit>`, which the specification requires, loads without position
-        limits, as MuJoCo reads it, with a warning), `<dynamics>` damping (used by the dynamics) and
-        friction (kept as data); `armature=` adds rotor inertia to every joint (URDF has no field
-        for it). `<mimic>` joints load as independent joints, as Pinocchio and MuJoCo load them,
-        with a warning; their couplings are the model's `closures` (`mbjax.loops.Coupling`s), which
-        `mbjax.loops.ClosedSystem(TreeSystem(model), model.closures)` enforces.
-
-    Collision geometry:
-        Each link's `<collision>` spheres, boxes and cylinders become the model's `geoms`
-        (`mbjax.model.Geoms`, on the body the link is merged into; MuJoCo's default contact
-        parameters), and a mesh (STL, OBJ or COLLADA) the box bounding its vertices, with a
-        `ModelWarning` that says so; `mbjax.contact.ContactSystem` detects their contacts with
-        what they are joined with (`model.geoms.join(mbjax.model.ground_plane())`: the robot on
-        a floor). No two of the robot's own geoms form a pair (a URDF does not say which may
-        touch, and the boxes of neighbouring links' meshes overlap); give the pairs for
-        self-collisions with `Geoms(..., pairs=...)`.
+    More on the mapping, inertial data, joint data, collision geometry: the documentation site's
+    Details page (docs/details.md).
     """
     if sibling_order not in ("name", "document"):
         raise ValueError(f"sibling_order must be 'name' or 'document', got {sibling_order!r}")

@@ -314,9 +314,9 @@ def batched_forward_dynamics(model: Model, q: Array, v: Array, tau: Array) -> Ar
     """`mbjax.forward_dynamics` of B states at once, in the throughput layout (batch last inside).
 
     Anderson 1993's O(n) recursion (§2.3) with every scalar an array over the batch
-    (`batch_aba`, laid out as below); agrees with `jax.vmap(mbjax.forward_dynamics)` to
-    rounding, which takes this route by itself for large batches. Gravity comes from the model;
-    no external wrenches. The arithmetic follows q's dtype.
+    (`batch_aba`, laid out as docs/details.md says); agrees with
+    `jax.vmap(mbjax.forward_dynamics)` to rounding, which takes this route by itself for large
+    batches. Gravity comes from the model; no external wrenches. The arithmetic follows q's dtype.
 
     Args:
         model: a tree of revolute and prismatic joints only (nq = nv).
@@ -330,34 +330,7 @@ def batched_forward_dynamics(model: Model, q: Array, v: Array, tau: Array) -> Ar
     Raises:
         ValueError: q is not (B, nv), or the model has a joint other than revolute or prismatic.
 
-    The layout:
-        The single-state recursion (`aba`, behind `mbjax.forward_dynamics`) is written for one
-        state, in ground coordinates, with general motion subspaces and 6x6 blocks; `jax.vmap`
-        of it puts the batch first and leaves XLA many tiny matrix products per state.
-        `batch_aba` runs the same three passes for B states at once, written for the CPU's
-        vector units and XLA's fusion:
-
-        - structure of arrays: every scalar of the recursion (a component of a 3-vector, of a
-          3x3 block) is one array over the batch, and the 3- and 6-vectors are Python tuples of
-          them. A step of a pass is then one straight-line program of elementwise operations on
-          B-long arrays, which XLA fuses into a few loops whose intermediates stay in
-          registers: no `dot_general`, no reduce, no concatenate;
-        - body coordinates (Featherstone's form of the recursion, X the parent-to-child
-          transform): a 1-DOF joint's motion subspace is then a constant unit vector s, (a; 0)
-          for a revolute joint about a, (0; a) for a prismatic one (joint-axis sparsity), so
-          U = I_2 s, D = s.U and S u_dot are products with constants, and the remainder
-          acceleration of eqs 29-31 is c = V x (s v);
-        - the articulated inertia handed to the parent (X^T I_3 X, Anderson 1993 eqs 45-50) in
-          3x3 blocks: a rotation, then a shift of origin by cross products;
-        - `mbjax.tree`'s passes (a carry-only scan for a chain, a scan over bodies or depth
-          levels for a tree), so compile time stays flat in n;
-        - the angular and linear blocks A and M of an (articulated) inertia are symmetric: their
-          upper triangles are computed and mirrored, the lower entries being the same arrays;
-        - the joint angles' sines and cosines are computed for the whole batch before the
-          passes, by `lie.sincos` (XLA calls the C library's for `jnp.sin` element by element,
-          slowest inside a loop compiled as one kernel).
-
-        The last two are the largest single gains (the timings are in benchmarks/README.md).
+    More on the layout: the documentation site's Details page (docs/details.md).
     """
     q = jnp.asarray(q)
     if q.ndim != 2 or q.shape[1] != model.nv:

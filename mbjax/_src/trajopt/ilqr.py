@@ -92,7 +92,7 @@ class ILQR(AbstractIterativeSolver):
     """Iterative LQR (DDP with the dynamics' first derivatives) with box-constrained controls.
 
     A solver strategy for `mbjax.trajopt.solve`; the algorithm and its schedule are described
-    below. It steps in the state's tangent space, so floating bases and continuous
+    in docs/details.md. It steps in the state's tangent space, so floating bases and continuous
     joints need nothing special. The result's `feedback` holds the gains of the last
     accepted iteration, acting on deviations `Problem.difference(x_k, x)`.
 
@@ -108,69 +108,8 @@ class ILQR(AbstractIterativeSolver):
             a failure).
         qp_iterations: projected Newton steps of the bounded control step (static).
 
-    The iteration:
-        Each iteration (Li and Todorov 2004; Tassa, Erez and Todorov 2012; the control bounds as in
-        Tassa, Mansard and Todorov 2014):
-
-        1.  linearize about the current trajectory in the state's tangent space (deviations
-            dx = difference(x_k, x), so a floating base's quaternion needs nothing special):
-            A_k = df/dx, B_k = df/du by `jax.jacfwd` of the problem's integrator step
-            (`Problem.linearize`), and the costs' gradients and Hessians (Gauss-Newton for
-            residual costs, `Problem`), all vmapped over time;
-
-        2.  a backward Riccati pass (`lax.scan`, reversed) from V = the terminal cost's expansion:
-
-            ```text
-            Q_x = l_x + A^T V_x,        Q_u = l_u + B^T V_x,
-            Q_xx = l_xx + A^T V_xx A,   Q_uu = l_uu + B^T V_xx B + mu I,   Q_ux = l_ux + B^T V_xx A,
-            ```
-
-            the control step k_k minimizes the quadratic model 1/2 d^T Q_uu d + Q_u^T d within the bounds
-            (a projected Newton method on the box, a fixed number of iterations), and the feedback
-            K_k = -Q_uu_ff^-1 Q_ux on the controls it leaves free (zero rows on the clamped ones); the
-            value function is carried back through the closed loop. The stage's small products are
-            written out (`linalg.small_dot`) and Q_uu's Cholesky too, so the scan compiles as one
-            kernel (the arm's pass 1.1 -> 0.25 ms, benchmarks/README.md);
-
-        3.  a forward pass u = clip(u_k + alpha k_k + K_k difference(x_k, x)), the step length alpha backtracking
-            through `steps` until the cost decrease is at least a fraction of the model's prediction;
-
-        4.  mu, the regularization of Q_uu, shrinks tenfold after an accepted step longer than
-            `shrink_above`, grows tenfold after one of `grow_below` or shorter and after a failure (a
-            Q_uu that is not positive definite, or no acceptable step), and stays otherwise; after a
-            failure the next iteration reuses step 1's expansion, the trajectory being the same.
-
-    Schedules:
-        The defaults shrink mu after every accepted step and accept a step achieving 1e-4 of the
-        predicted decrease (Armijo), with the step lengths 1, 1/2, 1/4, 1/10, ..., 1e-3.
-        `ILQR(**CROCODDYL_SCHEDULE)` takes Crocoddyl's FDDP schedule instead (Mastalli et al. 2020):
-        steps halving from 1 to 2^-9, a tenth of the predicted decrease to accept, mu starting at
-        FDDP's 1e-9, shrunk only after steps above 1/2 and grown after steps of 1/100 or shorter
-        (the iterations it takes against FDDP's: benchmarks/README.md). Neither schedule wins
-        everywhere (Crocoddyl's on the semi-implicit Euler benchmark problems, the defaults on the
-        acrobot with RK4 steps); see benchmarks/README.md.
-
-    Infeasible start:
-        From a state trajectory (`solve`'s states0, Crocoddyl's xs; each knot's state held where
-        the guess puts it, so the steps leave gaps e_k = difference(x_{k+1}, step(x_k, u_k))),
-        the iteration is Crocoddyl's FDDP (Mastalli et al. 2020, "Crocoddyl: an efficient and
-        versatile framework for multi-contact optimal control", Algorithm 1): the backward
-        pass takes each value's gradient at the step's end, V_x + V_xx e_k; the forward pass
-        closes a fraction alpha of every gap, x_{k+1} = step(x_k, u_k) (+) (alpha - 1) e_k (a full
-        step is a rollout); the predicted change counts the gaps, and a step that closes gaps
-        may raise the cost by up to twice a predicted increase. It is converged only once
-        the gaps are closed (below 1e-9); without states0 the gaps are zero and it is the
-        iteration above.
-
-    Stopping:
-        The iterations are one `lax.while_loop`, so `solve` compiles once. It stops with success
-        when an accepted step lowers the cost by less than `tolerance` relative to it (or the model
-        predicts less), and with NOT_CONVERGED when `iterations` run out or mu passes its ceiling. A
-        step cut short because a longer one's cost was not finite (a cost or dynamics undefined over
-        part of the controls) does not count as converged, however small its change: where a solve
-        stops unconverged after an iteration that a non-finite cost kept from progressing (no
-        acceptable step, or one changing the cost by less than the tolerance), its status adds
-        NONFINITE.
+    More on the iteration, schedules, infeasible start, stopping: the documentation site's Details
+    page (docs/details.md).
     """
 
     iterations: int = eqx.field(static=True, default=200)

@@ -33,42 +33,8 @@ class MultipleShooting(AbstractSolver):
         regularization: added to the control blocks, raised tenfold after a failed step.
         qp_iterations: projected Newton steps of the bounded control step (static).
 
-    The method:
-        Multiple shooting: the states at the knots are unknowns beside the controls, and the
-        dynamics are constraints, the defects e_k = f(x_k, u_k) - x_{k+1} = 0 (Bock and Plitt 1984),
-        measured in the state's tangent space (e_k = difference(x_{k+1}, f(x_k, u_k)), steps taken
-        by x (+) dx, as `ILQR`'s), enforced by an augmented Lagrangian (Hestenes 1969; Powell 1969):
-
-        ```text
-        M(xs, us) = sum_k l(x_k, u_k) dt + l_N(x_N) + sum_k lambda_k^T e_k + rho / 2 sum_k |e_k|^2.
-        ```
-
-        Inner iterations take Gauss-Newton steps on M for (xs, us) together (`ILQR`'s expansion: the
-        dynamics' Jacobians A_k, B_k and the costs' Gauss-Newton Hessians, all vmapped over the
-        knots). The step's linear-quadratic problem has the knots' states free, tied by the penalty:
-        in the backward pass each next state y is eliminated in closed form. With
-        V(y) = 1/2 y^T V y + v^T y the value at k + 1 and w = e_k + A dx + B du,
-
-        ```text
-        min_y rho/2 |w - y|^2 + lambda^T (w - y) + V(y):   y = S (rho w + lambda - v),
-        S = (rho I + V)^-1, value 1/2 w^T P w + p^T w with P = rho S V, p = S V lambda + rho S v,
-        ```
-
-        so the Riccati recursion of `ILQR` runs with (p + P e_k, P) in place of (V_x, V_xx); as rho
-        grows it becomes DDP's with the gaps e_k carried (as in Crocoddyl's FDDP). The step is
-        applied along the knots (no nonlinear rollout), with a backtracking line search on M: each
-        trial is one vmapped evaluation of all the knots at once. After an inner solve the
-        multipliers take lambda_k += rho e_k, and rho grows tenfold when the largest defect has not
-        fallen to a quarter.
-
-    First guess and result:
-        The first guess's states are the rollout of its controls, or a given state trajectory (an
-        infeasible start, as Crocoddyl's FDDP takes one: the knots need not be connected by the
-        dynamics; the first is the problem's x0). The trajectory returned is the rollout of the
-        final controls (its `cost` the problem's objective of it), which the knots match to the
-        defect tolerance; `costs` holds the merit M after each inner iteration. Success when the
-        largest defect is below `defect_tolerance` and the last inner solve's relative decrease fell
-        below `tolerance`.
+    More on the method, first guess and result: the documentation site's Details page
+    (docs/details.md).
     """
 
     iterations: int = eqx.field(static=True, default=300)

@@ -33,14 +33,14 @@ class Problem(eqx.Module):
         system (AbstractSystem | Sequence[Knot | Impulse]): any mbjax system with a control
             (`TreeSystem`, `FlexibleSystem`, `WristSystem`, `RigidBody`, a `ClosedSystem` of a
             tree, ...), whose control is replaced by the unknowns u_k; or one knot per step, a
-            multi-phase problem (see Phases, below).
+            multi-phase problem (see Phases in docs/details.md).
         q0 (Array): initial configuration, shape (nq,).
         v0 (Array): initial velocity, shape (nv,).
         dt: the step and control interval, seconds (keyword only).
         horizon: the number of steps N (keyword only); None for the number of knots.
         running: cost rate running(q, v, u), a scalar or a vector of residuals; or a tuple of
-            such functions, their sum (keyword only; see Costs, below); None with knots, which
-            carry their own.
+            such functions, their sum (keyword only; see Costs in docs/details.md); None with
+            knots, which carry their own.
         terminal: final cost terminal(q, v), likewise (keyword only).
         lower (float | Array | None): lower bound on each actuated force, a scalar or shape
             (nu,); None for none.
@@ -56,54 +56,8 @@ class Problem(eqx.Module):
             knots, knots of different numbers of controls, bounds of the wrong shape, lower
             above upper.
 
-    Formulation:
-        The unknowns are the controls u_0 ... u_{N-1}, one value per step of length dt held over
-        the step (a zero-order hold, as a digital controller and MuJoCo's `ctrl` apply them), on
-        the system's actuated velocity coordinates (its `actuation`, all of them by default). The
-        state is x = (q, v), and the discrete problem is
-
-        ```text
-        minimize    sum_k running(q_k, v_k, u_k) dt + terminal(q_N, v_N)
-        subject to  x_{k+1} = step(x_k, u_k)       (one step of `integrator` from t_k = k dt)
-                    lower <= u_k <= upper,
-        ```
-
-        where `step` runs the system with the constant control u_k, as `mbjax.simulate` would (its
-        `hold`, and after the step its `constrain`: a closed loop's projection). Running costs are
-        rates, weighted by dt as in Crocoddyl's integrated action models, so a problem's optimum
-        does not depend on how finely its horizon is cut. Costs are any JAX functions: weights held
-        in an equinox module are differentiable like the model's parameters.
-
-    Manifolds:
-        States live on the system's configuration manifold (a floating base's quaternion, a
-        continuous joint's angle): second-order solvers linearize in its tangent space, a deviation
-        being dx = difference(x_ref, x) = (system.difference(q_ref, q), v - v_ref), of length ndx =
-        2 nv for a tree (Crocoddyl's `StateMultibody`), and move along it with integrate(x, dx) =
-        (retract(q, dq), v + dv). On Euclidean coordinates both are plain subtraction and addition.
-
-    Phases:
-        A legged robot's problem changes its dynamics along the horizon: each contact phase is
-        its own system (`mbjax.contact.stance` of the feet on the ground), and where a foot lands
-        an impulse stops it (Crocoddyl's shooting problem of action models, one per knot). Such
-        a problem is written knot by knot: `Knot(system, running)` for a step of its system
-        under the held control, weighted by dt, and `Impulse(model, contacts, running)` for a
-        touchdown, which takes no time, moves nothing through the control and whose cost is not
-        weighted. Knots alike but for their arrays (a stance's anchors, a target) form one phase:
-        each phase's step and expansion are compiled once and mapped over its knots, and the
-        rollout takes each knot's branch (`lax.switch`), so compilation grows with the number of
-        distinct phases, not of knots. Costs that depend on the contact forces (a friction cone)
-        are differentiated in the step's forward-mode pass.
-        `mbjax.trajopt.quasi_static` gives Crocoddyl's first guess.
-
-    Costs:
-        A cost function returns either a scalar, taken as it is, or a vector of residuals r, meaning
-        the least-squares cost 1/2 |r|^2 (weights folded into r). The second form is what
-        second-order solvers want: its Hessian is taken as J^T J with J = dr/d(x, u) (Gauss-Newton,
-        as Crocoddyl's residual models do), positive semidefinite wherever the trajectory is, where
-        a scalar cost's exact Hessian (an end-effector distance, say) can be indefinite far from the
-        optimum. A tuple of cost functions is their sum (the residuals stacked).
-        `mbjax.trajopt.state_residual`, `frame_residual` and `control_residual` write Crocoddyl's
-        common costs.
+    More on formulation, manifolds, phases, costs: the documentation site's Details page
+    (docs/details.md).
     """
 
     system: AbstractSystem
@@ -309,8 +263,8 @@ class Problem(eqx.Module):
 
         Per step k: A = dF/ddx and B = dF/du at dx = 0, with F(dx, u) = difference(x_{k+1},
         step(x_k (+) dx, u)), and the gap e = F(0, u_k) (zero along a rollout); and the stage
-        cost's (l_x, l_u, l_xx, l_ux, l_uu), exact or Gauss-Newton for residuals (see Costs, in
-        `Problem`). One forward-mode pass for A and B: one per argument would trace the step
+        cost's (l_x, l_u, l_xx, l_ux, l_uu), exact or Gauss-Newton for residuals (see Costs in
+        docs/details.md). One forward-mode pass for A and B: one per argument would trace the step
         twice, which costs more compilation than it saves (see benchmarks/README.md).
 
         Args:

@@ -25,8 +25,8 @@ def solve(problem: Problem, solver: AbstractSolver = ILQR(), us0: Array | None =
     resolve its motion. A batch of problems is solved in one program too.
 
     Args:
-        problem: the trajectory-optimisation problem, or a batch of problems (see Batches,
-            below).
+        problem: the trajectory-optimisation problem, or a batch of problems (see Batches in
+            docs/details.md).
         solver: the method, an `AbstractSolver` instance (`ILQR()`, `MultipleShooting()`,
             `Shooting()`).
         us0: the first guess, shape (horizon, nu), clipped to the bounds; None for zeros.
@@ -48,26 +48,8 @@ def solve(problem: Problem, solver: AbstractSolver = ILQR(), us0: Array | None =
             starts from a rollout (`Shooting`), or width is not a positive int.
         equinox.EquinoxRuntimeError: with throw=True, the solve failed.
 
-    Compilation:
-        One compiled program: the solver's iterations run inside it. A second problem of the same
-        shapes (another target, another model parameter) reuses the program where its costs hold
-        their data as leaves (equinox modules, or `eqx.Partial` of module-level functions, as
-        `mbjax.scenes.arm.reach_problem` builds them); a fresh closure is a new function, and
-        compiles anew.
-
-    Batches:
-        A batch of problems (every array leaf with a leading axis, as `equinox.filter_vmap` of a
-        problem's builder returns it) is solved in one program too. An iterative solver (`ILQR`)
-        runs it through a working set of `width` problems: a member that stops leaves, and the next
-        problem takes its slot, so the batch costs about its members' total iterations, not its
-        slowest member's for everyone (`mbjax/_src/trajopt/batch.py`), and with several devices (the
-        CPU's cores made devices, GPUs) the batch is split over them, a working set on each. Other
-        solvers are `jax.vmap`ped. `jax.vmap(solve)` stays the plain map.
-
-    Accuracy:
-        The result's status also carries `mbjax.simulate`'s default accuracy check over the
-        optimised trajectory (`Result.resolution`): INACCURATE where its steps do not resolve its
-        motion, an optimum of the discrete dynamics that the continuous ones would not follow.
+    More on compilation, batches, accuracy: the documentation site's Details page
+    (docs/details.md).
     """
     if not isinstance(problem, Problem):
         raise TypeError(f"problem must be a mbjax.trajopt.Problem, got {type(problem).__name__}")
