@@ -36,13 +36,17 @@ LAYERS = (
 RANK = {name: rank for rank, names in enumerate(LAYERS) for name in names}
 NAMESPACES = ("lie", "model", "control", "integrate", "rigid", "flex", "loops", "tfe", "wrist",
               "trajopt", "scenes", "data", "contact")
-MAX_PUBLIC_NAMES = 189       # 150, the contact namespace (legged robots), multi-phase problems,
+MAX_PUBLIC_NAMES = 199       # 150, the contact namespace (legged robots), multi-phase problems,
                              # contacts that find themselves (geoms, their system and model,
                              # the Ant's and HalfCheetah's files) and contact costs (issue 45),
                              # model-predictive control (MPC, Plan, Cycle, Tick,
                              # ClosedLoop, closed_loop, follow), the private door closed (issue
                              # 60): integrate.INTEGRATORS, scenes.TOLERANCE, flex.centreline,
-                             # flex.geometric_stiffness, rigid.frame_poses
+                             # flex.geometric_stiffness, rigid.frame_poses; strategy objects for
+                             # string options (issue 60): trajopt.cosine_adam, wrist.AbstractGradient,
+                             # wrist.ForwardMode, wrist.ReverseMode, tfe.AbstractQuadrature,
+                             # tfe.ExactQuadrature, tfe.ReducedQuadrature, tfe.AbstractReference,
+                             # tfe.ConstantReference, tfe.ConstantVelocityReference
 
 
 def _imports(path: Path):

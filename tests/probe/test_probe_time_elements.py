@@ -17,7 +17,8 @@ from scipy.spatial.transform import Rotation
 
 from mbjax import Status
 from mbjax._src.tfe import State
-from mbjax.tfe import Body, Element, Mixed, PrimalUnsymmetric, initial_state, solve_tfe
+from mbjax.tfe import (Body, ConstantReference, Element, Mixed, PrimalUnsymmetric, initial_state,
+                       solve_tfe)
 
 # one xdist worker runs the module, so its programs compile once (the group tests/conftest.py
 # adds comes after xdist has read the groups)
@@ -247,9 +248,9 @@ def test_an_initial_rate_of_the_wrong_length_is_named(n):
 
 
 @FEW
-@given(st.text(max_size=20).filter(lambda s: s not in ("constant", "constant_velocity")))
+@given(st.text(max_size=20) | st.sampled_from(["constant", "constant_velocity", ConstantReference]))
 def test_unknown_references_are_named(reference):
-    with pytest.raises(ValueError, match="reference must be one of"):
+    with pytest.raises(TypeError, match="reference must be a reference strategy"):
         _march(reference=reference)
 
 

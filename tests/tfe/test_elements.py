@@ -5,8 +5,10 @@ import jax.numpy as jnp
 import numpy as np
 import pytest
 
-from mbjax.tfe import Element
+from mbjax.tfe import Element, ExactQuadrature, ReducedQuadrature
 from mbjax._src.tfe import gauss_legendre, lagrange
+
+QUADRATURES = {"exact": ExactQuadrature(), "reduced": ReducedQuadrature()}
 
 
 @pytest.mark.parametrize("points", [1, 2, 3, 4, 5])
@@ -61,13 +63,13 @@ def test_lagrange_derivative_matches_autodiff_of_the_interpolant(nodes):
 @pytest.mark.parametrize("nodes", [2, 3, 4])
 @pytest.mark.parametrize("quadrature", ["exact", "reduced"])
 def test_element_tables(nodes, quadrature):
-    element = Element(nodes, quadrature)
+    element = Element(nodes, QUADRATURES[quadrature])
     assert element.points == (nodes if quadrature == "exact" else nodes - 1)
     assert element.s.shape == element.ds.shape == (element.points, nodes)
     assert element.length(0.1) == pytest.approx((nodes - 1) * 0.1)
     # the element mass-like matrix int ds ds^T dtau: exact integration gets it right, reduced
     # integration of the two-node element is exact too (ds is constant) but of s s^T is not
-    exact = Element(nodes, "exact")
+    exact = Element(nodes)                     # ExactQuadrature(), the default
     M = (element.ds * element.weights[:, None]).T @ element.ds
     M_exact = (exact.ds * exact.weights[:, None]).T @ exact.ds
     if quadrature == "exact" or nodes == 2:
@@ -79,14 +81,35 @@ def test_element_tables(nodes, quadrature):
         a, b = 2 * N[0, 0], 2 * N[0, 1]
         np.testing.assert_allclose((a, b), (2 / 3, 1 / 3) if quadrature == "exact" else (0.5, 0.5),
                                    rtol=1e-14)
-    assert hash(element) == hash(Element(nodes, quadrature))
+    # a static argument of solve_tfe: equal elements hash alike, whatever instance of the rule
+    assert hash(element) == hash(Element(nodes, type(QUADRATURES[quadrature])()))
+    assert element == Element(nodes, type(QUADRATURES[quadrature])())
 
 
-@pytest.mark.parametrize("args, match", [((1,), "at least 2 nodes"), ((3, "full"), "quadrature must be"),
-                                         ((2.0,), "at least 2 nodes")])
+@pytest.mark.parametrize("args, match", [((1,), "at least 2 nodes"), ((2.0,), "at least 2 nodes")])
 def test_element_rejects_bad_input(args, match):
     with pytest.raises(ValueError, match=match):
         Element(*args)
+
+
+@pytest.mark.parametrize("quadrature, hint", [("exact", ""), ("reduced", ""), ("full", ""),
+                                              (ExactQuadrature, r" \(an instance")])
+def test_element_refuses_a_quadrature_that_is_not_a_strategy_by_name(quadrature, hint):
+    with pytest.raises(TypeError, match=r"quadrature must be a quadrature strategy, "
+                                        r"ExactQuadrature\(\) or ReducedQuadrature\(\)" + hint):
+        Element(3, quadrature)
+
+
+def test_the_quadratures_are_the_old_strings_rules():
+    """ExactQuadrature() is the n-point Gauss-Legendre rule "exact" took, ReducedQuadrature()
+    the (n - 1)-point rule of "reduced": the same points, weights and tables."""
+    for nodes in (2, 3, 4):
+        for quadrature, points in ((ExactQuadrature(), nodes), (ReducedQuadrature(), nodes - 1)):
+            element = Element(nodes, quadrature)
+            tau, weights = gauss_legendre(points)
+            np.testing.assert_array_equal(element.tau, tau)
+            np.testing.assert_array_equal(element.weights, weights)
+            np.testing.assert_array_equal(element.s, lagrange(element.node_tau, tau)[0])
 
 
 def test_bad_rules_and_nodes_are_rejected():

@@ -15,8 +15,12 @@ from mbjax import lie
 from mbjax._src.integrate import Status
 from mbjax.rigid import torque_free_motion
 from mbjax.scenes import torque_free_body as tfb
-from mbjax.tfe import Body, Element, initial_state, solve_tfe
-from mbjax._src.tfe import FORMS, REFERENCES, State, element_map, make_reference
+from mbjax.tfe import (Body, ConstantReference, ConstantVelocityReference, Element,
+                       ExactQuadrature, ReducedQuadrature, Reference, initial_state, solve_tfe)
+from mbjax._src.tfe import FORMS, State, element_map
+
+QUADRATURES = {"exact": ExactQuadrature(), "reduced": ReducedQuadrature()}
+REFERENCES = {"constant": ConstantReference(), "constant_velocity": ConstantVelocityReference()}
 
 TORQUE_FREE = Body(1.0, jnp.diag(jnp.array([tfb.J_TRANSVERSE, tfb.J_TRANSVERSE, tfb.J_AXIAL])),
                    gravity=(0.0, 0.0, 0.0), fixed_point=True)
@@ -26,8 +30,7 @@ STATE0 = initial_state(TORQUE_FREE, jnp.eye(3), jnp.array(tfb.OMEGA0))
 @eqx.filter_jit
 def one_element(form, element, reference, dt):
     """Rotation error after one element from the exact initial state (the local error)."""
-    ref = make_reference(reference, TORQUE_FREE, STATE0.R, STATE0.x, STATE0.p_hat)
-    q1 = jnp.zeros(3)
+    ref, q1 = reference.start(TORQUE_FREE, 0.0, STATE0.R, STATE0.x, STATE0.p_hat)
     z1 = jnp.concatenate([form.to_form(TORQUE_FREE, q1, STATE0.p_hat), q1])
     z2, info = element_map(form, TORQUE_FREE, ref, element, dt, z1)
     h = element.length(dt)
@@ -36,7 +39,8 @@ def one_element(form, element, reference, dt):
 
 
 def fitted_order(form, nodes, reference, quadrature="exact"):
-    element = Element(nodes, quadrature)
+    element = Element(nodes, QUADRATURES[quadrature])
+    reference = REFERENCES[reference]
     dts = np.array([0.04, 0.02, 0.01]) / (nodes - 1)
     errors = []
     for dt in dts:
@@ -102,7 +106,7 @@ def test_free_body_with_offset_reference_point_matches_closed_form(name):
 def test_newton_converges_quadratically():
     """Residual norms before each iteration: r_{k+1} <= C r_k^2 once in the basin."""
     form, element = FORMS["mixed"](), Element(4)
-    ref = make_reference("constant", TORQUE_FREE, STATE0.R, STATE0.x, STATE0.p_hat)
+    ref, _ = ConstantReference().start(TORQUE_FREE, 0.0, STATE0.R, STATE0.x, STATE0.p_hat)
     z1 = jnp.concatenate([STATE0.p_hat, jnp.zeros(3)])
     _, info = jax.jit(lambda z: element_map(form, TORQUE_FREE, ref, element, 0.05, z, tol=0.0,
                                             max_iter=6))(z1)
@@ -125,9 +129,55 @@ def test_status_reports_newton_failure_and_blow_up():
     assert int(sol.status) & int(Status.NONFINITE)
 
 
+# two 3-node primal elements 0.05 s between nodes from STATE0, by the strings "constant" with
+# "exact" quadrature and "constant_velocity" with "reduced" before they were replaced: the final
+# rotation, momentum and Newton iterations per element
+OLD_MARCHES = {
+    (ConstantReference(), ExactQuadrature()): (
+        [[-0.28755143586941606, -0.3395579894461636, 0.8955526469910723],
+         [-0.7645307379277806, -0.4818306175869679, -0.4281728701346739],
+         [0.5768942038996755, -0.8077992496648161, -0.1210514343075688]],
+        [18.749999999999993, 1.824874153436944e-15, 15.0], [6, 6]),
+    (ConstantVelocityReference(), ReducedQuadrature()): (
+        [[-0.2844365498176817, -0.33840746686198825, 0.8969817364360695],
+         [-0.7603594867731386, -0.49022813022558176, -0.4260631774861795],
+         [0.5839086401158174, -0.8032165129699359, -0.11787252983844172]],
+        [18.750000000000004, 9.2519996387361e-16, 14.999999999999991], [4, 4]),
+}
+
+
+@pytest.mark.parametrize("reference, quadrature", list(OLD_MARCHES), ids=["constant-exact",
+                                                                           "velocity-reduced"])
+def test_reference_and_quadrature_strategies_march_as_the_strings_did(reference, quadrature):
+    R, p_hat, iterations = OLD_MARCHES[reference, quadrature]
+    sol = solve_tfe(TORQUE_FREE, STATE0, dt=0.05, n_elements=2, form=FORMS["primal"](),
+                    element=Element(3, quadrature), reference=reference)
+    np.testing.assert_allclose(sol.R[-1], R, rtol=0, atol=1e-12)
+    np.testing.assert_allclose(sol.p_hat[-1], p_hat, rtol=0, atol=1e-12)
+    assert np.asarray(sol.iterations).tolist() == iterations
+
+
+def test_a_prescribed_reference_starts_as_the_one_built_from_the_state():
+    """`Reference.start` shifts the motion and carries the increments over; from the state it was
+    built from, they are zero and it is `ConstantVelocityReference().start`'s."""
+    built, q1 = ConstantVelocityReference().start(TORQUE_FREE, 0.0, STATE0.R, STATE0.x, STATE0.p_hat)
+    assert isinstance(built, Reference) and not np.any(q1)
+    ref, q = built.start(TORQUE_FREE, 0.0, STATE0.R, STATE0.x, STATE0.p_hat)
+    np.testing.assert_allclose(ref.R1, built.R1, atol=1e-15)
+    np.testing.assert_allclose(q, 0.0, atol=1e-15)
+    later, q = built.start(TORQUE_FREE, 0.1, STATE0.R, STATE0.x, STATE0.p_hat)
+    np.testing.assert_allclose(later.R1, built.at(0.1)[0], atol=1e-15)
+    # STATE0 is 0.1 s behind the reference there: its increment is the turn back, -0.1 omega
+    np.testing.assert_allclose(q, -0.1 * built.omega, atol=1e-12)
+
+
 def test_bad_arguments_get_clear_errors():
-    with pytest.raises(ValueError, match="reference must be one of"):
-        solve_tfe(TORQUE_FREE, STATE0, dt=0.1, n_elements=2, reference="spline")
+    for old in ("constant", "constant_velocity", "spline"):
+        with pytest.raises(TypeError, match=r"reference must be a reference strategy, "
+                                            r"ConstantReference\(\), ConstantVelocityReference\(\)"):
+            solve_tfe(TORQUE_FREE, STATE0, dt=0.1, n_elements=2, reference=old)
+    with pytest.raises(TypeError, match=r"an instance: ConstantReference\(\)"):
+        solve_tfe(TORQUE_FREE, STATE0, dt=0.1, n_elements=2, reference=ConstantReference)
     with pytest.raises(ValueError, match="n_elements"):
         solve_tfe(TORQUE_FREE, STATE0, dt=0.1, n_elements=0)
     with pytest.raises(TypeError, match="tfe.Element"):

@@ -11,8 +11,9 @@ from mbjax import lie
 from mbjax_harness.reproduce import top_long_run
 from mbjax_harness.reproduce import vertical_top as rep
 from mbjax.scenes import vertical_top as vt
-from mbjax.tfe import Element, initial_state, solve_tfe, stability
-from mbjax._src.tfe import FORMS, element_map, make_reference
+from mbjax.tfe import (ConstantVelocityReference, Element, ExactQuadrature, ReducedQuadrature,
+                       initial_state, solve_tfe, stability)
+from mbjax._src.tfe import FORMS, element_map
 
 
 # The 2-node rows by default; the 3- and 4-node elements (a compilation each) run with -m slow,
@@ -24,7 +25,7 @@ from mbjax._src.tfe import FORMS, element_map, make_reference
 def test_tables_1_and_2(quadrature, nodes):
     """Imaginary parts within 2e-4; real parts within 1 % where the table prints more than 1e-4,
     below 1e-4 where it prints less (the paper's round-off floor)."""
-    element = Element(nodes, quadrature)
+    element = Element(nodes, rep.QUADRATURES[quadrature])
     for dt, (re, im) in zip(rep.DTS, rep.PAPER[quadrature][str(nodes)]):
         T = rep.top_transition(vt.CRITICAL_SPIN, dt, form=FORMS["primal"](), element=element)
         e = rep.transverse_exponent(T, element.length(dt))
@@ -39,7 +40,7 @@ def test_tables_1_and_2(quadrature, nodes):
 def test_two_node_exponents_are_eqs_7_8_and_7_9(quadrature, a, b):
     """lambda = (B + iC) / |B + iC| mu with mu = (A +- sqrt(D)) / |B + iC| (eqs 7.6-7.9), at and
     above the critical spin."""
-    element = Element(2, quadrature)
+    element = Element(2, rep.QUADRATURES[quadrature])
     mgd = vt.MASS * vt.GRAVITY * vt.D
     for spin in (vt.CRITICAL_SPIN, 1.3 * vt.CRITICAL_SPIN):
         for dt in (0.05, 0.3):
@@ -67,7 +68,7 @@ def test_paper_transition_matrix_equals_the_implicit_function_jacobian(name):
     body = vt.build()
     form = FORMS[name]()
     p_hat = body.mass_matrix(jnp.eye(3)) @ jnp.array([0.0, 0.0, 1.2 * vt.CRITICAL_SPIN])
-    ref = make_reference("constant_velocity", body, jnp.eye(3), jnp.zeros(3), p_hat)
+    ref, _ = ConstantVelocityReference().start(body, 0.0, jnp.eye(3), jnp.zeros(3), p_hat)
     element, dt = Element(3), 0.1
     z1 = jnp.concatenate([p_hat, jnp.zeros(3)])
 
@@ -85,9 +86,9 @@ def test_paper_transition_matrix_equals_the_implicit_function_jacobian(name):
 @pytest.mark.slow     # test_cli's vertical-top reproduction checks the same boundaries by default
 def test_stability_boundaries_of_eq_7_10():
     dts = [0.05, 0.4, 1.0]
-    exact = rep.boundary(FORMS["primal"](), Element(2, "exact"), dts)
+    exact = rep.boundary(FORMS["primal"](), Element(2, ExactQuadrature()), dts)
     np.testing.assert_allclose(exact, vt.exact_boundaries(jnp.asarray(dts))[0], rtol=1e-9)
-    for form, quadrature in (("primal", "reduced"), ("mixed", "exact")):
+    for form, quadrature in (("primal", ReducedQuadrature()), ("mixed", ExactQuadrature())):
         np.testing.assert_allclose(rep.boundary(FORMS[form](), Element(2, quadrature), dts),
                                    vt.CRITICAL_SPIN, rtol=1e-9)
 
@@ -109,7 +110,8 @@ def test_long_march_follows_its_one_element_map(name, march):
     body = vt.build()
     eps = 1e-8
     state0 = initial_state(body, lie.exp(jnp.array([eps, 0.0, 0.0])), jnp.array([0.0, 0.0, spin]))
-    reference = top_long_run.steady_rotation(spin) if march == "steady" else march
+    reference = (top_long_run.steady_rotation(spin) if march == "steady"
+                 else ConstantVelocityReference())
     sol = solve_tfe(body, state0, dt=top_long_run.DT, n_elements=n, form=form, element=element,
                     reference=reference, tol=1e-14)
     assert sol.messages() == ["success"]

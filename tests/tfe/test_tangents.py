@@ -9,8 +9,9 @@ import pytest
 
 from mbjax import lie
 from mbjax.scenes import vertical_top as vt
-from mbjax.tfe import Body, Element, PrimalSymmetric, PrimalUnsymmetric
-from mbjax._src.tfe import FORMS, make_reference
+from mbjax.tfe import (Body, ConstantReference, ConstantVelocityReference, Element, ExactQuadrature,
+                       PrimalSymmetric, PrimalUnsymmetric, ReducedQuadrature)
+from mbjax._src.tfe import FORMS
 from mbjax._src.tfe.tangents import H, element_tangent, pointwise_tangent
 
 RNG = np.random.default_rng(4)
@@ -28,7 +29,8 @@ def test_H_closed_form_matches_autodiff_and_eq_A49(r):
 def steady_top(spin=vt.CRITICAL_SPIN):
     body = vt.build()
     p_hat = body.mass_matrix(jnp.eye(3)) @ jnp.array([0.0, 0.0, spin])
-    return body, make_reference("constant_velocity", body, jnp.eye(3), jnp.zeros(3), p_hat), p_hat
+    ref, _ = ConstantVelocityReference().start(body, 0.0, jnp.eye(3), jnp.zeros(3), p_hat)
+    return body, ref, p_hat
 
 
 def test_primal_tangents_of_the_spinning_top_are_eq_7_2():
@@ -46,9 +48,10 @@ def test_primal_tangents_of_the_spinning_top_are_eq_7_2():
 
 # exact quadrature by default; the reduced rule (covered by default through eqs 7.8-7.9 and
 # Table 2) runs with -m slow
-@pytest.mark.parametrize("quadrature, a, b", [("exact", 2 / 3, 1 / 3),
-                                              pytest.param("reduced", 0.5, 0.5,
-                                                           marks=pytest.mark.slow)])
+@pytest.mark.parametrize("quadrature, a, b", [(ExactQuadrature(), 2 / 3, 1 / 3),
+                                              pytest.param(ReducedQuadrature(), 0.5, 0.5,
+                                                           marks=pytest.mark.slow)],
+                         ids=["exact", "reduced"])
 def test_two_node_element_tangent_is_eq_7_5(quadrature, a, b):
     """K_BB of eq 7.5 on the transverse rotations (x, y): a complex entry alpha + i beta is the
     2x2 block [[alpha, -beta], [beta, alpha]] acting on psi = psi_x + i psi_y.
@@ -84,13 +87,14 @@ def free_body():
 
 
 @pytest.mark.parametrize("name", sorted(FORMS))
-@pytest.mark.parametrize("reference", ["constant", "constant_velocity"])
+@pytest.mark.parametrize("reference", [ConstantReference(), ConstantVelocityReference()],
+                         ids=["constant", "constant_velocity"])
 def test_element_tangent_matches_finite_differences(name, reference):
     body = free_body()
     form = FORMS[name]()
     R1 = lie.exp(jnp.array([0.4, -0.3, 0.8]))
     p_hat1 = body.mass_matrix(R1) @ jnp.array([1.0, -2.0, 3.0, 0.5, 0.1, -0.4])
-    ref = make_reference(reference, body, R1, jnp.array([0.1, 0.2, 0.3]), p_hat1)
+    ref, _ = reference.start(body, 0.0, R1, jnp.array([0.1, 0.2, 0.3]), p_hat1)
     element, dt = Element(3), 0.05
     z1 = jnp.concatenate([form.to_form(body, jnp.zeros(6), p_hat1), jnp.zeros(6)])
     U = form.guess(body, ref, element, z1) + 0.05 * jnp.asarray(RNG.standard_normal(
@@ -107,8 +111,8 @@ def test_symmetric_primal_kinetic_tangent_is_symmetric():
     """Eq B.16: the kinetic part of T_p is symmetric (no forces here), at a general state."""
     body = Body(3.0, free_body().inertia, com=(0.1, -0.2, 0.3), gravity=(0.0, 0.0, 0.0))
     R1 = lie.exp(jnp.array([0.4, -0.3, 0.8]))
-    ref = make_reference("constant_velocity", body, R1, jnp.zeros(3),
-                         body.mass_matrix(R1) @ jnp.array([1.0, -2.0, 3.0, 0.5, 0.1, -0.4]))
+    ref, _ = ConstantVelocityReference().start(
+        body, 0.0, R1, jnp.zeros(3), body.mass_matrix(R1) @ jnp.array([1.0, -2.0, 3.0, 0.5, 0.1, -0.4]))
     q, q_dot = jnp.asarray(RNG.standard_normal(6)) * 0.3, jnp.asarray(RNG.standard_normal(6))
     T = eqx.filter_jit(pointwise_tangent)(PrimalSymmetric(), body, ref, q, q_dot, 0.2)
     np.testing.assert_allclose(T, T.T, atol=1e-12 * float(jnp.abs(T).max()))

@@ -166,17 +166,19 @@ def test_bad_problems_are_refused_with_the_argument_named():
 
 @pytest.mark.slow     # 41 s; test_multiple_shooting keeps the LQR optimum
 def test_single_shooting_reaches_the_lqr_optimum_and_adam_descends():
-    from mbjax.trajopt import Shooting
+    import optax
+
+    from mbjax.trajopt import Shooting, cosine_adam
 
     H, g, c = _slider_qp()
     optimum = 0.5 * np.linalg.solve(H, -g) @ g + c       # 1/2 u^T H u + g^T u + c at u = -H^-1 g
-    lbfgs = solve(_slider_problem(), Shooting("lbfgs"))
+    lbfgs = solve(_slider_problem(), Shooting(optax.lbfgs()))
     assert lbfgs.messages() == ["success"]
     assert abs(float(lbfgs.cost) - optimum) < 1e-7 * optimum
-    adam = solve(_slider_problem(), Shooting("adam", iterations=300, learning_rate=0.5))
+    adam = solve(_slider_problem(), Shooting(cosine_adam(0.5, 300), iterations=300))
     costs = np.asarray(adam.costs)
     assert costs[-1] < 0.05 * costs[0] and float(adam.cost) > optimum - 1e-12
-    with pytest.raises(ValueError, match="method must be one of"):
+    with pytest.raises(TypeError, match="optimizer must be an optax optimizer"):
         Shooting("newton")
 
 

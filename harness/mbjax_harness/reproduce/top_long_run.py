@@ -18,10 +18,10 @@ Two ways of marching:
   (§6's setting, eq 6.7). The growth rate predicted by the transition matrix, max ln|lambda| / h,
   and the one measured from the tilt agree: the primal form's tilt grows exponentially until it
   saturates, the mixed form's follows the physical one.
-- "constant_velocity": `solve_tfe`'s default, a reference built afresh from each element's
-  initial state. The perturbation then also moves the reference, so the one-element map is no
-  longer eq 6.8 / 6.12; its Jacobian (jax.jacfwd through the whole step) gives the predicted rate,
-  and at this coarse step both forms drift.
+- "constant_velocity": `solve_tfe`'s default (`ConstantVelocityReference()`), a reference built
+  afresh from each element's initial state. The perturbation then also moves the reference, so
+  the one-element map is no longer eq 6.8 / 6.12; its Jacobian (jax.jacfwd through the whole
+  step) gives the predicted rate, and at this coarse step both forms drift.
 
 JSON: {"scene", "spin", "critical_spin", "exact_boundary", "dt", "nodes", "tilt0", "duration",
 "physical": {"t", "tilt"}, "runs": [{"form": "primal" | "primal_reduced" | "mixed", "march":
@@ -41,7 +41,8 @@ import numpy as np
 from mbjax import lie
 from mbjax.integrate import solve_reference
 from mbjax.scenes import vertical_top as vt
-from mbjax.tfe import Element, Mixed, PrimalUnsymmetric, Reference, initial_state, solve_tfe
+from mbjax.tfe import (ConstantVelocityReference, Element, ExactQuadrature, Mixed, PrimalUnsymmetric,
+                       ReducedQuadrature, Reference, initial_state, solve_tfe)
 from mbjax_harness.reproduce.vertical_top import top_transition
 from mbjax_harness.timing import measure
 
@@ -52,8 +53,9 @@ NODES = 2
 TILT0 = 1e-4
 DURATION = 80.0
 # (run name, form, quadrature)
-FORMS = (("primal", PrimalUnsymmetric(), "exact"), ("primal_reduced", PrimalUnsymmetric(), "reduced"),
-         ("mixed", Mixed(), "exact"))
+FORMS = (("primal", PrimalUnsymmetric(), ExactQuadrature()),
+         ("primal_reduced", PrimalUnsymmetric(), ReducedQuadrature()),
+         ("mixed", Mixed(), ExactQuadrature()))
 MARCHES = ("steady", "constant_velocity")
 WINDOW = 5.0        # s, for the tilt envelope
 LINEAR_TILT = 3e-2  # rad, below which the growth is fitted
@@ -115,7 +117,7 @@ def tilt_of(R) -> np.ndarray:
     return np.arccos(np.clip(np.asarray(R)[..., 2, 2], -1.0, 1.0))
 
 
-def run(form_name: str, form, quadrature: str, march: str, duration: float, repeats: int,
+def run(form_name: str, form, quadrature, march: str, duration: float, repeats: int,
         rotations: bool = False) -> dict:
     """One march of the top: its tilt, invariants, growth rates, time and status; with
     `rotations`, also "R", the body's rotation at every node (an array, for an animation)."""
@@ -124,7 +126,7 @@ def run(form_name: str, form, quadrature: str, march: str, duration: float, repe
     element = Element(NODES, quadrature)
     R0 = lie.exp(jnp.array([TILT0, 0.0, 0.0]))
     state0 = initial_state(body, R0, jnp.array([0.0, 0.0, spin]))
-    reference = steady_rotation(spin) if march == "steady" else march
+    reference = steady_rotation(spin) if march == "steady" else ConstantVelocityReference()
     n_elements = int(round(duration / element.length(DT)))
     sol, timing = measure(lambda: solve_tfe(body, state0, dt=DT, n_elements=n_elements, form=form,
                                             element=element, reference=reference),

@@ -2,9 +2,9 @@
 
 Each problem (a `mbjax.trajopt.Problem` built by its scene) is solved from the same first guess
 by iLQR (`ILQR`), multiple shooting (`MultipleShooting`: Gauss-Newton on an augmented
-Lagrangian of the defects), single shooting with L-BFGS (`Shooting("lbfgs")`) and Adam
-(`Shooting("adam")`, the first-order baseline). Each solve is one compiled program, timed after
-compiling (`mbjax_harness.timing.measure`); the cost after each iteration is plotted against the time it
+Lagrangian of the defects), single shooting with L-BFGS (`Shooting(optax.lbfgs())`) and Adam
+(`Shooting(cosine_adam(0.01, 1000))`, the first-order baseline). Each solve is one compiled
+program, timed after compiling (`mbjax_harness.timing.measure`); the cost after each iteration is plotted against the time it
 was reached, taken as the iteration's share of the solve's run time (iterations of one solver
 cost about the same). Each problem's iLQR solution is animated, NAME-PROBLEM.gif (JSON
 "animations"). Per problem and solver the JSON gives
@@ -32,14 +32,15 @@ from pathlib import Path
 
 import jax.numpy as jnp
 import numpy as np
+import optax
 
 from mbjax_harness.timing import measure
-from mbjax.trajopt import ILQR, MultipleShooting, Shooting, solve
+from mbjax.trajopt import ILQR, MultipleShooting, Shooting, cosine_adam, solve
 
 NAME = "trajopt"
 SOLVERS = {"ilqr": ILQR(iterations=300), "multiple-shooting": MultipleShooting(iterations=600),
-           "lbfgs": Shooting("lbfgs", iterations=1000),
-           "adam": Shooting("adam", iterations=1000, learning_rate=0.01)}
+           "lbfgs": Shooting(optax.lbfgs(), iterations=1000),
+           "adam": Shooting(cosine_adam(0.01, 1000), iterations=1000)}
 # The quick run (the test suite's) leaves out the first-order baselines: their reverse-mode
 # programs took 26 s of its 130 s to compile, to show costs 3 to 4 orders above iLQR's (the
 # full run has them; `tests/trajopt/test_ilqr.py` and notebook 11 run them by default).

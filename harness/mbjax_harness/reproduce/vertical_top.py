@@ -28,12 +28,15 @@ import jax.numpy as jnp
 import numpy as np
 
 from mbjax.scenes import vertical_top as vt
-from mbjax.tfe import Element, Mixed, PrimalUnsymmetric, Reference, stability
+from mbjax.tfe import (Element, ExactQuadrature, Mixed, PrimalUnsymmetric, ReducedQuadrature,
+                       Reference, stability)
 from mbjax_harness.progress import step
 
 NAME = "vertical-top"
 DTS = tuple(round(0.02 * k, 2) for k in range(1, 11))
 NODES = (2, 3, 4)
+# the tables' names for the quadratures (the JSON's keys, the paper's words)
+QUADRATURES = {"exact": ExactQuadrature(), "reduced": ReducedQuadrature()}
 # Tables 1 and 2 of Borri 1990 as printed: (real, imaginary) per node count, rows dt = 0.02 ... 0.20.
 PAPER = {
     "exact": {
@@ -65,9 +68,9 @@ RADIUS_TOL = 1e-7
 
 
 def moving_with(body, R1, p_hat1) -> Reference:
-    """The reference moving with the top's initial velocity (`solve_tfe`'s "constant_velocity",
-    Borri 1990 eqs 2.2-2.3): from R1, at the angular velocity of the momentum p_hat1 about the
-    fixed point."""
+    """The reference moving with the top's initial velocity (`solve_tfe`'s
+    `ConstantVelocityReference()`, Borri 1990 eqs 2.2-2.3): from R1, at the angular velocity of
+    the momentum p_hat1 about the fixed point."""
     omega = body.momentum_to_velocity(R1, p_hat1)[:3]
     return Reference(R1, jnp.zeros(3), omega, jnp.zeros(3))
 
@@ -95,7 +98,7 @@ def eigenvalue_table(form, quadrature: str, dts) -> dict:
     table = {}
     for nodes in NODES:
         step(f"{type(form).__name__}, {quadrature} quadrature, {nodes} nodes")
-        element = Element(nodes, quadrature)
+        element = Element(nodes, QUADRATURES[quadrature])
         rows = []
         for dt in dts:
             e = transverse_exponent(top_transition(vt.CRITICAL_SPIN, dt, form=form, element=element),
@@ -139,9 +142,9 @@ def reproduce(out: Path, quick: bool = False) -> dict:
         "stability_boundary": {
             "omega": vt.OMEGA,
             "dt": boundary_dts,
-            "exact": boundary(primal, Element(2, "exact"), boundary_dts),
-            "reduced": boundary(primal, Element(2, "reduced"), boundary_dts),
-            "mixed": boundary(mixed, Element(2, "exact"), boundary_dts),
+            "exact": boundary(primal, Element(2, ExactQuadrature()), boundary_dts),
+            "reduced": boundary(primal, Element(2, ReducedQuadrature()), boundary_dts),
+            "mixed": boundary(mixed, Element(2, ExactQuadrature()), boundary_dts),
             "exact_closed_form": [float(b) for b in vt.exact_boundaries(jnp.asarray(boundary_dts))[0]],
             "physical": vt.CRITICAL_SPIN,
         },

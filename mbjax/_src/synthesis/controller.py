@@ -33,7 +33,7 @@ from jax import Array
 
 from mbjax._src.control import AbstractControl
 from mbjax._src.integrate import RK4, simulate
-from mbjax._src.trajopt.descent import adam_descent
+from mbjax._src.trajopt.descent import AbstractGradient, ReverseMode, adam_descent
 from mbjax._src.wrist import WristSystem, kinematics
 
 
@@ -192,8 +192,8 @@ def _batch(episodes: Episodes):
 def train_controller(controller: NeuralController, wrist, episodes: Episodes, *, iterations: int = 300,
                      learning_rate: float = 3e-3, duration: float = 0.6, steps: int = 30, saves: int = 10,
                      pose_tolerance: float = 0.02, speed_tolerance: float = 1.0,
-                     effort_weight: float = 0.1, gradient: str = "reverse", end_power: float = 2.0,
-                     robust: bool = True):
+                     effort_weight: float = 0.1, gradient: AbstractGradient = ReverseMode(),
+                     end_power: float = 2.0, robust: bool = True):
     """Train the controller's MLP through the simulator: Adam on the batch mean of the episode
     cost J (the cost below).
 
@@ -205,8 +205,9 @@ def train_controller(controller: NeuralController, wrist, episodes: Episodes, *,
     from the first iteration, so gradients exist; the network learns what the soft servo lacks
     (speed, the coupling of the legs, gravity away from theta*).
 
-    Reverse-mode gradients by default: the network's weights outnumber what forward mode does
-    cheaply (see `adam_descent` in `mbjax/_src/trajopt/descent.py`). The whole descent is one jitted
+    Reverse-mode gradients by default (`ReverseMode()`): the network's weights outnumber what
+    forward mode (`ForwardMode()`) does cheaply (see `adam_descent` in
+    `mbjax/_src/trajopt/descent.py`). The whole descent is one jitted
     `lax.scan`.
 
     Args:
@@ -221,7 +222,7 @@ def train_controller(controller: NeuralController, wrist, episodes: Episodes, *,
         pose_tolerance: tol, the scale of the pose miss.
         speed_tolerance: omega_tol, the scale of the final speed [rad/s].
         effort_weight: w, the weight of the effort term.
-        gradient: "reverse" or "forward" mode, as `adam_descent` takes it.
+        gradient: how the gradient is taken, `ReverseMode()` or `ForwardMode()` (static).
         end_power: e, the weight (t_k / T)^e towards the end.
         robust: descend on the mean of log(1 + J) (True) or of J (False).
 
@@ -229,7 +230,7 @@ def train_controller(controller: NeuralController, wrist, episodes: Episodes, *,
         (the trained controller, the loss at each iteration, shape (iterations,)).
 
     Raises:
-        ValueError: gradient is neither "forward" nor "reverse".
+        TypeError: gradient is not a gradient strategy (a string, say).
 
     The episode cost:
         J is the tracking cost

@@ -1,6 +1,7 @@
 """Time finite elements for rigid-body dynamics (Borri 1990).
 
-Elements and quadrature (`Element`), the body and its reference motion (`Body`, `Reference`),
+Elements and their quadrature (`Element`; `ExactQuadrature`, `ReducedQuadrature`), the body and
+its reference motion (`Body`; `ConstantReference`, `ConstantVelocityReference`, `Reference`),
 the weak forms as residuals (`PrimalUnsymmetric`, `PrimalSymmetric`, `Mixed`, `MixedUnsymmetric`, `ThreeField`),
 Newton per element with implicit-function-theorem gradients (`newton`), time marching
 (`solve_tfe`, about references rebuilt per element or one prescribed `Reference`), linearized
@@ -10,8 +11,10 @@ stability by transition matrices (`mbjax._src.tfe.stability`) and the hand tange
 
 from mbjax._src.tfe.body import Body as Body
 from mbjax._src.tfe.elements import (
-    QUADRATURES as QUADRATURES,
+    AbstractQuadrature as AbstractQuadrature,
     Element as Element,
+    ExactQuadrature as ExactQuadrature,
+    ReducedQuadrature as ReducedQuadrature,
     gauss_legendre as gauss_legendre,
     lagrange as lagrange,
 )
@@ -23,9 +26,10 @@ from mbjax._src.tfe.primal import (
     PrimalUnsymmetric as PrimalUnsymmetric,
 )
 from mbjax._src.tfe.reference import (
-    REFERENCES as REFERENCES,
+    AbstractReference as AbstractReference,
+    ConstantReference as ConstantReference,
+    ConstantVelocityReference as ConstantVelocityReference,
     Reference as Reference,
-    make_reference as make_reference,
 )
 from mbjax._src.tfe.solve import (
     State as State,

@@ -3,20 +3,21 @@
 An n-node element spans [t_1, t_1 + (n - 1) dt] with its nodes dt apart (dt is "the time between
 nodes" of Tables 1-2). On the unit parameter tau = (t - t_1) / ((n - 1) dt) in [0, 1] the shape
 functions are the Lagrange polynomials through equally spaced nodes, s_k(tau_j) = delta_kj
-(eqs 5.1-5.2); the weak forms are integrated by Gauss-Legendre quadrature with n points ("exact",
-which integrates the element's mass-like products s_dot s_dot exactly) or n - 1 points
-("reduced": one point fewer, the single Gauss point of §7 for the two-node element).
+(eqs 5.1-5.2); the weak forms are integrated by Gauss-Legendre quadrature, a strategy the element
+takes: `ExactQuadrature()`, n points, which integrates the element's mass-like products
+s_dot s_dot exactly, or `ReducedQuadrature()`, n - 1 points (one point fewer, the single Gauss
+point of §7 for the two-node element).
 
 Everything here is static numpy, evaluated once per element type: residuals trace only the
 resulting constant tables.
 """
 
+import abc
 from dataclasses import dataclass
 from functools import cached_property
 
+import equinox as eqx
 import numpy as np
-
-QUADRATURES = ("exact", "reduced")
 
 
 def gauss_legendre(points: int) -> tuple[np.ndarray, np.ndarray]:
@@ -69,6 +70,58 @@ def lagrange(nodes: np.ndarray, tau) -> tuple[np.ndarray, np.ndarray]:
     return values, derivatives
 
 
+class AbstractQuadrature(eqx.Module):
+    """How many Gauss-Legendre points integrate an element's weak form (Borri 1990 §5, §7):
+    `ExactQuadrature()` or `ReducedQuadrature()`, passed to `Element` as `quadrature=`.
+
+    A subclass implements `points`; the rule is Gauss-Legendre's with that many points on the
+    element's unit parameter (`gauss_legendre`).
+    """
+
+    @abc.abstractmethod
+    def points(self, nodes: int) -> int:
+        """The number of Gauss points for an element of `nodes` nodes.
+
+        Args:
+            nodes: the element's number of nodes, at least 2.
+
+        Returns:
+            The number of points, at least 1.
+        """
+
+
+class ExactQuadrature(AbstractQuadrature):
+    """Full Gauss-Legendre quadrature: as many points as the element has nodes, which integrates
+    its mass-like products s_dot s_dot exactly (Borri 1990's "exact" integration, Table 1)."""
+
+    def points(self, nodes: int) -> int:
+        """The number of Gauss points, `nodes`.
+
+        Args:
+            nodes: the element's number of nodes, at least 2.
+
+        Returns:
+            nodes.
+        """
+        return nodes
+
+
+class ReducedQuadrature(AbstractQuadrature):
+    """Reduced Gauss-Legendre quadrature: one point fewer than the element has nodes (Borri 1990's
+    "reduced" integration, Table 2; the single Gauss point of §7 for the two-node element)."""
+
+    def points(self, nodes: int) -> int:
+        """The number of Gauss points, `nodes` - 1.
+
+        Args:
+            nodes: the element's number of nodes, at least 2.
+
+        Returns:
+            nodes - 1.
+        """
+        return nodes - 1
+
+
 @dataclass(frozen=True)
 class Element:
     """An n-node Lagrange time element with its quadrature rule (Borri 1990 §5).
@@ -80,26 +133,32 @@ class Element:
 
     Args:
         nodes: the number of nodes, at least 2, equally spaced dt apart.
-        quadrature: "exact" (Gauss-Legendre with `nodes` points) or "reduced" (one point
-            fewer; the single Gauss point of §7 for the two-node element).
+        quadrature: the quadrature strategy, `ExactQuadrature()` (Gauss-Legendre with `nodes`
+            points, the default) or `ReducedQuadrature()` (one point fewer; the single Gauss
+            point of §7 for the two-node element).
 
     Raises:
-        ValueError: nodes is not an int >= 2, or quadrature is not one of `QUADRATURES`.
+        ValueError: nodes is not an int >= 2.
+        TypeError: quadrature is not a quadrature strategy (the strings "exact" and "reduced"
+            of old, say).
     """
 
     nodes: int = 2
-    quadrature: str = "exact"
+    quadrature: AbstractQuadrature = ExactQuadrature()
 
     def __post_init__(self):
         if not (isinstance(self.nodes, int) and self.nodes >= 2):
             raise ValueError(f"a time element needs at least 2 nodes, got {self.nodes!r}")
-        if self.quadrature not in QUADRATURES:
-            raise ValueError(f"quadrature must be one of {QUADRATURES}, got {self.quadrature!r}")
+        if not isinstance(self.quadrature, AbstractQuadrature):
+            hint = (" (an instance: ExactQuadrature(), not ExactQuadrature)"
+                    if isinstance(self.quadrature, type) else "")
+            raise TypeError(f"quadrature must be a quadrature strategy, ExactQuadrature() or "
+                            f"ReducedQuadrature(){hint}, got {self.quadrature!r}")
 
     @property
     def points(self) -> int:
-        """The number of Gauss points: nodes (exact) or nodes - 1 (reduced)."""
-        return self.nodes if self.quadrature == "exact" else self.nodes - 1
+        """The number of Gauss points: nodes (exact) or nodes - 1 (reduced quadrature)."""
+        return self.quadrature.points(self.nodes)
 
     @cached_property
     def node_tau(self) -> np.ndarray:

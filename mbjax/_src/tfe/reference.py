@@ -3,12 +3,15 @@
 Over an element starting at t_1 the motion is written about a prescribed reference (x_o(t),
 R_o(t)) as x = x_o + x_* and R = R_* R_o with R_* = exp(r_* x I); the unknowns are the incremental
 coordinates q = (r_*, x_*), zero at t_1 when the reference starts from the initial state.
-Two references (§2) are built afresh for every element from its initial state: "constant" (held
-at the initial configuration) and "constant_velocity" (moving with the initial linear and angular
-velocity, R_o = exp((t - t_1) omega_o x I) R_1). A march can instead follow one prescribed
-`Reference` throughout, the steady rotation of eq 7.1 say; the incremental coordinates then carry
-over from element to element, as in the linearized analysis of §6 (eq 6.7).
+What each element is written about is a strategy (`AbstractReference`) `solve_tfe` takes. Two
+references (§2) are built afresh for every element from its initial state: `ConstantReference()`
+(held at the initial configuration) and `ConstantVelocityReference()` (moving with the initial
+linear and angular velocity, R_o = exp((t - t_1) omega_o x I) R_1). A march can instead follow one
+prescribed `Reference` throughout, the steady rotation of eq 7.1 say; the incremental coordinates
+then carry over from element to element, as in the linearized analysis of §6 (eq 6.7).
 """
+
+import abc
 
 import equinox as eqx
 import jax.numpy as jnp
@@ -17,10 +20,87 @@ from jax import Array
 from mbjax._src import lie
 from mbjax._src.tfe.body import Body
 
-REFERENCES = ("constant", "constant_velocity")
+
+class AbstractReference(eqx.Module):
+    """What each element of `solve_tfe` is written about (Borri 1990 §2), passed as `reference=`:
+    `ConstantReference()` or `ConstantVelocityReference()`, built afresh from each element's
+    initial state, or one prescribed `Reference` motion followed by the whole march.
+
+    A subclass implements `start`.
+    """
+
+    @abc.abstractmethod
+    def start(self, body: Body, t, R1: Array, x1: Array, p_hat1: Array) -> tuple["Reference", Array]:
+        """The reference of the element starting at time t in the state (R1, x1, p_hat1), and
+        that state's incremental coordinates about it.
+
+        Args:
+            body: the body.
+            t: the element's start [s], a scalar.
+            R1: initial rotation, shape (3, 3).
+            x1: initial position of O', shape (3,) [m].
+            p_hat1: initial spatial momentum about O', shape (nq,).
+
+        Returns:
+            ref: the element's `Reference`, its time counted from t.
+            q1: the incremental coordinates (r_*, x_*) of (R1, x1) about it, shape (nq,).
+        """
 
 
-class Reference(eqx.Module):
+def _afresh(body: Body, R1: Array, x1: Array, p_hat1: Array, moving: bool) -> tuple["Reference", Array]:
+    """A reference from (R1, x1), held there or moving with the velocities of p_hat1 (eqs
+    2.2-2.3), and q1 = 0."""
+    w1 = body.momentum_to_velocity(R1, p_hat1)
+    if not moving:
+        w1 = jnp.zeros_like(w1)
+    v = jnp.zeros(3, w1.dtype) if body.fixed_point else w1[3:]
+    return Reference(R1, x1, w1[:3], v), jnp.zeros(body.nq, p_hat1.dtype)
+
+
+class ConstantReference(AbstractReference):
+    """Each element about a reference held at its initial configuration ("simply held constant",
+    Borri 1990 §2): x_o = x_1, R_o = R_1."""
+
+    def start(self, body: Body, t, R1: Array, x1: Array, p_hat1: Array) -> tuple["Reference", Array]:
+        """The reference (R1, x1) at rest, and q1 = 0.
+
+        Args:
+            body: the body.
+            t: the element's start [s], a scalar (unused).
+            R1: initial rotation, shape (3, 3).
+            x1: initial position of O', shape (3,) [m].
+            p_hat1: initial spatial momentum about O', shape (nq,).
+
+        Returns:
+            ref: the `Reference` held at (R1, x1).
+            q1: zeros, shape (nq,).
+        """
+        return _afresh(body, R1, x1, p_hat1, moving=False)
+
+
+class ConstantVelocityReference(AbstractReference):
+    """Each element about a reference moving with its initial velocities (Borri 1990 eqs
+    2.2-2.3): x_o = x_1 + (t - t_1) v_1, R_o = exp((t - t_1) omega_1 x I) R_1; `solve_tfe`'s
+    default."""
+
+    def start(self, body: Body, t, R1: Array, x1: Array, p_hat1: Array) -> tuple["Reference", Array]:
+        """The reference from (R1, x1) at the velocities of p_hat1, and q1 = 0.
+
+        Args:
+            body: the body.
+            t: the element's start [s], a scalar (unused).
+            R1: initial rotation, shape (3, 3).
+            x1: initial position of O', shape (3,) [m].
+            p_hat1: initial spatial momentum about O', shape (nq,).
+
+        Returns:
+            ref: the `Reference` moving with the initial velocities.
+            q1: zeros, shape (nq,).
+        """
+        return _afresh(body, R1, x1, p_hat1, moving=True)
+
+
+class Reference(AbstractReference):
     """A reference motion x_o(t) = x_1 + t v_o, R_o(t) = exp(t omega_o x I) R_1 (Borri 1990 §2).
 
     t counts from the reference's start; the reference velocities v_o, omega_o (eqs 2.2-2.3)
@@ -63,31 +143,41 @@ class Reference(eqx.Module):
         R, x = self.at(t)
         return Reference(R, x, self.omega, self.v)
 
+    def start(self, body: Body, t, R1: Array, x1: Array, p_hat1: Array) -> tuple["Reference", Array]:
+        """This motion from time t, and the increments of (R1, x1) about it (they carry over from
+        the previous element).
 
-def make_reference(kind: str, body: Body, R1: Array, x1: Array, p_hat1: Array) -> Reference:
-    """The reference of an element whose initial state is (R1, x1, p_hat1).
+        Args:
+            body: the body.
+            t: the element's start [s], a scalar.
+            R1: initial rotation, shape (3, 3).
+            x1: initial position of O', shape (3,) [m].
+            p_hat1: initial spatial momentum about O', shape (nq,) (unused).
+
+        Returns:
+            ref: the motion shifted to t (`shifted`).
+            q1: the incremental coordinates of (R1, x1) about it, shape (nq,).
+        """
+        ref = self.shifted(t)
+        return ref, increment(body, ref, R1, x1)
+
+
+def check_reference(reference) -> None:
+    """Refuse what is not a reference strategy (the strings "constant" and "constant_velocity"
+    of old).
 
     Args:
-        kind: one of `REFERENCES`: "constant" (held at the initial configuration) or
-            "constant_velocity" (moving with the initial velocities).
-        body: the body.
-        R1: initial rotation, shape (3, 3).
-        x1: initial position of O', shape (3,) [m].
-        p_hat1: initial spatial momentum about O', shape (nq,).
-
-    Returns:
-        The `Reference`.
+        reference: what was passed as `reference=`.
 
     Raises:
-        ValueError: kind is not one of `REFERENCES`.
+        TypeError: reference is not an `AbstractReference` instance.
     """
-    if kind not in REFERENCES:
-        raise ValueError(f"reference must be one of {REFERENCES}, got {kind!r}")
-    w1 = body.momentum_to_velocity(R1, p_hat1)
-    if kind == "constant":
-        w1 = jnp.zeros_like(w1)
-    v = jnp.zeros(3, w1.dtype) if body.fixed_point else w1[3:]
-    return Reference(R1, x1, w1[:3], v)
+    if not isinstance(reference, AbstractReference):
+        hint = (" (an instance: ConstantReference(), not ConstantReference)"
+                if isinstance(reference, type) else "")
+        raise TypeError(f"reference must be a reference strategy, ConstantReference(), "
+                        f"ConstantVelocityReference() or a tfe.Reference motion{hint}, got "
+                        f"{reference!r}")
 
 
 def configuration(body: Body, ref: Reference, q: Array, t) -> tuple[Array, Array]:

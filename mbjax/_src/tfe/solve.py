@@ -1,12 +1,13 @@
 """Time marching element by element: `solve_tfe` (Borri 1990 §5).
 
-Each element starts from the converged end state of the previous one. Its reference (§2) is built
-from that state and the incremental coordinates start at zero; or one prescribed reference motion
-is followed throughout and the increments carry over (§6-7). Newton solves the element's equations
-(eqs 5.3 / 5.8) and the end state (R_2, x_2, p_hat_2) is carried on. Elements are a `lax.scan`,
-Newton a `lax.while_loop` differentiated by the implicit function theorem, so `jax.grad` of any
-function of the solution with respect to the initial state or the body's parameters is exact
-and cheap.
+Each element starts from the converged end state of the previous one. Its reference (§2), a
+strategy (`AbstractReference`), is built from that state and the incremental coordinates start at
+zero (`ConstantReference`, `ConstantVelocityReference`); or one prescribed reference motion
+(`Reference`) is followed throughout and the increments carry over (§6-7). Newton solves the
+element's equations (eqs 5.3 / 5.8) and the end state (R_2, x_2, p_hat_2) is carried on. Elements
+are a `lax.scan`, Newton a `lax.while_loop` differentiated by the implicit function theorem, so
+`jax.grad` of any function of the solution with respect to the initial state or the body's
+parameters is exact and cheap.
 """
 
 import dataclasses
@@ -28,7 +29,8 @@ from mbjax._src.tfe.elements import Element
 from mbjax._src.tfe.form import AbstractForm
 from mbjax._src.tfe.mixed import Mixed
 from mbjax._src.tfe.newton import NewtonInfo, newton
-from mbjax._src.tfe.reference import REFERENCES, Reference, configuration, increment, make_reference
+from mbjax._src.tfe.reference import (AbstractReference, ConstantVelocityReference, Reference,
+                                      check_reference, configuration)
 
 
 class State(eqx.Module):
@@ -162,17 +164,12 @@ def element_map(form: AbstractForm, body: Body, ref: Reference, element: Element
     return form.final(body, ref, element, dt, U, z1), info
 
 
-def _advance(body, state: State, t, dt, tol, prescribed, *, form, element, reference,
+def _advance(body, state: State, t, dt, tol, reference: AbstractReference, *, form, element,
              max_iter) -> tuple[State, NewtonInfo]:
     """One element of node spacing dt from `state` at time t (its reference built from the
-    state, or the prescribed one shifted to t)."""
+    state, or the prescribed one shifted to t: `AbstractReference.start`)."""
     nq = body.nq
-    if prescribed is None:
-        ref = make_reference(reference, body, state.R, state.x, state.p_hat)
-        q1 = jnp.zeros(nq, state.p_hat.dtype)
-    else:
-        ref = prescribed.shifted(t)
-        q1 = increment(body, ref, state.R, state.x)
+    ref, q1 = reference.start(body, t, state.R, state.x, state.p_hat)
     z1 = jnp.concatenate([form.to_form(body, q1, state.p_hat), q1])
     z2, info = element_map(form, body, ref, element, dt, z1, tol=tol, max_iter=max_iter)
     q2 = z2[nq:]
@@ -184,12 +181,15 @@ _STATIC = ("form", "element", "reference", "max_iter")
 
 
 @partial(jax.jit, static_argnames=(*_STATIC, "n_elements"))
-def _march(body, state0, dt, tol, prescribed, *, form, element, n_elements, reference, max_iter):
+def _march(body, state0, dt, tol, dynamic, *, form, element, n_elements, reference, max_iter):
+    """The march; the reference strategy split into its arrays (`dynamic`, traced: a prescribed
+    motion's) and the rest (`reference`, static)."""
     h = element.length(dt)
+    reference = eqx.combine(dynamic, reference)
 
     def step(state, k):
-        new, info = _advance(body, state, k * h, dt, tol, prescribed, form=form, element=element,
-                             reference=reference, max_iter=max_iter)
+        new, info = _advance(body, state, k * h, dt, tol, reference, form=form, element=element,
+                             max_iter=max_iter)
         return new, (new, info.iterations, info.residual, info.converged)
 
     _, (states, iterations, residual, converged) = jax.lax.scan(step, state0, jnp.arange(n_elements))
@@ -232,12 +232,12 @@ def _checked(body, solution: TFESolution, drift_limit) -> TFESolution:
 
 
 @partial(jax.jit, static_argnames=(*_STATIC, "n_elements"))
-def _error_estimate(body, states: State, ts, dt, tol, prescribed, rtol, atol, *, form, element,
+def _error_estimate(body, states: State, ts, dt, tol, dynamic, rtol, atol, *, form, element,
                     n_elements, reference, max_iter):
     """(estimated global error, its ratio to the tolerance) by step doubling from the sampled
-    boundary states (see `solve_tfe`)."""
-    advance = partial(_advance, body, tol=tol, prescribed=prescribed, form=form, element=element,
-                      reference=reference, max_iter=max_iter)
+    boundary states (see `solve_tfe`; the reference split as `_march`'s)."""
+    advance = partial(_advance, body, tol=tol, reference=eqx.combine(dynamic, reference),
+                      form=form, element=element, max_iter=max_iter)
     h = element.length(dt)
 
     def flat(s):
@@ -269,7 +269,8 @@ def _checked_state(body: Body, state0) -> State:
 
 
 def solve_tfe(body: Body, state0: State, *, dt, n_elements: int, form: AbstractForm = Mixed(),
-              element: Element = Element(4), reference: str | Reference = "constant_velocity",
+              element: Element = Element(4),
+              reference: AbstractReference = ConstantVelocityReference(),
               tol=1e-10, max_iter: int = 20, rtol: float | None = None,
               atol: float | None = None, throw: bool = False) -> TFESolution:
     """March a body through `n_elements` time elements of a weak form (Borri 1990 §5).
@@ -285,10 +286,11 @@ def solve_tfe(body: Body, state0: State, *, dt, n_elements: int, form: AbstractF
         n_elements: the number of elements, a positive int.
         form: the weak form, a strategy (`Mixed()`, `PrimalUnsymmetric()`, ...).
         element: the time element (nodes and quadrature).
-        reference: one of `REFERENCES` ("constant", "constant_velocity"), built afresh for
-            each element from its initial state, or a `Reference` motion (from t = 0) followed
-            by the whole march: the increments then carry over between elements, as in the
-            linearized analysis of §6-7, and must stay below pi in rotation.
+        reference: what each element is written about, a strategy: `ConstantReference()` or
+            `ConstantVelocityReference()` (the default), built afresh for each element from its
+            initial state, or a `Reference` motion (from t = 0) followed by the whole march: the
+            increments then carry over between elements, as in the linearized analysis of
+            §6-7, and must stay below pi in rotation.
         tol (float): Newton's tolerance on the step, relative to 1 + |U|.
         max_iter: the most Newton iterations per element.
         rtol: relative tolerance on the final state's error and the invariants' drift.
@@ -301,18 +303,18 @@ def solve_tfe(body: Body, state0: State, *, dt, n_elements: int, form: AbstractF
         The `TFESolution` at the n_elements + 1 boundaries.
 
     Raises:
-        ValueError: reference is neither one of `REFERENCES` nor a `Reference`, n_elements or
-            max_iter is not a positive int, tol is not positive and finite, rtol and atol are
-            negative or both zero, or state0's arrays have the wrong shapes or its R is not a
-            rotation.
-        TypeError: element is not an `Element`, form not a form instance, or state0 not a
-            `State`.
+        ValueError: n_elements or max_iter is not a positive int, tol is not positive and
+            finite, rtol and atol are negative or both zero, or state0's arrays have the wrong
+            shapes or its R is not a rotation.
+        TypeError: element is not an `Element`, form not a form instance, reference not a
+            reference strategy (the strings "constant" and "constant_velocity" of old, say), or
+            state0 not a `State`.
         equinox.EquinoxRuntimeError: with throw=True, the march failed.
 
     Compilation:
-        Jitted once per (form, element, n_elements, reference, max_iter); dt, tol, the body and
-        the state are traced, so sweeps over them do not recompile and they can be
-        differentiated.
+        Jitted once per (form, element, n_elements, reference, max_iter); dt, tol, the body, the
+        state and a prescribed `Reference`'s arrays are traced, so sweeps over them do not
+        recompile and they can be differentiated.
 
     Default accuracy check:
         Always on: `drift`, the largest relative drift of the body's invariants
@@ -332,12 +334,7 @@ def solve_tfe(body: Body, state0: State, *, dt, n_elements: int, form: AbstractF
         `DRIFT_LIMIT` as the drift's bound. The primal form past its stability boundary is
         caught this way (tests/tfe/test_accuracy.py).
     """
-    prescribed = reference if isinstance(reference, Reference) else None
-    if prescribed is not None:
-        reference = "prescribed"
-    elif reference not in REFERENCES:
-        raise ValueError(f"reference must be one of {REFERENCES} or a tfe.Reference, "
-                         f"got {reference!r}")
+    check_reference(reference)
     for name, value in (("n_elements", n_elements), ("max_iter", max_iter)):
         if not (isinstance(value, int) and not isinstance(value, bool) and value >= 1):
             raise ValueError(f"{name} must be a positive int, got {value!r}")
@@ -354,14 +351,15 @@ def solve_tfe(body: Body, state0: State, *, dt, n_elements: int, form: AbstractF
     if checked:
         rtol, atol = tolerances(rtol, atol)
     tol = jnp.asarray(tol, dtype=float)
+    dynamic, reference = eqx.partition(reference, eqx.is_array_like)
     static = dict(form=form, element=element, n_elements=n_elements, reference=reference,
                   max_iter=max_iter)
-    solution = _march(body, state0, dt, tol, prescribed, **static)
+    solution = _march(body, state0, dt, tol, dynamic, **static)
     solution = _checked(body, solution, rtol if checked and rtol > 0 else DRIFT_LIMIT)
     if checked:
         picks = jnp.asarray(sample_indices(n_elements))
         states = State(solution.R[picks], solution.x[picks], solution.p_hat[picks])
-        error, ratio = _error_estimate(body, states, solution.ts[picks], dt, tol, prescribed,
+        error, ratio = _error_estimate(body, states, solution.ts[picks], dt, tol, dynamic,
                                        rtol, atol, **static)
         estimated = ratio > 1.0
         k = FLAGS.index(Status.INACCURATE)

@@ -1,5 +1,6 @@
 """Single shooting: the controls are the unknowns, and the gradient is reverse mode through the
-rollout (`Shooting`, whose docstring describes the method)."""
+rollout, its steps taken by an optax optimizer (`Shooting`, whose docstring describes the
+method)."""
 
 import equinox as eqx
 import jax
@@ -7,11 +8,8 @@ import jax.numpy as jnp
 import optax
 from jax import Array
 
-from mbjax._src.trajopt.descent import cosine_adam
 from mbjax._src.trajopt.problem import Problem
 from mbjax._src.trajopt.result import AbstractSolver, Result, history, no_states, rollout_result
-
-METHODS = ("lbfgs", "adam")
 
 
 class Shooting(AbstractSolver):
@@ -22,29 +20,36 @@ class Shooting(AbstractSolver):
     at the optimum.
 
     Args:
-        method (str): "lbfgs" (optax's L-BFGS with its zoom line search) or "adam" (static).
+        optimizer (optax.GradientTransformation): the optax optimizer that takes the steps
+            (static): `optax.lbfgs()` (the default: L-BFGS with its zoom line search), or Adam
+            with its learning rate cosine-decayed over the run,
+            `mbjax.trajopt.cosine_adam(learning_rate, iterations)`; any other optax optimizer
+            too (see The method).
         iterations (int): the most iterations (static).
         tolerance (float): stop when the (projected) gradient's norm falls below this times its
             first value.
-        learning_rate (float): Adam's, cosine-decayed to a tenth over `iterations`; L-BFGS takes its
-            steps from the line search.
 
     Raises:
-        ValueError: method is not one of `METHODS`.
+        TypeError: optimizer is not an optax optimizer (the strings "lbfgs" and "adam" of old,
+            say).
 
     The method:
         Single shooting: the controls are the unknowns, the objective is the problem's cost of their
         rollout, and its gradient is reverse mode through the rollout (`mbjax/_src/rigid/adjoint.py`
         for trees: a few rollouts' cost, whatever the horizon).
 
-        `Shooting("lbfgs")` takes optax's L-BFGS with its zoom line search (Nocedal and Wright, Alg.
-        3.5 and 7.4); `Shooting("adam")`, optax's Adam with a cosine-decayed learning rate, is the
-        first-order baseline. Control bounds are kept by projecting the controls onto them after
-        every step (projected gradient for Adam; for L-BFGS a heuristic, sound where no bound is
-        active: use `ILQR` for problems whose optimum lies on its bounds). The iterations are one
-        `lax.while_loop`: success when the gradient's norm falls below `tolerance` times its first
-        value (its projection on the box, for bounded controls), NOT_CONVERGED when `iterations` run
-        out.
+        `Shooting(optax.lbfgs())` takes optax's L-BFGS with its zoom line search (Nocedal and
+        Wright, Alg. 3.5 and 7.4); `Shooting(cosine_adam(learning_rate, iterations))`, optax's
+        Adam with a cosine-decayed learning rate, is the first-order baseline. Every step calls
+        the optimizer's update with the extra arguments a line search needs (value, grad,
+        value_fn; optimizers without a line search ignore them), and an optimizer whose state
+        carries the value and gradient at the new point (optax's line searches) has them reused
+        (`optax.value_and_grad_from_state`) rather than evaluated again. Control bounds are kept
+        by projecting the controls onto them after every step (projected gradient for Adam; for
+        L-BFGS a heuristic, sound where no bound is active: use `ILQR` for problems whose optimum
+        lies on its bounds). The iterations are one `lax.while_loop`: success when the gradient's
+        norm falls below `tolerance` times its first value (its projection on the box, for
+        bounded controls), NOT_CONVERGED when `iterations` run out.
 
     Gauss-Newton:
         Gauss-Newton on the controls of single shooting is not offered: with the costs' residuals
@@ -55,14 +60,17 @@ class Shooting(AbstractSolver):
         `MultipleShooting` is Gauss-Newton on the knots' states and controls.
     """
 
-    method: str = eqx.field(static=True, default="lbfgs")
+    optimizer: optax.GradientTransformation = eqx.field(static=True, default=optax.lbfgs())
     iterations: int = eqx.field(static=True, default=500)
     tolerance: float = 1e-6
-    learning_rate: float = 1e-2
 
-    def __post_init__(self):
-        if self.method not in METHODS:
-            raise ValueError(f"method must be one of {METHODS}, got {self.method!r}")
+    def __check_init__(self):
+        if not isinstance(self.optimizer, optax.GradientTransformation):
+            hint = (" (call it: optax.lbfgs(), not optax.lbfgs)" if callable(self.optimizer)
+                    else "")
+            raise TypeError(f"optimizer must be an optax optimizer such as optax.lbfgs() or "
+                            f"mbjax.trajopt.cosine_adam(learning_rate, iterations){hint}, got "
+                            f"{self.optimizer!r}")
 
     def solve(self, problem: Problem, us: Array, states: Array | None = None) -> Result:
         """Optimise the controls of `problem` from `us` (normally through `mbjax.trajopt.solve`).
@@ -84,12 +92,7 @@ class Shooting(AbstractSolver):
         def objective(flat):
             return problem.objective(flat.reshape(shape))
 
-        if self.method == "lbfgs":
-            optimizer = optax.lbfgs()
-            value_and_grad = optax.value_and_grad_from_state(objective)
-        else:
-            optimizer = cosine_adam(self.learning_rate, self.iterations, 0.1)
-            value_and_grad = jax.value_and_grad(objective)
+        optimizer = optax.with_extra_args_support(self.optimizer)
         lower = jnp.broadcast_to(problem.lower, shape).ravel()
         upper = jnp.broadcast_to(problem.upper, shape).ravel()
 
@@ -98,28 +101,29 @@ class Shooting(AbstractSolver):
             held = ((x <= lower) & (grad > 0)) | ((x >= upper) & (grad < 0))
             return jnp.linalg.norm(jnp.where(held, 0.0, grad))
 
+        x0 = us.ravel()
+        state0 = optimizer.init(x0)
+        # a line search leaves the value and gradient at the point it accepted in the state
+        line_search = all(optax.tree.get(state0, k) is not None for k in ("value", "grad"))
+        value_and_grad = optax.value_and_grad_from_state(objective)
+
         def evaluate(x, state, projected=False):
-            """(cost, gradient) at x; L-BFGS's line search has them already, unless the
-            projection moved x."""
-            if self.method != "lbfgs":
-                return value_and_grad(x)
+            """(cost, gradient) at x; a line search has them already, unless the projection
+            moved x."""
+            if not line_search:
+                return jax.value_and_grad(objective)(x)
             return jax.lax.cond(projected, jax.value_and_grad(objective),
                                 lambda x: value_and_grad(x, state=state), x)
 
         def iterate(s):
             x, state, value, grad, i, costs = s
-            if self.method == "lbfgs":
-                updates, state = optimizer.update(grad, state, x, value=value, grad=grad,
-                                                  value_fn=objective)
-            else:
-                updates, state = optimizer.update(grad, state, x)
+            updates, state = optimizer.update(grad, state, x, value=value, grad=grad,
+                                              value_fn=objective)
             stepped = optax.apply_updates(x, updates)
             x = jnp.clip(stepped, lower, upper)
             value, grad = evaluate(x, state, jnp.any(x != stepped))
             return x, state, value, grad, i + 1, costs.at[i + 1].set(value)
 
-        x0 = us.ravel()
-        state0 = optimizer.init(x0)
         value0, grad0 = evaluate(x0, state0)
         first = projected_gradient(x0, grad0)
 
