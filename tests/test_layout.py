@@ -84,6 +84,35 @@ def test_layers_read_in_one_direction():
     assert not offences, "\n".join(sorted(set(offences)))
 
 
+def test_no_two_library_modules_import_each_other():
+    """The private modules' imports (at module level and inside functions alike) form no cycle:
+    `Model.locked` and `lock_joints` imported each other, the one circle there was."""
+    modules = {}
+    for path in SRC.rglob("*.py"):
+        parts = path.relative_to(PACKAGE.parent).with_suffix("").parts
+        name = ".".join(parts[:-1] if parts[-1] == "__init__" else parts)
+        modules[name] = path
+    graph = {name: {m for m in _imports(path) if m in modules and m != name
+                    and not name.startswith(m + ".")}           # a module's own package
+             for name, path in modules.items() if not path.name == "__init__.py"}
+    graph = {name: {m for m in targets if m in graph} for name, targets in graph.items()}
+    cycles, state = [], {}
+
+    def visit(name, trail):
+        state[name] = "open"
+        for m in sorted(graph[name]):
+            if state.get(m) == "open":
+                cycles.append(" -> ".join(trail[trail.index(m):] + [m]))
+            elif m not in state:
+                visit(m, trail + [m])
+        state[name] = "done"
+
+    for name in sorted(graph):
+        if name not in state:
+            visit(name, [name])
+    assert not cycles, "\n".join(cycles)
+
+
 def test_the_library_never_imports_the_harness():
     offences = [f"{path.relative_to(ROOT)}: {module}" for path in PACKAGE.rglob("*.py")
                 for module in _imports(path) if module.startswith("mbjax_harness")]

@@ -28,15 +28,14 @@ from mbjax._src.model.checks import combine
 from mbjax._src.model.closures import GROUND, Coupling, CutJoint, Prescribed
 from mbjax._src.model.geoms import Geoms
 from mbjax._src.model.joints import JOINT_TYPES
-from mbjax._src.model.model import Model
 
 
-def _starts(model: Model, size: str) -> np.ndarray:
+def _starts(model, size: str) -> np.ndarray:
     """Each joint's first coordinate in q ("nq") or v ("nv"), and the total, shape (n + 1,)."""
     return np.cumsum([0] + [getattr(JOINT_TYPES[k], size) for k in model.joint_types])
 
 
-def lock_joints(model: Model, joint_names, q) -> Model:
+def lock_joints(model, joint_names, q):
     """The model with the named joints fixed at q's values (see the module).
 
     Args:
@@ -145,7 +144,7 @@ def lock_joints(model: Model, joint_names, q) -> Model:
                       margin=geoms.margin, gap=geoms.gap, condim=geoms.condim, names=geoms.names,
                       pairs=[(i, j) for i, j in geoms.pairs if bodies[i] != bodies[j]
                              and not (bodies[i] < 0 and bodies[j] < 0)])
-    return Model(
+    return type(model)(               # the model's own class: this module imports no Model
         new_parents, [model.joint_types[k] for k in kept],
         mass=[m for m, _, _ in merged], com=[c for _, c, _ in merged],
         inertia=[J for _, _, J in merged], axis=per("axis", kept), axis2=per("axis2", kept),
@@ -163,7 +162,7 @@ def lock_joints(model: Model, joint_names, q) -> Model:
         geoms=geoms)
 
 
-def _remap(closure, model: Model, locked: np.ndarray, host: list, new_index: np.ndarray,
+def _remap(closure, model, locked: np.ndarray, host: list, new_index: np.ndarray,
            q0: np.ndarray, q_kept: np.ndarray):
     """The closure in the reduced model's bodies and coordinates (see the module)."""
     new_q = np.full(model.nq, -1)

@@ -29,6 +29,7 @@ from mbjax._src.model.joints import (
     wrap_angle,
 )
 from mbjax._src.model.checks import check_body
+from mbjax._src.model.locked import lock_joints
 from mbjax._src.tree.take import take
 from mbjax._src.spatial import inertia_matrix
 from mbjax._src.tree import Topology
@@ -698,7 +699,6 @@ class Model(eqx.Module):
             ValueError: an unknown joint name, a joint named twice, every joint locked, or q of
                 the wrong shape.
         """
-        from mbjax._src.model.locked import lock_joints
         return lock_joints(self, joint_names, q)
 
     def with_payload(self, mass, *, body: int | str, point=(0.0, 0.0, 0.0)) -> "Model":
