@@ -16,7 +16,7 @@ from mbjax._src.trajopt.ilqr import ILQR as ILQR
 from mbjax._src.trajopt.ilqr import CROCODDYL_SCHEDULE as CROCODDYL_SCHEDULE
 from mbjax._src.trajopt.multiple_shooting import MultipleShooting as MultipleShooting
 from mbjax._src.trajopt.shooting import Shooting as Shooting
-from mbjax._src.trajopt.descent import cosine_adam as cosine_adam
+from mbjax._src.trajopt.shooting import cosine_adam as cosine_adam
 from mbjax._src.trajopt.codesign import optimal_cost as optimal_cost
 from mbjax._src.trajopt.sweep import sweep as sweep
 from mbjax._src.trajopt.residuals import state_residual as state_residual

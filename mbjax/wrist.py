@@ -17,9 +17,9 @@ from mbjax._src.synthesis.controller import NeuralController as NeuralController
 from mbjax._src.synthesis.controller import train_controller as train_controller
 from mbjax._src.synthesis.controller import make_episodes as make_episodes
 from mbjax._src.synthesis.controller import evaluate_controller as evaluate_controller
-from mbjax._src.trajopt.descent import AbstractGradient as AbstractGradient
-from mbjax._src.trajopt.descent import ForwardMode as ForwardMode
-from mbjax._src.trajopt.descent import ReverseMode as ReverseMode
+from mbjax._src.synthesis.descent import AbstractGradient as AbstractGradient
+from mbjax._src.synthesis.descent import ForwardMode as ForwardMode
+from mbjax._src.synthesis.descent import ReverseMode as ReverseMode
 from mbjax._src.synthesis.sweeps import grid as grid
 from mbjax._src.synthesis.sweeps import peak_torque as peak_torque
 

@@ -33,7 +33,7 @@ from jax import Array
 
 from mbjax._src.control import AbstractControl
 from mbjax._src.integrate import RK4, simulate
-from mbjax._src.trajopt.descent import AbstractGradient, ReverseMode, adam_descent
+from mbjax._src.synthesis.descent import AbstractGradient, ReverseMode, adam_descent
 from mbjax._src.wrist import WristSystem, kinematics
 
 
@@ -207,7 +207,7 @@ def train_controller(controller: NeuralController, wrist, episodes: Episodes, *,
 
     Reverse-mode gradients by default (`ReverseMode()`): the network's weights outnumber what
     forward mode (`ForwardMode()`) does cheaply (see `adam_descent` in
-    `mbjax/_src/trajopt/descent.py`). The whole descent is one jitted
+    `mbjax/_src/synthesis/descent.py`). The whole descent is one jitted
     `lax.scan`.
 
     Args:

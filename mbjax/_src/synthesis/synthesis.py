@@ -22,7 +22,7 @@ from jax import Array
 
 from mbjax._src.integrate import RK4, simulate
 from mbjax._src.system.status import Flags, flags, WithStatus, raise_on_failure
-from mbjax._src.trajopt.descent import adam_descent
+from mbjax._src.synthesis.descent import adam_descent
 from mbjax._src.control import CubicSpline
 from mbjax._src.wrist import WristSystem, kinematics
 

@@ -12,6 +12,25 @@ from mbjax._src.trajopt.problem import Problem
 from mbjax._src.trajopt.result import AbstractSolver, Result, history, no_states, rollout_result
 
 
+
+def cosine_adam(learning_rate: float, iterations: int, final_fraction: float = 0.1):
+    """optax's Adam with its learning rate cosine-decayed over a run.
+
+    `Shooting(optimizer=cosine_adam(learning_rate, iterations), iterations=iterations)` is single
+    shooting's first-order baseline.
+
+    Args:
+        learning_rate: the first learning rate.
+        iterations: the steps over which it decays (the solver's iterations).
+        final_fraction: the fraction of learning_rate it decays to.
+
+    Returns:
+        The optax optimizer, `optax.adam(optax.cosine_decay_schedule(learning_rate, iterations,
+            alpha=final_fraction))`.
+    """
+    return optax.adam(optax.cosine_decay_schedule(learning_rate, iterations, alpha=final_fraction))
+
+
 class Shooting(AbstractSolver):
     """Single shooting: the controls are the unknowns, the gradient is reverse mode through the rollout.
 

@@ -7,7 +7,7 @@ import jax.numpy as jnp
 import numpy as np
 import pytest
 
-from mbjax._src.trajopt.descent import adam_descent
+from mbjax._src.synthesis.descent import adam_descent
 from mbjax.wrist import ForwardMode, NeuralController, ReverseMode, train_controller
 
 # adam_descent(loss, X0, learning_rate=0.1, iterations=10, final_fraction=0.05,

@@ -1,6 +1,6 @@
 """Adam on a flat parameter vector, the Carpal Wrist synthesis' and controller's loop, with the
-gradient taken by a strategy (`ForwardMode`, `ReverseMode`), and the cosine-decayed Adam it and
-`Shooting` share (`cosine_adam`)."""
+gradient taken by a strategy (`ForwardMode`, `ReverseMode`) and the learning rate cosine-decayed
+(`mbjax.trajopt.cosine_adam`, which single shooting's Adam shares)."""
 
 import abc
 
@@ -8,6 +8,8 @@ import equinox as eqx
 import jax
 import optax
 from jax import Array
+
+from mbjax._src.trajopt.shooting import cosine_adam
 
 
 class AbstractGradient(eqx.Module):
@@ -82,24 +84,6 @@ def check_gradient(gradient) -> None:
         hint = " (an instance: ReverseMode(), not ReverseMode)" if isinstance(gradient, type) else ""
         raise TypeError(f"gradient must be a gradient strategy, ForwardMode() or ReverseMode()"
                         f"{hint}, got {gradient!r}")
-
-
-def cosine_adam(learning_rate: float, iterations: int, final_fraction: float = 0.1):
-    """optax's Adam with its learning rate cosine-decayed over a run.
-
-    `Shooting(optimizer=cosine_adam(learning_rate, iterations), iterations=iterations)` is single
-    shooting's first-order baseline.
-
-    Args:
-        learning_rate: the first learning rate.
-        iterations: the steps over which it decays (the solver's iterations).
-        final_fraction: the fraction of learning_rate it decays to.
-
-    Returns:
-        The optax optimizer, `optax.adam(optax.cosine_decay_schedule(learning_rate, iterations,
-            alpha=final_fraction))`.
-    """
-    return optax.adam(optax.cosine_decay_schedule(learning_rate, iterations, alpha=final_fraction))
 
 
 def adam_descent(loss, x0: Array, *, learning_rate: float, iterations: int, final_fraction: float,
