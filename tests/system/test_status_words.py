@@ -12,7 +12,7 @@ from mbjax.flex import Beam, beam_body, craig_bampton
 from mbjax.integrate import RK4
 from mbjax.model import chain
 from mbjax.rigid import TreeSystem
-from mbjax.trajopt import Problem
+from mbjax.trajopt import ILQR, Problem, solve
 from tests.conftest import example_robots
 
 LIMIT = 0.5
@@ -96,6 +96,11 @@ def test_a_status_prints_its_flags_in_words_and_computes_as_an_integer_array():
         "Flags<shape (2,): limit exceeded; ")
     assert str(batch.status[0]) == "Flags<limit exceeded>"
     assert np.asarray(batch.status).tolist() == [int(s) for s in batch.status]
+    # the results whose drivers add flags after the run (trajopt's and the time elements' checks)
+    problem = Problem(TreeSystem(model), jnp.zeros(3), jnp.zeros(3), dt=0.05, horizon=4,
+                      running=lambda q, v, u: jnp.sum(u**2),
+                      terminal=lambda q, v: jnp.sum(q**2))
+    assert str(solve(problem, ILQR(iterations=1)).status).startswith("Flags<")
 
 
 def test_home_lies_inside_every_limit_of_every_example_robot():

@@ -151,8 +151,8 @@ class Flags(eqx.Module):
     def dtype(self):
         return self.code.dtype
 
-    def astype(self, dtype) -> Array:
-        return self.code.astype(dtype)
+    def astype(self, dtype) -> "Flags":
+        return Flags(self.code.astype(dtype))
 
     def item(self) -> int:
         return int(self.code)
