@@ -187,8 +187,7 @@ def _error_estimate(system, integrator, q, u, t, dt: float, n_steps: int, rtol, 
 
     def step(state, t, h):
         q, u = state
-        q1, u1, _ = integrator.step(system.hold(t, q, u), t, q, u, h)
-        return system.constrain(t + h, q1, u1)
+        return integrator.advance(system, t, q, u, h)[:2]
 
     def local(q, u, t):
         h = jnp.asarray(dt, q.dtype)
@@ -277,8 +276,7 @@ def _rollout(system, integrator, q0, u0, t0, dt, block: int, n_blocks: int, keep
         q, u, status, watch = carry
         t = t0 + k * dt
         # sampled controls take their value at the step's start for all of its stages
-        q1, u1, converged = integrator.step(system.hold(t, q, u), t, q, u, dt)
-        q1, u1 = system.constrain(t + dt, q1, u1)
+        q1, u1, converged = integrator.advance(system, t, q, u, dt)
         y0, y1 = flat(q, u), flat(q1, u1)
         finite = jnp.all(jnp.isfinite(y1[0]), axis=0) & jnp.all(jnp.isfinite(y1[1]), axis=0)
         # the default check: the step times the motion's rate, from consecutive increments
