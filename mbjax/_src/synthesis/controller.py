@@ -195,7 +195,7 @@ def train_controller(controller: NeuralController, wrist, episodes: Episodes, *,
                      effort_weight: float = 0.1, gradient: AbstractGradient = ReverseMode(),
                      end_power: float = 2.0, robust: bool = True):
     """Train the controller's MLP through the simulator: Adam on the batch mean of the episode
-    cost J (the cost below).
+    cost J (the episode cost in docs/details.md).
 
     Canfield 1997 §6.1: 'the simulation environment can be used to train a neural network
     control system'. Training rolls out a batch of random (start, target) pairs with `simulate`
@@ -232,20 +232,7 @@ def train_controller(controller: NeuralController, wrist, episodes: Episodes, *,
     Raises:
         TypeError: gradient is not a gradient strategy (a string, say).
 
-    The episode cost:
-        J is the tracking cost
-
-            J = sum_k (t_k / T)^e |y(t_k) - y*|^2 / (tol^2 sum_k (t_k / T)^e)
-                + |theta_dot(T)|^2 / omega_tol^2 + w mean_k |tau(t_k)|^2 / limit^2,
-
-        y = (p / l, g) the pose in the midplane chart, t_k the saved times, weighted towards
-        the end by (t_k / T)^e, e = end_power = 2 (the start is far from the target by
-        construction). The logarithm keeps a few far-off episodes from dominating the mean,
-        which otherwise trades the many near misses for them (training results in
-        benchmarks/README.md). The reverse-mode gradient (`jax.value_and_grad`) costs a few
-        forward passes for the network's hundred-odd weights, where `jax.jacfwd` would carry
-        one tangent per weight. Success on held-out targets (`evaluate_controller`): the final
-        pose within `kinematics.pose_error` < `success_tolerance`.
+    More on the episode cost: the documentation site's Details page (docs/details.md).
     """
     weights, rebuild = jax.flatten_util.ravel_pytree(eqx.filter(controller.mlp, eqx.is_inexact_array))
     static_mlp = eqx.filter(controller.mlp, eqx.is_inexact_array, inverse=True)

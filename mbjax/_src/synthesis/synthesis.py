@@ -77,7 +77,7 @@ def synthesize(wrist, theta0: Array, goal, *, duration: float, torque_limit: flo
                pose_tolerance: float = 1e-3, speed_tolerance: float = 1e-2, effort_weight: float = 0.1,
                integrator=RK4(), init: CubicSpline | None = None, throw: bool = False) -> Synthesis:
     """Torque splines that move the wrist from rest at theta0 to rest at goal = (plunge, slope)
-    in `duration` with least effort, |tau_i| <= torque_limit (the objective below).
+    in `duration` with least effort, |tau_i| <= torque_limit (the objective in docs/details.md).
 
     Gradient-based trajectory synthesis, Canfield 1997's stated purpose (§6.1: 'use the
     simulation environment as part of an optimization routine solving trajectory synthesis
@@ -118,14 +118,7 @@ def synthesize(wrist, theta0: Array, goal, *, duration: float, torque_limit: flo
     Raises:
         equinox.EquinoxRuntimeError: with throw=True, the final rollout failed.
 
-    The objective:
-        The effort int |tau|^2 dt plus penalties that bring the tool to the goal pose at rest
-        at t = duration:
-
-            J = |(p(T) - p*) / l|^2 / tol^2 + |g(T) - g*|^2 / tol^2
-                + |theta_dot(T)|^2 / omega_tol^2 + w int |tau|^2 dt / (limit^2 T),
-
-        with (p, g) the midplane chart of the final pose.
+    More on the objective: the documentation site's Details page (docs/details.md).
     """
     theta0 = jnp.asarray(theta0, dtype=float)
     goal_p, goal_g = (jnp.asarray(x, dtype=float) for x in goal)

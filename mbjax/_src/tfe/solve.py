@@ -311,28 +311,8 @@ def solve_tfe(body: Body, state0: State, *, dt, n_elements: int, form: AbstractF
             state0 not a `State`.
         equinox.EquinoxRuntimeError: with throw=True, the march failed.
 
-    Compilation:
-        Jitted once per (form, element, n_elements, reference, max_iter); dt, tol, the body, the
-        state and a prescribed `Reference`'s arrays are traced, so sweeps over them do not
-        recompile and they can be differentiated.
-
-    Default accuracy check:
-        Always on: `drift`, the largest relative drift of the body's invariants
-        (`Body.invariants`: the energy, the momenta) over the boundaries, sets INACCURATE above
-        `DRIFT_LIMIT` (0.1); a single body's invariants cost little to evaluate.
-        (`mbjax.simulate`'s step ratio does not apply: an element's reference carries the
-        rotation exactly, and a conserved momentum's boundary values differ only by Newton's
-        tolerance, whose increments read as a motion on the element's scale.)
-
-    Accuracy with a tolerance:
-        With a tolerance (rtol, atol, as `mbjax.simulate`'s) the solution carries `error`, a
-        step-doubling estimate of the final state's error (at up to `ERROR_SAMPLES` boundaries,
-        one element against two of half the spacing; their difference is taken as the element's
-        local error, the elements being of high order, and summed over the march; the rotation
-        matrix, position and momentum components together), the status INACCURATE where it
-        exceeds the tolerance (root mean square norm), and a positive rtol replaces
-        `DRIFT_LIMIT` as the drift's bound. The primal form past its stability boundary is
-        caught this way (tests/tfe/test_accuracy.py).
+    More on compilation, default accuracy check, accuracy with a tolerance: the documentation
+    site's Details page (docs/details.md).
     """
     check_reference(reference)
     for name, value in (("n_elements", n_elements), ("max_iter", max_iter)):
