@@ -1,4 +1,4 @@
-"""Crocoddyl's ANYmal walk (`mbjax_harness.crocoddyl_gaits.anymal_walk`), mbjax's iLQR with
+"""Crocoddyl's ANYmal walk (`mbjax_harness.crocoddyl.gaits.anymal_walk`), mbjax's iLQR with
 Crocoddyl's schedule against Crocoddyl's FDDP from the same quasi-static guess, mbjax's
 iterations driven one jitted `ILQR.step` at a time from Python, so that each iteration's wall
 time shows (`mbjax bench trajopt` times the whole solve as one program).
@@ -19,7 +19,7 @@ import jax
 import jax.numpy as jnp
 
 from mbjax.trajopt import CROCODDYL_SCHEDULE, ILQR
-from mbjax_harness.crocoddyl_gaits import anymal_walk
+from mbjax_harness.crocoddyl.gaits import anymal_walk
 
 
 def main(step_knots: int = 25, support_knots: int = 2) -> None:

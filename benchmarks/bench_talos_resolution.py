@@ -1,4 +1,4 @@
-"""Talos's step (`mbjax_harness.crocoddyl_gaits.talos_step`, Crocoddyl's biped example) at its
+"""Talos's step (`mbjax_harness.crocoddyl.gaits.talos_step`, Crocoddyl's biped example) at its
 30 ms step and at 15 and 7.5 ms (the same timeline cut finer): whether the solution's
 `inaccurate` status concerns the physical motion. Prints each solve's status, its step x rate
 (`Result.resolution`), cost, and where the three solutions' CoM and soles differ from the
@@ -15,7 +15,7 @@ import numpy as np
 
 from mbjax.rigid import center_of_mass, frame_pose
 from mbjax.trajopt import CROCODDYL_SCHEDULE, ILQR, solve
-from mbjax_harness.crocoddyl_gaits import SOLES, talos_step
+from mbjax_harness.crocoddyl.gaits import SOLES, talos_step
 
 DT = 3e-2
 

@@ -25,7 +25,7 @@ import jax.numpy as jnp
 import numpy as np
 
 from mbjax.trajopt import CROCODDYL_SCHEDULE, ILQR, solve
-from mbjax_harness.crocoddyl_gaits import anymal_walk
+from mbjax_harness.crocoddyl.gaits import anymal_walk
 
 
 def stacked(problems):

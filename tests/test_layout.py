@@ -119,6 +119,29 @@ def test_the_library_never_imports_the_harness():
     assert not offences, offences
 
 
+def test_the_benchmarks_and_the_reproductions_do_not_import_each_other():
+    """`mbjax_harness.bench` and `mbjax_harness.reproduce` share their helpers through neutral
+    modules (`mbjax_harness.common`, `mbjax_harness.timing`), at module level and inside
+    functions alike: the tree-scaling reproduction took its workloads from the rigid benchmark,
+    the speed and accuracy benchmarks theirs from two reproductions (issue 60)."""
+    offences = [f"{path.relative_to(ROOT)}: {module}"
+                for package, other in (("reproduce", "bench"), ("bench", "reproduce"))
+                for path in sorted((HARNESS / package).rglob("*.py"))
+                for module in _imports(path)
+                if module == f"mbjax_harness.{other}" or module.startswith(f"mbjax_harness.{other}.")]
+    assert not offences, "\n".join(offences)
+
+
+def test_the_tour_is_a_package_of_short_modules():
+    """`mbjax_harness.tour` is the scene registry and one module per family of scenes, each
+    under 400 lines (issue 60: one 980-line file held them all)."""
+    tour = HARNESS / "tour"
+    assert (tour / "__init__.py").is_file() and not (HARNESS / "tour.py").exists()
+    lengths = {path.name: len(path.read_text().splitlines()) for path in sorted(tour.rglob("*.py"))}
+    assert len(lengths) > 2, lengths
+    assert all(n < 400 for n in lengths.values()), lengths
+
+
 def test_no_type_tests_on_concrete_systems_outside_their_package():
     """trajopt, integrate and loops see systems through `AbstractSystem` and `AbstractTreeSystem`:
     no isinstance on a concrete system outside the package that defines it (checking that an

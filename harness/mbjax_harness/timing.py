@@ -4,6 +4,7 @@
 calls only run. Run time is the median of `repeats` calls after that warm-up, each ending with
 `jax.block_until_ready` on the output so that JAX's asynchronous dispatch is not mistaken for speed.
 `in_turns`: engines compared side by side, each the fastest of its calls, the calls alternating.
+`timed`: `measure` with its repeats cut to a time budget.
 """
 
 import functools
@@ -71,3 +72,15 @@ def write_jsonl(path: Path, records: Iterable[dict]) -> None:
     with open(path, "w") as f:
         for record in records:
             f.write(json.dumps(record) + "\n")
+
+
+def timed(fn, *args, repeats: int, budget_s: float) -> tuple[object, Timing]:
+    """`measure` with the repeats cut to what fits in budget_s (at least one): one compiling call
+    and one run first, then up to `repeats` runs whose median is the run time."""
+    out, first = measure(fn, *args, repeats=1)
+    runs = int(min(repeats, budget_s / max(first.run_s, 1e-9)))
+    if runs < 2:
+        return out, first
+    _, more = measure(fn, *args, repeats=runs)   # already compiled: its first call only runs
+    return out, Timing(compile_s=max(first.compile_s + first.run_s - more.run_s, 0.0),
+                       run_s=more.run_s, runs=more.runs)

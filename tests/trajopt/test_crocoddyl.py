@@ -1,20 +1,21 @@
 """iLQR against an independent optimal-control library: Crocoddyl's FDDP (analytic derivatives
 on Pinocchio) on the arm reach built from the same URDF, residuals, weights, semi-implicit Euler
-steps and first guess (`mbjax_harness.peers.crocoddyl_reach`), and on Crocoddyl's own
-contact-free examples (`mbjax_harness.crocoddyl_examples`: the Kinova arm, the double pendulum,
+steps and first guess (`mbjax_harness.crocoddyl.terms.crocoddyl_reach`), and on Crocoddyl's own
+contact-free examples (`mbjax_harness.crocoddyl.examples`: the Kinova arm, the double pendulum,
 the quadrotor's free base with and without thrust bounds). Skipped where Crocoddyl is not
-installed or its pairing with Pinocchio is broken (`peers.crocoddyl_working` says which)."""
+installed or its pairing with Pinocchio is broken (`crocoddyl_working` says which)."""
 
 import jax.numpy as jnp
 import numpy as np
 import pytest
 
-from mbjax_harness import peers
-from mbjax_harness.bench.trajopt import CrocoddylSolver, arm_reach
+from mbjax_harness.crocoddyl.terms import crocoddyl_working
+from mbjax_harness.bench.trajopt import arm_reach
+from mbjax_harness.crocoddyl.solver import CrocoddylSolver
 from mbjax.trajopt import ILQR, solve
 from mbjax._src.trajopt.ilqr import CROCODDYL_SCHEDULE
 
-WHY = peers.crocoddyl_working()
+WHY = crocoddyl_working()
 pytestmark = pytest.mark.skipif(WHY is not None, reason=str(WHY))
 
 
@@ -43,7 +44,7 @@ def test_arm_reach_matches_crocoddyl(schedule):
     assert final_error(jnp.asarray(croc.solver.xs[-1])[:problem.nq]) < 1e-5
 
 
-# -- Crocoddyl's own contact-free examples (`mbjax_harness.crocoddyl_examples`) --------------------
+# -- Crocoddyl's own contact-free examples (`mbjax_harness.crocoddyl.examples`) --------------------
 
 @pytest.mark.parametrize("name", [
     "double-pendulum", "quadrotor",
@@ -55,8 +56,8 @@ def test_crocoddyls_examples_reach_fddps_optimum(name):
     base; the guess costs the same), and iLQR from the same first guess ends within 1e-6
     (relative) of FDDP's optimum or below it, each engine pricing the other's solution as it
     does."""
-    from mbjax_harness.bench.trajopt import agreement
-    from mbjax_harness.crocoddyl_examples import EXAMPLES
+    from mbjax_harness.crocoddyl.solver import agreement
+    from mbjax_harness.crocoddyl.examples import EXAMPLES
 
     example = EXAMPLES[name]()
     croc_problem = example.crocoddyl()

@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 from mbjax import trajopt
-from mbjax_harness import peers
+from mbjax_harness.crocoddyl.terms import crocoddyl_working
 from mbjax.rigid import inverse_dynamics, mass_matrix
 from mbjax.scenes import arm
 
@@ -64,7 +64,7 @@ def test_closed_loop_equals_its_ticks(controller, plan):
     assert float(jnp.sqrt(jnp.mean(errors**2))) < 0.01 and float(errors.max()) < 0.03
 
 
-@pytest.mark.skipif(peers.crocoddyl_working() is not None, reason="Crocoddyl unavailable")
+@pytest.mark.skipif(crocoddyl_working() is not None, reason="Crocoddyl unavailable")
 def test_tick_is_one_crocoddyl_iteration():
     """A tick from a plan shifted and a measured state off the plan equals one iteration of
     Crocoddyl's FDDP (its `SolverFDDP.solve(xs, us, 1, False)`) on the same horizon from the

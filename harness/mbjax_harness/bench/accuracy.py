@@ -94,20 +94,20 @@ def _time_elements(records: list[dict]) -> None:
     from mbjax import lie
     from mbjax.scenes import vertical_top as vt
     from mbjax.tfe import Element, Mixed, PrimalUnsymmetric, initial_state, solve_tfe
-    from mbjax_harness.reproduce import top_long_run as tlr
+    from mbjax_harness.common import DT, SPIN_RATIO, TILT0, steady_rotation  # top-long-run's
 
     body = vt.build()
-    spin = tlr.SPIN_RATIO * vt.CRITICAL_SPIN
-    state0 = initial_state(body, lie.exp(jnp.array([tlr.TILT0, 0.0, 0.0])),
+    spin = SPIN_RATIO * vt.CRITICAL_SPIN
+    state0 = initial_state(body, lie.exp(jnp.array([TILT0, 0.0, 0.0])),
                            jnp.array([0.0, 0.0, spin]))
-    march = dict(element=Element(2), reference=tlr.steady_rotation(spin))
-    ref = solve_tfe(body, state0, dt=tlr.DT / 4, n_elements=160, form=Mixed(), **march)
+    march = dict(element=Element(2), reference=steady_rotation(spin))
+    ref = solve_tfe(body, state0, dt=DT / 4, n_elements=160, form=Mixed(), **march)
     for name, form in (("primal", PrimalUnsymmetric()), ("mixed", Mixed())):
-        run = solve_tfe(body, state0, dt=tlr.DT, n_elements=40, form=form, **march)
-        checked = solve_tfe(body, state0, dt=tlr.DT, n_elements=40, form=form, rtol=RTOL,
+        run = solve_tfe(body, state0, dt=DT, n_elements=40, form=form, **march)
+        checked = solve_tfe(body, state0, dt=DT, n_elements=40, form=form, rtol=RTOL,
                             atol=RTOL, **march)
         error = float(jnp.linalg.norm(lie.log(run.R[-1] @ ref.R[-1].T)))
-        records.append({"suite": NAME, "kind": "case", "dt": tlr.DT,
+        records.append({"suite": NAME, "kind": "case", "dt": DT,
                         "case": f"vertical top, {name} time elements of 0.5 s",
                         "error": error, "resolution": None,
                         "drift": float(run.drift), "status": run.messages()[0],

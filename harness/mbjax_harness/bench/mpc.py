@@ -61,6 +61,7 @@ from mbjax.integrate import RK4, SemiImplicitEuler
 from mbjax.rigid import TreeSystem, inverse_dynamics
 from mbjax.scenes import arm
 from mbjax_harness import peers
+from mbjax_harness.crocoddyl.terms import _crocoddyl_point, _crocoddyl_shooting, _crocoddyl_terms, crocoddyl_working
 from mbjax_harness.timing import write_jsonl
 
 NAME = "mpc"
@@ -120,7 +121,7 @@ def crocoddyl_tracking(tracking, plan):
     from mbjax.data import ARM7
 
     model = pin.buildModelFromUrdf(str(ARM7))
-    frame = peers._crocoddyl_point(model, model.njoints - 1, arm.FLANGE, "flange")
+    frame = _crocoddyl_point(model, model.njoints - 1, arm.FLANGE, "flange")
     state = crocoddyl.StateMultibody(model)
     actuation = crocoddyl.ActuationModelFull(state)
     nu, nv = actuation.nu, model.nv
@@ -141,7 +142,7 @@ def crocoddyl_tracking(tracking, plan):
             terms = [("goal", goal, None, w[3]),
                      ("velocity", crocoddyl.ResidualModelState(state, x_ref, nu),
                       np.r_[np.zeros(nv), np.ones(nv)], w[4])]
-        costs = peers._crocoddyl_terms(state, nu, terms)
+        costs = _crocoddyl_terms(state, nu, terms)
         dam = crocoddyl.DifferentialActionModelFreeFwdDynamics(state, actuation, costs)
         models.append(crocoddyl.IntegratedActionModelEuler(
             dam, arm.MPC_DT if k < tracking.horizon else 0.0))
@@ -180,7 +181,7 @@ def kinova_payload(payload: float = KINOVA_PAYLOAD, horizon: int = 50) -> Scenar
     from mbjax.model import state_from_pinocchio, state_to_pinocchio
     from mbjax.rigid import frame_pose
     from mbjax.trajopt import control_residual, frame_residual, state_residual
-    from mbjax_harness.crocoddyl_examples import _load, _robot
+    from mbjax_harness.crocoddyl.examples import _load, _robot
 
     robot = _robot("kinova")
     model = _load(robot)
@@ -232,7 +233,7 @@ def kinova_payload(payload: float = KINOVA_PAYLOAD, horizon: int = 50) -> Scenar
                    ("control", croc.ResidualModelControl(state, gravity), None, w["control"])]
         terminal = [("goal", goal, None, w["goal_end"]),
                     ("velocity", regularization, end_weights, 1.0)]
-        problem = peers._crocoddyl_shooting(state, actuation, x0, arm.MPC_DT, horizon, running,
+        problem = _crocoddyl_shooting(state, actuation, x0, arm.MPC_DT, horizon, running,
                                             terminal)
         problem.nthreads = 1
         solver = croc.SolverFDDP(problem)
@@ -267,7 +268,7 @@ def anymal_trot(step_length: float = 0.0) -> Scenario:
     from mbjax.contact import ContactSystem
     from mbjax.model import Geoms, ground_plane, state_from_pinocchio
     from mbjax.trajopt import Cycle, quasi_static
-    from mbjax_harness.crocoddyl_gaits import FEET, MU, _anymal_start, _converter
+    from mbjax_harness.crocoddyl.gaits import FEET, MU, _anymal_start, _converter
 
     robot, model, q_pin0, q0, v0, feet, com, gait = _anymal_start()
     lf, rf, lh, rh = FEET
@@ -536,7 +537,7 @@ def single(name: str, ticks: int, common: dict) -> list[dict]:
               "loop_agreement": float(np.max(np.abs(np.asarray(run.qs) - qs))),
               "iterations_mean": float(np.mean(np.asarray(run.iterations)))}
     records.append(record)
-    if (why := peers.crocoddyl_working()) is None:
+    if (why := crocoddyl_working()) is None:
         qs, vs, us, seconds, us_last = crocoddyl_loop(scenario, ticks, period, dt, steps)
         plant_status = _plant_status(scenario, ts, qs, vs, us_last)
         records.append({**base, **_summary(scenario, "crocoddyl", ts, qs, vs, us, seconds,
@@ -605,7 +606,7 @@ def batch(robots: int, ticks: int, common: dict, repeats: int = 1) -> list[dict]
             "map": lambda: mapped((centres, plans))}
     for fn in runs.values():
         jax.block_until_ready(fn())                      # compiled
-    crocoddyl = peers.crocoddyl_working() is None
+    crocoddyl = crocoddyl_working() is None
     steps = int(round(arm.MPC_DT / dt))
     loops = []
     if crocoddyl:
@@ -644,7 +645,7 @@ def batch(robots: int, ticks: int, common: dict, repeats: int = 1) -> list[dict]
                 "failed": int(np.sum((statuses[how] & int(Status.failures())) != 0))}
                for how in runs]
     if not crocoddyl:
-        return records + [{**base, "engine": "crocoddyl", "skipped": peers.crocoddyl_working()}]
+        return records + [{**base, "engine": "crocoddyl", "skipped": crocoddyl_working()}]
     # `seconds` counts Crocoddyl's solves alone: its loop's plant is mbjax's, called from
     # Python a period at a time (`loop_seconds`, the whole), which is not Crocoddyl's to pay
     records.append({**base, "engine": "crocoddyl", "how": "loop", "robots": robots,

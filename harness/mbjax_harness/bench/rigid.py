@@ -42,9 +42,9 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from mbjax import Dense, Recursive
 from mbjax_harness import peers
-from mbjax_harness.timing import Timing, measure, write_jsonl
+from mbjax_harness.common import STRATEGY, loop_length, looped_fn, states
+from mbjax_harness.timing import timed, write_jsonl
 from mbjax.integrate import RK4, simulate
 from mbjax.model import chain, to_urdf
 from mbjax.rigid import TreeSystem, forward_dynamics
@@ -54,8 +54,6 @@ NAME = "rigid"
 # command's closing line names those missing (`mbjax_harness.cli._declared`)
 PEERS = ("pinocchio", "mujoco")
 METHODS = ("recursive", "dense")
-# the strategy each method name stands for (the records keep the names)
-STRATEGY = {"recursive": Recursive(), "dense": Dense()}
 NS = (1, 7, 30, 100, 300, 1000)
 QUICK_NS = (1, 7, 30, 100)
 BATCHES = (1, 64, 1024, 4096)
@@ -76,26 +74,6 @@ LOOPED_DENSE_MAX_N = 300
 CROSSOVER_BATCHES = (64, 1024)
 # method="auto" tolerates the recursion being up to this factor slower in a loop (see summarize).
 AUTO_TOLERANCE = 1.5
-SEED = 0
-
-
-def timed(fn, *args, repeats: int, budget_s: float) -> tuple[object, Timing]:
-    """`measure` with the repeats cut to what fits in budget_s (at least one): one compiling call
-    and one run first, then up to `repeats` runs whose median is the run time."""
-    out, first = measure(fn, *args, repeats=1)
-    runs = int(min(repeats, budget_s / max(first.run_s, 1e-9)))
-    if runs < 2:
-        return out, first
-    _, more = measure(fn, *args, repeats=runs)   # already compiled: its first call only runs
-    return out, Timing(compile_s=max(first.compile_s + first.run_s - more.run_s, 0.0),
-                       run_s=more.run_s, runs=more.runs)
-
-
-def states(n: int, batch: int, seed: int = SEED):
-    """(q, v, tau), each (batch, n): angles in [-pi, pi), unit-normal rates and torques."""
-    rng = np.random.default_rng(seed + n)
-    return (rng.uniform(-np.pi, np.pi, (batch, n)), rng.normal(size=(batch, n)),
-            rng.normal(size=(batch, n)))
 
 
 def single_fn(method: str):
@@ -172,23 +150,6 @@ def relative_difference(a, ref) -> float:
     a, ref = np.asarray(a), np.asarray(ref)
     return float(np.max(np.abs(a - ref)) / max(np.max(np.abs(ref)), 1e-300))
 
-
-def looped_fn(method: str, evaluations: int):
-    """`evaluations` forward-dynamics calls in one jitted `fori_loop`, each at a velocity nudged by
-    the previous result (so none can be hoisted or skipped): its run time over `evaluations` is the
-    cost of one evaluation as a simulation or optimisation loop meets it, without the per-call
-    dispatch of `single_fn` (tens of us on CPU, more than the whole recursion for small n)."""
-    def run(model, q, v, tau):
-        def body(_, acc):
-            return forward_dynamics(model, q, v + 1e-12 * acc, tau, method=STRATEGY[method])
-        return jax.lax.fori_loop(0, evaluations, body, jnp.zeros_like(v))
-
-    return jax.jit(run)
-
-
-def loop_length(n: int) -> int:
-    """Evaluations per looped call: about 4000 body-evaluations, at least 4."""
-    return max(4, 4000 // n)
 
 
 def _looped_records(ns, repeats: int, budget_s: float, common: dict) -> list[dict]:

@@ -44,12 +44,12 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from mbjax_harness.bench.rigid import pinocchio_loop, relative_difference, timed
+from mbjax_harness.bench.rigid import pinocchio_loop, relative_difference
 from mbjax_harness.bench.throughput import pinocchio_parallel
 from mbjax.integrate import RK4, simulate
 from mbjax.model import chain, load_urdf, to_urdf
 from mbjax.rigid import TreeSystem, forward_dynamics
-from mbjax_harness.timing import write_jsonl
+from mbjax_harness.timing import timed, write_jsonl
 
 NAME = "speed"
 # the peers compared with where installed, left out of the records where not: the
@@ -74,7 +74,7 @@ def robots(quick: bool) -> list[tuple[str, str, bool]]:
         return out
     out.append(("chain30", to_urdf(chain(30)), False))
     try:
-        from mbjax_harness.reproduce.urdf_corpus import corpus_paths
+        from mbjax_harness.common import corpus_paths
         paths = {p.stem: p for p in corpus_paths()}
         out.append(("panda", paths["panda"].read_text(), False))
         out.append(("g1", paths["g1_29dof_rev_1_0"].read_text(), True))

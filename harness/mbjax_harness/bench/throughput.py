@@ -41,8 +41,9 @@ import numpy as np
 
 from mbjax import Recursive
 from mbjax_harness import peers
-from mbjax_harness.bench.rigid import pinocchio_loop, relative_difference, states, timed
-from mbjax_harness.timing import write_jsonl
+from mbjax_harness.bench.rigid import pinocchio_loop, relative_difference
+from mbjax_harness.common import states
+from mbjax_harness.timing import timed, write_jsonl
 from mbjax.integrate import RK4, simulate
 from mbjax.model import chain, to_urdf
 from mbjax.rigid import TreeSystem, batched_forward_dynamics, forward_dynamics

@@ -3,10 +3,10 @@ On identical problems, one at a time and 64 at once.
 
 Problems: `arm-reach`, the shipped 7-dof arm's flange moved 0.4 m, and `acrobot-swingup`, the
 double pendulum driven at its elbow to upright (`mbjax.scenes`); and Crocoddyl's own
-contact-free examples (`mbjax_harness.crocoddyl_examples`): `kinova-reach`, `double-pendulum`,
+contact-free examples (`mbjax_harness.crocoddyl.examples`): `kinova-reach`, `double-pendulum`,
 `quadrotor` (a free base driven by four thrusters through an actuation matrix) and
 `quadrotor-bounded` (thrusts in [0.1, 5] N, Crocoddyl's BoxDDP); and its legged gaits through
-contact (`mbjax_harness.crocoddyl_gaits`): `anymal-walk` (its quadrupedal walk, 108 knots of
+contact (`mbjax_harness.crocoddyl.gaits`): `anymal-walk` (its quadrupedal walk, 108 knots of
 contact phases and impulses) and `talos-step` (a step of each foot of Talos's legs), whose
 records also hold mbjax's solution (`xs` in Pinocchio's state layout, `us` in Crocoddyl's
 control order, empty at an impulse). Each is built twice, as an
@@ -56,8 +56,10 @@ import jax.numpy as jnp
 import numpy as np
 
 from mbjax_harness import peers
-from mbjax_harness.crocoddyl_examples import EXAMPLES, Example
-from mbjax_harness.crocoddyl_gaits import GAITS
+from mbjax_harness.crocoddyl.examples import EXAMPLES, Example
+from mbjax_harness.crocoddyl.gaits import GAITS
+from mbjax_harness.crocoddyl.solver import CrocoddylSolver, _controls, agreement
+from mbjax_harness.crocoddyl.terms import crocoddyl_reach, crocoddyl_swingup, crocoddyl_working
 from mbjax.integrate import SemiImplicitEuler
 from mbjax_harness.timing import in_turns, measure, write_jsonl
 from mbjax.trajopt import CROCODDYL_SCHEDULE, ILQR, solve
@@ -92,7 +94,7 @@ def arm_reach():
     zero = jnp.zeros(model.nv)
 
     def crocoddyl(target=target):
-        return peers.crocoddyl_reach(str(ARM7), problem.q0, target,
+        return crocoddyl_reach(str(ARM7), problem.q0, target,
                                      inverse_dynamics(model, problem.q0, zero, zero), arm.FLANGE,
                                      problem.dt, problem.horizon)
 
@@ -119,7 +121,7 @@ def acrobot_example() -> Example:
     goal = jnp.array([0.0, 0.0, 2 * acrobot.LENGTH])
 
     def crocoddyl():
-        return peers.crocoddyl_swingup(to_urdf(model), problem.q0, goal, acrobot.LENGTH,
+        return crocoddyl_swingup(to_urdf(model), problem.q0, goal, acrobot.LENGTH,
                                        problem.dt, problem.horizon)
 
     return Example(problem, np.zeros((problem.horizon, problem.nu)), crocoddyl, "SolverFDDP",
@@ -135,77 +137,6 @@ def _to_tolerance(costs, best: float) -> int | None:
     costs = np.asarray(costs)
     within = np.flatnonzero(costs <= best + TOLERANCE * abs(best))
     return int(within[0]) if len(within) else None
-
-
-class CrocoddylSolver:
-    """One Crocoddyl problem's solver (FDDP, or BoxDDP for bounded controls), from a fixed first
-    guess and its rollout (or the states xs0, an infeasible start), its problem set to
-    `threads` threads (None: Crocoddyl's default, a thread per core)."""
-
-    def __init__(self, problem, us0, solver: str = "SolverFDDP", threads: int | None = 1,
-                 xs0=None):
-        import crocoddyl
-
-        if threads is not None:
-            problem.nthreads = threads
-        self.problem, self.us0 = problem, [np.asarray(u, float) for u in us0]
-        self.xs0 = None if xs0 is None else [np.asarray(x, float) for x in xs0]
-        self.solver = getattr(crocoddyl, solver)(problem)
-
-    def _states(self) -> list:
-        return self.problem.rollout(self.us0) if self.xs0 is None else self.xs0
-
-    def solve(self, iterations: int) -> bool:
-        return self.solver.solve(self._states(), self.us0, iterations, self.xs0 is None)
-
-    def history(self) -> list[float]:
-        """The cost before and after each iteration of a full solve."""
-        import crocoddyl
-
-        costs = []
-
-        class Record(crocoddyl.CallbackAbstract):
-            def __call__(self, solver):
-                costs.append(solver.cost)
-
-        first = self.problem.calc(self._states(), self.us0)
-        self.solver.setCallbacks([Record()])
-        self.solve(ITERATIONS)
-        self.solver.setCallbacks([])
-        return [first] + costs
-
-    def timed(self, iterations: int, repeats: int) -> float:
-        """The median wall time of a solve of at most `iterations` (after one warm-up)."""
-        return measure(self.solve, iterations, repeats=repeats)[1].run_s
-
-
-def _controls(example: Example, croc_problem):
-    """(to Crocoddyl: mbjax's (N, nu) -> Crocoddyl's list, an impulse model's empty; back:
-    Crocoddyl's list -> (N, nu), zeros where a model takes none)."""
-    if example.controls is None:
-        return (lambda us: [np.asarray(u, float) for u in us]), np.asarray
-    to = example.controls(croc_problem)
-    nu = example.problem.nu
-    return to, lambda us: np.stack([np.pad(np.asarray(u, float), (0, nu - len(u))) for u in us])
-
-
-def agreement(example: Example, croc_problem) -> dict:
-    """That the two are one problem: the first guess's one-step states (each of Crocoddyl's
-    knots stepped from mbjax's state, largest difference in Crocoddyl's layout) and the guess's
-    cost in both (relative)."""
-    problem, us0 = example.problem, np.asarray(example.us0, float)
-    to_croc, _ = _controls(example, croc_problem)
-    xs = problem.rollout(jnp.asarray(us0))
-    xs_croc, us_croc = example.to_crocoddyl(xs), to_croc(us0)
-    step = 0.0
-    for k, model in enumerate(croc_problem.runningModels):
-        data = model.createData()
-        model.calc(data, xs_croc[k], us_croc[k])
-        step = max(step, float(np.max(np.abs(np.asarray(data.xnext) - xs_croc[k + 1]))))
-    cost_mbjax = float(problem.cost(xs, jnp.asarray(us0)))
-    cost_croc = croc_problem.calc(list(xs_croc), us_croc)
-    return {"one_step_agreement": step,
-            "cost_agreement": abs(cost_croc - cost_mbjax) / abs(cost_mbjax)}
 
 
 def single(name: str, repeats: int, common: dict) -> list[dict]:
@@ -224,7 +155,7 @@ def single(name: str, repeats: int, common: dict) -> list[dict]:
              "cost": float(result.cost), "final_error": final_error(result.qs[-1]),
              "status": result.messages()[0], "history": costs.tolist()}
     records = [mbjax]
-    why = peers.crocoddyl_working()
+    why = crocoddyl_working()
     if why is not None:
         records.append({**common, "kind": "single", "problem": name, "engine": "crocoddyl",
                         "skipped": why})
@@ -235,7 +166,7 @@ def single(name: str, repeats: int, common: dict) -> list[dict]:
         croc = CrocoddylSolver(croc_problem, to_croc(example.us0), example.solver,
                                xs0=None if states0 is None else example.to_crocoddyl(states0))
         checks = agreement(example, croc_problem)
-        history = croc.history()
+        history = croc.history(ITERATIONS)
         converged = croc.solve(ITERATIONS)
         us_croc = from_croc(croc.solver.us)
         q_end = problem.split(problem.rollout(jnp.asarray(us_croc))[-1])[0]
@@ -327,7 +258,7 @@ def many(n: int, repeats: int, common: dict, loop: bool = True) -> list[dict]:
                            compile_s=timing.compile_s))
     if loop:
         records.append(summary("mbjax", "a loop of jitted solves", *_looped(one, offsets)))
-    why = peers.crocoddyl_working()
+    why = crocoddyl_working()
     if why is not None:
         records.append({**common, "kind": "many", "problem": "arm-reach", "engine": "crocoddyl",
                         "skipped": why})
@@ -373,7 +304,7 @@ def sweep_acrobot(n: int, common: dict) -> list[dict]:
                        np.asarray(results.status) == 0, compile_s=timing.compile_s)]
     records.append(summary("mbjax", "a loop of jitted solves", *_looped(
         lambda scale: solve(variant(scale), solver, jnp.zeros((horizon, 1))), scales)))
-    why = peers.crocoddyl_working()
+    why = crocoddyl_working()
     if why is not None:
         return records + [{**common, "kind": "sweep", "problem": "acrobot-swingup",
                            "engine": "crocoddyl", "skipped": why}]
@@ -382,7 +313,7 @@ def sweep_acrobot(n: int, common: dict) -> list[dict]:
     for scale in scales:
         model = eqx.tree_at(lambda m: m.mass, base, base.mass * scale)
         problem = variant(scale)
-        built.append(CrocoddylSolver(peers.crocoddyl_swingup(
+        built.append(CrocoddylSolver(crocoddyl_swingup(
             to_urdf(model), problem.q0, goal, acrobot.LENGTH, problem.dt, horizon),
             np.zeros((horizon, 1)), threads=None))
     start = time.perf_counter()

@@ -42,15 +42,12 @@ from mbjax import lie
 from mbjax.integrate import solve_reference
 from mbjax.scenes import vertical_top as vt
 from mbjax.tfe import (ConstantVelocityReference, Element, ExactQuadrature, Mixed, PrimalUnsymmetric,
-                       ReducedQuadrature, Reference, initial_state, solve_tfe)
+                       ReducedQuadrature, initial_state, solve_tfe)
+from mbjax_harness.common import DT, NODES, SPIN_RATIO, TILT0, steady_rotation
 from mbjax_harness.reproduce.vertical_top import top_transition
 from mbjax_harness.timing import measure
 
 NAME = "top-long-run"
-SPIN_RATIO = 1.01
-DT = 0.5
-NODES = 2
-TILT0 = 1e-4
 DURATION = 80.0
 # (run name, form, quadrature)
 FORMS = (("primal", PrimalUnsymmetric(), ExactQuadrature()),
@@ -63,11 +60,6 @@ LINEAR_TILT = 3e-2  # rad, below which the growth is fitted
 # state to 1e-2 (the tilt to about 0.01 rad) and the energy and momentum to 1 %; at DT = 0.5 s
 # the spin's phase error alone is 1.4e-3 in the rotation matrix's components
 TOLERANCE = {"rtol": 1e-2, "atol": 1e-2}
-
-
-def steady_rotation(spin) -> Reference:
-    """R_o = exp(Omega t e_3) (eq 7.1)."""
-    return Reference(jnp.eye(3), jnp.zeros(3), jnp.array([0.0, 0.0, spin]), jnp.zeros(3))
 
 
 @partial(jax.jit, static_argnames=("form", "element"))

@@ -6,7 +6,7 @@ of degrees of freedom n (n = 4 ... 44, a closed (n/2)-body chain of Hooke's join
 open n-link revolute chain (`mbjax.model.chain(n)`, n degrees of freedom; closed loops are in
 `mbjax reproduce closed-chain`), the CPU time of one forward-dynamics evaluation, and n up to 384 so that both asymptotic
 slopes show. An mbjax time is that of one evaluation among many in a jitted loop
-(`mbjax_harness.bench.rigid.looped_fn`; the median of timed loops after a compiling warm-up, over the
+(`mbjax_harness.common.looped_fn`; the median of timed loops after a compiling warm-up, over the
 evaluations per loop), as a simulation meets it, free of the per-call dispatch of a lone jitted
 call (tens of microseconds on CPU, which would hide the small-n end of the chart):
 
@@ -31,7 +31,8 @@ import jax.numpy as jnp
 import numpy as np
 
 from mbjax_harness import peers
-from mbjax_harness.bench.rigid import loop_length, looped_fn, states, timed
+from mbjax_harness.common import loop_length, looped_fn, states
+from mbjax_harness.timing import timed
 from mbjax.model import chain, to_urdf
 
 NAME = "tree-scaling"

@@ -27,20 +27,12 @@ from mbjax import Recursive
 from mbjax.model import load_urdf, state_to_pinocchio
 from mbjax.rigid import (forward_dynamics, forward_kinematics, frame_jacobian, frame_poses,
                          inverse_dynamics, mass_matrix)
+from mbjax_harness.common import corpus_paths
 from mbjax_harness.progress import step
 
 # Above this condition number of the mass matrix, forward dynamics are compared by their backward
 # error: cond(M) eps exceeds 1e-10 there, so neither engine's accelerations are accurate to it.
 ILL_CONDITIONED = 1e5
-
-
-def corpus_paths() -> list[Path]:
-    """Every URDF that the example-robot-data package ships (PackageNotFoundError when it is
-    not installed)."""
-    from importlib.metadata import distribution
-    root = Path(distribution("example-robot-data").locate_file(
-        "cmeel.prefix/share/example-robot-data/robots"))
-    return sorted(root.rglob("*.urdf"))
 
 
 def name(path: Path) -> str:

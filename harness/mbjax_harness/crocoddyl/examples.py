@@ -89,7 +89,7 @@ def kinova_reach() -> Example:
         import crocoddyl as croc
         import pinocchio as pin
 
-        from mbjax_harness.peers import _crocoddyl_shooting
+        from mbjax_harness.crocoddyl.terms import _crocoddyl_shooting
 
         state = croc.StateMultibody(robot.model)
         actuation = croc.ActuationModelFull(state)
@@ -212,7 +212,7 @@ def quadrotor(bounded: bool = False) -> Example:
         import crocoddyl as croc
         import pinocchio as pin
 
-        from mbjax_harness.peers import _crocoddyl_shooting
+        from mbjax_harness.crocoddyl.terms import _crocoddyl_shooting
 
         state = croc.StateMultibody(robot.model)
         kinds = {-1.0: croc.ThrusterType.CCW, 1.0: croc.ThrusterType.CW}

@@ -14,7 +14,7 @@ problem from its own builder.
                     0.6 m, height 0.1 m, dt 3e-2 s, 15 knots a step, 4 of double support):
                     39 knots and the left foot's impulse model as the terminal cost
 
-Both sides write Crocoddyl's costs term by term (`harness/mbjax_harness/crocoddyl_examples.py` says how
+Both sides write Crocoddyl's costs term by term (`mbjax_harness.crocoddyl.examples` says how
 weights fold into residuals): its state and control regularisation, centre-of-mass and swing-foot
 tracking, friction cones with its quadratic barrier, the state bounds' barrier; an impulse
 knot's costs are not weighted by dt, as Crocoddyl's impulse models' are not.
@@ -34,7 +34,7 @@ from mbjax.rigid import TreeSystem, center_of_mass, frame_pose
 from mbjax.trajopt import (Impulse, Knot, Problem, barrier_residual, com_residual,
                            control_residual, frame_residual, friction_cone_residual,
                            quasi_static, state_residual, wrench_cone_residual)
-from mbjax_harness.crocoddyl_examples import Example, _converter, _load, _robot
+from mbjax_harness.crocoddyl.examples import Example, _converter, _load, _robot
 
 MU = 0.7                     # the examples' friction coefficient
 FEET = ("LF_FOOT", "RF_FOOT", "LH_FOOT", "RH_FOOT")
