@@ -1,7 +1,7 @@
 """Multi-phase problems through contact (issue 45): knots that carry their own system, impulse
 knots at touchdown, the contact costs and the quasi-static guess, against Crocoddyl's own gait
 builder (`crocoddyl.utils.quadruped.SimpleQuadrupedalGaitProblem`) on example-robot-data's
-ANYmal (`mbjax_harness.crocoddyl_gaits`), and a multi-phase problem of one phase against the
+ANYmal (`mbjax_harness.crocoddyl.gaits`), and a multi-phase problem of one phase against the
 one-system problem it restates."""
 
 import equinox as eqx
@@ -15,10 +15,10 @@ from mbjax.contact import PointContact, stance
 from mbjax.rigid import TreeSystem
 from mbjax.trajopt import (ILQR, Impulse, Knot, Problem, control_residual, friction_cone_residual,
                            knot_wrenches, optimal_cost, solve, state_residual)
-from mbjax_harness import peers
+from mbjax_harness.crocoddyl.terms import crocoddyl_working
 from tests.conftest import example_robots
 
-WHY = peers.crocoddyl_working()
+WHY = crocoddyl_working()
 crocoddyl_only = pytest.mark.skipif(WHY is not None, reason=str(WHY))
 
 
@@ -76,6 +76,27 @@ def test_knots_of_one_system_restate_the_one_system_problem():
                      want)
 
 
+def test_phases_are_counted_and_alike_knots_that_do_not_group_are_named():
+    """Knots alike but for their arrays make one phase (`Problem.n_phases`); a knot whose cost
+    tuple lacks a term makes a second, and the warning names the two knots and the difference,
+    so that a user learns why a schedule compiles more than once."""
+    model = mbjax.model.chain(3)
+    system = TreeSystem(model)
+    q0, v0 = jnp.zeros(3), jnp.zeros(3)
+    targets = np.linspace(0.0, 1.0, 4)[:, None] * np.ones(3)
+    costs = [(state_residual(model, t), control_residual(3, weight=1e-2)) for t in targets]
+    terminal = state_residual(model, targets[-1])
+    one = Problem([Knot(system, c) for c in costs], q0, v0, dt=0.05, terminal=terminal)
+    assert one.n_phases == 1
+    assert Problem(system, q0, v0, dt=0.05, horizon=4, running=costs[0],
+                   terminal=terminal).n_phases == 1
+    knots = [Knot(system, c) for c in costs[:2]] + [Knot(system, costs[2][:1])] + [
+        Knot(system, costs[3])]
+    with pytest.warns(UserWarning, match=r"knots\[1\] and knots\[2\].*2 entries in one, 1 in"):
+        two = Problem(knots, q0, v0, dt=0.05, terminal=terminal)
+    assert two.n_phases == 2 and two.knots.phase == (0, 0, 1, 0)
+
+
 def test_bad_multi_phase_input_is_refused_by_name():
     model = mbjax.model.chain(3)
     system = TreeSystem(model)
@@ -110,7 +131,7 @@ def test_short_walk_is_crocoddyls_problem():
     steps and impulses from mbjax's state lands on mbjax's next state and the two costs agree
     to 1e-10."""
     example_robots(["anymal_b_simple/anymal"])          # skips without example-robot-data
-    from mbjax_harness.crocoddyl_gaits import anymal_walk
+    from mbjax_harness.crocoddyl.gaits import anymal_walk
 
     example = anymal_walk(step_knots=4, support_knots=1)
     problem = example.problem
@@ -141,8 +162,8 @@ def test_anymal_walk_reaches_fddps_optimum():
     quasi-static guess, ends within 1e-6 of FDDP's optimum, and its controls, rolled out in
     Crocoddyl's dynamics, cost there what they cost here (feasible in Crocoddyl's problem)."""
     from mbjax._src.trajopt.ilqr import CROCODDYL_SCHEDULE
-    from mbjax_harness.bench.trajopt import CrocoddylSolver
-    from mbjax_harness.crocoddyl_gaits import anymal_walk
+    from mbjax_harness.crocoddyl.solver import CrocoddylSolver
+    from mbjax_harness.crocoddyl.gaits import anymal_walk
 
     example = anymal_walk()
     croc_problem = example.crocoddyl()
@@ -169,7 +190,7 @@ def test_short_talos_step_is_crocoddyls_problem():
     next state and the costs agree to 1e-10 (the soles are `SurfaceContact(spatial=True)`,
     which hold the spatial acceleration as Crocoddyl's `ContactModel6D` does)."""
     example_robots(["talos_data/talos_reduced"])
-    from mbjax_harness.crocoddyl_gaits import talos_step
+    from mbjax_harness.crocoddyl.gaits import talos_step
 
     example = talos_step(step_knots=4, support_knots=1)
     _agrees_with_crocoddyl(example, scale=0.3, seed=0, guess=1e-9, tolerance=1e-10)
@@ -186,8 +207,8 @@ def test_the_jump_from_an_infeasible_start_reaches_fddps_optimum():
     trajectory the rollout of its controls."""
     example_robots(["anymal_b_simple/anymal"])
     from mbjax._src.trajopt.ilqr import CROCODDYL_SCHEDULE
-    from mbjax_harness.bench.trajopt import CrocoddylSolver
-    from mbjax_harness.crocoddyl_gaits import anymal_jump
+    from mbjax_harness.crocoddyl.solver import CrocoddylSolver
+    from mbjax_harness.crocoddyl.gaits import anymal_jump
 
     example = anymal_jump()
     problem, states0 = example.problem, jnp.asarray(example.states0)
@@ -212,7 +233,7 @@ def test_the_trots_optimal_cost_is_differentiable_in_the_trunks_mass():
     the trunk's mass and inertia scale (the envelope theorem, one reverse pass through every
     stance and impulse) equals central differences of gaits re-solved at scale 1 +- 1e-3."""
     from mbjax._src.trajopt.ilqr import CROCODDYL_SCHEDULE
-    from mbjax_harness.crocoddyl_gaits import anymal_trot
+    from mbjax_harness.crocoddyl.gaits import anymal_trot
 
     example = anymal_trot()
     problem, us0 = example.problem, jnp.asarray(example.us0)
@@ -241,8 +262,8 @@ def test_multiple_shooting_reaches_fddps_optimum_on_the_short_walk():
     guess it ends at the optimum of Crocoddyl's FDDP on the same short walk."""
     example_robots(["anymal_b_simple/anymal"])
     from mbjax.trajopt import MultipleShooting
-    from mbjax_harness.bench.trajopt import CrocoddylSolver
-    from mbjax_harness.crocoddyl_gaits import anymal_walk
+    from mbjax_harness.crocoddyl.solver import CrocoddylSolver
+    from mbjax_harness.crocoddyl.gaits import anymal_walk
 
     example = anymal_walk(step_knots=4, support_knots=1)
     result = solve(example.problem, MultipleShooting(), jnp.asarray(example.us0))

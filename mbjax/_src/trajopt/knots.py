@@ -2,8 +2,10 @@
 impulse of a touchdown; grouped into phases so that each distinct phase compiles once."""
 
 import abc
+import dataclasses
+import enum
+import warnings
 from collections.abc import Callable, Sequence
-from typing import ClassVar
 
 import equinox as eqx
 import jax
@@ -24,15 +26,9 @@ from mbjax._src.trajopt.residuals import given_forces, knot_forces, reads_forces
 
 class AbstractKnot(eqx.Module):
     """One knot of a multi-phase `Problem`: how the state moves on to the next knot, and the
-    running cost there.
-
-    Attributes:
-        rate: whether the running cost is a rate, weighted by the step dt (a step), or a
-            cost taken as it is (an impulse, which takes no time).
-    """
+    running cost there."""
 
     running: eqx.AbstractVar[Callable]
-    rate: ClassVar[bool]
 
     @abc.abstractmethod
     def advance(self, integrator, t, q: Array, v: Array, u: Array,
@@ -62,9 +58,34 @@ class AbstractKnot(eqx.Module):
         `mbjax.contact.contact_wrenches` gives them; None where the knot holds no stance."""
         return None
 
+    @abc.abstractmethod
     def duration(self, dt: float) -> float:
-        """The time from this knot to the next."""
-        return dt if self.rate else 0.0
+        """The time from this knot to the next: dt for a step, none for an impulse."""
+
+    @abc.abstractmethod
+    def weight(self, dt: float) -> float:
+        """The running cost's weight: dt where the cost is a rate (a step), 1 where it is taken
+        as it is (an impulse, which takes no time)."""
+
+    def jumps(self) -> bool:
+        """Whether the state jumps by design at this knot (an impulse: the velocity changes in no
+        time)."""
+        return False
+
+    @abc.abstractmethod
+    def controlled(self) -> AbstractSystem | None:
+        """The system whose control the knot's u is; None where u moves nothing (an
+        impulse)."""
+
+    @abc.abstractmethod
+    def quasi_static_control(self, q: Array, nu: int) -> Array:
+        """The control u, shape (nu,), that holds the configuration q at rest (`quasi_static`);
+        the least-squares answer where none can."""
+
+    def kind(self) -> tuple:
+        """What two knots share to look alike to a reader, their class and what they step: two
+        alike knots that make different phases get a warning naming why (`Schedule`)."""
+        return (type(self),)
 
     def vectorizable(self) -> bool:
         """Whether a phase of such knots may be `vmap`ped over its knots (`Schedule.map`): not
@@ -89,7 +110,6 @@ class Knot(AbstractKnot):
 
     system: AbstractSystem
     running: Callable
-    rate: ClassVar[bool] = True
 
     def __init__(self, system: AbstractSystem, running: Callable):
         if not isinstance(system, AbstractSystem):
@@ -127,6 +147,36 @@ class Knot(AbstractKnot):
         one-system problem's steps are."""
         return not is_stance(self.system)
 
+    def duration(self, dt):
+        return dt
+
+    def weight(self, dt):
+        return dt
+
+    def controlled(self):
+        return self.system
+
+    def kind(self):
+        return (type(self), type(self.system))
+
+    def quasi_static_control(self, q, nu):
+        """The least-norm (u, f) of B u + A^T f = g(q): the actuation B, the Jacobian A of the
+        system's closures (a stance's feet), f their multipliers and g the generalized gravity
+        force (Crocoddyl's `quasiStatic`, pseudo-inverse and all)."""
+        system = self.system
+        tree = getattr(system, "tree", system)
+        rest = jnp.zeros(tree.nv, q.dtype)
+        A = (system.loops.jacobian(q) if hasattr(system, "loops")
+             else jnp.zeros((0, tree.nv), q.dtype))
+        M = tree.mass_matrix(q)
+
+        def force(u):              # the tree's generalized force at rest under u: B u - g(q)
+            return M @ tree.with_control(Constant(u)).hold(0.0, q, rest).acceleration(0.0, q, rest)
+
+        zero = jnp.zeros(nu, q.dtype)
+        minus_g, B = force(zero), jax.jacfwd(force)(zero)
+        return (jnp.linalg.pinv(jnp.concatenate([B, A.T], axis=1)) @ -minus_g)[:nu]
+
 
 class Impulse(AbstractKnot):
     """A touchdown: the contacts that start stop their frames at once (`mbjax.contact.impulse`),
@@ -143,7 +193,6 @@ class Impulse(AbstractKnot):
     model: Model
     contacts: tuple
     running: Callable
-    rate: ClassVar[bool] = False
 
     def __init__(self, model: Model, contacts: Sequence[AbstractContact], running: Callable):
         if not isinstance(model, Model):
@@ -158,6 +207,22 @@ class Impulse(AbstractKnot):
     def advance(self, integrator, t, q, v, u, dt):
         return q, impulse_map(self.model, q, v, self.contacts)[0], None
 
+    def duration(self, dt):
+        return 0.0
+
+    def weight(self, dt):
+        return 1.0
+
+    def jumps(self):
+        return True
+
+    def controlled(self):
+        return None
+
+    def quasi_static_control(self, q, nu):
+        """Zero: the impulse's control moves nothing."""
+        return jnp.zeros(nu, q.dtype)
+
 
 class Schedule(eqx.Module):
     """A sequence of knots grouped into phases: knots alike but for their arrays (a stance's
@@ -171,6 +236,11 @@ class Schedule(eqx.Module):
     Raises:
         TypeError: an entry that is not a knot.
         ValueError: no knots, or knots with different numbers of controls.
+
+    Warns:
+        UserWarning: two consecutive knots alike (`AbstractKnot.kind`: a class, a system's type)
+            that make different phases, naming the knots and the first difference found (a cost
+            missing, a different number of contacts): each phase compiles on its own.
     """
 
     templates: tuple = eqx.field(static=True)   # each phase's knots without their arrays
@@ -193,7 +263,7 @@ class Schedule(eqx.Module):
             arrays, template = eqx.partition(knot, eqx.is_array)
             shapes = jax.tree.map(lambda a: (a.shape, a.dtype), arrays)
             for p, (other, other_shapes) in enumerate(templates):
-                if other_shapes == shapes and _same(other, template):
+                if _same(other, template) and other_shapes == shapes:
                     break
             else:
                 p = len(templates)
@@ -211,6 +281,19 @@ class Schedule(eqx.Module):
                             for axes, m in zip(self.axes, members, strict=True))
         self.phase, self.index = tuple(phase), tuple(index)
         self.times = tuple(float(t) for t in np.cumsum([0.0] + [k.duration(dt) for k in knots])[:-1])
+        for i in range(1, len(knots)):
+            if phase[i] != phase[i - 1] and knots[i].kind() == knots[i - 1].kind():
+                warnings.warn(
+                    f"knots[{i - 1}] and knots[{i}] are alike ({type(knots[i]).__name__}s of the "
+                    f"same kind) but make different phases, each compiled on its own: "
+                    f"{_difference(knots[i - 1], knots[i], 'knot') or 'their structure differs'}; write alike knots over the "
+                    f"same contacts and costs (those not in use inactive or weighted 0) so that "
+                    f"they share a phase", stacklevel=2)
+
+    @property
+    def n_phases(self) -> int:
+        """The number of distinct phases, each compiled once."""
+        return len(self.templates)
 
     def knot(self, p: int, j) -> AbstractKnot:
         """The j-th knot of phase p (j may be traced)."""
@@ -269,15 +352,65 @@ def _none(x) -> bool:
 
 
 def _same(a, b) -> bool:
-    """Whether two knots stripped of their arrays are the same phase."""
+    """Whether two knots stripped of their arrays are the same phase: the same tree structure
+    (with the static fields of their modules) and the same other leaves (`_equal`)."""
     if jax.tree.structure(a) != jax.tree.structure(b):
         return False
-    return all(x is y or _equal(x, y) for x, y in zip(jax.tree.leaves(a), jax.tree.leaves(b),
-                                                       strict=True))
+    return all(_equal(x, y) for x, y in zip(jax.tree.leaves(a), jax.tree.leaves(b), strict=True))
+
+
+# leaves compared by value; any other leaf (a function, a callable object) is the same only if it
+# is that very object, as a function's == is
+_VALUES = (bool, int, float, complex, str, bytes, type(None), np.dtype, slice, enum.Enum)
 
 
 def _equal(x, y) -> bool:
-    try:
-        return bool(x == y)
-    except Exception:          # objects without a truth value of ==: the same only if identical
-        return False
+    """Whether two leaves of knots stripped of their arrays are the same."""
+    if x is y:
+        return True
+    return type(x) is type(y) and isinstance(x, _VALUES) and bool(x == y)
+
+
+def _difference(a, b, path: str) -> str:
+    """The first difference found between two knots (or their parts at `path`) that keeps them
+    out of one phase, in words."""
+    if type(a) is not type(b):
+        return f"{path} is of type {type(a).__name__} in one, {type(b).__name__} in the other"
+    if isinstance(a, eqx.Module):
+        for field in dataclasses.fields(a):
+            found = _difference(getattr(a, field.name), getattr(b, field.name),
+                                f"{path}.{field.name}")
+            if found:
+                return found
+        return ""
+    if isinstance(a, list | tuple):
+        if len(a) != len(b):
+            return f"{path} has {len(a)} entries in one, {len(b)} in the other"
+        for i, (x, y) in enumerate(zip(a, b, strict=True)):
+            found = _difference(x, y, f"{path}[{i}]")
+            if found:
+                return found
+        return ""
+    if isinstance(a, dict):
+        if a.keys() != b.keys():
+            return f"{path} has keys {sorted(map(str, a))} in one, {sorted(map(str, b))} in the other"
+        for key in a:
+            found = _difference(a[key], b[key], f"{path}[{key!r}]")
+            if found:
+                return found
+        return ""
+    if eqx.is_array(a):
+        if (np.shape(a), a.dtype) != (np.shape(b), b.dtype):
+            return (f"{path} has shape {np.shape(a)} {a.dtype} in one, {np.shape(b)} {b.dtype} in "
+                    f"the other")
+        return ""
+    if jax.tree.structure(a) != jax.tree.structure(b):
+        return f"{path} differs in structure"
+    if not all(_equal(x, y) for x, y in zip(jax.tree.leaves(a), jax.tree.leaves(b), strict=True)):
+        return f"{path} differs ({_short(a)} in one, {_short(b)} in the other)"
+    return ""
+
+
+def _short(x) -> str:
+    text = repr(x)
+    return text if len(text) <= 60 else text[:57] + "..."

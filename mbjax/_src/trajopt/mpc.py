@@ -74,7 +74,7 @@ class Cycle(eqx.Module):
     def __init__(self, knots, dt: float):
         knots = list(knots)
         for i, knot in enumerate(knots):
-            if not isinstance(knot, AbstractKnot) or not knot.rate:
+            if not isinstance(knot, AbstractKnot) or knot.jumps():
                 raise TypeError(f"knots[{i}] must be a Knot(system, running) (impulses take no "
                                 f"time and have no place in a cycle of steps), got "
                                 f"{type(knot).__name__}")

@@ -86,15 +86,15 @@ class Problem(eqx.Module):
                 raise ValueError(f"horizon must be the number of knots ({len(system)}) or None, "
                                  f"got {horizon!r}")
             self.knots = Schedule(system, dt)
-            steps = [k for k in system if isinstance(k, Knot)]
+            steps = [k for k in system if k.controlled() is not None]
             if not steps:
                 raise ValueError("knots must include at least one Knot(system, running): a "
                                  "problem of impulses alone has nothing to control")
-            sizes = {k.system.n_controls for k in steps}
+            sizes = {k.controlled().n_controls for k in steps}
             if len(sizes) > 1:
                 raise ValueError(f"knots: every Knot's system must have the same number of "
                                  f"controls, got {sorted(sizes)}")
-            system, running, horizon = steps[0].system, steps[0].running, len(system)
+            system, running, horizon = steps[0].controlled(), steps[0].running, len(system)
         if not isinstance(system, AbstractSystem):
             raise TypeError(f"system must be an mbjax system (TreeSystem, ...) or a sequence of "
                             f"knots (Knot, Impulse), got {type(system).__name__}")
@@ -193,7 +193,7 @@ class Problem(eqx.Module):
     def _step_cost(self, knot, x: Array, u: Array, t) -> tuple[Array, Array]:
         q, v = self.split(x)
         q1, v1, forces = knot.advance(self.integrator, t, q, v, u, jnp.asarray(self.dt, x.dtype))
-        cost = _value(knot.cost(t, q, v, u, forces)) * self._weight(knot, x.dtype)
+        cost = _value(knot.cost(t, q, v, u, forces)) * jnp.asarray(knot.weight(self.dt), x.dtype)
         return jnp.concatenate([q1, v1]), cost
 
     def _knot(self) -> Knot:
@@ -213,12 +213,24 @@ class Problem(eqx.Module):
             return jax.vmap(lambda *a: fn(knot, *a))(*args)
         return self.knots.map(fn, *args)
 
+    @property
+    def n_phases(self) -> int:
+        """The number of distinct phases, each compiled once: 1 for a problem of one system,
+        the schedule's for knots (alike knots, but for their arrays, make one phase)."""
+        return 1 if self.knots is None else self.knots.n_phases
+
+    def _phases(self) -> list:
+        """A knot of each phase (its first)."""
+        if self.knots is None:
+            return [self._knot()]
+        return [self.knots.knot(p, 0) for p in range(self.knots.n_phases)]
+
     def jumps(self) -> np.ndarray | None:
         """Which steps jump by design, one bool per knot: an `Impulse` (the velocity changes in
         no time); None for a problem of one system."""
         if self.knots is None:
             return None
-        return np.asarray([not self.knots.templates[p].rate for p in self.knots.phase])
+        return np.asarray([self.knots.templates[p].jumps() for p in self.knots.phase])
 
     def times(self, dtype=float) -> Array:
         """Each knot's time t_k, shape (N,): k dt, an impulse taking none."""
@@ -296,7 +308,7 @@ class Problem(eqx.Module):
 
         ((A, B), (Jx, Ju)), (e, r) = jax.jacfwd(both, argnums=(0, 1), has_aux=True)(
             jnp.zeros(self.ndx, x.dtype), u)
-        dt = self._weight(knot, x.dtype)
+        dt = jnp.asarray(knot.weight(self.dt), x.dtype)
         return (A, B, e), (Jx.T @ r * dt, Ju.T @ r * dt, Jx.T @ Jx * dt, Ju.T @ Jx * dt,
                            Ju.T @ Ju * dt)
 
@@ -315,13 +327,9 @@ class Problem(eqx.Module):
             jnp.zeros(self.ndx, x.dtype), u)
         return A, B, e
 
-    def _weight(self, knot, dtype):
-        """A knot's running cost weight: dt for a rate, 1 for an impulse's cost."""
-        return jnp.asarray(self.dt if knot.rate else 1.0, dtype)
-
     def _stage_cost(self, knot, x: Array, u: Array, t) -> Array:
         """running(q, v, u) dt (1/2 |r|^2 dt for residuals r); an impulse's not times dt."""
-        return _value(knot.cost(t, *self.split(x), u)) * self._weight(knot, x.dtype)
+        return _value(knot.cost(t, *self.split(x), u)) * jnp.asarray(knot.weight(self.dt), x.dtype)
 
     def final_cost(self, x: Array) -> Array:
         return _value(self.terminal(*self.split(x)))
@@ -336,7 +344,7 @@ class Problem(eqx.Module):
         tangent space."""
         zero_q, zero_v = jnp.zeros(self.ndq, x.dtype), jnp.zeros(self.nv, x.dtype)
         running = self._about(x, lambda q, v, u: knot.cost(t, q, v, u))
-        dt = self._weight(knot, x.dtype)
+        dt = jnp.asarray(knot.weight(self.dt), x.dtype)
         if _is_residual(running, zero_q, zero_v, u):
             (Jq, Jv, Ju), r = _jacobian_and_value(running, zero_q, zero_v, u)
             Jx = jnp.concatenate([Jq, Jv], axis=1)

@@ -1,12 +1,9 @@
 """A first guess that holds each knot's state still: Crocoddyl's `quasiStatic`."""
 
 import equinox as eqx
-import jax
 import jax.numpy as jnp
 from jax import Array
 
-from mbjax._src.control import Constant
-from mbjax._src.trajopt.knots import Knot
 from mbjax._src.trajopt.problem import Problem
 
 
@@ -42,22 +39,6 @@ def quasi_static(problem: Problem, xs: Array | None = None) -> Array:
 
 @eqx.filter_jit
 def _quasi_static(problem: Problem, xs: Array) -> Array:
-    us = problem._map(lambda knot, x: _hold(knot, problem.split(x)[0], problem.nu), xs)
+    us = problem._map(lambda knot, x: knot.quasi_static_control(problem.split(x)[0], problem.nu),
+                      xs)
     return jnp.clip(us, problem.lower, problem.upper)
-
-
-def _hold(knot, q: Array, nu: int) -> Array:
-    if not isinstance(knot, Knot):
-        return jnp.zeros(nu, q.dtype)
-    system = knot.system
-    tree = getattr(system, "tree", system)
-    rest = jnp.zeros(tree.nv, q.dtype)
-    A = system.loops.jacobian(q) if hasattr(system, "loops") else jnp.zeros((0, tree.nv), q.dtype)
-    M = tree.mass_matrix(q)
-
-    def force(u):                  # the tree's generalized force at rest under u: B u - g(q)
-        return M @ tree.with_control(Constant(u)).hold(0.0, q, rest).acceleration(0.0, q, rest)
-
-    zero = jnp.zeros(nu, q.dtype)
-    minus_g, B = force(zero), jax.jacfwd(force)(zero)
-    return (jnp.linalg.pinv(jnp.concatenate([B, A.T], axis=1)) @ -minus_g)[:nu]

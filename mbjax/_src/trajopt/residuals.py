@@ -23,8 +23,10 @@ from mbjax._src.contact.stance import contact_wrenches, friction, stance_contact
 from mbjax._src.control import Constant
 from mbjax._src.lie import gamma_inv, log
 from mbjax._src.lie.inputs import check_point
+from mbjax._src.model.model import Model
 from mbjax._src.rigid.centre import center_of_mass
 from mbjax._src.rigid.frames import frame_pose
+from mbjax._src.system.system import AbstractSystem
 
 
 def _root(weight) -> Array:
@@ -88,9 +90,9 @@ def state_residual(space, q_ref, v_ref=None, weight=1.0) -> eqx.Module:
         The residual function r(q, v, u=None), shape (2 nv,) for a tree.
 
     Raises:
-        TypeError: space has no `difference`.
+        TypeError: space is neither a Model nor a system.
     """
-    if not hasattr(space, "difference"):
+    if not isinstance(space, Model | AbstractSystem):
         raise TypeError(f"space must be a Model or a system with `difference`, got "
                         f"{type(space).__name__}")
     q_ref = jnp.asarray(q_ref, dtype=float)

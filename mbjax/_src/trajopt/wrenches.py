@@ -43,9 +43,7 @@ def _shapes(problem: Problem) -> list:
     """Each phase's wrenches' shape (None for a phase without a stance)."""
     x, u = problem.x0, jnp.zeros(problem.nu)
     q, v = problem.split(x)
-    knots = ([problem._knot()] if problem.knots is None else
-             [problem.knots.knot(p, 0) for p in range(len(problem.knots.templates))])
-    return [eqx.filter_eval_shape(lambda k: k.wrenches(0.0, q, v, u), k) for k in knots]
+    return [eqx.filter_eval_shape(lambda k: k.wrenches(0.0, q, v, u), k) for k in problem._phases()]
 
 
 @eqx.filter_jit
