@@ -62,19 +62,7 @@ class ConstantReference(AbstractReference):
     Borri 1990 §2): x_o = x_1, R_o = R_1."""
 
     def start(self, body: Body, t, R1: Array, x1: Array, p_hat1: Array) -> tuple["Reference", Array]:
-        """The reference (R1, x1) at rest, and q1 = 0.
-
-        Args:
-            body: the body.
-            t: the element's start [s], a scalar (unused).
-            R1: initial rotation, shape (3, 3).
-            x1: initial position of O', shape (3,) [m].
-            p_hat1: initial spatial momentum about O', shape (nq,).
-
-        Returns:
-            ref: the `Reference` held at (R1, x1).
-            q1: zeros, shape (nq,).
-        """
+        """The reference (R1, x1) at rest, and q1 = 0 (as `AbstractReference.start`)."""
         return _afresh(body, R1, x1, p_hat1, moving=False)
 
 
@@ -84,19 +72,8 @@ class ConstantVelocityReference(AbstractReference):
     default."""
 
     def start(self, body: Body, t, R1: Array, x1: Array, p_hat1: Array) -> tuple["Reference", Array]:
-        """The reference from (R1, x1) at the velocities of p_hat1, and q1 = 0.
-
-        Args:
-            body: the body.
-            t: the element's start [s], a scalar (unused).
-            R1: initial rotation, shape (3, 3).
-            x1: initial position of O', shape (3,) [m].
-            p_hat1: initial spatial momentum about O', shape (nq,).
-
-        Returns:
-            ref: the `Reference` moving with the initial velocities.
-            q1: zeros, shape (nq,).
-        """
+        """The reference from (R1, x1) at the velocities of p_hat1, and q1 = 0 (as
+        `AbstractReference.start`)."""
         return _afresh(body, R1, x1, p_hat1, moving=True)
 
 

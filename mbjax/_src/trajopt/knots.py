@@ -286,9 +286,9 @@ class Schedule(eqx.Module):
                 warnings.warn(
                     f"knots[{i - 1}] and knots[{i}] are alike ({type(knots[i]).__name__}s of the "
                     f"same kind) but make different phases, each compiled on its own: "
-                    f"{_difference(knots[i - 1], knots[i], 'knot') or 'their structure differs'}; write alike knots over the "
-                    f"same contacts and costs (those not in use inactive or weighted 0) so that "
-                    f"they share a phase", stacklevel=2)
+                    f"{_difference(knots[i - 1], knots[i], 'knot') or 'their structure differs'}"
+                    f"; write alike knots over the same contacts and costs (those not in use "
+                    f"inactive or weighted 0) so that they share a phase", stacklevel=2)
 
     @property
     def n_phases(self) -> int:
