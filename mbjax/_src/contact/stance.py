@@ -3,18 +3,16 @@
 from collections.abc import Sequence
 
 import equinox as eqx
-import jax
 import jax.numpy as jnp
-import numpy as np
 from jax import Array
 
 from mbjax._src.contact.contact import AbstractContact, on_ground, wrenches
+from mbjax._src.contact.friction import cone_flags, friction
 from mbjax._src.loops.coupled import Coupled
 from mbjax._src.loops.method import AbstractLoopMethod
 from mbjax._src.loops.system import ClosedSystem
 from mbjax._src.lie.inputs import check_unit_quaternions
 from mbjax._src.model.model import Model, coordinates
-from mbjax._src.system.status import Status
 from mbjax._src.system.tree_system import AbstractTreeSystem
 
 # Crocoddyl's contact models stabilize with Baumgarte gains (Kp, Kd) = (0, 50): the contact's
@@ -44,13 +42,7 @@ class Grip(eqx.Module):
         if self.mu is None:
             return jnp.zeros((), jnp.int32)
         w = wrenches(loops.closures[:len(self.contacts)], multipliers, *loops.tree.frames(q))
-        normals = jnp.stack([c.normal for c in self.contacts])
-        f = w[:, 3:]
-        fn = jnp.sum(f * normals, axis=1)
-        ft = jnp.linalg.norm(f - fn[:, None] * normals, axis=1)
-        slack = 1e-9 * jnp.linalg.norm(f, axis=1)
-        return (jnp.where(jnp.any(fn < -slack), int(Status.PULLING), 0)
-                | jnp.where(jnp.any(ft > self.mu * fn + slack), int(Status.SLIPPING), 0))
+        return cone_flags(w[:, 3:], jnp.stack([c.normal for c in self.contacts]), self.mu)
 
 
 def stance(tree: AbstractTreeSystem, q: Array, contacts: Sequence[AbstractContact], *,
@@ -96,16 +88,6 @@ def stance(tree: AbstractTreeSystem, q: Array, contacts: Sequence[AbstractContac
     method = Coupled(baumgarte=CROCODDYL_GAINS) if method is None else method
     watch = Grip(contacts, None if mu is None else friction(mu))
     return ClosedSystem(tree, closures, method, projection, watch=watch)
-
-
-def friction(mu) -> Array:
-    """mu as an array, or a ValueError naming it where it is concrete and not positive."""
-    mu = jnp.asarray(mu, dtype=float)
-    if mu.ndim != 0:
-        raise ValueError(f"mu must be a scalar friction coefficient, got shape {mu.shape}")
-    if not isinstance(mu, jax.core.Tracer) and not (float(mu) > 0 and np.isfinite(float(mu))):
-        raise ValueError(f"mu must be a positive friction coefficient, got {float(mu)!r}")
-    return mu
 
 
 def contact_wrenches(phase: ClosedSystem, t, q: Array, u: Array) -> Array:

@@ -19,7 +19,8 @@ import jax.numpy as jnp
 import numpy as np
 from jax import Array
 
-from mbjax._src.contact.stance import contact_wrenches, friction, stance_contacts
+from mbjax._src.contact.friction import cone_rows, friction, ground_frame, wrench_cone_rows
+from mbjax._src.contact.stance import contact_wrenches, stance_contacts
 from mbjax._src.control import Constant
 from mbjax._src.lie import gamma_inv, log
 from mbjax._src.lie.inputs import check_point
@@ -262,24 +263,6 @@ def friction_cone_residual(phase, mu=0.7, facets: int = 4, weight=1.0) -> eqx.Mo
     return _Cone(_Forces(phase), A, _root(weight))
 
 
-def ground_frame(normal: Array) -> Array:
-    """The ground's frame (t1, t2, n) as columns: n the unit normal, t1 the world's x made
-    normal to it (y where x is nearly along n), t2 = n x t1; the identity for n = z."""
-    n = normal / jnp.linalg.norm(normal)
-    helper = jnp.where(jnp.abs(n[0]) < 0.9, jnp.array([1.0, 0.0, 0.0]), jnp.array([0.0, 1.0, 0.0]))
-    t1 = helper - (helper @ n) * n
-    t1 = t1 / jnp.linalg.norm(t1)
-    return jnp.stack([t1, jnp.cross(n, t1), n], axis=1)
-
-
-def cone_rows(normal: Array, mu, facets: int) -> Array:
-    """The linearised cone's rows, (t_i - mu n) for each facet then n, shape (facets + 1, 3)."""
-    t1, t2, n = ground_frame(normal).T
-    angles = 2 * np.pi * np.arange(facets) / facets
-    tangents = np.cos(angles)[:, None] * t1 + np.sin(angles)[:, None] * t2
-    return jnp.concatenate([tangents - mu * n, n[None]])
-
-
 class _Force(eqx.Module):
     forces: _Forces
     reference: Array
@@ -358,23 +341,6 @@ class _WrenchCone(eqx.Module):
         return self.root * jnp.concatenate([jnp.maximum(r[:, :4], 0.0),
                                             jnp.minimum(r[:, 4:5], 0.0),
                                             jnp.maximum(r[:, 5:], 0.0)], axis=1).ravel()
-
-
-def wrench_cone_rows(mu, length, width, inner: bool = True) -> np.ndarray:
-    """The contact wrench cone of a rectangular sole (Caron, Pham and Nakamura 2015, eqs 13-17,
-    in Crocoddyl's `WrenchCone` order), rows on the ground-frame wrench (torque; force), shape
-    (17, 6): four friction facets, the normal force (bounded below), four centre-of-pressure
-    rows and eight yaw-torque rows, each bounded above by 0 but the normal's."""
-    m = mu / np.sqrt(2.0) if inner else mu
-    X, Y = length / 2, width / 2
-    rows = [[1, 0, -m, 0, 0, 0], [-1, 0, -m, 0, 0, 0], [0, 1, -m, 0, 0, 0], [0, -1, -m, 0, 0, 0],
-            [0, 0, 1, 0, 0, 0],
-            [0, 0, -Y, 1, 0, 0], [0, 0, -Y, -1, 0, 0], [0, 0, -X, 0, 1, 0], [0, 0, -X, 0, -1, 0]]
-    for yaw in (-1, 1):
-        for sx, sy in ((1, 1), (1, -1), (-1, 1), (-1, -1)):
-            rows.append([sx * Y, sy * X, -m * (X + Y), yaw * sx * m, yaw * sy * m, yaw])
-    rows = np.asarray(rows, dtype=float)                # on (force; torque)
-    return np.concatenate([rows[:, 3:], rows[:, :3]], axis=1)
 
 
 def wrench_cone_residual(phase, mu=0.7, length=0.1, width=0.05, weight=1.0,
