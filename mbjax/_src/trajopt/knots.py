@@ -127,8 +127,8 @@ class Knot(AbstractKnot):
         if reads_forces(self.running):          # one solve for the step and the costs
             a0, multipliers = system.solve(t, q, v)
             forces = stance_wrenches(system, q, multipliers)
-        q1, v1, _ = integrator.step(system, t, q, v, dt, a0=a0)
-        return (*system.constrain(t + dt, q1, v1), forces)
+        q1, v1, _ = integrator.advance(system, t, q, v, dt, a0=a0)     # held already: as is
+        return q1, v1, forces
 
     def cost(self, t, q, v, u, forces=None):
         if not reads_forces(self.running):
