@@ -10,6 +10,15 @@ from mbjax._src.loops.coupled import Coupled as Coupled
 from mbjax._src.loops.momentum import Momentum as Momentum
 from mbjax._src.loops.stabilized import Stabilized as Stabilized
 from mbjax._src.model.closures import CutJoint as CutJoint
+from mbjax._src.model.closures import AbstractCutKind as AbstractCutKind
+from mbjax._src.model.closures import Spherical as Spherical
+from mbjax._src.model.closures import Revolute as Revolute
+from mbjax._src.model.closures import Universal as Universal
+from mbjax._src.model.closures import Weld as Weld
+from mbjax._src.model.closures import SpatialWeld as SpatialWeld
+from mbjax._src.model.closures import Prismatic as Prismatic
+from mbjax._src.model.closures import PointOnLine as PointOnLine
+from mbjax._src.model.closures import PointOnPlane as PointOnPlane
 from mbjax._src.model.closures import Coupling as Coupling
 from mbjax._src.model.closures import Prescribed as Prescribed
 from mbjax._src.loops.constraints import Loops as Loops
@@ -19,6 +28,8 @@ from mbjax._src.loops.projection import project_velocity as project_velocity
 
 __all__ = [
     "ClosedSystem", "AbstractLoopMethod", "Coupled", "Momentum", "Stabilized", "CutJoint",
+    "AbstractCutKind", "Spherical", "Revolute", "Universal", "Weld", "SpatialWeld", "Prismatic",
+    "PointOnLine", "PointOnPlane",
     "Coupling", "Prescribed", "Loops", "consistent_state", "project_configuration",
     "project_velocity"
 ]

@@ -11,6 +11,9 @@ from mbjax._src.model.builders import chain as chain
 from mbjax._src.model.builders import random_tree as random_tree
 from mbjax._src.model.urdf import load_urdf as load_urdf
 from mbjax._src.model.urdf import to_urdf as to_urdf
+from mbjax._src.model.siblings import AbstractSiblingOrder as AbstractSiblingOrder
+from mbjax._src.model.siblings import ByName as ByName
+from mbjax._src.model.siblings import InDocument as InDocument
 from mbjax._src.model.mjcf import load_mjcf as load_mjcf
 from mbjax._src.model.mjcf import from_mujoco as from_mujoco
 from mbjax._src.model.states import state_from_mujoco as state_from_mujoco
@@ -20,6 +23,7 @@ from mbjax._src.model.states import state_to_pinocchio as state_to_pinocchio
 
 __all__ = [
     "Model", "Geoms", "ground_plane", "Topology", "ModelWarning", "chain", "random_tree", "load_urdf", "to_urdf",
+    "AbstractSiblingOrder", "ByName", "InDocument",
     "load_mjcf", "from_mujoco", "state_from_mujoco", "state_from_pinocchio", "state_to_mujoco",
     "state_to_pinocchio"
 ]

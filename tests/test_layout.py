@@ -36,7 +36,7 @@ LAYERS = (
 RANK = {name: rank for rank, names in enumerate(LAYERS) for name in names}
 NAMESPACES = ("lie", "model", "control", "integrate", "rigid", "flex", "loops", "tfe", "wrist",
               "trajopt", "scenes", "data", "contact")
-MAX_PUBLIC_NAMES = 199       # 150, the contact namespace (legged robots), multi-phase problems,
+MAX_PUBLIC_NAMES = 211       # 150, the contact namespace (legged robots), multi-phase problems,
                              # contacts that find themselves (geoms, their system and model,
                              # the Ant's and HalfCheetah's files) and contact costs (issue 45),
                              # model-predictive control (MPC, Plan, Cycle, Tick,
@@ -46,7 +46,11 @@ MAX_PUBLIC_NAMES = 199       # 150, the contact namespace (legged robots), multi
                              # string options (issue 60): trajopt.cosine_adam, wrist.AbstractGradient,
                              # wrist.ForwardMode, wrist.ReverseMode, tfe.AbstractQuadrature,
                              # tfe.ExactQuadrature, tfe.ReducedQuadrature, tfe.AbstractReference,
-                             # tfe.ConstantReference, tfe.ConstantVelocityReference
+                             # tfe.ConstantReference, tfe.ConstantVelocityReference,
+                             # model.AbstractSiblingOrder, model.ByName, model.InDocument,
+                             # the cut-joint kinds loops.AbstractCutKind, loops.Spherical,
+                             # loops.Revolute, loops.Universal, loops.Weld, loops.SpatialWeld,
+                             # loops.Prismatic, loops.PointOnLine, loops.PointOnPlane
 
 
 def _imports(path: Path):

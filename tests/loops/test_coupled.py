@@ -13,13 +13,14 @@ from scipy.integrate import solve_ivp
 from mbjax import Status
 from mbjax.integrate import RK4, simulate
 from mbjax.loops import ClosedSystem, CutJoint, Loops, Prescribed, Stabilized
+from mbjax.loops import Revolute, Spherical
 from mbjax._src.loops import coupled_acceleration
 from mbjax.rigid import kinetic_energy, potential_energy
 from mbjax.scenes import four_bar
 from mbjax._src.scenes.four_bar import OMEGA0, THETA0, joint_angles
 
 # the four-bar scene closed by the spatial revolute cut joint: 5 equations of rank 2
-SYSTEM, Q0, V0 = four_bar.build(closure="revolute")
+SYSTEM, Q0, V0 = four_bar.build(closure=Revolute())
 LOOPS, TREE = SYSTEM.loops, SYSTEM.tree
 MODEL = TREE.model
 
@@ -96,11 +97,11 @@ def test_gradient_through_a_constrained_rollout_matches_finite_differences():
 
 def test_ill_posed_closures_get_clear_errors():
     with pytest.raises(ValueError, match="two different bodies"):
-        CutJoint("revolute", 1, 1)
-    with pytest.raises(ValueError, match="kind must be one of"):
+        CutJoint(Revolute(), 1, 1)
+    with pytest.raises(TypeError, match="kind must be a cut-joint kind"):
         CutJoint("hinge", 0, 1)
     with pytest.raises(ValueError, match="not in the tree"):
-        Loops(TREE, [CutJoint("spherical", 0, 7)])
+        Loops(TREE, [CutJoint(Spherical(), 0, 7)])
     with pytest.raises(ValueError, match="at least one"):
         ClosedSystem(TREE, [])
 

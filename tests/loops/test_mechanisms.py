@@ -15,7 +15,7 @@ from scipy.integrate import solve_ivp
 from scipy.linalg import expm
 
 from mbjax.integrate import RK4, simulate
-from mbjax.loops import ClosedSystem, Coupled, project_velocity
+from mbjax.loops import ClosedSystem, Coupled, Revolute, Weld, project_velocity
 from mbjax._src.loops import gauss_newton, numerical_rank
 from mbjax.rigid import kinetic_energy, potential_energy
 from mbjax.scenes import bricard, four_bar, slider_crank
@@ -73,7 +73,7 @@ def on_motion(f, thetas):
 # -- planar four-bar ------------------------------------------------------------------------------
 
 def test_four_bar_closed_by_a_planar_pin_matches_minimal_coordinates():
-    """The four-bar closed by a `point_on_line` cut (2 equations of rank 2: no redundancy to
+    """The four-bar closed by a `PointOnLine()` cut (2 equations of rank 2: no redundancy to
     report) follows the one-dof DOP853 solution to 1e-8 over 0.5 s, on the closed-form loop,
     energy to 1e-8."""
     system, q0, v0 = four_bar.build()
@@ -92,12 +92,14 @@ def test_four_bar_closed_by_a_planar_pin_matches_minimal_coordinates():
 
 
 def test_four_bar_revolute_closure_is_redundant():
-    system, q0, _ = four_bar.build("revolute")
+    system, q0, _ = four_bar.build(Revolute())
     loops = system.loops
     rank = jax.jit(lambda q: numerical_rank(loops.jacobian(q) @ loops.jacobian(q).T))(q0)
     assert loops.m == 5 and int(rank) == 2
     with pytest.raises(ValueError, match="closure must be one of"):
-        four_bar.build("hinge")
+        four_bar.build(Weld())
+    with pytest.raises(TypeError, match="kind must be a cut-joint kind"):
+        four_bar.build("revolute")
 
 
 # -- slider-crank ---------------------------------------------------------------------------------

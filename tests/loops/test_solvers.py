@@ -13,6 +13,7 @@ from mbjax.integrate import RK4, simulate
 from mbjax._src.integrate import Status
 from mbjax._src.model.closures import GROUND
 from mbjax.loops import ClosedSystem, Coupled, CutJoint, Loops, Momentum, Prescribed, Stabilized, consistent_state
+from mbjax.loops import Spherical
 from mbjax._src.loops import coupled_acceleration, eta_and_gamma, loop_momentum_rate
 from mbjax.rigid import TreeSystem
 from mbjax._src.rigid.dynamics import forward_dynamics, mass_matrix
@@ -101,7 +102,7 @@ def test_inconsistent_initial_conditions_are_projected_or_rejected():
     same_q, same_v = consistent_state(LOOPS, q, v, project=False)   # consistent: unchanged
     np.testing.assert_array_equal(same_q, q)
     np.testing.assert_array_equal(same_v, v)
-    too_far = ClosedSystem(TREE, [CutJoint("spherical", 2, GROUND, origin_a=(0.0, 0.0, -0.3),
+    too_far = ClosedSystem(TREE, [CutJoint(Spherical(), 2, GROUND, origin_a=(0.0, 0.0, -0.3),
                                            origin_b=(5.0, 0.0, 0.0))])   # the chain is 0.9 m
     with pytest.raises(ValueError, match="cannot be projected"):
         consistent_state(too_far, Q0, V0)

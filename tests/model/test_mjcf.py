@@ -19,7 +19,7 @@ import numpy as np
 import pytest
 
 import mbjax
-from mbjax.loops import ClosedSystem, CutJoint, Loops
+from mbjax.loops import ClosedSystem, CutJoint, Loops, Spherical, Weld
 from mbjax._src.model.checks import ModelWarning
 from mbjax._src.model.mjcf import object_name, site_frame_name
 from mbjax_harness.reproduce.mjcf_corpus import (
@@ -366,7 +366,7 @@ def _check_closure(xml, kind, assembled=True):
     efc = d.efc_pos[d.efc_type == mujoco.mjtConstraint.mjCNSTR_EQUALITY]
     residual = np.asarray(phi(loops, jnp.asarray(d.qpos)))
     np.testing.assert_allclose(residual[:3], efc[:3], atol=1e-12)
-    if kind == "weld":
+    if kind == Weld():
         ids = [m.eq_obj1id[0], m.eq_obj2id[0]]
         if m.eq_objtype[0] == int(mujoco.mjtObj.mjOBJ_SITE):      # the two sites' frames
             bodies, turns = m.site_bodyid[ids], m.site_quat[ids]
@@ -401,11 +401,11 @@ def _check_closure(xml, kind, assembled=True):
     f'<connect site1="end" site2="pin" {SOFT}/>',
 ])
 def test_connect_closure(equality):
-    _check_closure(CONNECT.format(equality), "spherical")
+    _check_closure(CONNECT.format(equality), Spherical())
 
 
 def test_weld_closure():
-    _check_closure(WELD, "weld")
+    _check_closure(WELD, Weld())
     sites = WELD.replace('<geom type="capsule" fromto="0 0 0 0 0 0.3" size="0.03"/>',
                          '<geom type="capsule" fromto="0 0 0 0 0 0.3" size="0.03"/>'
                          '<site name="sb" pos="0 0.1 0.3" euler="10 0 40"/>')
@@ -413,7 +413,7 @@ def test_weld_closure():
                           'euler="0 -30 5"/><geom')
     sites = sites.replace('body1="a2" body2="b1" anchor="0.05 0.1 0.2"', 'site1="sa" site2="sb"')
     assert 'site1="sa"' in sites and 'name="sa"' in sites and 'name="sb"' in sites
-    _check_closure(sites, "weld", assembled=False)
+    _check_closure(sites, Weld(), assembled=False)
 
 
 # --------------------------------------------------------------------------------------------
@@ -446,7 +446,7 @@ def test_ignored_features_are_named_in_one_warning():
                  "model.closures"):
         assert what in message, message
     assert model.nv == 2
-    assert len(model.closures) == 1 and model.closures[0].kind == "spherical"
+    assert len(model.closures) == 1 and model.closures[0].kind == Spherical()
     _check(mjmodel, model)       # with what mbjax ignores switched off in MuJoCo
 
 

@@ -338,8 +338,22 @@ def test_body_numbering_matches_pinocchio_for_unsorted_sibling_names():
     xml = FIXED_URDF.replace("upper_a_tool", "upper_z_tool")
     assert list(pin.buildModelFromXML(xml).names)[1:] == list(mbjax.load_urdf(xml).joint_names)
     # document order is still available, and differs here
-    assert (list(mbjax.load_urdf(xml, sibling_order="document").joint_names)
+    assert (list(mbjax.load_urdf(xml, sibling_order=mbjax.model.InDocument()).joint_names)
             != list(mbjax.load_urdf(xml).joint_names))
+
+
+def test_sibling_orders_are_strategy_objects():
+    """ByName() numbers siblings by joint name (the default, the former "name"), InDocument() in
+    document order (the former "document"); the strings are refused with a TypeError."""
+    xml = FIXED_URDF.replace("upper_a_tool", "upper_z_tool")
+    by_name = mbjax.load_urdf(xml, sibling_order=mbjax.model.ByName()).joint_names
+    assert by_name == mbjax.load_urdf(xml).joint_names == ("shoulder", "elbow", "wrist", "slide")
+    in_document = mbjax.load_urdf(xml, sibling_order=mbjax.model.InDocument()).joint_names
+    assert in_document == ("shoulder", "slide", "elbow", "wrist")
+    for string in ("name", "document"):
+        with pytest.raises(TypeError, match=r"sibling_order must be .*ByName\(\) or "
+                                            r".*InDocument\(\)"):
+            mbjax.load_urdf(xml, sibling_order=string)
 
 
 # --------------------------------------------------------------------------------------------

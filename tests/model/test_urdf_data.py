@@ -242,7 +242,7 @@ def test_floating_base_against_mujoco_free_joint_layout():
     """MuJoCo's URDF import with a free joint added: positions, velocities (world linear) and
     accelerations convert through the state converters."""
     mujoco = pytest.importorskip("mujoco")
-    model = mbjax.load_urdf(ROBOT_MJ, floating_base=True, sibling_order="document")
+    model = mbjax.load_urdf(ROBOT_MJ, floating_base=True, sibling_order=mbjax.model.InDocument())
     spec = mujoco.MjSpec.from_string(ROBOT_MJ)
     spec.worldbody.first_body().add_freejoint()
     mj = spec.compile()

@@ -20,6 +20,7 @@ from mbjax import Status, lie, simulate
 from mbjax.integrate import RK4
 from mbjax.loops import (ClosedSystem, Coupled, CutJoint, Loops, Stabilized, consistent_state,
                          project_configuration, project_velocity)
+from mbjax.loops import PointOnLine, Spherical
 from mbjax.scenes import four_bar
 
 # one xdist worker runs the module, so its programs compile once (the group tests/conftest.py
@@ -45,9 +46,9 @@ class Scene(NamedTuple):
 @functools.cache
 def _scene() -> Scene:
     """The probes' tree and closed system, built on first use (collection stays quick)."""
-    system, q0, v0 = four_bar.build(closure="point_on_line")
+    system, q0, v0 = four_bar.build(closure=PointOnLine())
     return Scene(system.tree, np.asarray(q0), np.asarray(v0),
-                 ClosedSystem(system.tree, [CutJoint("spherical", 1, 2, **PIN)]))
+                 ClosedSystem(system.tree, [CutJoint(Spherical(), 1, 2, **PIN)]))
 
 
 def _rz(angle):
@@ -87,13 +88,13 @@ def test_cut_joint_bodies_are_checked_against_the_tree_and_valid_ones_close_the_
     n = _scene().tree.n_frames
     if body_a == body_b:
         with pytest.raises(ValueError, match=f"two different bodies, got body {body_a} twice"):
-            CutJoint("spherical", body_a, body_b)
+            CutJoint(Spherical(), body_a, body_b)
         return
     if body_a < 0:
         with pytest.raises(ValueError, match="body_a must be a body of the model"):
-            CutJoint("spherical", body_a, body_b)
+            CutJoint(Spherical(), body_a, body_b)
         return
-    joint = CutJoint("spherical", body_a, body_b, **PIN)
+    joint = CutJoint(Spherical(), body_a, body_b, **PIN)
     bad = next((b for b in (body_a, body_b) if b != -1 and not 0 <= b < n), None)
     if bad is not None:
         with pytest.raises(ValueError, match=rf"body {bad} is not in the tree \(0 \.\.\. {n - 1}"):
@@ -107,15 +108,15 @@ def test_cut_joint_bodies_are_checked_against_the_tree_and_valid_ones_close_the_
 @given(body=st.one_of(floats(0.0, 2.0), st.text(max_size=2), st.none()))
 def test_cut_joint_bodies_that_are_not_ints_are_named(body):
     with pytest.raises(TypeError, match="body_a and body_b must be body indices"):
-        CutJoint("spherical", body, 2)
+        CutJoint(Spherical(), body, 2)
 
 
 @FEW
-@given(kind=st.text(max_size=12).filter(lambda k: k not in
-                                        ("spherical", "revolute", "universal", "weld", "prismatic",
-                                         "point_on_line", "point_on_plane")))
+@given(kind=st.text(max_size=12) | st.sampled_from(
+    ["spherical", "revolute", "universal", "weld", "spatial_weld", "prismatic", "point_on_line",
+     "point_on_plane"]))
 def test_unknown_cut_joint_kinds_are_named(kind):
-    with pytest.raises(ValueError, match="cut joint kind must be one of"):
+    with pytest.raises(TypeError, match=r"kind must be a cut-joint kind, one of .*Spherical\(\)"):
         CutJoint(kind, 1, 2)
 
 
@@ -130,7 +131,7 @@ quaternions = st.lists(floats(-1, 1), min_size=4, max_size=4).filter(
 def test_cut_joint_frames_that_are_not_rotations_are_named(quaternion, which, defect, size, entry):
     q = np.asarray(quaternion) / np.linalg.norm(quaternion)
     R = np.asarray(lie.quat_to_matrix(jnp.asarray(q)))
-    CutJoint("spherical", 1, 2, **{which: R})                   # a rotation to round-off builds
+    CutJoint(Spherical(), 1, 2, **{which: R})                   # a rotation to round-off builds
     if defect == "scaled":
         bad, message = (1.0 + size) * R, "must be a rotation matrix"
     elif defect == "perturbed":
@@ -143,8 +144,8 @@ def test_cut_joint_frames_that_are_not_rotations_are_named(quaternion, which, de
         bad.flat[entry] = np.nan
     else:
         bad, message = R[:2], r"must be a rotation matrix of shape \(3, 3\)"
-    with pytest.raises(ValueError, match=f"cut joint 'spherical': {which} .*{message}"):
-        CutJoint("spherical", 1, 2, **{which: bad})
+    with pytest.raises(ValueError, match=rf"cut joint Spherical\(\): {which} .*{message}"):
+        CutJoint(Spherical(), 1, 2, **{which: bad})
 
 
 @FEW
@@ -152,7 +153,7 @@ def test_cut_joint_frames_that_are_not_rotations_are_named(quaternion, which, de
        shape=st.sampled_from([(), (2,), (4,), (3, 1), (1, 3), (0,)]))
 def test_cut_joint_origins_of_the_wrong_shape_are_named(which, shape):
     with pytest.raises(ValueError, match=rf"{which} must be a point of shape \(3,\)"):
-        CutJoint("spherical", 1, 2, **{which: np.zeros(shape)})
+        CutJoint(Spherical(), 1, 2, **{which: np.zeros(shape)})
 
 
 @DEFECT
@@ -162,7 +163,7 @@ def test_cut_joint_origins_that_are_not_finite_are_named(which, entry, value):
     origin = np.zeros(3)
     origin[entry] = value
     with pytest.raises(ValueError, match=which):
-        CutJoint("spherical", 1, 2, **{which: origin})
+        CutJoint(Spherical(), 1, 2, **{which: origin})
 
 
 # -- the residual and its Jacobian against NumPy -----------------------------------------------------
@@ -177,7 +178,7 @@ def _phi_and_jacobian(joint, q):
 @given(q=st.lists(angles, min_size=3, max_size=3), origin_a=points, origin_b=points)
 def test_spherical_residual_is_the_hand_written_gap_and_its_jacobian_the_finite_differences(
         q, origin_a, origin_b):
-    joint = CutJoint("spherical", 1, 2, origin_a=origin_a, origin_b=origin_b)
+    joint = CutJoint(Spherical(), 1, 2, origin_a=origin_a, origin_b=origin_b)
     phi, A = _phi_and_jacobian(joint, jnp.asarray(q))
     np.testing.assert_allclose(phi, _gap(q, 1, 2, origin_a, origin_b), atol=1e-14)
     h = 1e-6

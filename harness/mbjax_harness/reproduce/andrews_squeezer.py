@@ -1,7 +1,7 @@
 """`mbjax reproduce andrews-squeezer`: Andrews' squeezing mechanism against the IVP test set.
 
 The seven-body mechanism of Hairer & Wanner II §VII.7 (test set problem `andrews`), built from
-mbjax bodies, revolute joints, three `point_on_line` cut joints, a spring and a motor torque
+mbjax bodies, revolute joints, three `PointOnLine()` cut joints, a spring and a motor torque
 (`mbjax.scenes.andrews_squeezer`), integrated by RK4 with the coupled Lagrange multipliers
 (`ClosedSystem` with `Coupled()`, Jerkovsky 1978 eqs 89-93) from the test set's initial values to t = 0.03 s, and compared
 with the test set's reference solution (its `SOLN`, PSIDE at tolerance 1e-14).

@@ -10,7 +10,8 @@ import numpy as np
 from jax import Array
 
 from mbjax._src.lie.inputs import check_point
-from mbjax._src.model.closures import GROUND, CutJoint, active_flag, cut_joint_groups
+from mbjax._src.model.closures import (GROUND, AbstractCutKind, CutJoint, SpatialWeld, Spherical,
+                                       Weld, active_flag, cut_joint_groups)
 from mbjax._src.model.model import Model
 from mbjax._src.rigid.frames import frame_placement, frame_pose
 from mbjax._src.tree.take import take
@@ -89,8 +90,8 @@ class AbstractContact(eqx.Module):
 
     Attributes:
         size: the number of constraints (3 for a point, 6 for a surface).
-        kind: the kind of its cut joint ("spherical" for a point; "weld" or "spatial_weld" for
-            a surface).
+        kind: the kind of its cut joint (`mbjax.loops.Spherical()` for a point; `Weld()` or
+            `SpatialWeld()` for a surface).
     """
 
     frame: str = eqx.field(static=True)
@@ -98,7 +99,7 @@ class AbstractContact(eqx.Module):
     active: Array
     height: Array | None
     size: ClassVar[int]
-    kind: ClassVar[str]
+    kind: ClassVar[AbstractCutKind]
 
     def __init__(self, frame: str, normal=(0.0, 0.0, 1.0), active=True, height=None):
         if not isinstance(frame, str):
@@ -161,7 +162,7 @@ class PointContact(AbstractContact):
     """
 
     size: ClassVar[int] = 3
-    kind: ClassVar[str] = "spherical"
+    kind: ClassVar[AbstractCutKind] = Spherical()
 
 
 class SurfaceContact(AbstractContact):
@@ -173,10 +174,10 @@ class SurfaceContact(AbstractContact):
     rest) but not for a moving one, nor for the Baumgarte terms' drift:
 
     - spatial=False (the default), a weld: the residual is the frame's position and
-      orientation error (`mbjax.loops.CutJoint`'s "weld"), whose second derivative is the
+      orientation error (`mbjax.loops.Weld`), whose second derivative is the
       frame's classical acceleration (its origin's acceleration and its angular acceleration).
     - spatial=True: the position rows are the offset in the mean of the frame's and the
-      anchor's axes, (R_A + R_B)^T (p_A - p_B) / 2 (`mbjax.loops.CutJoint`'s "spatial_weld"),
+      anchor's axes, (R_A + R_B)^T (p_A - p_B) / 2 (`mbjax.loops.SpatialWeld`),
       whose rate on the ground is the frame's twist in its own axes and whose second
       derivative there is its spatial acceleration: what Pinocchio's `CONTACT_6D` and
       Crocoddyl's `ContactModel6D` hold. Rebuild a Crocoddyl or Pinocchio problem with it; the
@@ -206,8 +207,8 @@ class SurfaceContact(AbstractContact):
         self.spatial = bool(spatial)
 
     @property
-    def kind(self) -> str:
-        return "spatial_weld" if self.spatial else "weld"
+    def kind(self) -> AbstractCutKind:
+        return SpatialWeld() if self.spatial else Weld()
 
 
 def frame_wrench(joint: CutJoint, R: Array, p: Array, multipliers: Array) -> Array:

@@ -18,7 +18,9 @@ Planar mechanisms' redundant equations are detected and reported by the solvers
 (`mbjax._src.loops.coupled`).
 """
 
+import abc
 from collections.abc import Callable
+from typing import ClassVar
 
 import equinox as eqx
 import jax
@@ -30,13 +32,152 @@ from mbjax._src.lie.inputs import check_point, check_rotation
 from mbjax._src.tree.take import take
 
 GROUND = -1             # the ground as a body index (`CutJoint`'s body_b)
-SIZES = {"spherical": 3, "revolute": 5, "universal": 4, "weld": 6, "spatial_weld": 6,
-         "prismatic": 5, "point_on_line": 2, "point_on_plane": 1}
 
 
 def _vee_antisym(R: Array) -> Array:
     """vee((R - R^T) / 2): sin(angle) * axis, zero at R = I."""
     return 0.5 * jnp.array([R[2, 1] - R[1, 2], R[0, 2] - R[2, 0], R[1, 0] - R[0, 1]])
+
+
+def _orientation(RA: Array, RB: Array) -> Array:
+    """vee((R_B^T R_A - R_A^T R_B) / 2): the orientation error of frame A in frame B."""
+    return _vee_antisym(RB.T @ RA)
+
+
+class AbstractCutKind(eqx.Module):
+    """What a `CutJoint` holds (`Spherical`, `Revolute`, `Universal`, `Weld`, `SpatialWeld`,
+    `Prismatic`, `PointOnLine`, `PointOnPlane`), passed to it as `kind`.
+
+    A subclass sets `size`, its number of equations, and implements `residual`.
+    """
+
+    size: ClassVar[int]
+
+    @abc.abstractmethod
+    def residual(self, d: Array, RA: Array, RB: Array) -> Array:
+        """Phi of the joint from its frames' world poses.
+
+        Args:
+            d: p_A - p_B, frame A's origin less frame B's, world components [m], shape (3,).
+            RA: frame A's rotation in the world, shape (3, 3).
+            RB: frame B's rotation in the world, shape (3, 3).
+
+        Returns:
+            The residual, shape (size,).
+        """
+
+
+class Spherical(AbstractCutKind):
+    """A ball joint: the origins coincide, p_A - p_B = 0 (3 equations)."""
+
+    size: ClassVar[int] = 3
+
+    def residual(self, d: Array, RA: Array, RB: Array) -> Array:
+        """p_A - p_B, shape (3,) (arguments as `AbstractCutKind.residual`)."""
+        return d
+
+
+class Revolute(AbstractCutKind):
+    """A hinge about the frames' common z axis: the origins coincide and z_A is normal to x_B
+    and y_B (5 equations)."""
+
+    size: ClassVar[int] = 5
+
+    def residual(self, d: Array, RA: Array, RB: Array) -> Array:
+        """(p_A - p_B, z_A . x_B, z_A . y_B), shape (5,) (arguments as
+        `AbstractCutKind.residual`)."""
+        z_A, (x_B, y_B, _) = RA.T[2], RB.T
+        return jnp.concatenate([d, jnp.stack([z_A @ x_B, z_A @ y_B])])
+
+
+class Universal(AbstractCutKind):
+    """A Hooke joint: the origins coincide and x_A is normal to y_B (4 equations)."""
+
+    size: ClassVar[int] = 4
+
+    def residual(self, d: Array, RA: Array, RB: Array) -> Array:
+        """(p_A - p_B, x_A . y_B), shape (4,) (arguments as `AbstractCutKind.residual`)."""
+        return jnp.concatenate([d, (RA.T[0] @ RB.T[1])[None]])
+
+
+class Weld(AbstractCutKind):
+    """A rigid connection: the origins coincide and the frames are aligned (6 equations); the
+    position rows in world components."""
+
+    size: ClassVar[int] = 6
+
+    def residual(self, d: Array, RA: Array, RB: Array) -> Array:
+        """(p_A - p_B, vee((R_B^T R_A - R_A^T R_B) / 2)), shape (6,) (arguments as
+        `AbstractCutKind.residual`)."""
+        return jnp.concatenate([d, _orientation(RA, RB)])
+
+
+class SpatialWeld(AbstractCutKind):
+    """A rigid connection whose position rows are in the mean of the frames' axes,
+    (R_A + R_B)^T (p_A - p_B) / 2, so that their second derivative at rest is the spatial
+    acceleration (6 equations)."""
+
+    size: ClassVar[int] = 6
+
+    def residual(self, d: Array, RA: Array, RB: Array) -> Array:
+        """((R_A + R_B)^T d / 2, vee((R_B^T R_A - R_A^T R_B) / 2)), shape (6,) (arguments as
+        `AbstractCutKind.residual`)."""
+        return jnp.concatenate([0.5 * (RA + RB).T @ d, _orientation(RA, RB)])
+
+
+class Prismatic(AbstractCutKind):
+    """A slider along frame B's z axis: the offset has no x_B or y_B part and the frames are
+    aligned (5 equations)."""
+
+    size: ClassVar[int] = 5
+
+    def residual(self, d: Array, RA: Array, RB: Array) -> Array:
+        """(d . x_B, d . y_B, vee((R_B^T R_A - R_A^T R_B) / 2)), shape (5,) (arguments as
+        `AbstractCutKind.residual`)."""
+        x_B, y_B, _ = RB.T
+        return jnp.concatenate([jnp.stack([d @ x_B, d @ y_B]), _orientation(RA, RB)])
+
+
+class PointOnLine(AbstractCutKind):
+    """Frame A's origin on frame B's z line: d . x_B = d . y_B = 0 (2 equations; a planar
+    pin)."""
+
+    size: ClassVar[int] = 2
+
+    def residual(self, d: Array, RA: Array, RB: Array) -> Array:
+        """(d . x_B, d . y_B), shape (2,) (arguments as `AbstractCutKind.residual`)."""
+        x_B, y_B, _ = RB.T
+        return jnp.stack([d @ x_B, d @ y_B])
+
+
+class PointOnPlane(AbstractCutKind):
+    """Frame A's origin on frame B's xy plane: d . z_B = 0 (1 equation; a massless slider
+    pinned to a planar mechanism)."""
+
+    size: ClassVar[int] = 1
+
+    def residual(self, d: Array, RA: Array, RB: Array) -> Array:
+        """(d . z_B,), shape (1,) (arguments as `AbstractCutKind.residual`)."""
+        return (d @ RB.T[2])[None]
+
+
+_KIND_NAMES = {"spherical": "Spherical()", "revolute": "Revolute()", "universal": "Universal()",
+               "weld": "Weld()", "spatial_weld": "SpatialWeld()", "prismatic": "Prismatic()",
+               "point_on_line": "PointOnLine()", "point_on_plane": "PointOnPlane()"}
+
+
+def check_cut_kind(kind) -> AbstractCutKind:
+    """`kind` itself, or a TypeError naming the argument and the kinds.
+
+    Raises:
+        TypeError: kind is not a cut-joint kind (the strings of earlier versions included).
+    """
+    if not isinstance(kind, AbstractCutKind):
+        hint = (f" (the string {kind!r} is no longer accepted: use mbjax.loops."
+                f"{_KIND_NAMES[kind]})" if isinstance(kind, str) and kind in _KIND_NAMES else "")
+        raise TypeError(f"kind must be a cut-joint kind, one of mbjax.loops."
+                        f"{', '.join(_KIND_NAMES.values())}, got {type(kind).__name__}{hint}")
+    return kind
 
 
 def active_flag(active, name: str) -> Array:
@@ -62,8 +203,9 @@ class CutJoint(eqx.Module):
     z axis. For a flexible tree, `body_a` and `body_b` may also be marker frames (n, n + 1, ...).
 
     Args:
-        kind: "spherical", "revolute", "universal", "weld", "spatial_weld", "prismatic",
-            "point_on_line" or "point_on_plane"; static.
+        kind (AbstractCutKind): what the joint holds: `Spherical()`, `Revolute()`,
+            `Universal()`, `Weld()`, `SpatialWeld()`, `Prismatic()`, `PointOnLine()` or
+            `PointOnPlane()`; static.
         body_a: the body (frame index) of frame A, >= 0; static.
         body_b: the body of frame B, or `GROUND` (-1); static.
         origin_a (Array): origin of frame A in body_a's frame [m], shape (3,).
@@ -79,15 +221,16 @@ class CutJoint(eqx.Module):
             program.
 
     Raises:
-        ValueError: an unknown kind, the same body twice, the ground as body_a, an origin not
+        ValueError: the same body twice, the ground as body_a, an origin not
             of shape (3,), a rotation that is not one (orthonormal within 1e-6, det +1), or an
             `active` that is not a boolean scalar.
-        TypeError: body indices that are not ints.
+        TypeError: a kind that is not a cut-joint kind (a string, say), body indices that are
+            not ints.
 
     More on residuals: the documentation site's Details page (docs/details.md).
     """
 
-    kind: str = eqx.field(static=True)
+    kind: AbstractCutKind = eqx.field(static=True)
     body_a: int = eqx.field(static=True)
     body_b: int = eqx.field(static=True)
     rotation_a: Array
@@ -96,10 +239,10 @@ class CutJoint(eqx.Module):
     origin_b: Array
     active: Array
 
-    def __init__(self, kind: str, body_a: int, body_b: int = GROUND, *, origin_a=(0.0, 0.0, 0.0),
-                 origin_b=(0.0, 0.0, 0.0), rotation_a=None, rotation_b=None, active=True):
-        if kind not in SIZES:
-            raise ValueError(f"cut joint kind must be one of {sorted(SIZES)}, got {kind!r}")
+    def __init__(self, kind: AbstractCutKind, body_a: int, body_b: int = GROUND, *,
+                 origin_a=(0.0, 0.0, 0.0), origin_b=(0.0, 0.0, 0.0), rotation_a=None,
+                 rotation_b=None, active=True):
+        kind = check_cut_kind(kind)
         if not (isinstance(body_a, int | np.integer) and isinstance(body_b, int | np.integer)):
             raise TypeError("body_a and body_b must be body indices (int; -1 for the ground)")
         if body_a == body_b:
@@ -119,7 +262,7 @@ class CutJoint(eqx.Module):
     @property
     def size(self) -> int:
         """Number of scalar constraint equations."""
-        return SIZES[self.kind]
+        return self.kind.size
 
     @property
     def rows(self) -> Array:
@@ -155,26 +298,7 @@ class CutJoint(eqx.Module):
         else:
             RB = R_b @ self.rotation_b
             pB = p_b + R_b @ self.origin_b
-        d = pA - pB
-        x_A, y_A, z_A = RA.T
-        x_B, y_B, z_B = RB.T
-        if self.kind == "point_on_plane":       # a massless slider pinned to a planar mechanism
-            return (d @ z_B)[None]
-        orientation = _vee_antisym(RB.T @ RA)
-        if self.kind == "spherical":
-            return d
-        if self.kind == "revolute":
-            return jnp.concatenate([d, jnp.stack([z_A @ x_B, z_A @ y_B])])
-        if self.kind == "universal":
-            return jnp.concatenate([d, (x_A @ y_B)[None]])
-        if self.kind == "weld":
-            return jnp.concatenate([d, orientation])
-        if self.kind == "spatial_weld":
-            return jnp.concatenate([0.5 * (RA + RB).T @ d, orientation])
-        across = jnp.stack([d @ x_B, d @ y_B])
-        if self.kind == "prismatic":
-            return jnp.concatenate([across, orientation])
-        return across                                   # point_on_line
+        return self.kind.residual(pA - pB, RA, RB)
 
 
 def cut_joint_rows(closures, cut: Callable, other: Callable, frames) -> Array:

@@ -7,7 +7,7 @@ import warnings
 import numpy as np
 
 from mbjax._src.model.checks import ModelWarning, combine
-from mbjax._src.model.closures import CutJoint
+from mbjax._src.model.closures import CutJoint, Spherical, Weld
 from mbjax._src.model.geoms import DETECTED, Geoms
 from mbjax._src.model.geoms import KINDS as GEOM_KINDS
 from mbjax._src.model.joints import JOINT_TYPES
@@ -375,8 +375,8 @@ def _cut_joints(m, mujoco, where) -> tuple[list, int]:
         (ka, Ra, pa), (kb, Rb, pb) = sorted(mapped, key=lambda e: e[0] < 0)   # ground second
         if ka == kb:
             continue
-        cuts.append(CutJoint(kind, ka, kb, rotation_a=Ra, origin_a=pa, rotation_b=Rb,
-                             origin_b=pb))
+        cuts.append(CutJoint(Spherical() if kind == "spherical" else Weld(), ka, kb,
+                             rotation_a=Ra, origin_a=pa, rotation_b=Rb, origin_b=pb))
     return cuts, count
 
 

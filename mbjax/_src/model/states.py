@@ -2,7 +2,7 @@
 
 The coordinates of one joint differ between the engines only in their layout; the joints come in
 the same order when the peer numbers them as mbjax does (`load_urdf`'s default sibling order is
-Pinocchio's; `load_mjcf`, `from_mujoco` and `load_urdf(..., sibling_order="document")` follow
+Pinocchio's; `load_mjcf`, `from_mujoco` and `load_urdf(..., sibling_order=InDocument())` follow
 MuJoCo's).
 
     joint       mbjax q, v                       Pinocchio q, v                 MuJoCo qpos, qvel

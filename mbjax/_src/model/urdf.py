@@ -12,6 +12,7 @@ from mbjax._src.model.checks import ModelWarning, combine, warn
 from mbjax._src.model.closures import Coupling
 from mbjax._src.model.joints import JOINT_TYPES
 from mbjax._src.model.model import Model
+from mbjax._src.model.siblings import AbstractSiblingOrder, ByName, check_sibling_order
 from mbjax._src.model.urdf_geoms import collision_geoms
 
 _KINDS = {"revolute": "revolute", "continuous": "revolute", "prismatic": "prismatic",
@@ -116,7 +117,7 @@ def _armature(armature, nv: int) -> np.ndarray:
 
 
 def load_urdf(source: str | bytes | os.PathLike, *, floating_base: bool = False,
-              gravity=(0.0, 0.0, -9.81), sibling_order: str = "name", armature=0.0,
+              gravity=(0.0, 0.0, -9.81), sibling_order: AbstractSiblingOrder = ByName(), armature=0.0,
               min_mass: float = 0.0, min_inertia: float = 0.0, package_dirs=(),
               strict: bool = False) -> Model:
     """A `Model` from a URDF file or XML string.
@@ -130,8 +131,9 @@ def load_urdf(source: str | bytes | os.PathLike, *, floating_base: bool = False,
         source: a path, or an XML string (a string starting with '<' is read as XML).
         floating_base: add a free joint above the root link (else it is welded to the ground).
         gravity (Array): gravitational acceleration in the world frame [m/s^2], shape (3,).
-        sibling_order: "name" (Pinocchio's numbering) or "document" (MuJoCo's; see The
-            mapping in docs/details.md).
+        sibling_order: the order the children of a link are numbered in: `ByName()`
+            (Pinocchio's numbering, the default) or `InDocument()` (MuJoCo's; see The mapping in
+            docs/details.md).
         armature (float | Array): rotor inertia on every joint coordinate [kg m^2 or kg], a
             number or an (nv,) array.
         min_mass: lower bound on every body's mass [kg] (MuJoCo's boundmass), a remedy for
@@ -150,14 +152,13 @@ def load_urdf(source: str | bytes | os.PathLike, *, floating_base: bool = False,
     Raises:
         FileNotFoundError: a path that is not a file.
         ValueError: malformed XML or numbers, an unsupported joint type, a graph that is not a
-            tree, no movable joint, an unknown sibling_order, or (strict=True) implausible
-            inertial data.
+            tree, no movable joint, or (strict=True) implausible inertial data.
+        TypeError: sibling_order is not `ByName()` or `InDocument()` (a string, say).
 
     More on the mapping, inertial data, joint data, collision geometry: the documentation site's
     Details page (docs/details.md).
     """
-    if sibling_order not in ("name", "document"):
-        raise ValueError(f"sibling_order must be 'name' or 'document', got {sibling_order!r}")
+    sibling_order = check_sibling_order(sibling_order)
     text, path = source.decode() if isinstance(source, bytes) else str(source), None
     if isinstance(source, os.PathLike) or not text.lstrip().startswith("<"):
         path = Path(source)
@@ -199,9 +200,7 @@ def load_urdf(source: str | bytes | os.PathLike, *, floating_base: bool = False,
                              f"({has_parent[child]!r} and {name!r}): a URDF must be a tree")
         has_parent[child] = name
         children[parent].append(joint)
-    if sibling_order == "name":
-        children = {link: sorted(joints, key=lambda j: j.get("name"))
-                    for link, joints in children.items()}
+    children = {link: sibling_order.order(joints) for link, joints in children.items()}
     if not links:
         raise ValueError("URDF: the robot has no links")
     roots = [name for name in links if name not in has_parent]

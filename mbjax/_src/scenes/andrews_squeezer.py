@@ -58,7 +58,7 @@ only; the 3x3 inertias here are those of thin plates, diag(i/2, i/2, i), which n
 planar motion.
 
 The cuts: the rod's point P = (-d, 0) coincides with (0, -ss) on body gamma, with (0, -e) on body
-Phi and with (zf, 0) on body Omega; each is a `point_on_line` cut joint with the line along z,
+Phi and with (zf, 0) on body Omega; each is a `PointOnLine()` cut joint with the line along z,
 normal to the plane: two equations per loop, six in all as in the test set, full rank 6 (no
 redundancy). The residuals are g(q) of the test set rotated into the second body's frame (same
 zero set, same norm per loop).
@@ -78,6 +78,7 @@ from jax import Array
 
 from mbjax._src.control import AbstractControl, Constant
 from mbjax._src.loops import ClosedSystem, CutJoint
+from mbjax._src.model.closures import PointOnLine
 from mbjax._src.model import Model
 from mbjax._src.rigid import TreeSystem
 from mbjax._src.rigid.kinematics import forward_kinematics
@@ -216,7 +217,7 @@ class Squeezer(NamedTuple):
 
     Args:
         tree: the tree, driven by the motor torque `tau` plus the `spring`.
-        closures: the three `point_on_line` cut joints.
+        closures: the three `PointOnLine()` cut joints.
         spring: the `PointSpring`.
         tau: the constant motor torque, shape (7,) [N m].
         q0: the test set's initial configuration in tree order [rad], shape (7,).
@@ -262,9 +263,9 @@ def build() -> Squeezer:
                   placement_translation=placement, gravity=(0.0, 0.0, 0.0),
                   names=("crank_beta", "rod_Theta", "gamma", "delta", "Phi", "epsilon", "Omega"))
     P = (-d, 0.0, 0.0)                     # the rod's far end, where the three loops close
-    cuts = [CutJoint("point_on_line", 1, 2, origin_a=P, origin_b=(0.0, -ss, 0.0)),
-            CutJoint("point_on_line", 1, 4, origin_a=P, origin_b=(0.0, -e, 0.0)),
-            CutJoint("point_on_line", 1, 6, origin_a=P, origin_b=(zf, 0.0, 0.0))]
+    cuts = [CutJoint(PointOnLine(), 1, 2, origin_a=P, origin_b=(0.0, -ss, 0.0)),
+            CutJoint(PointOnLine(), 1, 4, origin_a=P, origin_b=(0.0, -e, 0.0)),
+            CutJoint(PointOnLine(), 1, 6, origin_a=P, origin_b=(zf, 0.0, 0.0))]
     spring = PointSpring(model, 2, point=(sd, -sc, 0.0), anchor=(xc, yc, 0.0), stiffness=c0,
                          rest_length=l0)
     tau = jnp.zeros(7).at[0].set(mom)

@@ -42,6 +42,7 @@ import jax.numpy as jnp
 import numpy as np
 
 from mbjax._src.loops import GROUND, ClosedSystem, CutJoint
+from mbjax._src.model.closures import Revolute
 from mbjax._src.model import Model
 from mbjax._src.rigid import TreeSystem
 from mbjax._src.rigid.kinematics import forward_kinematics
@@ -121,7 +122,7 @@ def build(phi0=0.0, phi_dot0=0.0, section=SECTION):
         v0: the tree velocity, shape (5,).
     """
     phi0 = jnp.asarray(phi0, float)
-    cut = CutJoint("revolute", 4, GROUND, origin_a=CORNERS[5] - CORNERS[4], origin_b=CORNERS[5],
+    cut = CutJoint(Revolute(), 4, GROUND, origin_a=CORNERS[5] - CORNERS[4], origin_b=CORNERS[5],
                    rotation_a=_ROT_Y, rotation_b=_ROT_Y)
     system = ClosedSystem(TreeSystem(model(section)), [cut])
     return system, joint_angles(phi0), jax.jacfwd(joint_angles)(phi0) * phi_dot0

@@ -12,6 +12,7 @@ import jax.numpy as jnp
 import numpy as np
 
 from mbjax._src.loops import GROUND, ClosedSystem, CutJoint, consistent_state, project_velocity
+from mbjax._src.model.closures import Universal
 from mbjax._src.model import Model
 from mbjax._src.rigid import TreeSystem
 
@@ -48,7 +49,7 @@ def build(n: int):
                   placement_translation=np.array([[0.0, 0.0, 0.0]]
                                                  + [[0.0, 0.0, -LINK]] * (bodies - 1)))
     end = (SPAN * bodies * LINK, 0.0, 0.0)
-    system = ClosedSystem(TreeSystem(model), [CutJoint("universal", bodies - 1, GROUND,
+    system = ClosedSystem(TreeSystem(model), [CutJoint(Universal(), bodies - 1, GROUND,
                                                        origin_a=(0.0, 0.0, -LINK), origin_b=end)])
     alpha = float(np.arcsin(SPAN))
     guess = np.zeros((bodies, 2))

@@ -11,7 +11,7 @@ a rheonomic `Prescribed` constraint); the rod a flexible body on a revolute join
 elements clamped at P (its joint grid J), all of its in-plane modes (Anderson 1993: "all available
 modes ... associated with motion of B in the x-y plane": 3 per element, so the basis spans what a
 Craig-Bampton basis with Q as interface would); the massless slider a cut joint putting Q's grid point on the plane y = 0
-(`point_on_plane`, one equation). Anderson 1993's route (`ClosedSystem(..., method=Stabilized())`) solves the loads;
+(`PointOnPlane()`, one equation). Anderson 1993's route (`ClosedSystem(..., method=Stabilized())`) solves the loads;
 (q, v) are projected back onto the constraints after every step.
 The midpoint deflection is the signed distance of the rod's material midpoint from the chord PQ,
 positive away from O at t = 0 (the rod frame's +y).
@@ -25,6 +25,7 @@ from mbjax._src.flex import Beam, FlexibleModel, FlexibleSystem, beam_body, crai
 from mbjax._src.flex.references import slider_crank_reference as reference  # noqa: F401 (the ANCF reference: mbjax.scenes.flexible_slider_crank.reference)
 from mbjax._src.integrate import RK4, simulate
 from mbjax._src.loops import GROUND, ClosedSystem, CutJoint, Prescribed, Stabilized
+from mbjax._src.model.closures import PointOnPlane
 from mbjax._src.model import Model
 
 INCH, LBF, LBM = 0.0254, 4.4482216152605, 0.45359237
@@ -75,7 +76,7 @@ def build(n_elements: int = 2, stiffening: bool = True):
                   axis=[[0.0, 0.0, 1.0]] * 2, placement_translation=[[0, 0, 0], [CRANK, 0, 0]],
                   gravity=(0.0, 0.0, 0.0))
     model = FlexibleModel(rigid, {1: body}, markers=((1, 0),))
-    slider = CutJoint("point_on_plane", model.n, GROUND, rotation_b=[[1, 0, 0], [0, 0, 1], [0, -1, 0]])
+    slider = CutJoint(PointOnPlane(), model.n, GROUND, rotation_b=[[1, 0, 0], [0, 0, 1], [0, -1, 0]])
     phi0 = np.arcsin(-CRANK / ROD)                          # the rod's angle at t = 0 (-30 deg)
     q0 = model.join(jnp.array([np.pi / 2, phi0 - np.pi / 2]), jnp.zeros((model.n, model.mu)))
     v0 = model.join(jnp.array([OMEGA, -OMEGA]), jnp.zeros((model.n, model.mu)))

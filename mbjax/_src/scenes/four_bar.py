@@ -5,8 +5,8 @@ revolute at the crank's tip), and the rocker (body 2, revolute at the ground poi
 the loop is cut at the coupler-rocker pin. All joint axes are z; each link is a uniform bar
 along its body x axis from its joint.
 
-The cut joint is, by default, a planar pin: a `point_on_line` cut joint (the coupler's tip on the
-rocker's z line through its tip), 2 equations of full rank. `closure="revolute"` uses the spatial
+The cut joint is, by default, a planar pin: a `PointOnLine()` cut joint (the coupler's tip on the
+rocker's z line through its tip), 2 equations of full rank. `closure=Revolute()` uses the spatial
 revolute cut joint instead, 5 equations of which only 2 are independent in a planar loop: the
 redundancy that `Status.REDUNDANT` reports (Jerkovsky 1978 §VI's multipliers then come from the
 least-squares solve of `mbjax/_src/loops/multipliers.py`).
@@ -20,6 +20,7 @@ import jax.numpy as jnp
 import numpy as np
 
 from mbjax._src.loops import ClosedSystem, CutJoint
+from mbjax._src.model.closures import AbstractCutKind, PointOnLine, Revolute, check_cut_kind
 from mbjax._src.model import Model
 from mbjax._src.rigid import TreeSystem
 
@@ -28,7 +29,7 @@ LENGTHS = np.array([A_, B_, C_])
 MASSES = np.array([0.5, 1.0, 0.8])             # [kg]
 GRAVITY = 9.81
 THETA0, OMEGA0 = 0.3, 2.0                      # initial crank angle [rad] and rate [rad/s]
-CLOSURES = ("point_on_line", "revolute")
+CLOSURES = (PointOnLine(), Revolute())
 
 
 def model(gravity=(0.0, -GRAVITY, 0.0)) -> Model:
@@ -71,15 +72,16 @@ def joint_angles(theta):
     return jnp.array([theta, phi - theta, psi])
 
 
-def build(closure: str = "point_on_line", theta0=THETA0, omega0=OMEGA0):
+def build(closure: AbstractCutKind = PointOnLine(), theta0=THETA0, omega0=OMEGA0):
     """The scene: the four-bar started on the loop.
 
     A `ClosedSystem` with coupled multipliers (rebuild it from `system.tree` and
     `system.closures` for another method).
 
     Args:
-        closure: "point_on_line" (the planar pin, 2 equations) or "revolute" (the spatial
-            revolute joint, 5 redundant equations).
+        closure: the cut joint's kind: `mbjax.loops.PointOnLine()` (the planar pin, 2
+            equations) or `mbjax.loops.Revolute()` (the spatial revolute joint, 5 redundant
+            equations).
         theta0: the initial crank angle [rad].
         omega0: the initial crank rate [rad/s].
 
@@ -90,7 +92,9 @@ def build(closure: str = "point_on_line", theta0=THETA0, omega0=OMEGA0):
 
     Raises:
         ValueError: closure is not one of `CLOSURES`.
+        TypeError: closure is not a cut-joint kind (a string, say).
     """
+    closure = check_cut_kind(closure)
     if closure not in CLOSURES:
         raise ValueError(f"closure must be one of {CLOSURES}, got {closure!r}")
     cut = CutJoint(closure, 1, 2, origin_a=(B_, 0.0, 0.0), origin_b=(C_, 0.0, 0.0))
@@ -131,7 +135,7 @@ def crank_problem(goal=CRANK_GOAL, steps: int = CRANK_STEPS):
     from mbjax._src.rigid import TreeSystem
     from mbjax._src.trajopt import Problem
 
-    cut = CutJoint("point_on_line", 1, 2, origin_a=(B_, 0.0, 0.0), origin_b=(C_, 0.0, 0.0))
+    cut = CutJoint(PointOnLine(), 1, 2, origin_a=(B_, 0.0, 0.0), origin_b=(C_, 0.0, 0.0))
     table = model(gravity=(0.0, 0.0, -GRAVITY))
     system = ClosedSystem(TreeSystem(table, actuation=[0]), [cut], projection=True)
     q0 = joint_angles(jnp.asarray(THETA0, float))

@@ -6,7 +6,7 @@ Tree (joint axes z for the pins, x for the guide):
     body 0  crank, revolute at the ground origin, a bar of length R along its x axis;
     body 1  connecting rod, revolute at the crank's tip (R, 0, 0), a bar of length L;
     body 2  slider, prismatic along the ground x axis, q = its position x.
-The loop is cut at the rod-slider pin: a `point_on_line` cut joint (the rod's tip on the
+The loop is cut at the rod-slider pin: a `PointOnLine()` cut joint (the rod's tip on the
 slider's z line), 2 equations of full rank (planar pin; R < L, so no configuration is singular).
 
 With `driven=True` the crank turns at constant speed, q_0 = theta0 + rate t, a `Prescribed`
@@ -25,6 +25,7 @@ import jax.numpy as jnp
 import numpy as np
 
 from mbjax._src.loops import ClosedSystem, CutJoint, Prescribed
+from mbjax._src.model.closures import PointOnLine
 from mbjax._src.model import Model
 from mbjax._src.rigid import TreeSystem
 
@@ -110,7 +111,7 @@ def build(rate=RATE, theta0=THETA0, driven: bool = True):
         v0: the tree velocity on the loop, shape (3,).
     """
     theta0 = jnp.asarray(theta0, float)
-    closures = [CutJoint("point_on_line", 1, 2, origin_a=(L_, 0.0, 0.0))]
+    closures = [CutJoint(PointOnLine(), 1, 2, origin_a=(L_, 0.0, 0.0))]
     if driven:
         closures.append(Prescribed(0, q0=theta0, rate=rate))
     system = ClosedSystem(TreeSystem(model()), closures)
