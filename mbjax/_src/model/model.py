@@ -785,6 +785,7 @@ def coordinates(model: Model, x, name: str) -> Array:
     which = "nq" if name.startswith("q") else "nv"
     size = model.nq if which == "nq" else model.nv
     if x.shape != (size,):
-        raise ValueError(f"{name} must have shape ({which},) = ({size},) for this model (nq = "
-                         f"{model.nq}, nv = {model.nv}), got {x.shape}; use jax.vmap for batches")
+        raise ValueError(f"{name} must have shape ({size},) ({which}) for this model (n = "
+                         f"{model.n} bodies, nq = {model.nq}, nv = {model.nv}), got shape "
+                         f"{x.shape}; use jax.vmap for batches")
     return x

@@ -11,6 +11,7 @@ import jax
 from jax import Array
 
 from mbjax._src.model import Model
+from mbjax._src.model.model import coordinates
 from mbjax._src.rigid.aba import aba
 from mbjax._src.rigid.adjoint import with_adjoint
 from mbjax._src.rigid.batching import aba_vmappable
@@ -21,16 +22,15 @@ from mbjax._src.system.dynamics import AbstractForwardDynamics, Auto, Recursive,
 
 
 def _check(model: Model, **arrays) -> None:
-    sizes = {"q": (model.nq,), "v": (model.nv,), "tau": (model.nv,), "v_dot": (model.nv,),
-             "f_ext": (model.n, 6)}
+    """Each array's shape for this model (`coordinates` in mbjax/_src/model/model.py), f_ext
+    (n, 6) or None."""
     for name, value in arrays.items():
-        if name == "f_ext" and value is None:
-            continue
-        shape = getattr(value, "shape", None)
-        if shape != sizes[name]:
-            raise ValueError(f"{name} must have shape {sizes[name]} for this model "
-                             f"(n = {model.n} bodies, nq = {model.nq}, nv = {model.nv}), got "
-                             f"shape {shape}; use jax.vmap for batches")
+        if name != "f_ext":
+            coordinates(model, value, name)
+        elif value is not None and getattr(value, "shape", None) != (model.n, 6):
+            raise ValueError(f"f_ext must have shape ({model.n}, 6) for this model (n = "
+                             f"{model.n} bodies), got shape {getattr(value, 'shape', None)}; use "
+                             "jax.vmap for batches")
 
 
 @partial(jax.jit, static_argnames="method")

@@ -12,7 +12,6 @@ from mbjax._src.trajopt.problem import Problem
 from mbjax._src.trajopt.result import AbstractSolver, Result, history, no_states, rollout_result
 
 
-
 def cosine_adam(learning_rate: float, iterations: int, final_fraction: float = 0.1):
     """optax's Adam with its learning rate cosine-decayed over a run.
 
