@@ -9,7 +9,7 @@ turns them off).
 
 The names below are the everyday ones; each topic has its namespace: `mbjax.lie`, `mbjax.model`,
 `mbjax.control`, `mbjax.contact`, `mbjax.rigid`, `mbjax.flex`, `mbjax.loops`, `mbjax.tfe`, `mbjax.wrist`,
-`mbjax.integrate`, `mbjax.trajopt`, `mbjax.scenes`, `mbjax.data`.
+`mbjax.integrate`, `mbjax.trajopt`, `mbjax.gaits`, `mbjax.scenes`, `mbjax.data`.
 """
 
 from mbjax._src import runtime as _runtime  # first: it sets XLA_FLAGS before JAX starts its backend
@@ -18,6 +18,7 @@ from mbjax import contact as contact
 from mbjax import control as control
 from mbjax import data as data
 from mbjax import flex as flex
+from mbjax import gaits as gaits
 from mbjax import integrate as integrate
 from mbjax import lie as lie
 from mbjax import loops as loops

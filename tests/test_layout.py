@@ -31,12 +31,13 @@ LAYERS = (
     {"contact"},                      # contacts with the ground: closures of a legged robot,
                                       # simulated through a schedule
     {"trajopt"},
-    {"synthesis", "scenes"},          # the Carpal Wrist's synthesis; the ready-made scenes
+    {"synthesis", "scenes", "gaits"},  # the Carpal Wrist's synthesis; the ready-made scenes;
+                                       # legged robots' gait problems
 )
 RANK = {name: rank for rank, names in enumerate(LAYERS) for name in names}
 NAMESPACES = ("lie", "model", "control", "integrate", "rigid", "flex", "loops", "tfe", "wrist",
-              "trajopt", "scenes", "data", "contact")
-MAX_PUBLIC_NAMES = 211       # 150, the contact namespace (legged robots), multi-phase problems,
+              "trajopt", "scenes", "data", "contact", "gaits")
+MAX_PUBLIC_NAMES = 218       # 150, the contact namespace (legged robots), multi-phase problems,
                              # contacts that find themselves (geoms, their system and model,
                              # the Ant's and HalfCheetah's files) and contact costs (issue 45),
                              # model-predictive control (MPC, Plan, Cycle, Tick,
@@ -50,7 +51,9 @@ MAX_PUBLIC_NAMES = 211       # 150, the contact namespace (legged robots), multi
                              # model.AbstractSiblingOrder, model.ByName, model.InDocument,
                              # the cut-joint kinds loops.AbstractCutKind, loops.Spherical,
                              # loops.Revolute, loops.Universal, loops.Weld, loops.SpatialWeld,
-                             # loops.Prismatic, loops.PointOnLine, loops.PointOnPlane
+                             # loops.Prismatic, loops.PointOnLine, loops.PointOnPlane;
+                             # gait builders (issue 61): gaits.Gait, Weights, QUADRUPED, BIPED,
+                             # walk, trot, jump
 
 
 def _imports(path: Path):

@@ -18,6 +18,7 @@ import pytest
 ROOT = Path(__file__).parent.parent
 README = ROOT / "README.md"
 GUIDE = ROOT / "docs" / "getting-started.md"
+LEGGED = ROOT / "docs" / "legged-robots.md"
 FIRST_LINES, MAX_WORDS = 60, 3000
 
 
@@ -93,6 +94,21 @@ def test_the_getting_started_guide_runs_as_one_session(tmp_path):
         result = _run("\n".join(blocks), tmp_path, interactive)
         _check(result)
         assert "Result: success" in result.stdout and (tmp_path / "arm.gif").exists()
+
+
+@pytest.mark.slow
+def test_the_legged_robots_guide_runs_as_one_session(tmp_path):
+    """The legged-robots guide (it needs the `robots` extra): ANYmal stands under its servo,
+    its hand-written step compiles two phases and lands its foot, the trot and Talos's walk
+    solve; as a script, then at the prompt (from the compilation cache)."""
+    pytest.importorskip("example_robot_data")
+    blocks = _blocks(LEGGED)
+    for interactive in (False, True):
+        result = _run("\n".join(blocks), tmp_path, interactive)
+        _check(result)
+        out = result.stdout
+        assert "Solution: success" in out and out.count("Result: success") == 3, out[-3000:]
+        assert "17 knots, 2 compiled phases" in out and (tmp_path / "step.gif").exists()
 
 
 def test_the_prompt_runner_fails_what_pasting_fails(tmp_path):

@@ -100,6 +100,9 @@ def _listing(entries: dict) -> str:
 
 
 SKIPPED = ("unavailable", "failed", "skipped")
+# the peers the `robots` extra installs (pyproject.toml), as the closing line names them
+ROBOT_PEERS = {"example_robot_data": "example-robot-data", "pinocchio": "Pinocchio",
+               "mujoco": "MuJoCo"}
 
 
 def _skipped(records) -> list[str]:
@@ -162,7 +165,11 @@ def _report(written: list[Path], records, declared=()) -> None:
     skipped = _skipped(records)
     named = {line.split(":", 1)[0] for line in skipped}
     skipped += _skipped([d for d in declared if d["peer"] not in named])
-    print("peers skipped: " + ("; ".join(skipped) if skipped else "none"))
+    robots = [line.split(":", 1)[0] for line in skipped
+              if line.split(":", 1)[0] in ROBOT_PEERS and ": unavailable" in line]
+    print("peers skipped: " + ("; ".join(skipped) if skipped else "none")
+          + (f' (pip install ".[robots]" installs {", ".join(ROBOT_PEERS.values())})'
+             if robots else ""))
 
 
 def _positive_int(text: str) -> int:

@@ -61,13 +61,19 @@ def test_the_closing_line_names_each_skipped_peer_and_the_scenes_that_skipped_it
     _report([], summary)
     assert capsys.readouterr().out.splitlines()[1] == (
         "peers skipped: mujoco: unavailable: mujoco is not installed (controls, models); "
-        "pinocchio: unavailable: pinocchio is not installed (models)")
+        "pinocchio: unavailable: pinocchio is not installed (models) "
+        '(pip install ".[robots]" installs example-robot-data, Pinocchio, MuJoCo)')
     # a peer compared is not skipped; a record's own "skipped" reason is
     summary["scenes"]["models"]["peers"]["pinocchio"]["status"] = "compared"
     _report([], [summary, {"library": "jaxsim", "skipped": "jaxsim is not installed"}])
     assert capsys.readouterr().out.splitlines()[1] == (
         "peers skipped: jaxsim: skipped: jaxsim is not installed; "
-        "mujoco: unavailable: mujoco is not installed (controls, models)")
+        "mujoco: unavailable: mujoco is not installed (controls, models) "
+        '(pip install ".[robots]" installs example-robot-data, Pinocchio, MuJoCo)')
+    # a missing peer that the robots extra does not bring names no extra
+    _report([], [{"library": "jaxsim", "skipped": "jaxsim is not installed"}])
+    assert capsys.readouterr().out.splitlines()[1] == (
+        "peers skipped: jaxsim: skipped: jaxsim is not installed")
 
 
 def test_bench_and_reproduce_name_the_declared_peers_they_left_out(no_peers, capsys):

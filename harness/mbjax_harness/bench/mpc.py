@@ -270,19 +270,20 @@ def anymal_trot(step_length: float = 0.0) -> Scenario:
     from mbjax.trajopt import Cycle, quasi_static
     from mbjax_harness.crocoddyl.gaits import FEET, MU, _anymal_start, _converter
 
-    robot, model, q_pin0, q0, v0, feet, com, gait = _anymal_start()
+    robot, model, q_pin0, gait = _anymal_start()
+    q0, v0 = gait.q0, jnp.zeros(model.nv)
     lf, rf, lh, rh = FEET
-    support = [gait.knot(FEET) for _ in range(TROT_SUPPORT_KNOTS)]
+    support = gait.support(TROT_SUPPORT_KNOTS)
+    targets = [gait.com, dict(gait.positions)]        # moved on by each step (`Gait.steps`)
 
-    targets = (np.array(com), dict(feet))         # moved on by each step (`_Gait.footsteps`)
-
-    def step(legs, swing, length):  # a diagonal pair's swing, its touchdown impulse left out
-        return gait.footsteps(*targets, length, TROT_HEIGHT, TROT_STEP_KNOTS, legs,
-                              swing)[0][:-1]
+    def step(swing, length):  # a diagonal pair's swing, its touchdown impulse left out
+        knots, com, feet = gait.steps(*targets, swing, length, TROT_HEIGHT, TROT_STEP_KNOTS)
+        targets[:] = com, feet
+        return knots[:-1]
 
     def cycle_of(first):
-        return (support + step([lf, rh], [rf, lh], first * step_length) + support
-                + step([rf, lh], [lf, rh], step_length))
+        return (support + step([rf, lh], first * step_length) + support
+                + step([lf, rh], step_length))
 
     knots = cycle_of(0.5)
     cycle_knots = len(knots)
@@ -291,7 +292,7 @@ def anymal_trot(step_length: float = 0.0) -> Scenario:
             knots += cycle_of(1.0)
     cycle = Cycle(knots, TROT_DT)
     speed = step_length / (cycle_knots * TROT_DT)
-    terminal = (gait.regularisation(gait.state_weights), *gait.bounds)
+    terminal = (gait.regularisation(), *gait.bounds)
 
     def horizon_problem(t, q, v):
         return trajopt.Problem(cycle.window(t, TROT_HORIZON), q, v, dt=TROT_DT,
