@@ -12,8 +12,9 @@ from jax import Array
 from mbjax._src.integrate.base import AbstractIntegrator
 from mbjax._src.integrate.solution import Solution
 from mbjax._src.lie.inputs import check_unit_quaternions
-from mbjax._src.system.accuracy import (ERROR_SAMPLES, RESOLUTION_LIMIT, SUSTAINED, doubled,
-                                        number, sample_indices, step_ratio, tolerances)
+from mbjax._src.system.accuracy import (DEFAULT_DRIFT_LIMIT, ERROR_SAMPLES, RESOLUTION_LIMIT,
+                                        SUSTAINED, doubled, number, sample_indices, step_ratio,
+                                        tolerances)
 from mbjax._src.system.invariants import drifts
 from mbjax._src.system.status import (DRIFTED, ESTIMATED, FLAGS, RESOLVED, Status,
                                       raise_on_failure)
@@ -98,7 +99,7 @@ def simulate(system: AbstractSystem, integrator: AbstractIntegrator, q0: Array, 
             grows like sqrt(T) rather than T, for about one more forward pass. The values
             computed are the same.
         rtol: relative tolerance on the final state's error and on the invariants' drift
-            (see Accuracy with a tolerance in docs/details.md); None for 0 where atol is given.
+            (held to 1 % without a tolerance: docs/details.md); None for 0 where atol is given.
         atol: absolute tolerance on the final state's error, in the state's units.
         throw: raise an error naming the failure (`Status.failures()`) instead of returning a
             solution whose status carries it (also under `jit` and `vmap`, through
@@ -106,7 +107,7 @@ def simulate(system: AbstractSystem, integrator: AbstractIntegrator, q0: Array, 
 
     Returns:
         A `Solution` with the saved times ts (T,), states qs (T, nq) and us (T, nv), the
-            status, and with a tolerance the error estimate and the invariants' drift.
+            status, the invariants' drift, and with a tolerance the error estimate.
 
     Raises:
         TypeError: system or integrator is not an mbjax instance (a class, a bare `Model`), q0
@@ -145,38 +146,41 @@ def simulate(system: AbstractSystem, integrator: AbstractIntegrator, q0: Array, 
                                       n_steps // block, tuple((kept // block).tolist()),
                                       _segment(block) if checkpoint else block)
     ts = jnp.asarray(t0 + idx * dt, dtype=q0.dtype)
-    if not checked:
-        return raise_on_failure(Solution(ts=ts, qs=qs, us=us, status=status, **fields), throw,
-                                "mbjax.simulate")
-    all_qs, all_us, all_ts = qs, us, jnp.asarray(t0 + kept * dt, dtype=q0.dtype)
-    if len(kept) != len(idx):
-        at = np.searchsorted(kept, idx)
-        qs, us = all_qs[at], all_us[at]
-    # the samples: the start and the kept states before t1, at most ERROR_SAMPLES, spread out
-    before = np.flatnonzero((kept > 0) & (kept < n_steps))
-    picks = before[sample_indices(len(before))]
-    starts = (jnp.concatenate([q0[None], all_qs[picks]]),
-              jnp.concatenate([u0[None], all_us[picks]]),
-              jnp.concatenate([jnp.asarray([t0], q0.dtype), all_ts[picks]]))
-    error, ratio = _error_estimate(system, integrator, *starts, float(dt), n_steps, rtol, atol)
-    estimated = ratio > 1.0
-    new = status | jnp.where(estimated, int(Status.INACCURATE), 0).astype(status.dtype)
-    # the estimate is of the final state's error: at t1 unless raised before
-    first = _raised(fields["flagged_at"], status, new, jnp.asarray(t1, q0.dtype))
-    by = fields["inaccurate_by"] | jnp.where(estimated, ESTIMATED, 0)
-    drift = _drift(system, jnp.concatenate([jnp.asarray([t0], q0.dtype), all_ts]),
-                   jnp.concatenate([q0[None], all_qs]), jnp.concatenate([u0[None], all_us]),
-                   rtol)
+    new, first, by = status, fields["flagged_at"], fields["inaccurate_by"]
+    all_qs, all_us, all_ts = qs, us, ts
+    if checked:
+        all_ts = jnp.asarray(t0 + kept * dt, dtype=q0.dtype)
+        if len(kept) != len(idx):
+            at = np.searchsorted(kept, idx)
+            qs, us = all_qs[at], all_us[at]
+        # the samples: the start and the kept states before t1, at most ERROR_SAMPLES, spread out
+        before = np.flatnonzero((kept > 0) & (kept < n_steps))
+        picks = before[sample_indices(len(before))]
+        starts = (jnp.concatenate([q0[None], all_qs[picks]]),
+                  jnp.concatenate([u0[None], all_us[picks]]),
+                  jnp.concatenate([jnp.asarray([t0], q0.dtype), all_ts[picks]]))
+        error, ratio = _error_estimate(system, integrator, *starts, float(dt), n_steps, rtol,
+                                       atol)
+        estimated = ratio > 1.0
+        new = status | jnp.where(estimated, int(Status.INACCURATE), 0).astype(status.dtype)
+        # the estimate is of the final state's error: at t1 unless raised before
+        first = _raised(first, status, new, jnp.asarray(t1, q0.dtype))
+        by = by | jnp.where(estimated, ESTIMATED, 0)
+        fields.update(error=error)
+    # the invariants' drift: held to rtol where a tolerance is given (rtol = 0: reported, not
+    # held), else to DEFAULT_DRIFT_LIMIT; a check, not differentiated
+    limit = rtol if checked else DEFAULT_DRIFT_LIMIT
+    drift = _drift(system, jnp.asarray(t0, q0.dtype), q0, u0, all_ts, all_qs, all_us, limit)
     if drift is not None:
         (value, which, when), names = drift
-        drifted = (value > rtol) & (rtol > 0)
+        drifted = (value > limit) & (limit > 0)
         status, new = new, new | jnp.where(drifted, int(Status.INACCURATE), 0).astype(new.dtype)
         first = _raised(first, status, new, when)
         by = by | jnp.where(drifted, DRIFTED, 0)
         fields.update(drift=value, drifting=which, invariant_names=names)
     fields.update(flagged_at=first, inaccurate_by=by)
-    return raise_on_failure(Solution(ts=ts, qs=qs, us=us, status=new, error=error, **fields),
-                            throw, "mbjax.simulate")
+    return raise_on_failure(Solution(ts=ts, qs=qs, us=us, status=new, **fields), throw,
+                            "mbjax.simulate")
 
 
 @eqx.filter_jit
@@ -201,19 +205,41 @@ def _error_estimate(system, integrator, q, u, t, dt: float, n_steps: int, rtol, 
     return n_steps * jnp.mean(errors), n_steps * jnp.mean(ratios)
 
 
-@eqx.filter_jit
-def _drift(system, ts, qs, us, rtol: float):
-    """((the invariants' largest relative drift over the states (ts, qs, us), the index of the
-    invariant, the first time it exceeds a positive rtol or NaN), their names), or None for a
-    system that knows none (`mbjax._src.system.invariants.drifts`)."""
-    if system.invariants(ts[0], qs[0], us[0]) is None:
+def _drift(system, t0, q0, u0, ts, qs, us, limit: float):
+    """((the invariants' largest relative drift over the start (t0, q0, u0) and the states (ts,
+    qs, us), the index of the invariant, the first time it exceeds `limit` or NaN), their
+    names), or None for a system that knows none (`mbjax._src.system.invariants.drifts`); a
+    limit of 0 holds it to nothing. A check, not differentiated.
+
+    The check's program runs for about a microsecond a state: called at the top level on the
+    CPU, XLA compiles it without its backend optimizations, three times faster for a run about
+    2.7 times slower (benchmarks/README.md, the accuracy section); JAX takes compiler options
+    at the top level only, so under jit, vmap or grad the check compiles with the program
+    around it."""
+    traced = any(isinstance(x, jax.core.Tracer)
+                 for x in jax.tree.leaves((system, t0, q0, u0, ts, qs, us)))
+    fast = not traced and jax.default_backend() == "cpu"
+    return (_drift_top if fast else _drift_nested)(system, t0, q0, u0, ts, qs, us, limit)
+
+
+def _drift_of(system, t0, q0, u0, ts, qs, us, limit: float):
+    """`_drift`, to be compiled."""
+    if system.invariants(t0, q0, u0) is None:
         return None
+    system = jax.tree.map(lambda x: jax.lax.stop_gradient(x) if eqx.is_array(x) else x, system)
+    ts, qs, us = jax.lax.stop_gradient((jnp.concatenate([t0[None], ts]),
+                                        jnp.concatenate([q0[None], qs]),
+                                        jnp.concatenate([u0[None], us])))
     history = jax.vmap(system.invariants)(ts, qs, us)
     ratios = drifts(history)                                    # (T, k)
-    over = (jnp.max(ratios, axis=1) > rtol) & (rtol > 0)
+    over = (jnp.max(ratios, axis=1) > limit) & (limit > 0)
     when = jnp.where(jnp.any(over), ts[jnp.argmax(over)], jnp.nan)
     return ((jnp.max(ratios, initial=0.0), jnp.argmax(jnp.max(ratios, axis=0)), when),
             history.labels())
+
+
+_drift_top = eqx.filter_jit(_drift_of, compiler_options={"xla_backend_optimization_level": 0})
+_drift_nested = eqx.filter_jit(_drift_of)
 
 
 def _sample_steps(n_steps: int, idx: np.ndarray) -> np.ndarray:

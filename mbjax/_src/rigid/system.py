@@ -19,7 +19,7 @@ from jax import Array
 from mbjax._src.control import AbstractControl
 from mbjax._src.system.driven import AbstractDrivenSystem, about_origins, drive, held
 from mbjax._src.system.dynamics import AbstractForwardDynamics, Auto, Recursive, as_dynamics
-from mbjax._src.system.invariants import join
+from mbjax._src.system.invariants import energy_invariant, join
 from mbjax._src.system.system import AbstractSystem
 from mbjax._src.system.tree_system import AbstractTreeSystem
 from mbjax._src.system.status import Status
@@ -30,7 +30,7 @@ from mbjax._src.rigid.motion import body_forces, body_motion
 from mbjax._src.rigid.batched import batch_aba
 from mbjax._src.rigid.dense import dense_responses
 from mbjax._src.rigid.dynamics import forward_dynamics, mass_matrix
-from mbjax._src.rigid.energy import energy, floating, free_momenta, kinetic_energy
+from mbjax._src.rigid.energy import energies, energy, floating, free_momenta, kinetic_energy
 from mbjax._src.rigid.kinematics import forward_kinematics
 from mbjax._src.rigid.momentum import momentum_rate, velocity_from_momentum
 from mbjax._src.rigid import rnea_derivatives
@@ -148,10 +148,14 @@ class TreeSystem(AbstractTreeSystem):
         return jnp.any(self.model.damping != 0)
 
     def invariants(self, t, q, u):
-        """The energy of a passive tree, and, where every base body hangs from a free joint,
-        the momenta of `free_momenta`."""
-        energy_part = super().invariants(t, q, u)
-        if energy_part is None or not floating(self.model):
+        """The energy of a passive tree (from one outward sweep: `energies`, what
+        `simulate`'s default check evaluates along a run), and, where every base body hangs from
+        a free joint, the momenta of `free_momenta`; None under a control or an external load."""
+        if not self.passive:
+            return None
+        T, E = energies(self.model, q, u)
+        energy_part = energy_invariant(E, T, self.dissipative())
+        if not floating(self.model):
             return energy_part
         return join(energy_part, free_momenta(self.model, t, q, u))
 

@@ -3,11 +3,11 @@
 A passive system (no control, no external load, no prescribed motion) conserves its energy, or
 with damping can only lose it; a free-floating tree also conserves its angular momentum about
 the gravity axis (all of it without gravity) and its linear momentum less the weight's impulse
-M g t. `simulate(..., rtol=)` compares each invariant along the saved states with its value at
-the start, relative to a scale of the motion (the largest kinetic energy for the energy, the
-sum of the bodies' momentum magnitudes for the momentum: `drifts`), and reports the largest
-ratio as `Solution.drift` and `Status.INACCURATE` where it exceeds rtol; `solve_tfe` does so by
-default, against `DRIFT_LIMIT`.
+M g t. `simulate` compares each invariant along the saved states with its value at the start,
+relative to a scale of the motion (the largest kinetic energy for the energy, the sum of the
+bodies' momentum magnitudes for the momentum: `drifts`), and reports the largest ratio as
+`Solution.drift` and `Status.INACCURATE` where it exceeds rtol, or without a tolerance
+`DEFAULT_DRIFT_LIMIT`; `solve_tfe` does so by default, against `DRIFT_LIMIT`.
 """
 
 import equinox as eqx

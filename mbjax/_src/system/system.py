@@ -211,7 +211,8 @@ class AbstractSystem(eqx.Module):
         """The quantities the exact motion conserves at a state.
 
         The energy of a passive system, a free tree's momentum (`mbjax/_src/system/invariants.py`):
-        their drift is what `simulate(..., rtol=)` holds to rtol.
+        their drift is what `simulate` holds to rtol, or by default to 1 %. `simulate` evaluates
+        them at every saved state, so they should be cheap to compile and to run.
 
         Args:
             t: time [s], a scalar.
