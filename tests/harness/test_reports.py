@@ -87,7 +87,8 @@ def test_bench_and_reproduce_name_the_declared_peers_they_left_out(no_peers, cap
     _report([], [{"engine": "mujoco", "status": "failed: SolverError"}], _declared(SUITES["rigid"]))
     assert capsys.readouterr().out.splitlines()[1] == (
         "peers skipped: mujoco: failed: SolverError; "
-        "pinocchio: unavailable: pinocchio is not installed")
+        "pinocchio: unavailable: pinocchio is not installed "
+        '(pip install ".[robots]" installs example-robot-data, Pinocchio, MuJoCo)')
 
 
 def test_what_to_look_at_says_which_comparisons_did_not_run():
@@ -187,7 +188,8 @@ def test_a_tour_without_mujoco_and_pinocchio_says_so(tmp_path):
     assert out.returncode == 0, out.stderr[-2000:]
     assert out.stdout.splitlines()[-1] == (
         "peers skipped: mujoco: unavailable: mujoco is not installed (models); "
-        "pinocchio: unavailable: pinocchio is not installed (models)")
+        "pinocchio: unavailable: pinocchio is not installed (models) "
+        '(pip install ".[robots]" installs example-robot-data, Pinocchio, MuJoCo)')
     markdown = (tmp_path / "summary.md").read_text()
     assert "compared with no peer here (Pinocchio not installed: pip install pin; MuJoCo not " \
            "installed: pip install mujoco)" in markdown
