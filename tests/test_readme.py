@@ -19,6 +19,7 @@ ROOT = Path(__file__).parent.parent
 README = ROOT / "README.md"
 GUIDE = ROOT / "docs" / "getting-started.md"
 LEGGED = ROOT / "docs" / "legged-robots.md"
+SOLVING = ROOT / "docs" / "solving.md"
 FIRST_LINES, MAX_WORDS = 60, 3000
 
 
@@ -109,6 +110,24 @@ def test_the_legged_robots_guide_runs_as_one_session(tmp_path):
         out = result.stdout
         assert "Solution: success" in out and out.count("Result: success") == 3, out[-3000:]
         assert "17 knots, 2 compiled phases" in out and (tmp_path / "step.gif").exists()
+
+
+@pytest.mark.slow
+def test_the_solving_guide_runs_as_one_session(tmp_path):
+    """The guide to an unconverged solve (it needs the `robots` extra): the UR5's first reach
+    stops on short steps and names Crocoddyl's schedule, which converges within 1 mm; a second
+    target reuses the compiled solve; as a script, then at the prompt."""
+    pytest.importorskip("example_robot_data")
+    blocks = _blocks(SOLVING)
+    for interactive in (False, True):
+        result = _run("\n".join(blocks), tmp_path, interactive)
+        _check(result)
+        out = result.stdout.splitlines()
+        first = next(line for line in out if line.startswith("Result: not converged"))
+        assert first.startswith("Result: not converged (iterations=200 ran out on short steps")
+        assert "ILQR(**mbjax.trajopt.CROCODDYL_SCHEDULE)" in first
+        solved = [line.split() for line in out if line.startswith("Result: success")]
+        assert len(solved) == 2 and all(float(words[-1]) < 1e-3 for words in solved), out
 
 
 def test_the_prompt_runner_fails_what_pasting_fails(tmp_path):

@@ -80,7 +80,9 @@ def test_an_infeasible_start_closes_its_gaps_on_the_lqr_optimum():
     u = np.linalg.solve(H, -g)
     states = jnp.asarray(np.random.default_rng(0).normal(size=(N + 1, 2)))
     first = solve(problem, ILQR(iterations=1), states0=states)
-    assert first.messages() == ["not converged"]
+    # not converged after its one iteration, and the message says what to change
+    assert first.messages()[0].startswith("not converged (iterations=1 ran out")
+    assert "raise ILQR(iterations=...)" in first.messages()[0]
     np.testing.assert_allclose(problem.rollout(first.us),
                                jnp.concatenate([first.qs, first.vs], axis=1), rtol=0, atol=1e-12)
     result = solve(problem, ILQR(), states0=states)

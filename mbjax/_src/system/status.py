@@ -29,9 +29,10 @@ class Status(enum.IntFlag):
             (position, velocity or effort: `Model.lower`, `upper`, `velocity_limit`,
             `effort_limit`).
         INACCURATE: the steps do not resolve the motion (the default check,
-            `Solution.resolution` above 1), or the estimated error or the invariants' drift
-            exceeds the tolerance asked for (`simulate`'s rtol and atol; `Solution.error`,
-            `Solution.drift`).
+            `Solution.resolution` above 1), the invariants' drift (`Solution.drift`) exceeds
+            the tolerance asked for (rtol) or by default a bound (1 % of the motion's scale in
+            `simulate`, 10 % in `solve_tfe`), or the estimated error exceeds the tolerance
+            (`simulate`'s rtol and atol; `Solution.error`).
         SINGULAR: a saved state at (or within the system's tolerance of) a singular
             configuration, where the dynamics are not defined (the Carpal Wrist's inverse or
             direct singularity: `WristSystem.check`).
@@ -239,6 +240,13 @@ def describe(code: int, notes: dict) -> str:
     return ", ".join(words) or "success"
 
 
+def run_member(result, x, i: int):
+    """The i-th (flattened) run's value of a field x of a possibly batched `result` (its
+    leading axes those of its status), for the host-side messages."""
+    x = np.asarray(x)
+    return x.reshape(-1, *x.shape[np.ndim(result.status):])[i] if x.ndim else x
+
+
 # why a run is INACCURATE (`Solution.inaccurate_by`, a mask of these)
 RESOLVED, DRIFTED, ESTIMATED = 1, 2, 4
 
@@ -248,8 +256,7 @@ def accuracy_notes(result, i: int, flags_at=None) -> dict:
     `TFESolution`: resolution, drift, drifting, invariant_names, error, inaccurate_by) and
     optionally the time each flag was first raised, for its i-th (flattened) run."""
     def member(x):
-        x = np.asarray(x)
-        return x.reshape(-1, *x.shape[np.ndim(result.status):])[i] if x.ndim else x
+        return run_member(result, x, i)
 
     notes = {}
     if flags_at is not None:

@@ -9,9 +9,10 @@ from jax import Array
 from mbjax._src.system.status import Status
 from mbjax._src.linalg import small_dot, spd_solve
 from mbjax._src.trajopt.problem import Problem
-from mbjax._src.trajopt.result import AbstractIterativeSolver, Result, cost_floor, history
+from mbjax._src.trajopt.result import (MU_CEILING, AbstractIterativeSolver, Result, cost_floor,
+                                       history)
 
-MU_MIN, MU_MAX, MU_FACTOR = 1e-9, 1e10, 10.0
+MU_MIN, MU_FACTOR = 1e-9, 10.0
 # an infeasible start (Mastalli et al. 2020, FDDP): the gaps below which a trajectory is a
 # rollout, and the fraction of a predicted cost increase a gap-closing step may cost
 GAP_TOLERANCE, INCREASE_ACCEPTANCE = 1e-9, 2.0
@@ -132,6 +133,7 @@ class ILQR(AbstractIterativeSolver):
                     iteration=jnp.array(0), done=jnp.array(False), stalled=jnp.array(False),
                     met_nonfinite=jnp.array(False),
                     costs=history(self.iterations + 1, cost),
+                    step_lengths=jnp.full(self.iterations, jnp.nan, cost.dtype),
                     K=jnp.zeros((N, nu, nx), cost.dtype), stale=jnp.array(True),
                     expansion=jax.tree.map(lambda a: jnp.zeros(a.shape, a.dtype), jax.eval_shape(
                         lambda: self._linearize(problem, xs, us))))
@@ -199,7 +201,8 @@ class ILQR(AbstractIterativeSolver):
         i = s["iteration"] + 1
         # a rejected step leaves the trajectory, and so its expansion, as they were
         return dict(xs=xs, us=us, cost=cost, mu=mu, iteration=i, done=converged,
-                    stalled=mu > MU_MAX, costs=s["costs"].at[i].set(cost),
+                    stalled=mu > MU_CEILING, costs=s["costs"].at[i].set(cost),
+                    step_lengths=s["step_lengths"].at[i - 1].set(jnp.where(accept, taken, 0.0)),
                     K=jnp.where(accept, K, s["K"]), expansion=expansion, stale=accept,
                     met_nonfinite=blocked & ~(accept & (change > self.tolerance * jnp.abs(cost))))
 
@@ -213,7 +216,18 @@ class ILQR(AbstractIterativeSolver):
                   | jnp.where(finite, 0, int(Status.NONFINITE)))
         q, v = problem.split(s["xs"])
         return Result(qs=q, vs=v, us=s["us"], cost=s["cost"], costs=s["costs"],
-                      iterations=s["iteration"], feedback=s["K"], status=status)
+                      iterations=s["iteration"], feedback=s["K"], status=status,
+                      regularization=s["mu"], step_lengths=s["step_lengths"], solver="ILQR",
+                      hint=self._hint())
+
+    def _hint(self) -> str:
+        """What to try where the accepted steps stay short (`Result.messages`): a schedule
+        that raises the regularization after short steps, unless this one does already."""
+        other = "MultipleShooting() for a long horizon or an unstable rollout"
+        if not isinstance(self.grow_below, jax.core.Tracer) and self.grow_below > 0:
+            return f"more iterations, ILQR(iterations=...), or {other}"
+        return ("ILQR(**mbjax.trajopt.CROCODDYL_SCHEDULE), a regularization schedule that "
+                f"raises it after short steps, or {other}")
 
     @staticmethod
     def _linearize(problem: Problem, xs: Array, us: Array) -> tuple:

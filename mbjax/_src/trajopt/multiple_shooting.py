@@ -8,8 +8,8 @@ from jax import Array
 
 from mbjax._src.trajopt.ilqr import riccati_step
 from mbjax._src.trajopt.problem import Problem
-from mbjax._src.trajopt.result import (AbstractSolver, Result, cost_floor, history,
-                                       rollout_result)
+from mbjax._src.trajopt.result import (MU_CEILING, AbstractSolver, Result, cost_floor,
+                                       history, rollout_result)
 
 STEPS = tuple(0.5**k for k in range(10))
 
@@ -136,7 +136,7 @@ class MultipleShooting(AbstractSolver):
             stop = jnp.minimum(i + self.inner, self.iterations)
 
             def more(t):
-                return ~t[6] & (t[7] < stop) & (t[4] < 1e10)
+                return ~t[6] & (t[7] < stop) & (t[4] < MU_CEILING)
 
             xs, us, lam, rho, mu, value, settled, i, costs = jax.lax.while_loop(
                 more, inner, (xs, us, lam, rho, mu, value, jnp.array(False), i, costs))
@@ -149,7 +149,7 @@ class MultipleShooting(AbstractSolver):
         def running(s):
             settled, i, mu, defect = s[6], s[7], s[4], s[9]
             done = settled & (defect <= self.defect_tolerance)
-            return ~done & (i < self.iterations) & (mu < 1e10)
+            return ~done & (i < self.iterations) & (mu < MU_CEILING)
 
         xs = problem.initial_states(states, us)
         lam = jnp.zeros((problem.horizon, nx), us.dtype)
@@ -159,6 +159,6 @@ class MultipleShooting(AbstractSolver):
              jnp.array(False), jnp.array(0), history(self.iterations + 1, value),
              jnp.asarray(jnp.inf, us.dtype))
         s = jax.lax.while_loop(running, outer, s)
-        us, settled, iterations, costs, defect = s[1], s[6], s[7], s[8], s[9]
+        us, mu, settled, iterations, costs, defect = s[1], s[4], s[6], s[7], s[8], s[9]
         return rollout_result(problem, us, costs, iterations,
-                              settled & (defect <= self.defect_tolerance))
+                              settled & (defect <= self.defect_tolerance), "MultipleShooting", mu)

@@ -6,12 +6,20 @@ from functools import partial
 import equinox as eqx
 import jax
 import jax.numpy as jnp
+import numpy as np
 from jax import Array
 
 from mbjax._src.system.accuracy import RESOLUTION_LIMIT
 from mbjax._src.system.accuracy import resolution as accuracy_resolution
-from mbjax._src.system.status import Flags, flags, RESOLVED, Status, WithStatus, accuracy_notes
+from mbjax._src.system.status import (Flags, flags, RESOLVED, Status, WithStatus, accuracy_notes,
+                                      run_member)
 from mbjax._src.trajopt.problem import Problem
+
+
+# the regularization past which `ILQR` and `MultipleShooting` give up (no step lowers the cost)
+MU_CEILING = 1e10
+# the median step length of an iteration's last fifth below which `messages()` calls them short
+SHORT_STEP = 0.1
 
 
 class Result(WithStatus):
@@ -39,12 +47,20 @@ class Result(WithStatus):
             above 1 the discrete dynamics the solver optimised are far from the continuous
             ones (an optimum that exploits the integrator's error); NaN before the check.
         inaccurate_by: 1 where the resolution made it INACCURATE, else 0.
+        regularization: the regularization mu at the end (`ILQR`, `MultipleShooting`); NaN
+            for a solver without one.
+        step_lengths: the step length each iteration accepted, 0 where it accepted none,
+            shape (iterations,) of the solver's maximum, NaN past the iterations taken
+            (`ILQR`); all NaN for a solver that does not record them.
+        solver: the solver's class name (static), which `messages()` names in its advice.
+        hint: the solver's advice where its steps stay short (static; `messages()`).
 
     Status:
         The status is success when the solver's convergence test passed, NOT_CONVERGED when it
         ran out of iterations or could not make progress, NONFINITE when the cost or the
         trajectory blew up (for `ILQR` also when it stopped unconverged after an iteration that a
-        non-finite cost kept from progressing).
+        non-finite cost kept from progressing). `messages()` names the likely remedy of each
+        failure from what the result records (see docs/solving.md).
     """
 
     qs: Array
@@ -57,10 +73,56 @@ class Result(WithStatus):
     status: Flags = eqx.field(converter=flags)
     resolution: Array = float("nan")
     inaccurate_by: Array = 0
+    regularization: Array = float("nan")
+    step_lengths: Array = float("nan")
+    solver: str = eqx.field(static=True, default="")
+    hint: str = eqx.field(static=True, default="", repr=False)
 
     def notes(self, i: int) -> dict:
-        """What tripped each flag of the i-th result (`WithStatus.messages`)."""
-        return accuracy_notes(self, i)
+        """What tripped each flag of the i-th result, and what to change (`WithStatus.messages`)."""
+        notes = accuracy_notes(self, i)
+        code = int(run_member(self, self.status, i))
+        if code & Status.NOT_CONVERGED:
+            notes[Status.NOT_CONVERGED] = self._not_converged(i)
+        if code & Status.NONFINITE:
+            notes[Status.NONFINITE] = ("the cost or the trajectory became inf or NaN: try a finer "
+                                       "Problem(dt=...), bounds Problem(lower=..., upper=...) "
+                                       "on the controls, or a first guess us0 nearer a solution")
+        if code & Status.INACCURATE and Status.INACCURATE in notes:
+            notes[Status.INACCURATE] += ("; try a finer Problem(dt=...), with horizon= raised "
+                                         "to keep the duration")
+        return notes
+
+    def _not_converged(self, i: int) -> str:
+        """Why the i-th run stopped unconverged, and the likely remedy."""
+        taken = int(run_member(self, self.iterations, i))
+        costs = np.asarray(run_member(self, self.costs, i), dtype=float)
+        limit = costs.shape[-1] - 1
+        mu = float(run_member(self, self.regularization, i))
+        if taken < limit and mu >= MU_CEILING:
+            return (f"no step lowered the cost: the regularization reached {mu:.0e} after "
+                    f"{taken} iterations; try a first guess nearer a solution (us0=, states0=), "
+                    "MultipleShooting() from states, or cost weights of similar scales")
+        if taken < limit:
+            return f"stopped after {taken} of {limit} iterations"
+        k = max(1, taken // 5)
+        steps = np.asarray(run_member(self, self.step_lengths, i), dtype=float)
+        recent = steps[taken - k:taken] if steps.ndim else np.full(k, np.nan)
+        if self.hint and np.all(np.isfinite(recent)) and np.median(recent) < SHORT_STEP:
+            return (f"iterations={limit} ran out on short steps (median step length "
+                    f"{np.median(recent):.2g} over the last {k}): try {self.hint}")
+        before, after = costs[taken - k], costs[taken]
+        if before > 2 * after > 0:
+            ratio = before / after
+            change = f"the cost fell {ratio:.2g}-fold" if ratio < 10 else (
+                f"the cost fell {ratio:,.0f}-fold")
+        elif before > after != 0:
+            change = f"the cost fell {100 * (before - after) / abs(after):.2g}%"
+        else:
+            change = "the cost did not fall"
+        raise_ = f"{self.solver}(iterations=...)" if self.solver else "the solver's iterations"
+        return (f"iterations={limit} ran out, {change} over the last {k}: raise {raise_}, or "
+                "go on from this result: solve(problem, solver, result.us)")
 
 
 def cost_floor(dtype) -> float:
@@ -145,9 +207,10 @@ def no_states(states, solver: str) -> None:
 
 
 def rollout_result(problem: Problem, us: Array, costs: Array, iterations: Array,
-                   converged: Array) -> Result:
-    """The Result of controls us found without feedback gains: their rollout and its cost, with
-    success where `converged` and NONFINITE where the rollout blew up."""
+                   converged: Array, solver: str = "", regularization=jnp.nan) -> Result:
+    """The Result of controls us found without feedback gains by `solver` (its class name): their
+    rollout and its cost, with success where `converged` and NONFINITE where the rollout blew
+    up, and the solver's final `regularization` (NaN for none)."""
     xs = problem.rollout(us)
     cost = problem.cost(xs, us)
     finite = jnp.isfinite(cost) & jnp.all(jnp.isfinite(xs))
@@ -156,4 +219,5 @@ def rollout_result(problem: Problem, us: Array, costs: Array, iterations: Array,
     q, v = problem.split(xs)
     return Result(qs=q, vs=v, us=us, cost=cost, costs=costs, iterations=iterations,
                   feedback=jnp.zeros((problem.horizon, problem.nu, problem.ndx), us.dtype),
-                  status=status)
+                  status=status, regularization=jnp.asarray(regularization, cost.dtype),
+                  step_lengths=jnp.full(costs.shape[0] - 1, jnp.nan, cost.dtype), solver=solver)

@@ -153,4 +153,5 @@ class Shooting(AbstractSolver):
 
         s = jax.lax.while_loop(running, iterate, (x0, state0, value0, grad0, jnp.array(0),
                                                   history(self.iterations + 1, value0)))
-        return rollout_result(problem, s[0].reshape(shape), s[5], s[4], converged(s))
+        return rollout_result(problem, s[0].reshape(shape), s[5], s[4], converged(s),
+                              "Shooting")

@@ -22,7 +22,15 @@ def solve(problem: Problem, solver: AbstractSolver = ILQR(), us0: Array | None =
 
     One compiled program runs the solver's iterations and returns the optimised trajectory as a
     `Result`, whose status says whether the solver converged and whether the trajectory's steps
-    resolve its motion. A batch of problems is solved in one program too.
+    resolve its motion, and where not, what to try (`print(result)`). A batch of problems is
+    solved in one program too.
+
+    The program is compiled once for what is not an array in the problem and the solver (the
+    cost functions, sizes, the solver's settings): a problem that differs only in arrays reuses
+    it. So pass the data a cost reads (a target, a weight) as arrays, bound to a module-level
+    function by `eqx.Partial(terminal, target=target)` or held by a residual module
+    (`frame_residual(model, frame, target)`); a closure over a target is a new function each
+    time it is defined, and compiles anew (docs/solving.md).
 
     Args:
         problem: the trajectory-optimisation problem, or a batch of problems (see Batches in
