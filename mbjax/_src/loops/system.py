@@ -247,6 +247,11 @@ class ClosedSystem(AbstractSystem):
         """The closed system with its tree driven by `control`."""
         return eqx.tree_at(lambda s: s.loops.tree, self, self.tree.with_control(control))
 
+    def holding_control(self, q, nu):
+        """The tree's holding control with the closures' forces helping
+        (`AbstractTreeSystem.holding_control`)."""
+        return self.tree.holding_control(q, nu, self.loops.jacobian(q))
+
     def hold(self, t, q, u):
         tree = self.tree.hold(t, q, self.velocity(q, u))
         return self if tree is self.tree else eqx.tree_at(lambda s: s.loops.tree, self, tree)

@@ -261,6 +261,24 @@ class AbstractSystem(eqx.Module):
                         "RigidBody, a ClosedSystem of a tree, ...)")
 
     @eqx.filter_jit
+    def holding_control(self, q: Array, nu: int) -> Array:
+        """The control that holds configuration q at rest (`mbjax.trajopt.quasi_static`'s first
+        guess; Crocoddyl's `quasiStatic`).
+
+        Args:
+            q: configuration, shape (nq,).
+            nu: the number of controls.
+
+        Returns:
+            u, shape (nu,): the least-squares answer where no control holds q.
+
+        Raises:
+            TypeError: the system has no quasi-static hold (trees and their closed systems
+                have one).
+        """
+        raise TypeError(f"{type(self).__name__} has no quasi-static hold: give solve a first "
+                        "guess us0 instead of quasi_static's")
+
     def relative_energy_error(self, qs: Array, us: Array) -> Array:
         """(E(t) - E(0)) / |E(0)| along a saved trajectory, for systems with an `energy(q, u)`.
 

@@ -4,9 +4,11 @@
 import abc
 
 import equinox as eqx
+import jax
 import jax.numpy as jnp
 from jax import Array
 
+from mbjax._src.control import Constant
 from mbjax._src.system.driven import AbstractDrivenSystem, about_origins
 from mbjax._src.system.invariants import energy_invariant
 
@@ -194,6 +196,31 @@ class AbstractTreeSystem(AbstractDrivenSystem):
         if not self.passive:
             return None
         return energy_invariant(self.energy(q, u), self.kinetic_energy(q, u), self.dissipative())
+
+    def holding_control(self, q: Array, nu: int, closures: Array | None = None) -> Array:
+        """The least-norm (u, f) of B u + A^T f = g(q), its u: the actuation B, the Jacobian A
+        (m, nv) of the closures that help hold q (a stance's feet; none by default), f their
+        multipliers and g the generalized gravity force (Crocoddyl's `quasiStatic`,
+        pseudo-inverse and all).
+
+        Args:
+            q: configuration, shape (nq,).
+            nu: the number of controls.
+            closures: A, shape (m, nv), or None.
+
+        Returns:
+            u, shape (nu,).
+        """
+        rest = jnp.zeros(self.nv, q.dtype)
+        A = jnp.zeros((0, self.nv), q.dtype) if closures is None else closures
+        M = self.mass_matrix(q)
+
+        def force(u):              # the generalized force at rest under u: B u - g(q)
+            return M @ self.with_control(Constant(u)).hold(0.0, q, rest).acceleration(0.0, q, rest)
+
+        zero = jnp.zeros(nu, q.dtype)
+        minus_g, B = force(zero), jax.jacfwd(force)(zero)
+        return (jnp.linalg.pinv(jnp.concatenate([B, A.T], axis=1)) @ -minus_g)[:nu]
 
     @abc.abstractmethod
     def mass_matrix(self, q: Array) -> Array:

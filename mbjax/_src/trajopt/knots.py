@@ -160,22 +160,9 @@ class Knot(AbstractKnot):
         return (type(self), type(self.system))
 
     def quasi_static_control(self, q, nu):
-        """The least-norm (u, f) of B u + A^T f = g(q): the actuation B, the Jacobian A of the
-        system's closures (a stance's feet), f their multipliers and g the generalized gravity
-        force (Crocoddyl's `quasiStatic`, pseudo-inverse and all)."""
-        system = self.system
-        tree = getattr(system, "tree", system)
-        rest = jnp.zeros(tree.nv, q.dtype)
-        A = (system.loops.jacobian(q) if hasattr(system, "loops")
-             else jnp.zeros((0, tree.nv), q.dtype))
-        M = tree.mass_matrix(q)
-
-        def force(u):              # the tree's generalized force at rest under u: B u - g(q)
-            return M @ tree.with_control(Constant(u)).hold(0.0, q, rest).acceleration(0.0, q, rest)
-
-        zero = jnp.zeros(nu, q.dtype)
-        minus_g, B = force(zero), jax.jacfwd(force)(zero)
-        return (jnp.linalg.pinv(jnp.concatenate([B, A.T], axis=1)) @ -minus_g)[:nu]
+        """The control that holds q at rest in the knot's system (`holding_control`: a stance's
+        feet help hold it)."""
+        return self.system.holding_control(q, nu)
 
 
 class Impulse(AbstractKnot):
