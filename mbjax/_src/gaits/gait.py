@@ -97,8 +97,10 @@ class Gait:
                  impulse_tracking: float = 1e7):
         if isinstance(feet, str) or not len(feet):
             raise ValueError(f"feet must be a sequence of frame names, got {feet!r}")
-        if model.nv < 6:
-            raise ValueError(f"model must be on a floating base (nv >= 6), got nv = {model.nv}")
+        if model.joint_types[0] != "free":
+            raise ValueError(f"model must be on a floating base (its first joint free, as "
+                             f"load_urdf(..., floating_base=True) makes it), got a "
+                             f"{model.joint_types[0]} joint")
         self.model = model
         self.q0 = jnp.asarray(q0, float)
         if self.q0.shape != (model.nq,):
