@@ -126,9 +126,17 @@ class ILQR(AbstractIterativeSolver):
         """The iteration's state before the first iteration, from the first guess us and a
         state trajectory (an infeasible start; None for us's rollout): its cost, mu, and room
         for the expansion and the costs' history."""
-        xs = problem.initial_states(states, us)
-        cost = problem.cost(xs, us)
         N, nx, nu = problem.horizon, problem.ndx, problem.nu
+        if states is None and problem.knots is not None:
+            # the rollout priced as it steps, by the forward pass the iterations run (one
+            # stance solve a knot, and one program less to compile than a rollout and a cost)
+            zero = jnp.zeros((N, nu), us.dtype)
+            xs, us, cost = self._forward(problem, jnp.broadcast_to(problem.x0, (N + 1, problem.nx)), us,
+                                         zero, jnp.zeros((N, nu, nx), us.dtype),
+                                         jnp.zeros((N, nx), us.dtype), jnp.asarray(1.0, us.dtype))
+        else:
+            xs = problem.initial_states(states, us)
+            cost = problem.cost(xs, us)
         return dict(xs=xs, us=us, cost=cost, mu=jnp.asarray(self.regularization, cost.dtype),
                     iteration=jnp.array(0), done=jnp.array(False), stalled=jnp.array(False),
                     met_nonfinite=jnp.array(False),
