@@ -90,6 +90,7 @@ def test_an_infeasible_start_closes_its_gaps_on_the_lqr_optimum():
     np.testing.assert_allclose(np.asarray(result.us[:, 0]), u, rtol=0, atol=1e-9)
     assert abs(float(result.cost) - (0.5 * u @ H @ u + g @ u + c)) < 1e-10
     xs = jnp.concatenate([result.qs, result.vs], axis=1)
+    np.testing.assert_array_equal(result.xs, xs)          # the states as Problem takes them
     np.testing.assert_allclose(problem.rollout(result.us), xs, rtol=0, atol=1e-12)
     guess = states.at[0].set(problem.x0)
     assert float(result.costs[0]) == pytest.approx(

@@ -174,8 +174,7 @@ def single(name: str, repeats: int, common: dict) -> list[dict]:
         mbjax["cost_in_other_engine"] = croc_problem.calc(croc_problem.rollout(us_mbjax),
                                                           us_mbjax)
         if name in GAITS:      # the solution, in Pinocchio's state layout and Crocoddyl's controls
-            mbjax["xs"] = example.to_crocoddyl(
-                jnp.concatenate([result.qs, result.vs], axis=1)).tolist()
+            mbjax["xs"] = example.to_crocoddyl(result.xs).tolist()
             mbjax["us"] = [u.tolist() for u in us_mbjax]
         records.append({
             **common, "kind": "single", "problem": name, "engine": "crocoddyl",

@@ -104,7 +104,7 @@ def legged_gait_tour(out: Path, quick: bool) -> dict:
     result, timing = measure(partial(solve, problem, ILQR(iterations=100, **CROCODDYL_SCHEDULE),
                                      us0), repeats=1)
     iterations = int(result.iterations)
-    xs = jnp.concatenate([result.qs, result.vs], axis=1)
+    xs = result.xs
     forces = np.asarray(knot_wrenches(problem, xs, result.us))[..., 3:]
     ts = np.asarray(problem.times())
     histories = {"mbjax iLQR": np.asarray(result.costs)[:iterations + 1]}

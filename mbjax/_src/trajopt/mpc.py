@@ -189,8 +189,7 @@ class MPC(eqx.Module):
         problem = self.horizon(t, q, v)
         solver = self.solver if solver is None else solver
         result = solver.solve(problem, problem.initial_controls(us0))
-        return Plan(jnp.asarray(t, float), jnp.concatenate([result.qs, result.vs], axis=1),
-                    result.us, result.feedback)
+        return Plan(jnp.asarray(t, float), result.xs, result.us, result.feedback)
 
     def tick(self, plan: Plan, t, q: Array, v: Array) -> tuple[Plan, Tick]:
         """One control tick: the horizon from (q, v) at time t solved warm from `plan` shifted.
@@ -216,8 +215,7 @@ class MPC(eqx.Module):
         state = jax.lax.while_loop(solver.running, lambda s: solver.step(problem, s),
                                    solver.init(problem, problem.initial_controls(us), xs))
         result = solver.result(problem, state)
-        new = Plan(jnp.asarray(t, float), jnp.concatenate([result.qs, result.vs], axis=1),
-                   result.us, result.feedback)
+        new = Plan(jnp.asarray(t, float), result.xs, result.us, result.feedback)
         return new, Tick(result.iterations, result.cost, result.status)
 
     def control(self, plan: Plan, t, q: Array, v: Array) -> Array:

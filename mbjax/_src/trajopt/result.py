@@ -78,6 +78,12 @@ class Result(WithStatus):
     solver: str = eqx.field(static=True, default="")
     hint: str = eqx.field(static=True, default="", repr=False)
 
+    @property
+    def xs(self) -> Array:
+        """The states (N + 1, nq + nv), qs and vs side by side, as `Problem`'s functions and
+        `knot_wrenches` take them."""
+        return jnp.concatenate([self.qs, self.vs], axis=-1)
+
     def notes(self, i: int) -> dict:
         """What tripped each flag of the i-th result, and what to change (`WithStatus.messages`)."""
         notes = accuracy_notes(self, i)
