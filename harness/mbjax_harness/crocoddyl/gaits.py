@@ -85,7 +85,7 @@ def _anymal_start():
     return robot, model, q_pin0, gait
 
 
-def _example(robot, model, q_pin0, problem, crocoddyl, states0=None) -> Example:
+def _example(model, problem, crocoddyl, states0=None) -> Example:
     return Example(problem, np.asarray(quasi_static(problem)), crocoddyl, "SolverFDDP",
                    _converter(model), controls=_controls, states0=states0)
 
@@ -101,7 +101,7 @@ def _anymal(schedule, builder: str, *args) -> Example:
         x0 = np.concatenate([q_pin0, np.zeros(robot.model.nv)])
         return getattr(SimpleQuadrupedalGaitProblem(robot.model, *FEET), builder)(x0, *args)
 
-    return _example(robot, model, q_pin0, schedule(gait, *args), crocoddyl)
+    return _example(model, schedule(gait, *args), crocoddyl)
 
 
 def anymal_walk(step_length=0.25, step_height=0.15, dt=1e-2, step_knots=25,
@@ -134,7 +134,7 @@ def anymal_jump(jump_height=0.15, jump_length=(0.0, 0.3, 0.0), dt=1e-2, ground_k
             x0, jump_height, list(jump_length), dt, ground_knots, flying_knots)
 
     states0 = np.tile(np.asarray(problem.x0), (problem.horizon + 1, 1))
-    return _example(robot, model, q_pin0, problem, crocoddyl, states0)
+    return _example(model, problem, crocoddyl, states0)
 
 
 def talos_step(step_length=0.6, step_height=0.1, dt=3e-2, step_knots=15,
@@ -157,7 +157,7 @@ def talos_step(step_length=0.6, step_height=0.1, dt=3e-2, step_knots=15,
                                             support_knots)
 
     problem = walk(gait, step_length, step_height, dt, step_knots, support_knots)
-    return _example(robot, model, q_pin0, problem, crocoddyl)
+    return _example(model, problem, crocoddyl)
 
 
 GAITS = {"anymal-walk": anymal_walk, "talos-step": talos_step, "anymal-jump": anymal_jump}

@@ -10,17 +10,17 @@ from mbjax._src.trajopt.problem import Problem
 from mbjax._src.trajopt.residuals import com_residual
 
 
-def _strides(gait: Gait, strides, length, height, step_knots, support_knots):
-    """The knots of `strides` (groups of feet stepping in turn; (group, fraction of the step
-    length)), the first double support before them and where a 0 fraction stands, more."""
+def _cycle(gait: Gait, first, second, length, height, step_knots, support_knots):
+    """A gait cycle's knots: a double support, each group of feet in `first` stepping half of
+    `length` in turn, a double support, each group in `second` stepping the whole of it."""
     com, feet = gait.com, dict(gait.positions)
-    knots = gait.support(support_knots)
-    for swing, fraction in strides:
-        if not swing:
-            knots += gait.support(support_knots)
-            continue
-        step, com, feet = gait.steps(com, feet, swing, fraction * length, height, step_knots)
-        knots += step
+    knots = []
+    for groups, fraction in ((first, 0.5), (second, 1.0)):
+        knots += gait.support(support_knots)
+        for swing in groups:
+            step, com, feet = gait.steps(com, feet, swing, fraction * length, height,
+                                         step_knots)
+            knots += step
     return knots
 
 
@@ -45,9 +45,8 @@ def walk(gait: Gait, step_length: float = 0.25, step_height: float = 0.15, dt: f
     """
     order = _order(gait, {4: (3, 1, 2, 0), 2: (0, 1)}, "walk")
     half = len(order) // 2
-    strides = ([([f], 0.5) for f in order[:half]] + [([], 0.0)]
-               + [([f], 1.0) for f in order[half:]])
-    knots = _strides(gait, strides, step_length, step_height, step_knots, support_knots)
+    knots = _cycle(gait, [[f] for f in order[:half]], [[f] for f in order[half:]], step_length,
+                   step_height, step_knots, support_knots)
     if len(order) == 2:         # the biped's last impulse is its terminal cost
         return gait.problem(knots[:-1], dt, knots[-1].running)
     return gait.problem(knots, dt)
@@ -69,9 +68,8 @@ def trot(gait: Gait, step_length: float = 0.25, step_height: float = 0.15, dt: f
         The problem, from the standing state at rest.
     """
     lf, rf, lh, rh = _order(gait, {4: (0, 1, 2, 3)}, "trot")
-    strides = [([rf, lh], 0.5), ([], 0.0), ([lf, rh], 1.0)]
-    return gait.problem(_strides(gait, strides, step_length, step_height, step_knots,
-                                 support_knots), dt)
+    return gait.problem(_cycle(gait, [[rf, lh]], [[lf, rh]], step_length, step_height,
+                               step_knots, support_knots), dt)
 
 
 def jump(gait: Gait, jump_height: float = 0.15, jump_length=(0.0, 0.3, 0.0),
