@@ -76,6 +76,24 @@ def test_knots_of_one_system_restate_the_one_system_problem():
                      want)
 
 
+def test_a_problem_of_one_system_is_its_knot_repeated():
+    """`Problem(system, ..., running=)` holds the schedule of `[Knot(system, running)] * N`:
+    leaf for leaf the same problem, one phase, each knot's time k dt exactly, no jumps; and
+    its iterates are the knots' bit for bit."""
+    model = mbjax.model.chain(3)
+    system = TreeSystem(model)
+    q0, v0 = jnp.full(3, 0.3), jnp.zeros(3)
+    running = (state_residual(model, jnp.zeros(3)), control_residual(3, weight=1e-2))
+    args = dict(dt=0.07, terminal=state_residual(model, jnp.zeros(3)))
+    one = Problem(system, q0, v0, horizon=9, running=running, **args)
+    knots = Problem([Knot(system, running)] * 9, q0, v0, **args)
+    assert bool(eqx.tree_equal(one, knots))
+    assert one.n_phases == 1 and one.jumps() is None
+    assert one.times().tolist() == [k * 0.07 for k in range(9)]
+    a, b = (solve(p, ILQR(iterations=3)) for p in (one, knots))
+    np.testing.assert_array_equal(a.us, b.us)
+
+
 def test_phases_are_counted_and_alike_knots_that_do_not_group_are_named():
     """Knots alike but for their arrays make one phase (`Problem.n_phases`); a knot whose cost
     tuple lacks a term makes a second, and the warning names the two knots and the difference,

@@ -127,7 +127,7 @@ class ILQR(AbstractIterativeSolver):
         state trajectory (an infeasible start; None for us's rollout): its cost, mu, and room
         for the expansion and the costs' history."""
         N, nx, nu = problem.horizon, problem.ndx, problem.nu
-        if states is None and problem.knots is not None:
+        if states is None and not problem.vectorized:
             # the rollout priced as it steps, by the forward pass the iterations run (one
             # stance solve a knot, and one program less to compile than a rollout and a cost)
             zero = jnp.zeros((N, nu), us.dtype)
@@ -270,9 +270,9 @@ class ILQR(AbstractIterativeSolver):
                  alpha: Array):
         """(xs, us, cost) of the closed-loop rollout with step length alpha, which closes that
         fraction of each gap (FDDP's forward pass; a rollout where alpha = 1 or no gaps)."""
-        # a multi-phase problem's knots price their step's forces as they step (one stance
-        # solve a knot, not two); a one-system problem's costs stay vectorized over the knots
-        fused = problem.knots is not None
+        # knots that solve contacts price their step's forces as they step (one stance solve a
+        # knot, not two); a vectorized problem's costs stay vectorized over the knots
+        fused = not problem.vectorized
 
         def f(x, inputs):
             x_ref, u_ref, k_, K_, e, i = inputs

@@ -1,5 +1,6 @@
-"""The knots of a multi-phase problem: each step's own system and running cost, and the
-impulse of a touchdown; grouped into phases so that each distinct phase compiles once."""
+"""The knots of a problem: each step's own system and running cost, and the impulse of a
+touchdown; grouped into phases so that each distinct phase compiles once (a problem of one
+system is one phase of one knot repeated)."""
 
 import abc
 import dataclasses
@@ -25,7 +26,7 @@ from mbjax._src.trajopt.residuals import given_forces, knot_forces, reads_forces
 
 
 class AbstractKnot(eqx.Module):
-    """One knot of a multi-phase `Problem`: how the state moves on to the next knot, and the
+    """One knot of a `Problem`: how the state moves on to the next knot, and the
     running cost there."""
 
     running: eqx.AbstractVar[Callable]
@@ -143,8 +144,7 @@ class Knot(AbstractKnot):
         return contact_wrenches(self._held(t, q, v, u), t, q, v)
 
     def vectorizable(self) -> bool:
-        """A step of a system without contacts is vectorized over the phase's knots, as a
-        one-system problem's steps are."""
+        """A step of a system without contacts is vectorized over the phase's knots."""
         return not is_stance(self.system)
 
     def duration(self, dt):
@@ -245,29 +245,30 @@ class Schedule(eqx.Module):
             if not isinstance(knot, AbstractKnot):
                 raise TypeError(f"knots[{i}] must be a Knot(...) or an Impulse(...), got "
                                 f"{type(knot).__name__}")
-        templates, members, phase, index = [], [], [], []
+        templates, members, phase, index, steps = [], [], [], [], []
+        previous = None
         for knot in knots:
-            arrays, template = eqx.partition(knot, eqx.is_array)
-            shapes = jax.tree.map(lambda a: (a.shape, a.dtype), arrays)
-            for p, (other, other_shapes) in enumerate(templates):
-                if _same(other, template) and other_shapes == shapes:
-                    break
-            else:
-                p = len(templates)
-                templates.append((template, shapes))
-                members.append([])
+            if knot is not previous:         # a knot repeated (a one-system problem's) is read once
+                duration = knot.duration(1.0)            # in steps dt
+                arrays, template = eqx.partition(knot, eqx.is_array)
+                shapes = jax.tree.map(lambda a: (a.shape, a.dtype), arrays)
+                for p, (other, other_shapes) in enumerate(templates):
+                    if _same(other, template) and other_shapes == shapes:
+                        break
+                else:
+                    p = len(templates)
+                    templates.append((template, shapes))
+                    members.append([])
+                previous = knot
             phase.append(p)
             index.append(len(members[p]))
             members[p].append(arrays)
+            steps.append(duration)
         self.templates = tuple(t for t, _ in templates)
-        # an array every knot of a phase holds (the model, a weight) is kept once, not stacked
-        self.axes = tuple(jax.tree.map(lambda *a: None if all(x is a[0] for x in a) else 0, *m)
-                          for m in members)
-        self.arrays = tuple(jax.tree.map(lambda axis, *a: a[0] if axis is None else jnp.stack(a),
-                                         axes, *m, is_leaf=_none)
-                            for axes, m in zip(self.axes, members, strict=True))
+        self.axes, self.arrays = zip(*(_stacked(m) for m in members), strict=True)
         self.phase, self.index = tuple(phase), tuple(index)
-        self.times = tuple(float(t) for t in np.cumsum([0.0] + [k.duration(dt) for k in knots])[:-1])
+        # a knot's time is its count of steps times dt, as k dt exactly
+        self.times = tuple(float(n * dt) for n in np.cumsum([0.0] + steps)[:-1])
         for i in range(1, len(knots)):
             if phase[i] != phase[i - 1] and knots[i].kind() == knots[i - 1].kind():
                 warnings.warn(
@@ -309,7 +310,7 @@ class Schedule(eqx.Module):
         0.10.2 splits over XLA's CPU thread pool and waits for; two at once on a two-thread pool
         wait for each other forever (the ANYmal walk's iterations hung so). The loop also
         compiles faster (benchmarks/README.md). A phase of knots without contacts
-        (`AbstractKnot.vectorizable`) is vmapped, as a one-system problem's steps are."""
+        (`AbstractKnot.vectorizable`) is vmapped."""
         outs, order = [], []
         for p, template in enumerate(self.templates):
             ks = self.members(p)
@@ -317,7 +318,7 @@ class Schedule(eqx.Module):
 
             def one(xs, t=template, shared=shared):
                 return fn(eqx.combine(shared, xs[0], t), *xs[1:])
-            inputs = (stacked, *(a[ks] for a in args))
+            inputs = (stacked, *(args if len(self.templates) == 1 else (a[ks] for a in args)))
             outs.append(jax.vmap(one)(inputs) if template.vectorizable()
                         else jax.lax.map(one, inputs))
             order.append(ks)
@@ -325,6 +326,16 @@ class Schedule(eqx.Module):
             return outs[0]
         inverse = np.argsort(np.concatenate(order))
         return jax.tree.map(lambda *o: jnp.concatenate(o)[inverse], *outs)
+
+
+def _stacked(members: list) -> tuple:
+    """(axes, arrays) of a phase's knots' arrays: an array every knot holds (the model, a
+    weight) kept once (axis None), the others stacked along a first axis (0)."""
+    if all(a is members[0] for a in members):      # one knot repeated
+        return jax.tree.map(lambda _: None, members[0]), members[0]
+    axes = jax.tree.map(lambda *a: None if all(x is a[0] for x in a) else 0, *members)
+    return axes, jax.tree.map(lambda axis, *a: a[0] if axis is None else jnp.stack(a), axes,
+                              *members, is_leaf=_none)
 
 
 def _split(arrays, axes):

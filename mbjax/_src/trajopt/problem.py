@@ -61,10 +61,9 @@ class Problem(eqx.Module):
     """
 
     system: AbstractSystem
+    knots: Schedule
     q0: Array
     v0: Array
-    running: Callable
-    knots: Schedule | None
     terminal: Callable
     lower: Array
     upper: Array
@@ -73,11 +72,12 @@ class Problem(eqx.Module):
     horizon: int = eqx.field(static=True)
     ndq: int = eqx.field(static=True)   # a configuration deviation's length (nv for a tree)
     bounded: bool = eqx.field(static=True)   # whether lower or upper was given
+    controlled: tuple = eqx.field(static=True)   # (phase, index) of the first knot with a control
 
     def __init__(self, system, q0, v0, *, dt: float, horizon: int | None = None,
                  running: Callable | None = None, terminal: Callable, lower=None, upper=None,
                  integrator: AbstractIntegrator = RK4()):
-        self.knots = None
+        knots = None
         if isinstance(system, list | tuple):
             if running is not None:
                 raise ValueError("running: each knot of a multi-phase problem carries its own "
@@ -85,7 +85,7 @@ class Problem(eqx.Module):
             if horizon is not None and horizon != len(system):
                 raise ValueError(f"horizon must be the number of knots ({len(system)}) or None, "
                                  f"got {horizon!r}")
-            self.knots = Schedule(system, dt)
+            knots = Schedule(system, dt)
             steps = [k for k in system if k.controlled() is not None]
             if not steps:
                 raise ValueError("knots must include at least one Knot(system, running): a "
@@ -94,7 +94,8 @@ class Problem(eqx.Module):
             if len(sizes) > 1:
                 raise ValueError(f"knots: every Knot's system must have the same number of "
                                  f"controls, got {sorted(sizes)}")
-            system, running, horizon = steps[0].controlled(), steps[0].running, len(system)
+            first = next(k for k, knot in enumerate(system) if knot.controlled() is not None)
+            system, horizon = system[first].controlled(), len(system)
         if not isinstance(system, AbstractSystem):
             raise TypeError(f"system must be an mbjax system (TreeSystem, ...) or a sequence of "
                             f"knots (Knot, Impulse), got {type(system).__name__}")
@@ -106,8 +107,7 @@ class Problem(eqx.Module):
                 and not isinstance(dt, bool) and np.ndim(dt) == 0
                 and np.isrealobj(dt) and float(dt) > 0 and np.isfinite(dt)):
             raise ValueError(f"dt must be a positive number, finite, got {dt!r}")
-        running, terminal = as_cost(running, "running(q, v, u)"), as_cost(terminal, "terminal(q, v)")
-        self.system = system
+        terminal = as_cost(terminal, "terminal(q, v)")
         self.q0, self.v0 = jnp.asarray(q0, dtype=float), jnp.asarray(v0, dtype=float)
         if self.q0.ndim != 1 or self.v0.ndim != 1:
             raise ValueError(f"q0 and v0 must be vectors, got shapes {self.q0.shape} and "
@@ -117,11 +117,16 @@ class Problem(eqx.Module):
             if size is not None and x.shape != (size,):
                 raise ValueError(f"{name} must have shape ({size},) for this system, got {x.shape}")
         check_unit_quaternions(self.q0, system.quaternions(), "q0")
-        self.running, self.terminal = running, terminal
+        if knots is None:                 # a problem of one system: each step the same knot
+            knots, first = Schedule([Knot(system, running)] * horizon, dt), 0
+        # the system whose control the unknowns are (the first step's: every step's has the
+        # same controls), for the state's manifold and the controls' number
+        self.system, self.knots, self.terminal = system, knots, terminal
+        self.controlled = (knots.phase[first], knots.index[first])
         self.integrator = integrator
         self.dt, self.horizon = float(dt), int(horizon)
         self.ndq = jax.eval_shape(system.difference, self.q0, self.q0).shape[0]
-        nu = self.nu
+        nu = system.n_controls
         self.bounded = lower is not None or upper is not None
         bounds = []
         for name, value, default in (("lower", lower, -jnp.inf), ("upper", upper, jnp.inf)):
@@ -134,6 +139,18 @@ class Problem(eqx.Module):
         if not isinstance(self.lower, jax.core.Tracer) and np.any(np.asarray(self.lower)
                                                                   > np.asarray(self.upper)):
             raise ValueError(f"lower must not exceed upper, got {self.lower} and {self.upper}")
+
+    @property
+    def running(self) -> Callable:
+        """The first step's running cost (every step's, for a problem of one system)."""
+        return self.knots.knot(*self.controlled).running
+
+    @property
+    def vectorized(self) -> bool:
+        """Whether every phase's knots are vmapped (no contact solves: `AbstractKnot.
+        vectorizable`): the costs of such a problem are taken over a rollout, vmapped, rather
+        than priced as each step goes (one contact solve a knot for the step and its costs)."""
+        return all(t.vectorizable() for t in self.knots.templates)
 
     @property
     def nq(self) -> int:
@@ -167,8 +184,6 @@ class Problem(eqx.Module):
     def step(self, x: Array, u: Array, k) -> Array:
         """x_{k+1}: knot k's transition from x_k under the control u (a step of the integrator
         from t_k with the control held at u, or a knot's impulse)."""
-        if self.knots is None:
-            return self._transition(self._knot(), x, u, jnp.asarray(k, x.dtype) * self.dt)
         t = jnp.asarray(self.knots.times, x.dtype)[k]
         return self.knots.switch(k, self._transition, x, u, t)
 
@@ -185,8 +200,6 @@ class Problem(eqx.Module):
         Returns:
             (x_{k+1}, the stage cost), shapes (nx,) and ().
         """
-        if self.knots is None:
-            return self._step_cost(self._knot(), x, u, jnp.asarray(k, x.dtype) * self.dt)
         t = jnp.asarray(self.knots.times, x.dtype)[k]
         return self.knots.switch(k, self._step_cost, x, u, t)
 
@@ -196,46 +209,34 @@ class Problem(eqx.Module):
         cost = _value(knot.cost(t, q, v, u, forces)) * jnp.asarray(knot.weight(self.dt), x.dtype)
         return jnp.concatenate([q1, v1]), cost
 
-    def _knot(self) -> Knot:
-        """The knot every step of a one-phase problem is."""
-        return Knot(self.system, self.running)
-
     def _transition(self, knot, x: Array, u: Array, t) -> Array:
         q, v = self.split(x)
         q1, v1 = knot.transition(self.integrator, t, q, v, u, jnp.asarray(self.dt, x.dtype))
         return jnp.concatenate([q1, v1])
 
     def _map(self, fn: Callable, *args):
-        """fn(knot k, *args[k]) for every knot k: vmapped, or for a multi-phase problem mapped
-        over each phase's knots in turn, so that each phase compiles once (`Schedule.map`)."""
-        if self.knots is None:
-            knot = self._knot()
-            return jax.vmap(lambda *a: fn(knot, *a))(*args)
+        """fn(knot k, *args[k]) for every knot k, over each phase's knots in turn, so that each
+        phase compiles once (`Schedule.map`)."""
         return self.knots.map(fn, *args)
 
     @property
     def n_phases(self) -> int:
-        """The number of distinct phases, each compiled once: 1 for a problem of one system,
-        the schedule's for knots (alike knots, but for their arrays, make one phase)."""
-        return 1 if self.knots is None else self.knots.n_phases
+        """The number of distinct phases, each compiled once: 1 for a problem of one system;
+        alike knots, but for their arrays, make one phase."""
+        return self.knots.n_phases
 
     def _phases(self) -> list:
         """A knot of each phase (its first)."""
-        if self.knots is None:
-            return [self._knot()]
         return [self.knots.knot(p, 0) for p in range(self.knots.n_phases)]
 
     def jumps(self) -> np.ndarray | None:
         """Which steps jump by design, one bool per knot: an `Impulse` (the velocity changes in
-        no time); None for a problem of one system."""
-        if self.knots is None:
-            return None
-        return np.asarray([self.knots.templates[p].jumps() for p in self.knots.phase])
+        no time); None where none does."""
+        jumps = np.asarray([self.knots.templates[p].jumps() for p in self.knots.phase])
+        return jumps if jumps.any() else None
 
     def times(self, dtype=float) -> Array:
         """Each knot's time t_k, shape (N,): k dt, an impulse taking none."""
-        if self.knots is None:
-            return jnp.arange(self.horizon, dtype=dtype) * self.dt
         return jnp.asarray(self.knots.times, dtype)
 
     @property
@@ -290,12 +291,13 @@ class Problem(eqx.Module):
 
     def _stage(self, knot, x: Array, u: Array, t, x_next: Array):
         """A knot's ((A, B, e), (l_x, l_u, l_xx, l_ux, l_uu)). A knot's residual costs may
-        depend on its dynamics (a stance's contact forces in a friction cone): in a multi-phase
-        problem the step and the residuals are differentiated in one forward-mode pass over
-        (dx, u), rather than one pass for the step and one per argument for the costs."""
+        depend on its dynamics (a stance's contact forces in a friction cone): in a knot that
+        solves contacts (not `AbstractKnot.vectorizable`) the step and the residuals are
+        differentiated in one forward-mode pass over (dx, u), rather than one pass for the step
+        and one per argument for the costs."""
         zero_q, zero_v = jnp.zeros(self.ndq, x.dtype), jnp.zeros(self.nv, x.dtype)
         running = self._about(x, lambda q, v, u, forces=None: knot.cost(t, q, v, u, forces))
-        if self.knots is None or not _is_residual(running, zero_q, zero_v, u):
+        if knot.vectorizable() or not _is_residual(running, zero_q, zero_v, u):
             return self._jacobians(knot, x, u, t, x_next), self._expansion(knot, x, u, t)
 
         def both(dx, u):          # the costs read the forces the step solved (`Knot.advance`)
