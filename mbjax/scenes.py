@@ -1,5 +1,5 @@
 """Ready-made scenes: the papers' mechanisms and the examples the tests, benchmarks, notebooks and
-the `mbjax` command share. Each is a module with `build(...)` returning (system, q0, u0) and the
+the `mbjax` command share. Each is a module with `build(...)` returning (system, q0, v0) and the
 scene's constants; the two built for trajectory optimisation only, `acrobot` and `slewing_beam`,
 have `model()` and a `Problem` builder instead. `TOLERANCE` is the accuracy the tour and the
 reproductions ask of a run (`simulate(..., **TOLERANCE)`)."""

@@ -171,7 +171,7 @@ def test_anymal_stands_on_its_four_feet():
         moved = (mbjax.rigid.frame_pose(model, sol.qs[-1], foot.frame)[1]
                  - mbjax.rigid.frame_pose(model, q0, foot.frame)[1])
         assert float(jnp.abs(moved).max()) < 1e-8
-    wrenches = contact_wrenches(phase, 1.0, sol.qs[-1], sol.us[-1])
+    wrenches = contact_wrenches(phase, 1.0, sol.qs[-1], sol.vs[-1])
     weight = float(model.mass.sum()) * 9.81
     assert float(wrenches[:, 5].sum()) == pytest.approx(weight, rel=1e-6)
     assert np.all(np.asarray(wrenches[:, :3]) == 0.0)       # a point contact carries no torque

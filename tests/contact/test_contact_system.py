@@ -300,5 +300,5 @@ def test_torsional_and_rolling_friction_follow_mujoco(geom, qvel, spin):
         v0 = state_from_mujoco(model, m.qpos0, np.asarray(qvel, float))[1]
         sol = mbjax.simulate(system, SemiImplicitEuler(), jnp.asarray(m.qpos0), v0,
                              dt=m.opt.timestep, t1=0.5)
-        np.testing.assert_allclose(np.asarray(sol.us[1:, 2]), spins, atol=1e-9)
+        np.testing.assert_allclose(np.asarray(sol.vs[1:, 2]), spins, atol=1e-9)
         assert spins[-1] < 0.8 * qvel[5]                   # the torsional friction slows it

@@ -43,7 +43,7 @@ def test_sampled_force_on_a_point_mass_integrates_exactly():
     sol = simulate(system, RK4(), jnp.zeros(1), jnp.zeros(1), dt=dt, t1=n * dt, saveat=[n * dt])
     k = jnp.arange(n)
     np.testing.assert_allclose(sol.qs[-1, 0], dt**2 * jnp.sum((n - k - 0.5) * u), rtol=1e-13)
-    np.testing.assert_allclose(sol.us[-1, 0], dt * jnp.sum(u), rtol=1e-13)
+    np.testing.assert_allclose(sol.vs[-1, 0], dt * jnp.sum(u), rtol=1e-13)
 
 
 def test_cubic_spline_fits_cubics_and_stays_inside_its_limit():

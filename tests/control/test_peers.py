@@ -58,7 +58,7 @@ def test_driven_and_pushed_chain_matches_mujoco_rollout():
     assert ours.messages() == ["success"]
     assert np.abs(qpos - q0).max() > 0.5                          # it did move
     np.testing.assert_allclose(ours.qs[-1], qpos, rtol=0, atol=1e-12)      # measured 1.5e-14
-    np.testing.assert_allclose(ours.us[-1], qvel, rtol=0, atol=1e-11)      # measured 1.5e-13
+    np.testing.assert_allclose(ours.vs[-1], qvel, rtol=0, atol=1e-11)      # measured 1.5e-13
 
 
 def _pinocchio_fext(pin, pin_model, data, model, q_pin, wrenches):

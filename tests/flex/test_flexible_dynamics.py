@@ -110,7 +110,7 @@ def test_energy_is_conserved_without_stiffening():
     errors = []
     for dt in (5e-4, 2.5e-4):
         sol = simulate(system, RK4(), q0, jnp.zeros(model.nv), dt=dt, t1=0.1, saveat=[0.0, 0.1])
-        E = jax.jit(jax.vmap(energy, (None, 0, 0)))(model, sol.qs, sol.us)
+        E = jax.jit(jax.vmap(energy, (None, 0, 0)))(model, sol.qs, sol.vs)
         errors.append(abs(float(E[1] - E[0])) / abs(float(E[0])))
     assert errors[1] < 1e-7 and 10 < errors[0] / errors[1] < 25      # fourth order: ratio ~ 16
 

@@ -21,7 +21,7 @@ T1 = 2.0
 @pytest.fixture(scope="module")
 def reference():
     sol = simulate(SYSTEM, RK4(), Q0, V0, dt=1e-4, t1=T1, saveat=[T1])
-    return jnp.concatenate([sol.qs[-1], sol.us[-1]])
+    return jnp.concatenate([sol.qs[-1], sol.vs[-1]])
 
 
 def test_rk4_estimate_follows_the_true_error_and_its_order(reference):
@@ -29,7 +29,7 @@ def test_rk4_estimate_follows_the_true_error_and_its_order(reference):
     for dt in (0.04, 0.02, 0.01):
         sol = simulate(SYSTEM, RK4(), Q0, V0, dt=dt, t1=T1, saveat=[T1], rtol=1e-6, atol=1e-6)
         estimates.append(float(sol.error))
-        errors.append(float(jnp.max(jnp.abs(jnp.concatenate([sol.qs[-1], sol.us[-1]])
+        errors.append(float(jnp.max(jnp.abs(jnp.concatenate([sol.qs[-1], sol.vs[-1]])
                                             - reference))))
     for estimate, error in zip(estimates, errors, strict=True):
         assert error / 10 < estimate < 10 * error, (estimates, errors)
@@ -97,8 +97,8 @@ def test_the_reference_solver_and_time_elements_throw_too():
 def _energy_drift(system, sol):
     """The energy's largest change over the run relative to the largest kinetic energy, from the
     system's energy functions directly."""
-    E = jax.vmap(system.energy)(sol.qs, sol.us)
-    T = jax.vmap(system.kinetic_energy)(sol.qs, sol.us)
+    E = jax.vmap(system.energy)(sol.qs, sol.vs)
+    T = jax.vmap(system.kinetic_energy)(sol.qs, sol.vs)
     return float(jnp.max(jnp.abs(E - E[0])) / jnp.max(T))
 
 
@@ -146,7 +146,7 @@ def test_momentum_of_a_floating_tree_with_and_without_gravity():
         for dt in (0.02, 0.01):
             sol = simulate(system, RK4(), q0, v0, dt=dt, t1=1.0, rtol=1e-6, atol=1e-6)
             moments = jax.vmap(lambda t, q, v: free_momenta(system.model, t, q, v))(
-                sol.ts, sol.qs, sol.us)
+                sol.ts, sol.qs, sol.vs)
             change = jnp.max(jnp.abs(moments.values - moments.values[0]))
             drifts.append(float(change / jnp.max(moments.scale)))
             assert float(sol.drift) >= drifts[-1] * (1 - 1e-9)   # the energy's drift joins it
@@ -161,7 +161,7 @@ def test_momentum_of_a_floating_tree_with_and_without_gravity():
     assert 0 < float(sol.drift) < 1e-6, float(sol.drift)
     # the gravity terms are right: without `- M g t`, P changes by the weight's impulse
     sol = simulate(TreeSystem(model), RK4(), q0, v0, dt=0.01, t1=1.0)
-    P = jax.vmap(lambda q, v: free_momenta(model, 0.0, q, v).values[3:])(sol.qs, sol.us)
+    P = jax.vmap(lambda q, v: free_momenta(model, 0.0, q, v).values[3:])(sol.qs, sol.vs)
     np.testing.assert_allclose(P[-1] - P[0], jnp.sum(model.mass) * model.gravity * 1.0,
                                rtol=1e-6, atol=1e-7)
 
@@ -207,7 +207,7 @@ def test_the_status_follows_the_true_error_over_random_starts():
     def runs(q0, v0):
         coarse = simulate(SYSTEM, RK4(), q0, v0, dt=0.05, t1=1.0, saveat=[1.0], **tolerance)
         fine = simulate(SYSTEM, RK4(), q0, v0, dt=0.0025, t1=1.0, saveat=[1.0])
-        error = jnp.concatenate([coarse.qs[-1] - fine.qs[-1], coarse.us[-1] - fine.us[-1]])
+        error = jnp.concatenate([coarse.qs[-1] - fine.qs[-1], coarse.vs[-1] - fine.vs[-1]])
         return coarse.status, jnp.sqrt(jnp.mean((error / tolerance["atol"]) ** 2))
 
     seen = set()

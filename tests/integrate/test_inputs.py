@@ -34,6 +34,15 @@ def test_integer_float32_and_list_states_give_the_float64_answer():
     assert reference.status == 0
 
 
+def test_velocities_are_vs_and_us_is_a_deprecated_alias():
+    """A `Solution`'s velocities are `vs`, named as `simulate`'s v0 (u names controls, as in
+    mbjax.trajopt); the old name still reads them, with a DeprecationWarning that says so."""
+    sol = simulate(SYSTEM, RK4(), q0=Q0, v0=V0 + 0.1, **STEPS)
+    np.testing.assert_array_equal(sol.vs[0], V0 + 0.1)
+    with pytest.warns(DeprecationWarning, match="Solution.us is renamed Solution.vs"):
+        np.testing.assert_array_equal(sol.us, sol.vs)
+
+
 @pytest.mark.parametrize(("kwargs", "error", "names"), [
     (dict(system=MODEL), TypeError, "system .*wrap a Model in TreeSystem"),
     (dict(system=TreeSystem), TypeError, "system .*not the class"),
@@ -45,7 +54,7 @@ def test_integer_float32_and_list_states_give_the_float64_answer():
     (dict(saveat=[]), ValueError, "saveat must be None or a non-empty"),
     (dict(saveat=[0.0, np.nan]), ValueError, "saveat times must be finite"),
     (dict(q0=Q0 + 0j), TypeError, "q0 must be real"),
-    (dict(v0="abc"), TypeError, "u0 must be"),
+    (dict(v0="abc"), TypeError, "v0 must be"),
     (dict(q0=np.zeros(4)), ValueError, r"q0 must have shape \(3,\)"),
 ])
 def test_bad_arguments_are_named(kwargs, error, names):
@@ -59,7 +68,7 @@ def test_bad_arguments_are_named(kwargs, error, names):
        kind=st.sampled_from(["float", "int", "complex"]))
 def test_malformed_states_raise_a_clear_error(length, which, kind):
     value = np.ones(length, dtype={"float": float, "int": int, "complex": complex}[kind])
-    name = "q0" if which == "q0" else "u0"
+    name = which
     expected = "must be real" if kind == "complex" else r"must have shape \(3,\)"
     with pytest.raises((TypeError, ValueError), match=rf"{name} {expected}"):
         _run(**{which: value})

@@ -191,7 +191,7 @@ def test_accelerations_are_the_test_sets(squeezer, quick_run):
     expected = np.array([14222.4439199541138705911625887, -10666.8329399655854029433719415,
                          0, 0, 0, 0, 0])
     np.testing.assert_allclose(a0, expected, rtol=0, atol=1e-12 * np.abs(expected).max())
-    q, v = quick_run.qs[30], quick_run.us[30]
+    q, v = quick_run.qs[30], quick_run.vs[30]
     a = np.asarray(S.to_testset(acceleration(quick_run.ts[30], q, v)))
     y, yp = np.asarray(S.to_testset(q)), np.asarray(S.to_testset(v))
     theirs = andrews_rhs(0.0, np.concatenate([y, yp]))[7:]

@@ -43,7 +43,7 @@ def test_order_n_route_agrees_with_the_coupled_one_on_the_closed_chain():
     np.testing.assert_allclose(recursive.qs, dense.qs, atol=1e-12)
     assert float(jnp.abs(jax.jit(lambda q: loops.phi(q))(dense.qs[-1])).max()) < 1e-8
     # the free chain (gravity only, ideal joints and closure) conserves its energy
-    energies = np.asarray(jax.jit(jax.vmap(dense_system.energy))(dense.qs, dense.us))
+    energies = np.asarray(jax.jit(jax.vmap(dense_system.energy))(dense.qs, dense.vs))
     np.testing.assert_allclose(energies, energies[0], rtol=0, atol=1e-9 * abs(energies[0]))
 
 

@@ -49,7 +49,7 @@ def test_four_bar_matches_minimal_coordinates():
     assert bool(sol.ok) and sol.messages() == ["redundant (first at t = 0 s)"]    # 5 equations of rank 2
     assert abs(float(sol.qs[-1, 0]) - ref.y[0, -1]) < 1e-8
     assert float(jnp.abs(LOOPS.phi(sol.qs[-1])).max()) < 1e-8
-    E0, E1 = system.energy(Q0, V0), system.energy(sol.qs[-1], sol.us[-1])
+    E0, E1 = system.energy(Q0, V0), system.energy(sol.qs[-1], sol.vs[-1])
     assert abs(float(E1 / E0) - 1) < 1e-8
 
 
@@ -116,7 +116,7 @@ def test_order_n_stabilization_agrees_with_the_coupled_solution():
                          dt=1e-3, t1=0.5, saveat=ts)
     assert recursive.messages() == coupled.messages() == ["redundant (first at t = 0 s)"]
     np.testing.assert_allclose(recursive.qs, coupled.qs, atol=1e-12)
-    np.testing.assert_allclose(recursive.us, coupled.us, atol=1e-10)
+    np.testing.assert_allclose(recursive.vs, coupled.vs, atol=1e-10)
 
 
 @pytest.mark.slow
@@ -129,21 +129,21 @@ def test_epsilon_dynamics_keeps_the_velocity_error_at_epsilon_times_the_loads():
     assert Status(int(sol.status)) == Status.CONSTRAINT_VIOLATED | Status.REDUNDANT
     assert re.fullmatch(r"constraint violated \(first at t = 0\.\d+ s\), redundant \(first at "
                         r"t = 0 s\)", sol.messages()[0]), sol.messages()
-    rates = jax.jit(jax.vmap(LOOPS.rate))(sol.qs, sol.us[:, :3])
-    np.testing.assert_allclose(rates, 1e-2 * sol.us[:, 3:], atol=1e-9)
-    assert float(jnp.abs(sol.us[-1, 3:]).max()) > 1.0        # the loads did act
+    rates = jax.jit(jax.vmap(LOOPS.rate))(sol.qs, sol.vs[:, :3])
+    np.testing.assert_allclose(rates, 1e-2 * sol.vs[:, 3:], atol=1e-9)
+    assert float(jnp.abs(sol.vs[-1, 3:]).max()) > 1.0        # the loads did act
 
 
 def test_a_velocity_state_of_the_wrong_length_is_a_named_error():
-    """simulate checks u against the method's state: v (nv,) for the coupled method, (v, f_c)
+    """simulate checks v0 against the method's state: v (nv,) for the coupled method, (v, f_c)
     (nv + m,) for Stabilized(epsilon > 0)."""
     nv = MODEL.nv
-    with pytest.raises(ValueError, match=rf"u0.*\({nv},\)"):
+    with pytest.raises(ValueError, match=rf"v0.*\({nv},\)"):
         simulate(SYSTEM, RK4(), Q0, jnp.zeros(nv + 1), dt=1e-3, t1=2e-3)
     epsilon = ClosedSystem(TREE, SYSTEM.closures, Stabilized(epsilon=1e-2))
     m = LOOPS.m
     assert epsilon.state_sizes() == (MODEL.nq, nv + m)
-    with pytest.raises(ValueError, match=rf"u0.*\({nv + m},\)"):
+    with pytest.raises(ValueError, match=rf"v0.*\({nv + m},\)"):
         simulate(epsilon, RK4(), Q0, V0, dt=1e-3, t1=2e-3)           # v without the loads
     u0 = epsilon.initial_state(Q0, V0)
-    assert simulate(epsilon, RK4(), Q0, u0, dt=1e-3, t1=2e-3).us.shape[-1] == nv + m
+    assert simulate(epsilon, RK4(), Q0, u0, dt=1e-3, t1=2e-3).vs.shape[-1] == nv + m

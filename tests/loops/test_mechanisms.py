@@ -62,7 +62,7 @@ def residual(loops, qs, ts=None):
 
 
 def energies(system, sol):
-    return jax.jit(jax.vmap(system.energy))(sol.qs, sol.us)
+    return jax.jit(jax.vmap(system.energy))(sol.qs, sol.vs)
 
 
 def on_motion(f, thetas):
@@ -155,8 +155,8 @@ def test_driven_slider_crank_simulation():
     loops = system.loops
     sol = simulate(system, RK4(), q0, v0, dt=1e-3, t1=SLIDER_TS[-1], saveat=SLIDER_TS)
     assert sol.messages() == ["success"]
-    torque = jax.jit(jax.vmap(system.loads))(sol.ts, sol.qs, sol.us)[:, -1]
-    check_driven_slider_crank(loops, sol.ts, sol.qs, sol.us, torque)
+    torque = jax.jit(jax.vmap(system.loads))(sol.ts, sol.qs, sol.vs)[:, -1]
+    check_driven_slider_crank(loops, sol.ts, sol.qs, sol.vs, torque)
 
 
 @pytest.mark.slow          # the four-bar's test covers a free loop against DOP853 by default
@@ -240,7 +240,7 @@ def bricard_reference():
 def check_bricard(projection: bool, *, angle_tol, residual_tol, energy_tol):
     system, sol = bricard_run(projection)
     assert bool(sol.ok) and sol.messages() == ["redundant (first at t = 0 s)"]        # 5 equations of rank 4
-    assert bool(jnp.all(jnp.isfinite(sol.qs)) & jnp.all(jnp.isfinite(sol.us)))
+    assert bool(jnp.all(jnp.isfinite(sol.qs)) & jnp.all(jnp.isfinite(sol.vs)))
     assert residual(system.loops, sol.qs) < residual_tol
     E = energies(system, sol)
     assert float(jnp.abs(E - E[0]).max()) < energy_tol * float(jnp.abs(E[0]))

@@ -51,8 +51,8 @@ def test_momentum_form_follows_the_same_motion():
     velocity = simulate(ClosedSystem(TREE, CHAIN.closures), RK4(), Q0, V0, dt=1e-3, t1=0.2, saveat=ts)
     assert momentum.messages() == velocity.messages() == ["success"]
     np.testing.assert_allclose(momentum.qs, velocity.qs, atol=1e-9)
-    v_end = jax.jit(jax.vmap(system.velocity))(momentum.qs, momentum.us)
-    np.testing.assert_allclose(v_end, velocity.us, atol=1e-8)
+    v_end = jax.jit(jax.vmap(system.velocity))(momentum.qs, momentum.vs)
+    np.testing.assert_allclose(v_end, velocity.vs, atol=1e-8)
 
 
 def test_one_triangularization_gives_the_unit_load_responses():
@@ -84,7 +84,7 @@ def test_projection_after_every_step_holds_a_driven_loop_on_its_constraints():
     assert projected.messages() == ["success"]
     loops = projected_system.loops
     phi = jax.jit(jax.vmap(loops.phi))(projected.qs, projected.ts)
-    rate = jax.jit(jax.vmap(loops.rate))(projected.qs, projected.us, projected.ts)
+    rate = jax.jit(jax.vmap(loops.rate))(projected.qs, projected.vs, projected.ts)
     assert float(jnp.abs(phi).max()) < 1e-10 and float(jnp.abs(rate).max()) < 1e-10
     free = simulate(ClosedSystem(TREE, closures, tolerance=1e-10), RK4(), q0, v0, dt=2e-3,
                     t1=0.3, saveat=ts)
@@ -140,7 +140,7 @@ def test_epsilon_dynamics_with_position_feedback_keeps_its_invariant():
     def invariant(q, u):
         return LOOPS.rate(q, u[:6]) + kappa * LOOPS.phi(q) - eps * u[6:]
 
-    values = jax.jit(jax.vmap(invariant))(sol.qs, sol.us)
+    values = jax.jit(jax.vmap(invariant))(sol.qs, sol.vs)
     np.testing.assert_allclose(values, values[0] + 0 * values, atol=1e-8 * np.abs(values).max())
 
 

@@ -203,7 +203,7 @@ def test_held_force_on_a_point_mass_integrates_exactly(u):
     assert int(sol.status) & ~int(Status.INACCURATE) == 0
     np.testing.assert_allclose(sol.qs[-1, 0], HOLD_DT**2 / MASS * np.sum((HOLD_STEPS - k - 0.5) * u),
                                atol=1e-13 * scale + 1e-300)
-    np.testing.assert_allclose(sol.us[-1, 0], HOLD_DT / MASS * u.sum(), atol=1e-13 * scale + 1e-300)
+    np.testing.assert_allclose(sol.vs[-1, 0], HOLD_DT / MASS * u.sum(), atol=1e-13 * scale + 1e-300)
 
 
 @pytest.mark.xfail(strict=True, reason="issue 43: simulate's default resolution check flags a held "
@@ -255,7 +255,7 @@ def test_pd_servo_on_a_slider_is_the_damped_oscillator(kp, kd, target, x0, v0):
     A = np.array([[0.0, 1.0], [-kp / MASS, -kd / MASS]])
     error, rate = scipy.linalg.expm(A * SERVO_T1) @ np.array([x0 - target, v0])
     assert bool(sol.ok)
-    np.testing.assert_allclose([sol.qs[-1, 0], sol.us[-1, 0]], [target + error, rate], atol=1e-7)
+    np.testing.assert_allclose([sol.qs[-1, 0], sol.vs[-1, 0]], [target + error, rate], atol=1e-7)
 
 
 @FEW
@@ -265,7 +265,7 @@ def test_nonfinite_gains_give_a_nonfinite_status_not_a_silent_nan(gain, value):
     args = dict(kp=4.0, kd=1.0, target=0.5, x0=0.1, v0=0.0)
     args[gain] = value
     sol = _servo(**args)
-    finite = bool(np.all(np.isfinite(sol.qs)) and np.all(np.isfinite(sol.us)))
+    finite = bool(np.all(np.isfinite(sol.qs)) and np.all(np.isfinite(sol.vs)))
     if not finite:
         assert int(sol.status) & Status.NONFINITE and not bool(sol.ok)
         assert sol.messages()[0].startswith("nonfinite")

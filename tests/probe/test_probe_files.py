@@ -227,7 +227,7 @@ def test_a_massless_moving_leaf_is_warned_about_and_flagged_and_a_point_mass_is_
     with pytest.warns(ModelWarning, match="body 'arm' is massless"):
         model = mbjax.load_urdf(text)
     sol = mbjax.simulate(TreeSystem(model), RK4(), jnp.array([q]), jnp.zeros(1), dt=0.01, t1=0.03)
-    finite = bool(np.isfinite(sol.qs).all() and np.isfinite(sol.us).all())
+    finite = bool(np.isfinite(sol.qs).all() and np.isfinite(sol.vs).all())
     assert not finite and int(sol.status) & Status.NONFINITE
 
 

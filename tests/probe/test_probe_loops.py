@@ -256,7 +256,7 @@ def test_projections_of_a_state_of_the_wrong_length_are_named(which, n):
 
 
 @FEW
-@given(name=st.sampled_from(["q0", "u0"]), n=st.integers(0, 6).filter(lambda n: n != 3))
+@given(name=st.sampled_from(["q0", "v0"]), n=st.integers(0, 6).filter(lambda n: n != 3))
 def test_simulating_a_state_of_the_wrong_length_is_named(name, n):
     q0, u0 = (np.zeros(n), _scene().v0) if name == "q0" else (_scene().q0, np.zeros(n))
     with pytest.raises(ValueError, match=rf"{name} must have shape \(3,\) for this system"):

@@ -105,7 +105,7 @@ def test_batch_rollout_equals_vmapped_rollouts():
     one = jax.jit(jax.vmap(lambda q0, v0: simulate(TreeSystem(model, tau), RK4(), q0, v0, dt=2e-3, t1=0.2,
                                                    saveat=np.array([0.1, 0.2]))))(q, v)
     assert _relative(batch.qs, jnp.moveaxis(one.qs, 0, -1)) < 1e-11
-    assert _relative(batch.us, jnp.moveaxis(one.us, 0, -1)) < 1e-11
+    assert _relative(batch.vs, jnp.moveaxis(one.vs, 0, -1)) < 1e-11
     # a status per copy, as the vmapped runs have
     assert batch.status.shape == (8,) and np.all(np.asarray(batch.status) == 0)
     np.testing.assert_array_equal(batch.status, one.status)

@@ -69,8 +69,8 @@ def test_implicit_midpoint_conserves_quadratic_invariants():
     only converges at second order."""
     body, q0, u0 = tfb.build()
     sol = simulate(body, ImplicitMidpoint(), q0, u0, dt=0.05, t1=tfb.DURATION)
-    T = jax.jit(jax.vmap(body.kinetic_energy))(sol.qs, sol.us)
-    h_norm = jnp.linalg.norm(sol.us @ body.inertia, axis=1)
+    T = jax.jit(jax.vmap(body.kinetic_energy))(sol.qs, sol.vs)
+    h_norm = jnp.linalg.norm(sol.vs @ body.inertia, axis=1)
     np.testing.assert_allclose(T, T[0], rtol=1e-13)
     np.testing.assert_allclose(h_norm, h_norm[0], rtol=1e-13)
     np.testing.assert_allclose(jnp.linalg.norm(sol.qs, axis=1), 1.0, atol=1e-14)
@@ -83,7 +83,7 @@ def test_heavy_top_against_diffrax_reference():
     err = jnp.linalg.norm(lie.log(body.rotation_matrix(sol.qs[-1]) @
                                   body.rotation_matrix(ref.qs[-1]).T))
     assert float(err) < 1e-9
-    np.testing.assert_allclose(sol.us[-1], ref.us[-1], atol=1e-8)
+    np.testing.assert_allclose(sol.vs[-1], ref.vs[-1], atol=1e-8)
 
 
 @pytest.mark.skipif(not peers.available("mujoco"), reason="optional peer MuJoCo not installed")
@@ -98,7 +98,7 @@ def test_heavy_top_against_mujoco():
     err = jnp.linalg.norm(lie.log(lie.quat_to_matrix(jnp.asarray(quat[0])) @
                                   body.rotation_matrix(sol.qs[-1]).T))
     assert float(err) < 1e-9
-    np.testing.assert_allclose(Omega[0], sol.us[-1], atol=1e-8)
+    np.testing.assert_allclose(Omega[0], sol.vs[-1], atol=1e-8)
 
 
 def test_free_body_falls_and_spins_independently():
@@ -110,7 +110,7 @@ def test_free_body_falls_and_spins_independently():
     t = 2.0
     np.testing.assert_allclose(body.position(sol.qs[-1]),
                                x0 + v0 * t + 0.5 * jnp.array([0, 0, -9.81]) * t**2, atol=1e-12)
-    E = jax.jit(jax.vmap(body.energy))(jnp.stack([q0, sol.qs[-1]]), jnp.stack([u0, sol.us[-1]]))
+    E = jax.jit(jax.vmap(body.energy))(jnp.stack([q0, sol.qs[-1]]), jnp.stack([u0, sol.vs[-1]]))
     np.testing.assert_allclose(E[1], E[0], rtol=1e-9)
 
 
@@ -155,7 +155,7 @@ def test_parameters_vmap_without_recompiling():
     def final_energy(mass):
         b = RigidBody(mass, body.inertia, com=body.com, gravity=body.gravity, fixed_point=True)
         sol = simulate(b, ImplicitMidpoint(), q0, u0, dt=0.01, t1=1.0, saveat=[0.0, 1.0])
-        return b.energy(sol.qs[-1], sol.us[-1]) - b.energy(sol.qs[0], sol.us[0])
+        return b.energy(sol.qs[-1], sol.vs[-1]) - b.energy(sol.qs[0], sol.vs[0])
 
     drift = jax.jit(jax.vmap(final_energy))(masses)
     np.testing.assert_allclose(drift, 0.0, atol=1e-10)

@@ -367,8 +367,8 @@ def _seven_link_run(form: str, gravity: str, dt: float):
         system, u0 = rigid.MomentumSystem(model), jax.jit(rigid.momentum)(model, Q0_SEVEN, V0_SEVEN)
     sol = simulate(system, RK4(), Q0_SEVEN, u0, dt=dt, t1=2.0, saveat=SAVE)
     assert sol.messages() == ["success"]
-    energy = jax.jit(jax.vmap(system.energy))(sol.qs, sol.us)
-    velocity = sol.us if form == "velocity" else jax.jit(jax.vmap(system.velocity))(sol.qs, sol.us)
+    energy = jax.jit(jax.vmap(system.energy))(sol.qs, sol.vs)
+    velocity = sol.vs if form == "velocity" else jax.jit(jax.vmap(system.velocity))(sol.qs, sol.vs)
     return np.asarray(sol.qs), np.asarray(velocity), np.asarray(energy)
 
 
@@ -416,7 +416,7 @@ def test_floating_base_conserves_momentum():
         return (jax.jit(jax.vmap(rigid.spatial_momentum, (None, 0, 0)))(model, qs, us),
                 jax.jit(jax.vmap(rigid.energy, (None, 0, 0)))(model, qs, us))
 
-    h, E = invariants(sol.qs, sol.us)
+    h, E = invariants(sol.qs, sol.vs)
     np.testing.assert_allclose(h, np.broadcast_to(h[0], h.shape), rtol=0,
                                atol=1e-8 * float(jnp.abs(h[0]).max()))
     np.testing.assert_allclose(E, E[0], rtol=1e-8)

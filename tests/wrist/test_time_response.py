@@ -29,7 +29,7 @@ def test_energy_is_conserved_and_rk4_converges_at_order_four():
     for dt in (0.02, 0.01, 0.005):
         sol = simulate(system, RK4(), q0, u0, dt=dt, t1=T, saveat=np.linspace(0, T, 11))
         assert sol.messages() == ["success"]
-        E = jax.jit(jax.vmap(system.model.energy))(sol.qs, sol.us)
+        E = jax.jit(jax.vmap(system.model.energy))(sol.qs, sol.vs)
         drifts.append(float(jnp.max(jnp.abs(E - E0)) / E0))
         ends.append(np.asarray(sol.qs[-1]))
     ref = np.asarray(simulate(system, RK4(), q0, u0, dt=1e-3, t1=T, saveat=[T]).qs[-1])

@@ -88,7 +88,7 @@ def run(out: Path, quick: bool = False) -> list[dict]:
             for dt in steps:
                 sol, timing = measure(partial(simulate, rigid, INTEGRATORS[name](), q0, u0, dt=dt,
                                               t1=T, saveat=[T]), repeats=repeats)
-                q, u = sol.qs[-1], sol.us[-1]
+                q, u = sol.qs[-1], sol.vs[-1]
                 finite = bool(jnp.all(jnp.isfinite(q)) & jnp.all(jnp.isfinite(u)))
                 q = rigid.project(q) if finite else q
                 records.append({**common, "scene": scene, "method": name, "family": "integrator",

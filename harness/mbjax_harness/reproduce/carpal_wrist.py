@@ -58,7 +58,7 @@ def rollout(wrist, law, theta0, duration: float, steps: int, integrator=RK4()):
     at theta0, `steps` steps to `duration` (what `synthesize` scores a law by)."""
     sol = simulate(WristSystem(wrist, law), integrator, theta0, jnp.zeros_like(theta0),
                    dt=duration / steps, t1=duration, saveat=np.array([duration]))
-    return sol.qs[-1], sol.us[-1], sol.status
+    return sol.qs[-1], sol.vs[-1], sol.status
 
 
 def masked_rollout(system, integrator, q0, u0, dts, duration: float, monitor, timings: dict | None = None):

@@ -51,7 +51,7 @@ def timing(n: int, repeats: int) -> tuple[float, float, float]:
     """(recursive_s, dense_s, max_abs_diff) per 1 s of the n-dof chain."""
     chain, q0, v0 = closed_chain.build(n)
     window = closed_chain.DURATION if n <= 44 else 0.1 * closed_chain.DURATION
-    run = partial(simulate, integrator=RK4(), q0=q0, u0=v0, dt=1e-3, t1=window,
+    run = partial(simulate, integrator=RK4(), q0=q0, v0=v0, dt=1e-3, t1=window,
                   saveat=np.linspace(0.0, window, 11))
     stabilized = ClosedSystem(chain.tree, chain.closures, Stabilized())
     recursive, t_rec = measure(partial(run, stabilized), repeats=repeats)

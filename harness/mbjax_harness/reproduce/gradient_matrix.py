@@ -49,7 +49,7 @@ TOLERANCE = 1e-5           # relative, float64
 
 def _scalar(sol):
     """A smooth scalar of the final state that every coordinate enters."""
-    q, u = sol.qs[-1], sol.us[-1]
+    q, u = sol.qs[-1], sol.vs[-1]
     return jnp.sum(jnp.sin(q) * jnp.arange(1, q.shape[0] + 1)) + 0.1 * jnp.sum(u**2)
 
 

@@ -55,7 +55,7 @@ def fit_order(dts, errors) -> float | None:
 
 def relative_energy_drift(body, sol) -> float:
     """max |E/E0 - 1| over the saved states."""
-    return float(jnp.max(jnp.abs(body.relative_energy_error(sol.qs, sol.us))))
+    return float(jnp.max(jnp.abs(body.relative_energy_error(sol.qs, sol.vs))))
 
 
 def torque_free_sweep(steps: dict, repeats: int) -> list[dict]:
@@ -125,7 +125,7 @@ def energy_histories(dt: float):
     out = {}
     for name, cls in INTEGRATORS.items():
         sol = simulate(body, cls(), q0, u0, dt=dt, t1=top.DURATION, saveat=saveat)
-        out[name] = (np.asarray(sol.ts), np.asarray(body.relative_energy_error(sol.qs, sol.us)))
+        out[name] = (np.asarray(sol.ts), np.asarray(body.relative_energy_error(sol.qs, sol.vs)))
     return out
 
 

@@ -30,7 +30,7 @@ def controls_tour(out: Path, quick: bool) -> dict:
     duration = 0.5 if quick else 1.0
     ts = np.linspace(0.0, duration, 51)                     # every 5 steps
     q0, v0 = jnp.asarray(scene.Q_REF), jnp.zeros(arm.nv)
-    run = partial(simulate, integrator=INTEGRATORS["rk4"](), q0=q0, u0=v0, dt=scene.DT, t1=duration,
+    run = partial(simulate, integrator=INTEGRATORS["rk4"](), q0=q0, v0=v0, dt=scene.DT, t1=duration,
                   saveat=ts)
     held = run(TreeSystem(arm, scene.servo(arm)))
     pushed, timing = measure(partial(run, scene.pushed(arm)), repeats=3)
@@ -118,7 +118,7 @@ def models_tour(out: Path, quick: bool) -> dict:
     flange = jax.jit(jax.vmap(lambda q: frame_pose(arm, q, "flange")[1]))(fall.qs)
     # how far each saved state lies beyond the arm's position and velocity limits (`Model.lower`,
     # `upper`, `velocity_limit`; what `simulate`'s status checks)
-    qs, us = np.asarray(fall.qs), np.asarray(fall.us)
+    qs, us = np.asarray(fall.qs), np.asarray(fall.vs)
     beyond = np.concatenate([np.maximum(np.asarray(arm.lower) - qs, 0.0)
                              + np.maximum(qs - np.asarray(arm.upper), 0.0),
                              np.maximum(np.abs(us) - np.asarray(arm.velocity_limit), 0.0)], axis=1)

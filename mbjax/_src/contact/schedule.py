@@ -121,12 +121,12 @@ def simulate_schedule(tree: AbstractTreeSystem, integrator: AbstractIntegrator, 
         w = jnp.zeros((sol.ts.shape[0], len(frames), 6))
         if contacts:
             forces = jax.vmap(lambda t_, q_, u_, s=system: contact_wrenches(s, t_, q_, u_))(
-                sol.ts, sol.qs, sol.us)
+                sol.ts, sol.qs, sol.vs)
             w = w.at[:, [frames.index(c.frame) for c in contacts]].set(forces)
         keep = slice(0, None) if k == 0 else slice(1, None)     # a phase's first state is the
-        parts.append((sol.ts[keep], sol.qs[keep], sol.us[keep], w[keep],     # last one's end
+        parts.append((sol.ts[keep], sol.qs[keep], sol.vs[keep], w[keep],     # last one's end
                       jnp.full(sol.ts[keep].shape, k), sol.status))
-        q, v, t, held = sol.qs[-1], sol.us[-1], t + duration, contacts
+        q, v, t, held = sol.qs[-1], sol.vs[-1], t + duration, contacts
         if not isinstance(q, jax.core.Tracer) and not bool(jnp.all(jnp.isfinite(q))):
             break                       # blown up (NONFINITE): no pose to start the next from
     ts, qs, vs, ws, ks, codes = zip(*parts, strict=True)

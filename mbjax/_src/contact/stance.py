@@ -90,7 +90,7 @@ def stance(tree: AbstractTreeSystem, q: Array, contacts: Sequence[AbstractContac
     return ClosedSystem(tree, closures, method, projection, watch=watch)
 
 
-def contact_wrenches(phase: ClosedSystem, t, q: Array, u: Array) -> Array:
+def contact_wrenches(phase: ClosedSystem, t, q: Array, v: Array) -> Array:
     """The ground's wrench on each of a stance's contacts, (torque; force) in world components
     at the frame's origin: the contacts' multipliers (Pinocchio's `constraintDynamics` forces,
     in its LOCAL_WORLD_ALIGNED frame).
@@ -99,7 +99,7 @@ def contact_wrenches(phase: ClosedSystem, t, q: Array, u: Array) -> Array:
         phase: the stance, as `stance` made it.
         t: time [s], a scalar.
         q: configuration, shape (nq,).
-        u: the phase's velocity state (the joint velocities for `Coupled`).
+        v: the phase's velocity state (the joint velocities for `Coupled`).
 
     Returns:
         The wrenches, shape (len(contacts), 6), in the order `stance` took the contacts; a point
@@ -108,7 +108,7 @@ def contact_wrenches(phase: ClosedSystem, t, q: Array, u: Array) -> Array:
     Raises:
         ValueError: the phase is not a stance.
     """
-    return stance_wrenches(phase, q, phase.multipliers(t, q, u))
+    return stance_wrenches(phase, q, phase.multipliers(t, q, v))
 
 
 def stance_wrenches(phase: ClosedSystem, q: Array, multipliers: Array) -> Array:

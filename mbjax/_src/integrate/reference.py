@@ -15,7 +15,7 @@ from mbjax._src.system.status import Status, raise_on_failure
 from mbjax._src.system.system import AbstractSystem
 
 
-def solve_reference(system: AbstractSystem, q0: Array, u0: Array, ts, *, rtol: float = 1e-11,
+def solve_reference(system: AbstractSystem, q0: Array, v0: Array, ts, *, rtol: float = 1e-11,
                     atol: float = 1e-11, solver=None, max_steps: int = 1_000_000,
                     throw: bool = False) -> Solution:
     """An adaptive, error-controlled reference solution through diffrax.
@@ -28,7 +28,7 @@ def solve_reference(system: AbstractSystem, q0: Array, u0: Array, ts, *, rtol: f
     Args:
         system: the system to integrate, an `AbstractSystem`.
         q0: initial configuration, shape (nq,).
-        u0: initial velocity coordinates, shape (nv,).
+        v0: initial velocity coordinates, shape (nv,).
         ts (Array): save times [s], shape (T,), T >= 2, increasing; ts[0] is the initial time.
         rtol: the step-size controller's relative tolerance.
         atol: its absolute tolerance, in the state's units.
@@ -62,7 +62,7 @@ def solve_reference(system: AbstractSystem, q0: Array, u0: Array, ts, *, rtol: f
         times = np.asarray(ts, dtype=float)
         if times.ndim != 1 or times.size < 2 or not np.all(np.diff(times) > 0):
             raise ValueError(f"ts must be at least two increasing times, got {ts!r}")
-    return raise_on_failure(_solve(system, q0, u0, ts, rtol, atol, solver, max_steps), throw,
+    return raise_on_failure(_solve(system, q0, v0, ts, rtol, atol, solver, max_steps), throw,
                             "mbjax.integrate.solve_reference")
 
 
@@ -76,7 +76,7 @@ def _diffrax():
 
 
 @eqx.filter_jit
-def _solve(system, q0, u0, ts, rtol, atol, solver, max_steps):
+def _solve(system, q0, v0, ts, rtol, atol, solver, max_steps):
     diffrax = _diffrax()
     ts = jnp.asarray(ts)
     term = diffrax.ODETerm(
@@ -91,8 +91,8 @@ def _solve(system, q0, u0, ts, rtol, atol, solver, max_steps):
         y1 = jax.tree.map(lambda a: a[-1], sol.ys)
         return y1, (y1, sol.result != diffrax.RESULTS.successful)
 
-    y0 = (jnp.asarray(q0), jnp.asarray(u0))
+    y0 = (jnp.asarray(q0), jnp.asarray(v0))
     _, ((q, u), failed) = jax.lax.scan(interval, y0, jnp.stack([ts[:-1], ts[1:]], 1))
     qs = jax.vmap(system.project)(jnp.concatenate([y0[0][None], q]))
     status = jnp.where(jnp.any(failed), int(Status.SOLVER_FAILED), 0).astype(jnp.int32)
-    return Solution(ts=ts, qs=qs, us=jnp.concatenate([y0[1][None], u]), status=status)
+    return Solution(ts=ts, qs=qs, vs=jnp.concatenate([y0[1][None], u]), status=status)

@@ -22,7 +22,7 @@ from mbjax._src.system.system import AbstractSystem
 
 
 def _state(x, name: str, size: int | None) -> Array:
-    """q0 or u0 as a real array in the working precision (integers and float32 promoted, as
+    """q0 or v0 as a real array in the working precision (integers and float32 promoted, as
     a carry of the time loop must keep its type), its length checked where the system has
     one."""
     try:
@@ -71,11 +71,11 @@ def _save_indices(t0: float, t1: float, dt: float, saveat) -> tuple[int, np.ndar
     return n_steps, idx
 
 
-def simulate(system: AbstractSystem, integrator: AbstractIntegrator, q0: Array, u0: Array, *,
+def simulate(system: AbstractSystem, integrator: AbstractIntegrator, q0: Array, v0: Array, *,
              dt: float, t1: float, t0: float = 0.0, saveat=None, checkpoint: bool = False,
              rtol: float | None = None, atol: float | None = None,
              throw: bool = False) -> Solution:
-    """Integrate `system` from (q0, u0) at t0 to t1 with fixed steps dt.
+    """Integrate `system` from (q0, v0) at t0 to t1 with fixed steps dt.
 
     The states saved at `saveat` come back in a `Solution` whose status flags a failed or
     inaccurate run. dt, t0, t1 and saveat fix the shape of the computation and must be concrete
@@ -87,7 +87,7 @@ def simulate(system: AbstractSystem, integrator: AbstractIntegrator, q0: Array, 
             ...), an `AbstractSystem` instance.
         integrator: the fixed-step method, an `AbstractIntegrator` instance (`RK4()`, ...).
         q0: initial configuration, shape (nq,).
-        u0: initial velocity coordinates, shape (nv,).
+        v0: initial velocity coordinates, shape (nv,).
         dt: the step [s], a positive concrete number; t1 - t0 must be a whole number of steps.
         t1: the final time [s].
         t0: the initial time [s].
@@ -106,14 +106,14 @@ def simulate(system: AbstractSystem, integrator: AbstractIntegrator, q0: Array, 
             `eqx.error_if`).
 
     Returns:
-        A `Solution` with the saved times ts (T,), states qs (T, nq) and us (T, nv), the
+        A `Solution` with the saved times ts (T,), states qs (T, nq) and vs (T, nv), the
             status, the invariants' drift, and with a tolerance the error estimate.
 
     Raises:
         TypeError: system or integrator is not an mbjax instance (a class, a bare `Model`), q0
-            or u0 is not real, or dt, t0, t1, rtol, atol are traced or not real numbers.
+            or v0 is not real, or dt, t0, t1, rtol, atol are traced or not real numbers.
         ValueError: dt is not positive, t1 - t0 is not a positive whole number of steps,
-            saveat is off the grid, empty, non-finite or decreasing, q0 or u0 has the wrong
+            saveat is off the grid, empty, non-finite or decreasing, q0 or v0 has the wrong
             shape, a quaternion in a concrete q0 is not of unit norm (within 1e-6), or rtol
             and atol are negative or both zero.
         equinox.EquinoxRuntimeError: with throw=True, the run failed (raised when the compiled
@@ -140,7 +140,7 @@ def simulate(system: AbstractSystem, integrator: AbstractIntegrator, q0: Array, 
     kept = np.union1d(idx, _sample_steps(n_steps, idx)) if checked else idx
     block = math.gcd(*kept.tolist(), n_steps)
     nq, nv = system.state_sizes()
-    q0, u0 = _state(q0, "q0", nq), _state(u0, "u0", nv)
+    q0, u0 = _state(q0, "q0", nq), _state(v0, "v0", nv)
     check_unit_quaternions(q0, system.quaternions(), "q0")
     qs, us, status, fields = _rollout(system, integrator, q0, u0, float(t0), float(dt), block,
                                       n_steps // block, tuple((kept // block).tolist()),
@@ -179,7 +179,7 @@ def simulate(system: AbstractSystem, integrator: AbstractIntegrator, q0: Array, 
         by = by | jnp.where(drifted, DRIFTED, 0)
         fields.update(drift=value, drifting=which, invariant_names=names)
     fields.update(flagged_at=first, inaccurate_by=by)
-    return raise_on_failure(Solution(ts=ts, qs=qs, us=us, status=new, **fields), throw,
+    return raise_on_failure(Solution(ts=ts, qs=qs, vs=us, status=new, **fields), throw,
                             "mbjax.simulate")
 
 

@@ -1,5 +1,7 @@
 """The result of a simulation."""
 
+import warnings
+
 import equinox as eqx
 from jax import Array
 
@@ -7,7 +9,7 @@ from mbjax._src.system.status import Flags, flags, WithStatus, accuracy_notes
 
 
 class Solution(WithStatus):
-    """The result of a simulation: states saved at times `ts`, qs[i] = q(ts[i]), us[i] = u(ts[i]).
+    """The result of a simulation: states saved at times `ts`, qs[i] = q(ts[i]), vs[i] = v(ts[i]).
 
     Returned by `simulate` and `solve_reference`; under `jax.vmap` every field gains a leading
     batch axis. `ok` and `messages()` read the status.
@@ -15,7 +17,7 @@ class Solution(WithStatus):
     Args:
         ts: save times [s], shape (T,).
         qs: configurations, shape (T, nq).
-        us: velocity coordinates, shape (T, nv).
+        vs: velocity coordinates, shape (T, nv).
         status: the `Status` flags, one per solution (batched under vmap), as `Flags`: an
             integer array that prints in words.
         error: the estimated global error of the final state (largest component, in the
@@ -40,7 +42,7 @@ class Solution(WithStatus):
 
     ts: Array
     qs: Array
-    us: Array
+    vs: Array
     status: Flags = eqx.field(converter=flags)
     error: Array = float("nan")
     drift: Array = float("nan")
@@ -51,6 +53,13 @@ class Solution(WithStatus):
     invariant_names: tuple[str, ...] = eqx.field(static=True, default=())
     culprit: Array = -1
     culprit_names: tuple[str, ...] = eqx.field(static=True, default=())
+
+    @property
+    def us(self) -> Array:
+        """Deprecated: the velocities are `vs` (`us` names controls, as in `mbjax.trajopt`)."""
+        warnings.warn("Solution.us is renamed Solution.vs (the velocities; us names controls, as "
+                      "in mbjax.trajopt)", DeprecationWarning, stacklevel=2)
+        return self.vs
 
     def notes(self, i: int) -> dict:
         """What tripped each flag of the i-th run (`WithStatus.messages`)."""

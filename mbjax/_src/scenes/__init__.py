@@ -1,6 +1,6 @@
 """Ready-made scenes used by the tests, the benchmarks, the notebooks and the `mbjax` CLI.
 
-Each scene module has `build(...)` returning (system, q0, u0) and the scene's constants.
+Each scene module has `build(...)` returning (system, q0, v0) and the scene's constants.
 """
 
 from mbjax._src.scenes import heavy_top as heavy_top, torque_free_body as torque_free_body

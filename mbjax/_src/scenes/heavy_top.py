@@ -29,12 +29,12 @@ def build(rotation: AbstractRotation = Quaternion()):
     Returns:
         body: the `mbjax.rigid.RigidBody`.
         q0: the initial attitude coordinates, shape (4,) or (3,).
-        u0: the initial body angular velocity [rad/s], shape (3,).
+        v0: the initial body angular velocity [rad/s], shape (3,).
 
     Raises:
         TypeError: rotation is not a rotation strategy instance.
     """
     body = RigidBody(MGL / GRAVITY, jnp.diag(jnp.array(INERTIA)), com=(0.0, 0.0, 1.0),
                      gravity=(0.0, 0.0, -GRAVITY), fixed_point=True, rotation=rotation)
-    q0, u0 = body.initial_state(lie.exp(jnp.array(LAMBDA0)), jnp.array(W0))
-    return body, q0, u0
+    q0, v0 = body.initial_state(lie.exp(jnp.array(LAMBDA0)), jnp.array(W0))
+    return body, q0, v0

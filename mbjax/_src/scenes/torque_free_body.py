@@ -29,15 +29,15 @@ def build(rotation: AbstractRotation = Quaternion()):
     Returns:
         body: the `mbjax.rigid.RigidBody` (rotation only, about its centre of mass).
         q0: the initial attitude coordinates, shape (4,) or (3,).
-        u0: the initial body angular velocity [rad/s], shape (3,).
+        v0: the initial body angular velocity [rad/s], shape (3,).
 
     Raises:
         TypeError: rotation is not a rotation strategy instance.
     """
     body = RigidBody(1.0, np.diag([J_TRANSVERSE, J_TRANSVERSE, J_AXIAL]),
                      gravity=(0.0, 0.0, 0.0), fixed_point=True, rotation=rotation)
-    q0, u0 = body.initial_state(np.eye(3), np.array(OMEGA0))
-    return body, q0, u0
+    q0, v0 = body.initial_state(np.eye(3), np.array(OMEGA0))
+    return body, q0, v0
 
 
 def exact_rotation(t):

@@ -174,9 +174,9 @@ def episode_cost(controller, wrist, start, target, plunge, slope, gravity, *, du
     weight = (sol.ts[1:] / duration) ** end_power
     miss = ((p - plunge) / wrist.link_length) ** 2 + jnp.sum((g - slope) ** 2, axis=1)
     track = jnp.sum(weight * miss) / jnp.sum(weight)
-    tau = jax.vmap(law)(sol.ts, sol.qs, sol.us)
+    tau = jax.vmap(law)(sol.ts, sol.qs, sol.vs)
     work = jnp.mean(jnp.sum(tau**2, axis=1)) / law.limit**2
-    cost = (track / pose_tolerance**2 + jnp.sum(sol.us[-1] ** 2) / speed_tolerance**2
+    cost = (track / pose_tolerance**2 + jnp.sum(sol.vs[-1] ** 2) / speed_tolerance**2
             + effort_weight * work)
     final = kinematics.pose_error(wrist, kinematics.forward_kinematics(wrist, sol.qs[-1]),
                                   kinematics.pose_from_chart(wrist, plunge, slope))

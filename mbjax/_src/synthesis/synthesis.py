@@ -55,7 +55,7 @@ def rollout(wrist, law, theta0: Array, duration: float, steps: int, integrator=R
     """The final (theta, theta_dot, status) of the wrist driven by `law` from rest at theta0."""
     sol = simulate(WristSystem(wrist, law), integrator, theta0, jnp.zeros_like(theta0),
                    dt=duration / steps, t1=duration, saveat=np.array([duration]))
-    return sol.qs[-1], sol.us[-1], sol.status
+    return sol.qs[-1], sol.vs[-1], sol.status
 
 
 def effort(law, duration: float, samples: int = 400) -> tuple[Array, Array]:

@@ -23,7 +23,9 @@ class AbstractSystem(eqx.Module):
     The interface:
         What a time integrator needs from a mechanical system.
 
-        A system has configuration coordinates q and velocities u with
+        A system has configuration coordinates q and velocities u (Kane's generalized speeds, as
+        the papers write them: the `v` of `simulate`'s v0 and of `Solution.vs`, which keep u
+        for controls as `mbjax.trajopt` does) with
 
         ```text
         q_dot = kinematics(q, u),        u_dot = acceleration(t, q, u).
