@@ -317,6 +317,30 @@ def test_no_public_docstring_or_error_message_names_the_private_package():
     assert not offences, "\n".join(offences)
 
 
+def test_public_docstrings_fit_a_screen():
+    """A public object's docstring says what it does in a screen: at most 40 lines besides its
+    Args list (`Model`'s thirty arguments alone take 59); the long sections (formulation,
+    methods, sources) live on the documentation site's Details page."""
+    import inspect
+
+    def length(doc: str) -> int:
+        lines, inside = doc.splitlines(), False
+        count = 0
+        for line in lines:
+            if line == "Args:":
+                inside = True
+                continue
+            if inside and line and not line.startswith(" "):
+                inside = False
+            count += not inside
+        return count
+
+    offences = [f"{name}: {length(doc)} lines" for name, obj in _public_items()
+                if length(doc := inspect.getdoc(obj.fget if isinstance(obj, property) else obj)
+                          or "") > 40]
+    assert not offences, offences
+
+
 def test_scenes_do_not_import_the_harness():
     offences = [f"{path.name}: {module}" for path in (SRC / "scenes").glob("*.py")
                 for module in _imports(path) if module.startswith("mbjax_harness")]

@@ -77,10 +77,8 @@ def simulate(system: AbstractSystem, integrator: AbstractIntegrator, q0: Array, 
              throw: bool = False) -> Solution:
     """Integrate `system` from (q0, v0) at t0 to t1 with fixed steps dt.
 
-    The states saved at `saveat` come back in a `Solution` whose status flags a failed or
-    inaccurate run. dt, t0, t1 and saveat fix the shape of the computation and must be concrete
-    numbers; the system's parameters and the initial state may be traced, so `jax.grad`,
-    `jax.vmap` and `jax.jit` compose.
+    A `Solution` whose status flags a failed or inaccurate run. dt, t0, t1 and saveat are
+    concrete numbers; everything else may be traced (`jax.grad`, `jax.vmap`, `jax.jit`).
 
     Args:
         system: the system to integrate (`TreeSystem(model)`, `RigidBody`, `ClosedSystem`,
@@ -93,11 +91,9 @@ def simulate(system: AbstractSystem, integrator: AbstractIntegrator, q0: Array, 
         t0: the initial time [s].
         saveat (Array | None): None (every step) or the save times [s], a 1-D increasing array
             on the grid t0 + k dt within [t0, t1].
-        checkpoint: for reverse-mode gradients of long rollouts: each block's steps run as a
-            scan over segments of about sqrt(block) steps under `jax.checkpoint`, so `jax.grad`
-            keeps the states at the segment ends and recomputes one segment at a time: memory
-            grows like sqrt(T) rather than T, for about one more forward pass. The values
-            computed are the same.
+        checkpoint: for reverse-mode gradients of long rollouts: `jax.grad` keeps the states
+            at segments of about sqrt(T) steps and recomputes one at a time (`jax.checkpoint`),
+            memory like sqrt(T) rather than T for about one more forward pass; same values.
         rtol: relative tolerance on the final state's error and on the invariants' drift
             (held to 1 % without a tolerance: docs/details.md); None for 0 where atol is given.
         atol: absolute tolerance on the final state's error, in the state's units.
@@ -110,14 +106,12 @@ def simulate(system: AbstractSystem, integrator: AbstractIntegrator, q0: Array, 
             status, the invariants' drift, and with a tolerance the error estimate.
 
     Raises:
-        TypeError: system or integrator is not an mbjax instance (a class, a bare `Model`), q0
-            or v0 is not real, or dt, t0, t1, rtol, atol are traced or not real numbers.
-        ValueError: dt is not positive, t1 - t0 is not a positive whole number of steps,
-            saveat is off the grid, empty, non-finite or decreasing, q0 or v0 has the wrong
-            shape, a quaternion in a concrete q0 is not of unit norm (within 1e-6), or rtol
-            and atol are negative or both zero.
-        equinox.EquinoxRuntimeError: with throw=True, the run failed (raised when the compiled
-            program runs).
+        TypeError: naming the argument: system or integrator not an mbjax instance, q0 or v0
+            not real, dt, t0, t1, rtol or atol traced or not a real number.
+        ValueError: naming the argument: a non-positive dt or one that does not divide t1 - t0,
+            saveat off the grid, q0 or v0 of the wrong shape, a quaternion in q0 not of unit
+            norm, rtol and atol negative or both zero.
+        equinox.EquinoxRuntimeError: with throw=True, the run failed.
 
     More on the rollout, default accuracy check, accuracy with a tolerance: the documentation
     site's Details page (docs/details.md).

@@ -7,65 +7,9 @@ and Fig. 7.1-7.2, after Giles 1978 and Manning 1981; also benchmark A03 of the I
 computational benchmark problems), built from mbjax bodies, joints and cut joints rather than from
 the test set's hand-written mass matrix.
 
-Constants, initial values and the reference solution at t = 0.03 s are the test set's; they were
-read, and checked digit by digit against each other, in
-
-- the test set's Fortran driver and problem routines (`SUBROUTINE F`, `INITIAL`, `SOLN`: the
-  MEBDFI driver of the index-3 Andrews problem, and its MATLAB port `ANDREW`),
-- the R package deTestSet (K. Soetaert, J. Cash, F. Mazzia), `pkg/deTestSet/R/ex_andrews.R`
-  in rforge/bvpsolve (the parameter vector and `yini`),
-- pySDC's `pySDC/projects/DAE/problems/andrewsSqueezingMechanism.py` (lisawim/pySDC: the
-  parameters, `qend_ref_testset`, and the position constraints g(q)).
-
-The reference (test set `SOLN`) was computed by CWI with PSIDE at rtol = atol = 1e-14 on a Cray
-C90; the test set prints it to 16 significant digits.
-
-Geometry, from the test set's position constraints g(q) (ground frame x, y; R(a) the rotation by
-a): the crank (beta) turns about the origin O; the rod (Theta, relative to the crank) is hinged on
-it at R(beta)(rr, 0); the rod's far end is the point
-
-    P = R(beta)(rr, 0) + R(beta + Theta)(-d, 0),
-
-where the three loops close (the test set's E):
-
-    g1,2:  P = B + R(gamma)(0, -ss)                                      body gamma turns about B
-    g3,4:  P = A + R(delta)(zt, 0) + R(Phi + delta)(0, -e)               Phi relative to delta
-    g5,6:  P = A + R(epsilon)(0, -u) + R(Omega + epsilon)(zf, 0)         Omega relative to epsilon
-
-so Theta, Phi and Omega are relative angles (of the rod to the crank, of body Phi to body delta,
-of body Omega to body epsilon), and beta, gamma, delta, epsilon absolute ones.
-
-The tree (`Model`): every joint a revolute joint about z, its angle one of the test set's. mbjax
-numbers a body after its parent (Anderson 1993 §2.1 rule (i)), and Phi's body hangs from delta's,
-Omega's from epsilon's, so the tree's order is (beta, Theta, gamma, delta, Phi, epsilon, Omega):
-
-    body 0  beta     ground, at O                 m1, centre (ra, 0),         i1
-    body 1  Theta    body 0, at (rr, 0)           m2, centre (-da, 0),        i2
-    body 2  gamma    ground, at B = (xb, yb)      m3, centre (sa, sb),        i3
-    body 3  delta    ground, at A = (xa, ya)      m5, centre (ta, tb),        i5
-    body 4  Phi      body 3, at (zt, 0)           m4, centre (0, -(e - ea)),  i4
-    body 5  epsilon  ground, at A                 m7, centre (ua, ub),        i7
-    body 6  Omega    body 5, at (0, -u)           m6, centre (zf - fa, 0),    i6
-
-q_tree = y[TREE_ORDER] with y the test set's (beta, Theta, gamma, Phi, delta, Omega, epsilon);
-`to_testset` / `from_testset` convert (the permutation swaps two pairs and is its own inverse).
-Same angles and signs, so the tree's mass matrix is the test set's m(i, j) permuted (the tests
-check it). Only the distance of a centre of mass from a fixed pivot enters the equations for the
-bodies turning about O, B and A, so the directions chosen for (ra, 0), (sa, sb), (ta, tb),
-(ua, ub) are immaterial; the rod's, Phi's and Omega's centres lie on the lines to P as the test
-set's coupling terms require. The test set gives the moments of inertia about the plane's normal
-only; the 3x3 inertias here are those of thin plates, diag(i/2, i/2, i), which never enter a
-planar motion.
-
-The cuts: the rod's point P = (-d, 0) coincides with (0, -ss) on body gamma, with (0, -e) on body
-Phi and with (zf, 0) on body Omega; each is a `PointOnLine()` cut joint with the line along z,
-normal to the plane: two equations per loop, six in all as in the test set, full rank 6 (no
-redundancy). The residuals are g(q) of the test set rotated into the second body's frame (same
-zero set, same norm per loop).
-
-Loads: the driving torque mom on the crank's joint (`tau`), and the spring of stiffness c0 and
-rest length l0 from D = B + R(gamma)(sd, -sc) on body gamma to the fixed point C = (xc, yc)
-(`PointSpring`, the generalized force J^T F). No gravity. At t = 0 the mechanism is at rest.
+Constants, initial values and the reference solution at t = 0.03 s are the test set's. Where
+they were read, the geometry, the tree, the cuts and the loads: the documentation site's
+Details page (docs/details.md).
 """
 
 from typing import NamedTuple

@@ -85,11 +85,9 @@ def synthesize(wrist, theta0: Array, goal, *, duration: float, torque_limit: flo
     torque limit (`mbjax.control.CubicSpline` with a limit). Each evaluation of the objective J
     runs the simulator (`mbjax.simulate`, RK4 by default); optax's Adam takes the steps, and
     the whole descent is one `lax.scan`, so `synthesize` compiles once. The gradient is forward
-    mode through the rollout's `lax.scan` (`jax.jacfwd` over the 3 n_knots spline values): for
-    a few dozen parameters it compiles several times faster than reverse mode through the
-    rollout's scan.
-    The result's figures come from the same discrete rollout; re-simulate `spline` with a finer
-    or higher-order integrator to see the continuous-time miss (`mbjax reproduce carpal-wrist`).
+    mode through the rollout (`jax.jacfwd` over the 3 n_knots spline values). The result's
+    figures come from the same discrete rollout; re-simulate `spline` with a finer or
+    higher-order integrator to see the continuous-time miss (`mbjax reproduce carpal-wrist`).
 
     Args:
         wrist: the `CarpalWrist`.
@@ -106,8 +104,7 @@ def synthesize(wrist, theta0: Array, goal, *, duration: float, torque_limit: flo
         effort_weight: w, the weight of the effort term.
         integrator: the rollouts' integrator (`mbjax.integrate.RK4()` by default).
         init: the starting spline; None: the constant torque that holds theta0 against
-            gravity. The feed-forward baseline fitted to a spline (`CubicSpline.fit`, clipped to
-            the limit) is a far better start for this open-loop unstable robot.
+            gravity. The feed-forward baseline as a spline (`CubicSpline.fit`) starts far better.
         throw: raise on a failed final rollout instead of reporting it in `status`, as
             `mbjax.simulate` does.
 

@@ -33,7 +33,7 @@ def cosine_adam(learning_rate: float, iterations: int, final_fraction: float = 0
 class Shooting(AbstractSolver):
     """Single shooting: the controls are the unknowns, the gradient is reverse mode through the rollout.
 
-    A solver strategy for `mbjax.trajopt.solve` (see The method, below). It works for any system,
+    A solver strategy for `mbjax.trajopt.solve`. It works for any system,
     quaternion coordinates included; bounds are kept by projection, sound where none is active
     at the optimum.
 
@@ -42,7 +42,7 @@ class Shooting(AbstractSolver):
             (static): `optax.lbfgs()` (the default: L-BFGS with its zoom line search), or Adam
             with its learning rate cosine-decayed over the run,
             `mbjax.trajopt.cosine_adam(learning_rate, iterations)`; any other optax optimizer
-            too (see The method).
+            too.
         iterations (int): the most iterations (static).
         tolerance (float): stop when the (projected) gradient's norm falls below this times its
             first value.
@@ -51,31 +51,8 @@ class Shooting(AbstractSolver):
         TypeError: optimizer is not an optax optimizer (the strings "lbfgs" and "adam" of old,
             say).
 
-    The method:
-        Single shooting: the controls are the unknowns, the objective is the problem's cost of their
-        rollout, and its gradient is reverse mode through the rollout (`mbjax/_src/rigid/adjoint.py`
-        for trees: a few rollouts' cost, whatever the horizon).
-
-        `Shooting(optax.lbfgs())` takes optax's L-BFGS with its zoom line search (Nocedal and
-        Wright, Alg. 3.5 and 7.4); `Shooting(cosine_adam(learning_rate, iterations))`, optax's
-        Adam with a cosine-decayed learning rate, is the first-order baseline. Every step calls
-        the optimizer's update with the extra arguments a line search needs (value, grad,
-        value_fn; optimizers without a line search ignore them), and an optimizer whose state
-        carries the value and gradient at the new point (optax's line searches) has them reused
-        (`optax.value_and_grad_from_state`) rather than evaluated again. Control bounds are kept
-        by projecting the controls onto them after every step (projected gradient for Adam; for
-        L-BFGS a heuristic, sound where no bound is active: use `ILQR` for problems whose optimum
-        lies on its bounds). The iterations are one `lax.while_loop`: success when the gradient's
-        norm falls below `tolerance` times its first value (its projection on the box, for
-        bounded controls), NOT_CONVERGED when `iterations` run out.
-
-    Gauss-Newton:
-        Gauss-Newton on the controls of single shooting is not offered: with the costs' residuals
-        stacked into one vector r(u), a dense Levenberg-Marquardt on all N nu controls converged far
-        more slowly than iLQR on the benchmark problems (see benchmarks/README.md). The stage
-        structure is what Gauss-Newton needs here: `ILQR` is Gauss-Newton on the controls with the
-        step solved by a Riccati recursion and applied through a closed-loop rollout, and
-        `MultipleShooting` is Gauss-Newton on the knots' states and controls.
+    More on the method and on Gauss-Newton: the documentation site's Details page
+    (docs/details.md).
     """
 
     optimizer: optax.GradientTransformation = eqx.field(static=True, default=optax.lbfgs())
