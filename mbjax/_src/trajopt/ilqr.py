@@ -143,8 +143,7 @@ class ILQR(AbstractIterativeSolver):
                     costs=history(self.iterations + 1, cost),
                     step_lengths=jnp.full(self.iterations, jnp.nan, cost.dtype),
                     K=jnp.zeros((N, nu, nx), cost.dtype), stale=jnp.array(True),
-                    expansion=jax.tree.map(lambda a: jnp.zeros(a.shape, a.dtype), jax.eval_shape(
-                        lambda: self._linearize(problem, xs, us))))
+                    expansion=_zero_expansion(N, nx, nu, cost.dtype))
 
     def running(self, s: dict) -> Array:
         """Whether the iteration goes on from state s (not converged, not stalled, iterations
@@ -287,3 +286,13 @@ class ILQR(AbstractIterativeSolver):
         if not fused:
             return x_new, u_seq, problem.cost(x_new, u_seq)
         return x_new, u_seq, jnp.sum(costs) + problem.final_cost(x_end)
+
+
+def _zero_expansion(N: int, n: int, m: int, dtype) -> tuple:
+    """Room for `ILQR._linearize`'s expansion, zeros of its shapes (N steps, deviations of n,
+    controls of m): written out, not `jax.eval_shape` of it, which would trace the whole
+    linearization (a stance's contact solve and its derivatives) a second time."""
+    def z(*shape):
+        return jnp.zeros(shape, dtype)
+    return ((z(N, n, n), z(N, n, m), z(N, n), z(N, n), z(N, m), z(N, n, n), z(N, m, n),
+             z(N, m, m)), (z(n), z(n, n)))
