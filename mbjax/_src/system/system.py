@@ -24,8 +24,8 @@ class AbstractSystem(eqx.Module):
         What a time integrator needs from a mechanical system.
 
         A system has configuration coordinates q and velocities u (Kane's generalized speeds, as
-        the papers write them: the `v` of `simulate`'s v0 and of `Solution.vs`, which keep u
-        for controls as `mbjax.trajopt` does) with
+        the papers write them; what users pass and read names them v, `simulate`'s v0 and
+        `Solution.vs`, since u names controls in `mbjax.trajopt`) with
 
         ```text
         q_dot = kinematics(q, u),        u_dot = acceleration(t, q, u).
