@@ -127,18 +127,19 @@ class ILQR(AbstractIterativeSolver):
         state trajectory (an infeasible start; None for us's rollout): its cost, mu, and room
         for the expansion and the costs' history."""
         N, nx, nu = problem.horizon, problem.ndx, problem.nu
-        if states is None and not problem.vectorized:
-            # the rollout priced as it steps, by the forward pass the iterations run (one
-            # stance solve a knot, and one program less to compile than a rollout and a cost)
-            zero = jnp.zeros((N, nu), us.dtype)
-            xs, us, cost = self._forward(problem, jnp.broadcast_to(problem.x0, (N + 1, problem.nx)), us,
-                                         zero, jnp.zeros((N, nu, nx), us.dtype),
-                                         jnp.zeros((N, nx), us.dtype), jnp.asarray(1.0, us.dtype))
+        # a problem whose knots solve contacts rolls us out in the first step's forward pass
+        # (`fresh`): priced as it steps (one stance solve a knot), and no second instance of
+        # the forward pass to compile
+        fresh = states is None and not problem.vectorized
+        if fresh:
+            xs = jnp.broadcast_to(problem.x0, (N + 1, problem.nx))
+            cost = jnp.asarray(jnp.inf, us.dtype)
         else:
             xs = problem.initial_states(states, us)
             cost = problem.cost(xs, us)
         return dict(xs=xs, us=us, cost=cost, mu=jnp.asarray(self.regularization, cost.dtype),
                     iteration=jnp.array(0), done=jnp.array(False), stalled=jnp.array(False),
+                    fresh=jnp.array(fresh),
                     met_nonfinite=jnp.array(False),
                     costs=history(self.iterations + 1, cost),
                     step_lengths=jnp.full(self.iterations, jnp.nan, cost.dtype),
@@ -146,18 +147,23 @@ class ILQR(AbstractIterativeSolver):
                     expansion=_zero_expansion(N, nx, nu, cost.dtype))
 
     def running(self, s: dict) -> Array:
-        """Whether the iteration goes on from state s (not converged, not stalled, iterations
-        left)."""
-        return ~s["done"] & ~s["stalled"] & (s["iteration"] < self.iterations)
+        """Whether the iteration goes on from state s (its first guess not yet rolled out, or
+        not converged, not stalled, iterations left)."""
+        return s["fresh"] | (~s["done"] & ~s["stalled"] & (s["iteration"] < self.iterations))
 
     def step(self, problem: Problem, s: dict) -> dict:
-        """One iteration (steps 1-4 of `ILQR`'s iteration) from state s."""
+        """One iteration (steps 1-4 of `ILQR`'s iteration) from state s; from a fresh state
+        (`init`), the first guess's rollout instead: a forward pass of no step and no
+        feedback, taken whatever its cost, which counts no iteration."""
         alphas = jnp.asarray(self.steps, s["cost"].dtype)
+        fresh = s["fresh"]
         # linearized at the top of an iteration, after an accepted step (and first): the
         # expansion is traced once, inside the loop, not also before it
         expansion = jax.lax.cond(s["stale"], lambda: self._linearize(problem, s["xs"], s["us"]),
                                  lambda: s["expansion"])
         k, K, (dg, dq), Vxx, ok = self._backward(problem, expansion, s["us"], s["mu"])
+        k, K = jnp.where(fresh, 0.0, k), jnp.where(fresh, 0.0, K)
+        ok = ok | fresh
         gaps = expansion[0][2]
         gap = jnp.max(jnp.abs(gaps))
 
@@ -175,7 +181,7 @@ class ILQR(AbstractIterativeSolver):
             change = s["cost"] - cost
             decreased = jnp.where(expected >= 0, change > self.acceptance * expected,
                                   change > INCREASE_ACCEPTANCE * expected)
-            return (i > 0) & jnp.isfinite(cost) & decreased
+            return (i > 0) & (fresh | (jnp.isfinite(cost) & decreased))
 
         def next_step(trial):                          # the longest acceptable step first
             i, blocked = trial[3], trial[4]
@@ -197,21 +203,23 @@ class ILQR(AbstractIterativeSolver):
         taken = alphas[jnp.maximum(tried - 1, 0)]
         # converged only from a trajectory without gaps (a step from one with gaps compares
         # costs of different kinds, and may raise the cost)
-        converged = (gap <= GAP_TOLERANCE) & (
+        converged = ~fresh & (gap <= GAP_TOLERANCE) & (
             (ok & (s["mu"] <= self.regularization)
              & (dg <= self.tolerance * jnp.abs(s["cost"]) + floor))
             | (accept & ~blocked & (change <= self.tolerance * jnp.abs(cost) + floor)))
-        mu = jnp.where(accept & (taken > self.shrink_above),
-                       jnp.maximum(s["mu"] / MU_FACTOR, MU_MIN),
-                       jnp.where(accept & (taken > self.grow_below), s["mu"],
-                                 s["mu"] * MU_FACTOR))
-        i = s["iteration"] + 1
+        mu = jnp.where(fresh, s["mu"], jnp.where(
+            accept & (taken > self.shrink_above), jnp.maximum(s["mu"] / MU_FACTOR, MU_MIN),
+            jnp.where(accept & (taken > self.grow_below), s["mu"], s["mu"] * MU_FACTOR)))
+        i = s["iteration"] + jnp.where(fresh, 0, 1)
         # a rejected step leaves the trajectory, and so its expansion, as they were
         return dict(xs=xs, us=us, cost=cost, mu=mu, iteration=i, done=converged,
                     stalled=mu > MU_CEILING, costs=s["costs"].at[i].set(cost),
-                    step_lengths=s["step_lengths"].at[i - 1].set(jnp.where(accept, taken, 0.0)),
+                    step_lengths=jnp.where(fresh, s["step_lengths"], s["step_lengths"].at[i - 1].set(
+                        jnp.where(accept, taken, 0.0))),
                     K=jnp.where(accept, K, s["K"]), expansion=expansion, stale=accept,
-                    met_nonfinite=blocked & ~(accept & (change > self.tolerance * jnp.abs(cost))))
+                    fresh=jnp.array(False),
+                    met_nonfinite=~fresh & blocked & ~(accept & (change > self.tolerance
+                                                                 * jnp.abs(cost))))
 
     def result(self, problem: Problem, s: dict) -> Result:
         """The `Result` of the iteration's state s."""
