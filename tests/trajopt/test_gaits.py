@@ -115,6 +115,27 @@ def test_phases_are_counted_and_alike_knots_that_do_not_group_are_named():
     assert two.n_phases == 2 and two.knots.phase == (0, 0, 1, 0)
 
 
+@pytest.mark.slow     # 35 s: two programs of a solve through contacts
+def test_a_contact_problem_rolls_its_first_guess_out_in_its_first_step():
+    """ILQR rolls out the first guess of a problem whose knots solve contacts in its first
+    step's forward pass (one forward pass to compile, not two): the history starts at the
+    rollout's cost, and the iterates are those of the same problem started from that rollout
+    given as a state trajectory (the route of a rollout, then its cost)."""
+    model = mbjax.model.chain(4)
+    q0, v0 = jnp.array([0.3, -0.4, 0.5, 0.2]), jnp.zeros(4)
+    phase = stance(TreeSystem(model), q0, [PointContact("body3")])
+    knot = Knot(phase, (state_residual(model, q0 + 0.1), control_residual(4, weight=1e-2),
+                        friction_cone_residual(phase, 0.7)))
+    problem = Problem([knot] * 5, q0, v0, dt=0.02, terminal=state_residual(model, q0 + 0.1))
+    us0 = jnp.asarray(np.random.default_rng(0).normal(scale=0.1, size=(5, 4)))
+    xs = _rollout(problem, us0)
+    fresh, given = (solve(problem, ILQR(iterations=3), us0, states) for states in (None, xs))
+    assert int(fresh.iterations) == int(given.iterations) == 3
+    np.testing.assert_allclose(fresh.costs[0], _cost(problem, xs, us0), rtol=1e-12)
+    np.testing.assert_allclose(fresh.costs, given.costs, rtol=1e-10)
+    np.testing.assert_allclose(fresh.us, given.us, rtol=1e-9, atol=1e-12)
+
+
 def test_bad_multi_phase_input_is_refused_by_name():
     model = mbjax.model.chain(3)
     system = TreeSystem(model)
