@@ -110,8 +110,9 @@ def test_phases_are_counted_and_alike_knots_that_do_not_group_are_named():
                    terminal=terminal).n_phases == 1
     knots = [Knot(system, c) for c in costs[:2]] + [Knot(system, costs[2][:1])] + [
         Knot(system, costs[3])]
-    with pytest.warns(UserWarning, match=r"knots\[1\] and knots\[2\].*2 entries in one, 1 in"):
+    with pytest.warns(UserWarning, match=r"knots\[1\] and knots\[2\].*2 entries in one, 1 in") as caught:
         two = Problem(knots, q0, v0, dt=0.05, terminal=terminal)
+    assert caught[0].filename == __file__          # the user's line, not the library's
     assert two.n_phases == 2 and two.knots.phase == (0, 0, 1, 0)
 
 

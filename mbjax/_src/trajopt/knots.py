@@ -5,8 +5,11 @@ system is one phase of one knot repeated)."""
 import abc
 import dataclasses
 import enum
+import os
+import sys
 import warnings
 from collections.abc import Callable, Sequence
+from pathlib import Path
 
 import equinox as eqx
 import jax
@@ -276,7 +279,8 @@ class Schedule(eqx.Module):
                     f"same kind) but make different phases, each compiled on its own: "
                     f"{_difference(knots[i - 1], knots[i], 'knot') or 'their structure differs'}"
                     f"; write alike knots over the same contacts and costs (those not in use "
-                    f"inactive or weighted 0) so that they share a phase", stacklevel=2)
+                    f"inactive or weighted 0) so that they share a phase",
+                    stacklevel=_caller_level())
 
     @property
     def n_phases(self) -> int:
@@ -326,6 +330,17 @@ class Schedule(eqx.Module):
             return outs[0]
         inverse = np.argsort(np.concatenate(order))
         return jax.tree.map(lambda *o: jnp.concatenate(o)[inverse], *outs)
+
+
+def _caller_level() -> int:
+    """The `warnings.warn` stacklevel of the first caller outside mbjax and equinox (whose
+    module constructors wrap `__init__`), so that a warning names the user's line."""
+    inside = tuple(str(folder) + os.sep for folder in (Path(__file__).parents[2],
+                                                       Path(eqx.__file__).parent))
+    frame, level = sys._getframe(1), 1
+    while frame is not None and frame.f_code.co_filename.startswith(inside):
+        frame, level = frame.f_back, level + 1
+    return level
 
 
 def _stacked(members: list) -> tuple:
