@@ -31,7 +31,20 @@ measurements behind them are in benchmarks/README.md.
    cost. With dispatch synchronous the call returns when its result is ready; nothing else
    changes.
 
-All are read once, when JAX first starts a backend. So `import mbjax` sets them only if no
+A fifth is per program, not per process:
+
+5. No loop-invariant code motion in a program that loops over knots solving contacts
+   (`CONTACT_OPTIONS`, XLA's ``while-loop-invariant-code-motion`` pass off; `contact_jit`). Such
+   a knot's step runs the tree's passes several times on the same state (the mass matrix, the
+   contacts' positions, Jacobians and drift, the costs' frames), each a loop that XLA merges
+   into one by common-subexpression elimination where the step stands alone. Inside the loop
+   over a phase's knots the motion pass hoists a different part of each copy out first, so the
+   copies no longer match and all of them are compiled and run: ANYmal's stance step compiled
+   85 matrix products instead of 40. Off, the legged guide's step compiles about a tenth faster
+   and runs faster; a problem without contacts (the quadrotor) ran slower without it, so only
+   programs that solve contacts turn it off (benchmarks/README.md, "Issue 61").
+
+The first four are read once, when JAX first starts a backend. So `import mbjax` sets them only if no
 backend has started yet, each only if the user has not set it (XLA_FLAGS naming the flag or
 option; JAX_CPU_ENABLE_ASYNC_DISPATCH), and the XLA flags only on a jaxlib known to have them (an
 unknown flag aborts the process). MBJAX_XLA_DEFAULTS=0 leaves all alone. `applied()` and
@@ -103,6 +116,26 @@ def synchronous() -> bool:
     import jax
 
     return not jax.config.read("jax_cpu_enable_async_dispatch")
+
+
+# 5: per program (a `jax.jit` compiler option), for programs that loop over contact knots
+CONTACT_OPTIONS = {"xla_disable_hlo_passes": "while-loop-invariant-code-motion"}
+
+
+def contact_jit(fn):
+    """fn under `eqx.filter_jit` twice: (plain, with `CONTACT_OPTIONS`), and the rule that
+    picks one, `pick(solves_contacts) -> jitted fn` (item 5 of the module): the second for a
+    program that solves contacts, on a CPU, unless MBJAX_XLA_DEFAULTS is 0."""
+    import equinox as eqx
+    import jax
+
+    plain, contacts = eqx.filter_jit(fn), eqx.filter_jit(fn, compiler_options=CONTACT_OPTIONS)
+    defaults = os.environ.get("MBJAX_XLA_DEFAULTS", "") not in ("0", "false", "no")
+
+    def pick(solves_contacts: bool):
+        return contacts if solves_contacts and defaults and jax.default_backend() == "cpu" \
+            else plain
+    return pick
 
 
 configure_xla()

@@ -7,6 +7,7 @@ import numpy as np
 from jax import Array
 from jax.sharding import Mesh, PartitionSpec
 
+from mbjax._src.runtime import contact_jit
 from mbjax._src.system.status import raise_on_failure
 
 from mbjax._src.trajopt.ilqr import ILQR
@@ -70,19 +71,17 @@ def solve(problem: Problem, solver: AbstractSolver = ILQR(), us0: Array | None =
             width = 1 if jax.default_backend() == "cpu" else 64
         if not (isinstance(width, int | np.integer) and width >= 1):
             raise ValueError(f"width must be a positive int (a batch's working set), got {width!r}")
-        return _solve_batch(problem, solver, us0, states0, throw, width)
-    return _solve(problem, solver, us0, states0, throw)
+        return _solve_batch(not problem.vectorized)(problem, solver, us0, states0, throw, width)
+    return _solve(not problem.vectorized)(problem, solver, us0, states0, throw)
 
 
-@eqx.filter_jit
-def _solve(problem: Problem, solver: AbstractSolver, us0: Array | None, states0: Array | None,
+def _solve_one(problem: Problem, solver: AbstractSolver, us0: Array | None, states0: Array | None,
            throw: bool) -> Result:
     result = solver.solve(problem, problem.initial_controls(us0), states0)
     return raise_on_failure(checked(result, problem.jumps()), throw, "mbjax.trajopt.solve")
 
 
-@eqx.filter_jit
-def _solve_batch(problems: Problem, solver: AbstractSolver, us0: Array | None,
+def _solve_many(problems: Problem, solver: AbstractSolver, us0: Array | None,
                  states0: Array | None, throw: bool, width: int) -> Result:
     params, static = eqx.partition(problems, eqx.is_array)
     size = problems.q0.shape[0]
@@ -100,6 +99,11 @@ def _solve_batch(problems: Problem, solver: AbstractSolver, us0: Array | None,
     jumps = problems.jumps()
     return raise_on_failure(jax.vmap(lambda r: checked(r, jumps))(result), throw,
                             "mbjax.trajopt.solve")
+
+
+# jitted, and compiled without XLA's loop-invariant code motion where the knots solve contacts
+# (`mbjax._src.runtime`, item 5)
+_solve, _solve_batch = contact_jit(_solve_one), contact_jit(_solve_many)
 
 
 def _split(fn, params, us: Array):
