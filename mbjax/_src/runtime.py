@@ -123,18 +123,20 @@ CONTACT_OPTIONS = {"xla_disable_hlo_passes": "while-loop-invariant-code-motion"}
 
 
 def contact_jit(fn):
-    """fn under `eqx.filter_jit` twice: (plain, with `CONTACT_OPTIONS`), and the rule that
-    picks one, `pick(solves_contacts) -> jitted fn` (item 5 of the module): the second for a
-    program that solves contacts, on a CPU, unless MBJAX_XLA_DEFAULTS is 0."""
+    """fn under `eqx.filter_jit` twice: plain, and with `CONTACT_OPTIONS` (item 5 of the
+    module). Returns `pick(solves_contacts, *args) -> jitted fn`: the second for a program that
+    solves contacts, on a CPU, unless MBJAX_XLA_DEFAULTS is 0 or args hold tracers (called
+    inside another `jax.jit`, whose compilation decides: only a top-level jit takes options)."""
     import equinox as eqx
     import jax
 
     plain, contacts = eqx.filter_jit(fn), eqx.filter_jit(fn, compiler_options=CONTACT_OPTIONS)
     defaults = os.environ.get("MBJAX_XLA_DEFAULTS", "") not in ("0", "false", "no")
 
-    def pick(solves_contacts: bool):
-        return contacts if solves_contacts and defaults and jax.default_backend() == "cpu" \
-            else plain
+    def pick(solves_contacts: bool, *args):
+        traced = any(isinstance(x, jax.core.Tracer) for x in jax.tree.leaves(args))
+        top = solves_contacts and defaults and not traced and jax.default_backend() == "cpu"
+        return contacts if top else plain
     return pick
 
 

@@ -71,8 +71,10 @@ def solve(problem: Problem, solver: AbstractSolver = ILQR(), us0: Array | None =
             width = 1 if jax.default_backend() == "cpu" else 64
         if not (isinstance(width, int | np.integer) and width >= 1):
             raise ValueError(f"width must be a positive int (a batch's working set), got {width!r}")
-        return _solve_batch(not problem.vectorized)(problem, solver, us0, states0, throw, width)
-    return _solve(not problem.vectorized)(problem, solver, us0, states0, throw)
+        args = (problem, solver, us0, states0)
+        return _solve_batch(not problem.vectorized, *args)(*args, throw, width)
+    args = (problem, solver, us0, states0)
+    return _solve(not problem.vectorized, *args)(*args, throw)
 
 
 def _solve_one(problem: Problem, solver: AbstractSolver, us0: Array | None, states0: Array | None,
