@@ -123,4 +123,5 @@ def test_a_loop_over_contact_knots_compiles_a_steps_repeated_passes_once():
     assert products(pick(True, *args), *args) == alone
     assert products(pick(False, *args), *args) > alone     # XLA's default, as measured
     # inside another jit the outer program's compilation decides (options are top-level only)
-    assert jax.jit(lambda qs: pick(True, knot, qs, zeros, zeros)(knot, qs, zeros, zeros))(qs)[0].shape == qs.shape
+    nested = jax.jit(lambda qs: pick(True, knot, qs, zeros, zeros)(knot, qs, zeros, zeros))
+    assert nested(qs)[0].shape == qs.shape

@@ -38,14 +38,15 @@ A fifth is per program, not per process:
    a knot's step runs the tree's passes several times on the same state (the mass matrix, the
    contacts' positions, Jacobians and drift, the costs' frames), each a loop that XLA merges
    into one by common-subexpression elimination where the step stands alone. Inside the loop
-   over a phase's knots the motion pass hoists a different part of each copy out first, so the
-   copies no longer match and all of them are compiled and run: ANYmal's stance step compiled
-   85 matrix products instead of 40. Off, the legged guide's step compiles about a tenth faster
-   and runs faster; a problem without contacts (the quadrotor) ran slower without it, so only
-   programs that solve contacts turn it off (benchmarks/README.md, "Issue 61").
+   over a phase's knots, loop-invariant code motion first hoists a different part of each copy
+   out of the loop, so the copies no longer match and all of them are compiled and run:
+   ANYmal's stance step compiled 85 matrix products instead of 40. Off, the legged guide's step
+   compiles about a tenth faster and runs faster; a problem without contacts (the quadrotor)
+   ran slower without it, so only programs that solve contacts turn it off
+   (benchmarks/README.md, "Issue 61").
 
-The first four are read once, when JAX first starts a backend. So `import mbjax` sets them only if no
-backend has started yet, each only if the user has not set it (XLA_FLAGS naming the flag or
+The first four are read once, when JAX first starts a backend. So `import mbjax` sets them only
+if no backend has started yet, each only if the user has not set it (XLA_FLAGS naming the flag or
 option; JAX_CPU_ENABLE_ASYNC_DISPATCH), and the XLA flags only on a jaxlib known to have them (an
 unknown flag aborts the process). MBJAX_XLA_DEFAULTS=0 leaves all alone. `applied()` and
 `synchronous()` say whether the running process has them.

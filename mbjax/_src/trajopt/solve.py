@@ -77,14 +77,14 @@ def solve(problem: Problem, solver: AbstractSolver = ILQR(), us0: Array | None =
     return _solve(not problem.vectorized, *args)(*args, throw)
 
 
-def _solve_one(problem: Problem, solver: AbstractSolver, us0: Array | None, states0: Array | None,
-           throw: bool) -> Result:
+def _solve_one(problem: Problem, solver: AbstractSolver, us0: Array | None,
+               states0: Array | None, throw: bool) -> Result:
     result = solver.solve(problem, problem.initial_controls(us0), states0)
     return raise_on_failure(checked(result, problem.jumps()), throw, "mbjax.trajopt.solve")
 
 
 def _solve_many(problems: Problem, solver: AbstractSolver, us0: Array | None,
-                 states0: Array | None, throw: bool, width: int) -> Result:
+                states0: Array | None, throw: bool, width: int) -> Result:
     params, static = eqx.partition(problems, eqx.is_array)
     size = problems.q0.shape[0]
     if us0 is not None and us0.shape[:1] != (size,):
