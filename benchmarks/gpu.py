@@ -62,6 +62,7 @@ def main(out: Path, data: Path, budget_s: float) -> None:
     from mbjax.scenes import arm
     from mbjax.trajopt import CROCODDYL_SCHEDULE, ILQR, solve
     from mbjax_harness.common import states
+    from mbjax_harness.timing import measure
 
     warnings.filterwarnings("ignore", category=UserWarning)     # the Panda's meshes, mimics
     out.mkdir(parents=True, exist_ok=True)
@@ -84,16 +85,9 @@ def main(out: Path, data: Path, budget_s: float) -> None:
             f.write(line + "\n")
 
     def timed(fn, *args, repeats=5):
-        start = time.perf_counter()
-        result = jax.block_until_ready(fn(*args))
-        first = time.perf_counter() - start
-        runs = []
-        for _ in range(repeats):
-            start = time.perf_counter()
-            jax.block_until_ready(fn(*args))
-            runs.append(time.perf_counter() - start)
-        run = float(np.median(runs))
-        return result, run, max(first - run, 0.0)
+        """(result, run_s, compile_s): the harness's `measure`, its figures unpacked."""
+        result, timing = measure(fn, *args, repeats=repeats)
+        return result, timing.run_s, timing.compile_s
 
     def ahead(fn, *args):
         """fn compiled ahead of time, then run once: (result, run_s, compile_s)."""
